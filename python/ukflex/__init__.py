@@ -1,0 +1,62 @@
+"""ukflex: planar flexible multibody dynamics with the Udwadia-Kalaba formulation.
+
+Rust core (``ukflex._core``, private) + Python API:
+
+* :class:`Scene` -- scene description builder (bodies, joints, drivers, forces, initial guess);
+* :class:`System` -- compiled Rust-backed system with a consistent initial state;
+* :func:`simulate` -- time integration with ``scipy.integrate.solve_ivp``;
+* :mod:`ukflex.scenes` -- built-in scenes (the paper's slider-crank, pendulums, ...).
+"""
+
+from .errors import (
+    InconsistentInitialStateError,
+    InvalidSceneError,
+    NonFiniteError,
+    SingularMassError,
+    SolverError,
+    UkflexError,
+)
+from .scene import (
+    BeamRef,
+    Circular,
+    ConstantSpeed,
+    CustomSection,
+    GroundRef,
+    Harmonic,
+    Marker,
+    Polynomial,
+    Rectangular,
+    RigidBodyRef,
+    Scene,
+)
+from .system import InitialCorrection, System
+from .results import SimulationResult
+from .simulate import simulate
+from . import scenes
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Scene",
+    "Marker",
+    "RigidBodyRef",
+    "BeamRef",
+    "GroundRef",
+    "Circular",
+    "Rectangular",
+    "CustomSection",
+    "ConstantSpeed",
+    "Polynomial",
+    "Harmonic",
+    "System",
+    "InitialCorrection",
+    "SimulationResult",
+    "simulate",
+    "scenes",
+    "UkflexError",
+    "InvalidSceneError",
+    "SingularMassError",
+    "SolverError",
+    "NonFiniteError",
+    "InconsistentInitialStateError",
+]

@@ -1,0 +1,59 @@
+"""Type stubs of the compiled Rust extension ``ukflex._core`` (private; use ``ukflex.System``)."""
+
+from typing import Dict, List, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+F64 = npt.NDArray[np.float64]
+
+class UkflexError(Exception): ...
+class InvalidSceneError(UkflexError): ...
+class SingularMassError(UkflexError): ...
+class SolverError(UkflexError): ...
+class NonFiniteError(UkflexError): ...
+
+class System:
+    """Compiled model + workspace built from a JSON scene description (docs/scene-format.md)."""
+
+    def __init__(self, description_json: str) -> None: ...
+    def M(self, q: F64) -> F64:
+        """Mass matrix, shape (n, n)."""
+    def Q(self, t: float, q: F64, qd: F64) -> F64:
+        """Generalized forces (applied + quadratic velocity + elastic), shape (n,)."""
+    def phi(self, t: float, q: F64) -> F64:
+        """Constraint residual Phi(q, t), shape (m,)."""
+    def A(self, q: F64) -> F64:
+        """Constraint Jacobian Phi_q, shape (m, n)."""
+    def phi_t(self, t: float) -> F64:
+        """Partial time derivative of Phi, shape (m,)."""
+    def b(self, t: float, q: F64, qd: F64) -> F64:
+        """Right-hand side gamma of A qdd = b, shape (m,)."""
+    def qdd(self, t: float, q: F64, qd: F64) -> F64:
+        """Udwadia-Kalaba accelerations, shape (n,)."""
+    def rhs(self, t: float, y: F64) -> F64:
+        """First-order right-hand side [qd, qdd] of y = [q, qd], shape (2n,)."""
+    def multipliers(self, t: float, q: F64, qd: F64) -> F64:
+        """Lagrange multipliers with M qdd + A^T lam = Q, shape (m,)."""
+    def residuals(self, t: float, q: F64, qd: F64) -> Tuple[F64, F64, F64]:
+        """(Phi, A qd + Phi_t, A qdd - b), each shape (m,)."""
+    def rank(self) -> Tuple[int, float]:
+        """(rank, smallest kept singular value) of the last UK solve."""
+    def initial_guess(self) -> Tuple[F64, F64]:
+        """(q, qd) from the description's state fields, each shape (n,)."""
+    def beam_shape(self, body_name: str, xi: float) -> Tuple[F64, F64]:
+        """(S (2, n_f), N_psi (n_f,)) at x = xi * length of a beam."""
+    def kinetic_energy(self, q: F64, qd: F64) -> float: ...
+    def potential_energy(self, q: F64) -> float: ...
+    @property
+    def n_coords(self) -> int: ...
+    @property
+    def n_constraints(self) -> int: ...
+    @property
+    def body_names(self) -> List[str]: ...
+    @property
+    def body_slices(self) -> Dict[str, Tuple[int, int]]: ...
+    @property
+    def coordinate_names(self) -> List[str]: ...
+    @property
+    def constraint_names(self) -> List[str]: ...

@@ -1,0 +1,175 @@
+"""Simulation results: time histories, residuals, solver statistics and post-processing helpers."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+__all__ = ["SimulationResult"]
+
+
+@dataclass
+class SimulationResult:
+    """Outcome of :func:`ukflex.simulate`.
+
+    Attributes
+    ----------
+    t : ndarray, shape (nt,)
+        Output times [s].
+    q, qd : ndarray, shape (nt, n)
+        Generalized coordinates and velocities at the output times.
+    residuals : dict of str -> ndarray, shape (nt,)
+        Euclidean norms of the constraint residuals at each output time: ``"position"``
+        (``Phi``), ``"velocity"`` (``A qd + Phi_t``), ``"acceleration"`` (``A qdd - b``).
+    nfev, njev, nlu : int
+        Right-hand-side evaluations, Jacobian evaluations and LU decompositions of the integrator.
+    wall_time : float
+        Wall-clock time of the integration [s] (residual evaluation excluded).
+    status : int
+        ``solve_ivp`` status (0: reached ``t_end``, -1: integration step failed, 1: event).
+    message : str
+        Integrator message.
+    system : ukflex.System
+        The system that was simulated (its description, names and per-step methods).
+    method, formulation : str
+        Integrator and formulation used.
+    rtol, atol : float
+        Tolerances used.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    residuals: Dict[str, np.ndarray]
+    nfev: int
+    njev: int
+    nlu: int
+    wall_time: float
+    status: int
+    message: str
+    system: Any = None
+    method: str = ""
+    formulation: str = "uk"
+    rtol: float = float("nan")
+    atol: Any = float("nan")
+    extra: Dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        """True if the integrator reached the end time."""
+        return self.status >= 0
+
+    @property
+    def y(self) -> np.ndarray:
+        """``[q, qd]`` stacked, shape (nt, 2n)."""
+        return np.hstack([self.q, self.qd])
+
+    def __repr__(self) -> str:
+        t_end = self.t[-1] if self.t.size else float("nan")
+        return (
+            f"SimulationResult(formulation={self.formulation!r}, method={self.method!r}, nt={self.t.size}, "
+            f"t_end={t_end:g}, status={self.status}, nfev={self.nfev}, wall_time={self.wall_time:.3g}s)"
+        )
+
+    # ------------------------------------------------------------------------------ access
+    def coordinate(self, name: str) -> np.ndarray:
+        """History of coordinate ``name`` (e.g. ``"crank.theta"``), shape (nt,)."""
+        return self.q[:, self.system.coordinate_index(name)]
+
+    def velocity(self, name: str) -> np.ndarray:
+        """History of the rate of coordinate ``name``, shape (nt,)."""
+        return self.qd[:, self.system.coordinate_index(name)]
+
+    def beam_displacement(self, body: str, xi: float) -> Tuple[np.ndarray, np.ndarray]:
+        """Elastic displacement of beam ``body`` at ``x = xi * length``, in the beam frame.
+
+        Returns
+        -------
+        u, v : ndarray, shape (nt,)
+            Axial and transverse elastic displacement [m] (``u_f = S(x) q_f``).  The paper's Fig. 4
+            plots ``v(xi = 0.5) / length``.
+        """
+        S, _ = self.system.beam_shape(body, float(xi))
+        S = np.asarray(S)
+        qf = self.q[:, self.system.elastic_slice(body)]
+        uv = qf @ S.T
+        return uv[:, 0], uv[:, 1]
+
+    def beam_rotation(self, body: str, xi: float) -> np.ndarray:
+        """Elastic cross-section rotation ``psi`` of beam ``body`` at ``xi``, shape (nt,)."""
+        _, n_psi = self.system.beam_shape(body, float(xi))
+        return self.q[:, self.system.elastic_slice(body)] @ np.asarray(n_psi)
+
+    def energy(self) -> np.ndarray:
+        """Total mechanical energy ``T + V`` at each output time, shape (nt,)."""
+        s = self.system
+        return np.array([s.kinetic_energy(q, qd) + s.potential_energy(q) for q, qd in zip(self.q, self.qd)])
+
+    def multipliers(self) -> np.ndarray:
+        """Lagrange multipliers (``M qdd + A^T lam = Q``) at each output time, shape (nt, m)."""
+        s = self.system
+        return np.array([s.multipliers(t, q, qd) for t, q, qd in zip(self.t, self.q, self.qd)])
+
+    def qdd(self) -> np.ndarray:
+        """Accelerations at each output time, shape (nt, n)."""
+        s = self.system
+        return np.array([s.qdd(t, q, qd) for t, q, qd in zip(self.t, self.q, self.qd)])
+
+    def max_residual(self, kind: str = "position") -> float:
+        """Largest residual norm of ``kind`` over the run."""
+        r = self.residuals[kind]
+        return float(np.max(r)) if r.size else 0.0
+
+    # ------------------------------------------------------------------------------ output
+    def _column(self, name: str) -> np.ndarray:
+        if name == "t":
+            return self.t
+        if name.startswith("d:"):
+            return self.velocity(name[2:])
+        if name.startswith("residual."):
+            return self.residuals[name.split(".", 1)[1]]
+        return self.coordinate(name)
+
+    def to_csv(self, path: str, columns: Optional[Sequence[str]] = None) -> None:
+        """Write a CSV file with a header row.
+
+        Parameters
+        ----------
+        path : str
+            Output file.
+        columns : sequence of str, optional
+            Column names: ``"t"``, coordinate names (``"crank.theta"``), ``"d:<coordinate>"`` for
+            rates, ``"residual.position"`` etc.  Default: ``t``, every coordinate, every rate.
+        """
+        if columns is None:
+            names = self.system.coordinate_names
+            columns = ["t"] + list(names) + ["d:" + n for n in names]
+        data = np.column_stack([self._column(c) for c in columns])
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(columns)
+            for row in data:
+                w.writerow([repr(float(x)) for x in row])
+
+    def save_npz(self, path: str) -> None:
+        """Save ``t, q, qd``, the residual histories, statistics and names to ``path`` (NumPy .npz)."""
+        np.savez(
+            path,
+            t=self.t,
+            q=self.q,
+            qd=self.qd,
+            residual_position=self.residuals["position"],
+            residual_velocity=self.residuals["velocity"],
+            residual_acceleration=self.residuals["acceleration"],
+            nfev=self.nfev,
+            njev=self.njev,
+            nlu=self.nlu,
+            wall_time=self.wall_time,
+            status=self.status,
+            coordinate_names=np.array(self.system.coordinate_names),
+            method=self.method,
+            formulation=self.formulation,
+        )

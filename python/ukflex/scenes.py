@@ -1,0 +1,415 @@
+"""Built-in scenes: the paper's flexible slider-crank and a few small test mechanisms.
+
+Every function returns a :class:`ukflex.Scene` (call ``.build()`` or pass it to
+:func:`ukflex.simulate`).  ``SCENES`` maps the names used by ``ukflex run`` to the functions.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable, Dict, Optional, Tuple
+
+from .scene import Circular, ConstantSpeed, Harmonic, Polynomial, Rectangular, Scene
+
+__all__ = [
+    "slider_crank",
+    "pendulum",
+    "double_pendulum",
+    "four_bar",
+    "cantilever",
+    "pinned_beam",
+    "every_joint",
+    "SCENES",
+    "PAPER",
+]
+
+#: Data of the paper's slider-crank (Pennestri, Valentini, de Falco 2010), DESIGN.md section 3.
+PAPER = {
+    "crank_length": 0.1524,
+    "coupler_length": 0.3048,
+    "diameter": 0.00635,
+    "density": 7834.56,
+    "youngs_modulus": 2.06843e11,
+    "poisson_ratio": 0.285,
+    "shear_factor": 0.8,
+    "omega": 124.8,
+    "g": 9.81,
+}
+
+STEEL = {"density": 7850.0, "youngs_modulus": 2.1e11, "poisson_ratio": 0.3, "shear_factor": 5.0 / 6.0}
+
+
+def _gravity(gravity) -> Optional[Tuple[float, float]]:
+    if gravity is True:
+        return (0.0, -PAPER["g"])
+    if gravity is False or gravity is None:
+        return None
+    g = tuple(float(v) for v in gravity)
+    return (g[0], g[1])
+
+
+def slider_crank(
+    beam: str = "timoshenko",
+    elements: int = 1,
+    gravity=True,
+    omega: float = PAPER["omega"],
+    crank_length: float = PAPER["crank_length"],
+    coupler_length: float = PAPER["coupler_length"],
+    diameter: float = PAPER["diameter"],
+    density: float = PAPER["density"],
+    youngs_modulus: float = PAPER["youngs_modulus"],
+    poisson_ratio: float = PAPER["poisson_ratio"],
+    shear_factor: float = PAPER["shear_factor"],
+    rotary_inertia: Optional[bool] = None,
+    damping: float = 0.0,
+) -> Scene:
+    """The paper's flexible slider-crank (section 5, Fig. 3; data in DESIGN.md section 3).
+
+    Rigid crank (mass ``rho a L``, inertia ``m L^2 / 12`` about its centre, body frame at the
+    ground pivot, centre of mass ``(L/2, 0)``) driven at constant speed ``omega``; coupler = FFRF
+    beam with ``elements`` elements, pinned-pinned frame; its end ``xi = 1`` slides on the ground
+    X axis (point-on-line).  At ``t = 0`` crank and coupler lie along +X, undeformed, with the
+    exactly consistent velocities: crank tip ``(0, L omega)``, coupler angular velocity
+    ``-L omega / Lb``.
+
+    Parameters
+    ----------
+    beam : {"timoshenko", "euler-bernoulli"}
+        Coupler beam theory.
+    elements : int
+        Number of coupler elements (the paper: 1).
+    gravity : bool or (2,) sequence
+        ``True``: ``(0, -9.81)``; ``False``: no gravity; or an explicit vector.
+    omega : float
+        Crank speed [rad/s].
+    rotary_inertia : bool, optional
+        Coupler rotary inertia (default: the core's default for the theory).
+    damping : float
+        Coupler stiffness-proportional damping [s] (the paper: none).
+
+    Returns
+    -------
+    Scene
+        Bodies ``crank`` (rigid) and ``coupler`` (beam); ``n = 6 + 3 * elements`` coordinates,
+        6 constraint rows.
+    """
+    L, Lb, d = crank_length, coupler_length, diameter
+    area = math.pi * d * d / 4.0
+    m_crank = density * area * L
+    s = Scene(gravity=_gravity(gravity))
+    crank = s.rigid_body(
+        "crank",
+        mass=m_crank,
+        inertia=m_crank * L * L / 12.0,
+        com=(L / 2.0, 0.0),
+        position=(0.0, 0.0),
+        angle=0.0,
+        angular_velocity=omega,
+    )
+    kw = {}
+    if beam == "timoshenko":
+        kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor}
+    coupler = s.beam(
+        "coupler",
+        length=Lb,
+        elements=elements,
+        theory=beam,
+        section=Circular(d),
+        density=density,
+        youngs_modulus=youngs_modulus,
+        frame="pinned-pinned",
+        rotary_inertia=rotary_inertia,
+        damping=damping,
+        position=(L, 0.0),
+        angle=0.0,
+        velocity=(0.0, L * omega),
+        angular_velocity=-L * omega / Lb,
+        **kw,
+    )
+    s.revolute(s.ground.point(0.0, 0.0), crank.point(0.0, 0.0), name="crank_pivot")
+    s.revolute(crank.point(L, 0.0), coupler.at(0.0), name="crank_coupler")
+    s.point_on_line(coupler.at(1.0), s.ground.line((0.0, 0.0), angle=0.0), name="slider")
+    s.angle_driver(crank.frame(), ConstantSpeed(omega, initial=0.0), name="crank_speed")
+    return s
+
+
+def pendulum(
+    length: float = 1.0,
+    mass: float = 1.0,
+    angle: float = -math.pi / 4,
+    angular_velocity: float = 0.0,
+    g: float = 9.81,
+) -> Scene:
+    """Rigid rod pendulum (uniform rod, inertia ``m L^2 / 12`` about its centre) under gravity.
+
+    The body reference point is the rod's centre, so all three coordinates move; the pivot is the
+    rod end ``(-L/2, 0)`` pinned to the world origin.  ``angle`` is measured from +X (``-pi/2``
+    hangs straight down).  Conservative: ``T + V`` is constant.
+    """
+    s = Scene(gravity=(0.0, -g))
+    c, si = math.cos(angle), math.sin(angle)
+    h = length / 2.0
+    rod = s.rigid_body(
+        "rod",
+        mass=mass,
+        inertia=mass * length**2 / 12.0,
+        position=(h * c, h * si),
+        angle=angle,
+        velocity=(-h * si * angular_velocity, h * c * angular_velocity),
+        angular_velocity=angular_velocity,
+    )
+    s.revolute(s.ground.point(0.0, 0.0), rod.point(-h, 0.0), name="pivot")
+    return s
+
+
+def double_pendulum(
+    lengths: Tuple[float, float] = (1.0, 0.7),
+    masses: Tuple[float, float] = (1.0, 0.5),
+    angles: Tuple[float, float] = (0.0, math.pi / 3),
+    g: float = 9.81,
+) -> Scene:
+    """Two uniform rigid rods in a chain, released from rest (angles from +X)."""
+    s = Scene(gravity=(0.0, -g))
+    (l1, l2), (m1, m2), (a1, a2) = lengths, masses, angles
+    p1 = (0.5 * l1 * math.cos(a1), 0.5 * l1 * math.sin(a1))
+    tip = (l1 * math.cos(a1), l1 * math.sin(a1))
+    p2 = (tip[0] + 0.5 * l2 * math.cos(a2), tip[1] + 0.5 * l2 * math.sin(a2))
+    r1 = s.rigid_body("rod1", mass=m1, inertia=m1 * l1**2 / 12, position=p1, angle=a1)
+    r2 = s.rigid_body("rod2", mass=m2, inertia=m2 * l2**2 / 12, position=p2, angle=a2)
+    s.revolute(s.ground.point(0, 0), r1.point(-l1 / 2, 0), name="pivot")
+    s.revolute(r1.point(l1 / 2, 0), r2.point(-l2 / 2, 0), name="elbow")
+    return s
+
+
+def four_bar(
+    crank: float = 0.1,
+    coupler: float = 0.3,
+    rocker: float = 0.25,
+    ground: float = 0.3,
+    crank_angle: float = math.pi / 2,
+    omega: Optional[float] = 10.0,
+    gravity=True,
+    flexible_coupler: Optional[str] = None,
+    elements: int = 2,
+) -> Scene:
+    """Four-bar linkage (Grashof crank-rocker for the defaults), rigid or with a flexible coupler.
+
+    Pivots at the world origin and at ``(ground, 0)``.  The initial guess is the exact assembly
+    (circle intersection, open configuration) perturbed by nothing; velocities are zero except
+    the crank's, and :class:`ukflex.System` projects them.  With ``omega=None`` the crank is free
+    (a one-degree-of-freedom mechanism under gravity).
+
+    Parameters
+    ----------
+    flexible_coupler : {None, "timoshenko", "euler-bernoulli"}
+        Model the coupler as a pinned-pinned steel beam (rectangular 10 x 5 mm section).
+    """
+    s = Scene(gravity=_gravity(gravity))
+    a, b, c, d = crank, coupler, rocker, ground
+    A = (a * math.cos(crank_angle), a * math.sin(crank_angle))
+    # B: |B - A| = b, |B - D| = c, D = (d, 0); take the intersection above the line A-D
+    D = (d, 0.0)
+    dx, dy = D[0] - A[0], D[1] - A[1]
+    r = math.hypot(dx, dy)
+    if r > b + c or r < abs(b - c):
+        raise ValueError("four_bar: the links cannot be assembled at this crank angle")
+    x = (b * b - c * c + r * r) / (2 * r)
+    h = math.sqrt(max(b * b - x * x, 0.0))
+    B = (A[0] + x * dx / r - h * dy / r, A[1] + x * dy / r + h * dx / r)
+    th_b = math.atan2(B[1] - A[1], B[0] - A[0])
+    th_c = math.atan2(B[1] - D[1], B[0] - D[0])
+    m_per_length = 2.0  # kg/m for the rigid links
+    cr = s.rigid_body(
+        "crank",
+        mass=m_per_length * a,
+        inertia=m_per_length * a**3 / 12,
+        com=(a / 2, 0),
+        angle=crank_angle,
+        angular_velocity=omega or 0.0,
+    )
+    if flexible_coupler is None:
+        cp = s.rigid_body(
+            "coupler", mass=m_per_length * b, inertia=m_per_length * b**3 / 12, com=(b / 2, 0), position=A, angle=th_b
+        )
+        cp_start, cp_end = cp.point(0, 0), cp.point(b, 0)
+    else:
+        kw = {"poisson_ratio": STEEL["poisson_ratio"], "shear_factor": STEEL["shear_factor"]}
+        cp = s.beam(
+            "coupler",
+            length=b,
+            elements=elements,
+            theory=flexible_coupler,
+            section=Rectangular(0.01, 0.005),
+            density=STEEL["density"],
+            youngs_modulus=STEEL["youngs_modulus"],
+            frame="pinned-pinned",
+            position=A,
+            angle=th_b,
+            **(kw if flexible_coupler == "timoshenko" else {}),
+        )
+        cp_start, cp_end = cp.at(0.0), cp.at(1.0)
+    rk = s.rigid_body(
+        "rocker", mass=m_per_length * c, inertia=m_per_length * c**3 / 12, com=(c / 2, 0), position=D, angle=th_c
+    )
+    s.revolute(s.ground.point(0, 0), cr.point(0, 0), name="A0")
+    s.revolute(cr.point(a, 0), cp_start, name="A")
+    s.revolute(cp_end, rk.point(c, 0), name="B")
+    s.revolute(rk.point(0, 0), s.ground.point(d, 0), name="B0")
+    if omega is not None:
+        s.angle_driver(cr.frame(), ConstantSpeed(omega, initial=crank_angle), name="crank_speed")
+    return s
+
+
+def cantilever(
+    length: float = 1.0,
+    elements: int = 4,
+    theory: str = "euler-bernoulli",
+    section=None,
+    gravity=True,
+    tip_force: Tuple[float, float] = (0.0, 0.0),
+    damping: float = 0.0,
+    **material,
+) -> Scene:
+    """Horizontal cantilever: a beam along +X, clamped frame, welded to the ground at ``xi = 0``.
+
+    Loaded by its weight (``gravity``) and a constant ``tip_force`` [N] at ``xi = 1``.  Default
+    section: rectangular 20 x 10 mm steel (``material`` overrides ``density``,
+    ``youngs_modulus``, ``poisson_ratio``, ``shear_factor``).  Static tip deflection under a tip
+    load ``P``: ``P L^3 / (3 E I)``.
+    """
+    mat = dict(STEEL)
+    mat.update(material)
+    s = Scene(gravity=_gravity(gravity))
+    kw = {}
+    if theory == "timoshenko":
+        kw = {"poisson_ratio": mat["poisson_ratio"], "shear_factor": mat["shear_factor"]}
+    b = s.beam(
+        "beam",
+        length=length,
+        elements=elements,
+        theory=theory,
+        section=section if section is not None else Rectangular(0.02, 0.01),
+        density=mat["density"],
+        youngs_modulus=mat["youngs_modulus"],
+        frame="clamped",
+        damping=damping,
+        **kw,
+    )
+    s.weld(s.ground.frame(), b.at(0.0), name="clamp")
+    if tuple(tip_force) != (0.0, 0.0):
+        s.point_force(b.at(1.0), tip_force, name="tip_load")
+    return s
+
+
+def pinned_beam(
+    length: float = PAPER["coupler_length"],
+    elements: int = 1,
+    theory: str = "euler-bernoulli",
+    diameter: float = PAPER["diameter"],
+    density: float = PAPER["density"],
+    youngs_modulus: float = PAPER["youngs_modulus"],
+    poisson_ratio: float = PAPER["poisson_ratio"],
+    shear_factor: float = PAPER["shear_factor"],
+    rotary_inertia: Optional[bool] = None,
+    gravity=False,
+) -> Scene:
+    """The paper's coupler alone, simply supported: pinned at ``xi = 0`` (revolute to ground) and
+    its ``xi = 1`` end on the ground X axis (point-on-line), frame pinned-pinned.
+
+    The supports fix the frame's ``x``, ``y`` and ``theta`` at the undeformed state, so the
+    elastic block ``M_ff``, ``K_ff`` gives the simply supported beam's natural frequencies.
+    """
+    s = Scene(gravity=_gravity(gravity))
+    kw = {}
+    if theory == "timoshenko":
+        kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor}
+    b = s.beam(
+        "beam",
+        length=length,
+        elements=elements,
+        theory=theory,
+        section=Circular(diameter),
+        density=density,
+        youngs_modulus=youngs_modulus,
+        frame="pinned-pinned",
+        rotary_inertia=rotary_inertia,
+        **kw,
+    )
+    s.revolute(s.ground.point(0, 0), b.at(0.0), name="pin")
+    s.point_on_line(b.at(1.0), s.ground.line((0, 0), angle=0.0), name="roller")
+    return s
+
+
+def every_joint(gravity=True) -> Scene:
+    """A scene using every joint, driver and force kind, with rigid and beam bodies.
+
+    * ``crank`` (rigid): revolute to ground, angle driver with harmonic motion;
+    * ``link`` (Timoshenko beam, 2 elements, pinned-pinned): revolute to the crank tip and to
+      the ``slider``;
+    * ``slider`` (rigid): prismatic joint along the ground X axis, spring-damper to the ground;
+    * ``arm`` (Euler-Bernoulli beam, clamped frame): welded upright on the slider, a point force
+      and a torque at its tip;
+    * ``lifter`` (rigid pendulum): its pivot runs on a vertical ground line (point-on-line) with
+      its height prescribed by a coordinate driver (polynomial), a torque on it.
+
+    Returns
+    -------
+    Scene
+        ``n = 24`` coordinates, 14 constraint rows, 10 degrees of freedom.
+    """
+    s = Scene(gravity=_gravity(gravity))
+    Lc, Ll = 0.1, 0.3
+    crank = s.rigid_body("crank", mass=0.2, inertia=0.2 * Lc**2 / 12, com=(Lc / 2, 0), angular_velocity=1.5)
+    link = s.beam(
+        "link",
+        length=Ll,
+        elements=2,
+        theory="timoshenko",
+        section=Rectangular(0.01, 0.006),
+        density=2700.0,
+        youngs_modulus=7.0e10,
+        poisson_ratio=0.33,
+        shear_factor=5.0 / 6.0,
+        frame="pinned-pinned",
+        position=(Lc, 0.0),
+    )
+    slider = s.rigid_body("slider", mass=0.5, inertia=1e-3, position=(Lc + Ll, 0.0))
+    arm = s.beam(
+        "arm",
+        length=0.2,
+        elements=1,
+        theory="euler-bernoulli",
+        section=Rectangular(0.008, 0.004),
+        density=2700.0,
+        youngs_modulus=7.0e10,
+        frame="clamped",
+        position=(Lc + Ll, 0.02),
+        angle=math.pi / 2,
+    )
+    lifter = s.rigid_body(
+        "lifter", mass=0.3, inertia=0.3 * 0.15**2 / 12, com=(0.075, 0.0), position=(-0.3, 0.1), angle=-math.pi / 2
+    )
+    s.revolute(s.ground.point(0, 0), crank.point(0, 0), name="crank_pivot")
+    s.revolute(crank.point(Lc, 0), link.at(0.0), name="crank_link")
+    s.revolute(link.at(1.0), slider.point(0, 0), name="link_slider")
+    s.prismatic(slider.frame(), s.ground.line((0, 0), angle=0.0), name="slide")
+    s.weld(slider.point(0.0, 0.02, angle=math.pi / 2), arm.at(0.0), name="arm_mount")
+    s.point_on_line(lifter.point(0, 0), s.ground.line((-0.3, 0.0), angle=math.pi / 2), name="lifter_rail")
+    s.angle_driver(crank.frame(), Harmonic(amplitude=0.3, frequency=5.0), name="crank_motion")
+    s.coordinate_driver(lifter.point(0, 0), "y", Polynomial([0.1, 0.0, 0.5]), name="lifter_height")
+    s.spring_damper(slider.point(0, 0), s.ground.point(0.6, 0.0), stiffness=200.0, damping=2.0, name="slider_spring")
+    s.point_force(arm.at(1.0), (0.5, 0.0), name="arm_push")
+    s.torque(arm.at(1.0), 0.01, name="arm_twist")
+    s.torque(lifter.frame(), -0.05, name="lifter_torque")
+    return s
+
+
+SCENES: Dict[str, Callable[..., Scene]] = {
+    "slider_crank": slider_crank,
+    "pendulum": pendulum,
+    "double_pendulum": double_pendulum,
+    "four_bar": four_bar,
+    "cantilever": cantilever,
+    "pinned_beam": pinned_beam,
+    "every_joint": every_joint,
+}

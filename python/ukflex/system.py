@@ -1,0 +1,417 @@
+"""The compiled system: a thin Python class around the Rust ``ukflex._core.System``.
+
+:class:`System` keeps the scene description, the corrected consistent initial state ``q0``,
+``qd0`` and the report of that correction, and exposes the core's per-step methods (``rhs``,
+``qdd``, ``M``, ``Q``, ``phi``, ``A``, ...) as the bound methods of the compiled object: calling
+``system.rhs(t, y)`` goes straight into Rust with no Python layer in between.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from .errors import InconsistentInitialStateError, InvalidSceneError, SingularMassError
+from .scene import Scene
+
+__all__ = ["System", "InitialCorrection"]
+
+
+@dataclass
+class InitialCorrection:
+    """Report of the initial-state correction done by :class:`System`.
+
+    Attributes
+    ----------
+    iterations : int
+        Newton iterations of the position correction (0 if the guess was already consistent).
+    position_residual_before, position_residual_after : float
+        ``max |Phi(q, t0)|`` at the guess and after the correction.
+    velocity_residual_before, velocity_residual_after : float
+        ``max |A qd + Phi_t|`` at the guess (with corrected positions) and after projection.
+    dq, dqd : ndarray, shape (n,)
+        Changes applied to the guessed positions and velocities.
+    held : list of str
+        Coordinates that were held at their guessed values.
+    coordinate_names : list of str
+        Names of the ``n`` coordinates (order of ``dq``).
+    """
+
+    iterations: int
+    position_residual_before: float
+    position_residual_after: float
+    velocity_residual_before: float
+    velocity_residual_after: float
+    dq: np.ndarray
+    dqd: np.ndarray
+    held: List[str] = field(default_factory=list)
+    coordinate_names: List[str] = field(default_factory=list)
+
+    @property
+    def max_position_change(self) -> float:
+        """``max |dq|``."""
+        return float(np.max(np.abs(self.dq))) if self.dq.size else 0.0
+
+    @property
+    def max_velocity_change(self) -> float:
+        """``max |dqd|``."""
+        return float(np.max(np.abs(self.dqd))) if self.dqd.size else 0.0
+
+    @property
+    def position_change_norm(self) -> float:
+        """``||dq||_2``."""
+        return float(np.linalg.norm(self.dq))
+
+    @property
+    def velocity_change_norm(self) -> float:
+        """``||dqd||_2``."""
+        return float(np.linalg.norm(self.dqd))
+
+    def per_coordinate(self) -> Dict[str, Tuple[float, float]]:
+        """``{coordinate name: (dq, dqd)}`` for every coordinate."""
+        return {n: (float(a), float(b)) for n, a, b in zip(self.coordinate_names, self.dq, self.dqd)}
+
+    def __str__(self) -> str:
+        def worst(v: np.ndarray) -> str:
+            if not v.size:
+                return "-"
+            i = int(np.argmax(np.abs(v)))
+            return f"{abs(v[i]):.3e} ({self.coordinate_names[i]})"
+
+        return (
+            f"initial correction: {self.iterations} Newton iteration(s); "
+            f"max|Phi| {self.position_residual_before:.3e} -> {self.position_residual_after:.3e}; "
+            f"max|A qd + Phi_t| {self.velocity_residual_before:.3e} -> {self.velocity_residual_after:.3e}; "
+            f"max|dq| {worst(self.dq)}; max|dqd| {worst(self.dqd)}"
+        )
+
+
+def _core_module():
+    try:
+        from . import _core  # type: ignore[attr-defined]
+    except ImportError as exc:  # pragma: no cover - depends on the build
+        raise ImportError(
+            "ukflex._core (the compiled Rust extension) is not available; build it with "
+            "`bash scripts/dev-build.sh`"
+        ) from exc
+    return _core
+
+
+class System:
+    """A compiled multibody system (Rust core) with a consistent initial state.
+
+    Parameters
+    ----------
+    description : Scene or dict
+        The scene (a :class:`ukflex.Scene` or its description dict, validated in Python first).
+    correct : bool
+        Correct the initial guess onto the constraints (default True).  With ``False``, ``q0`` and
+        ``qd0`` are the guess itself.
+    hold : "elastic", None or sequence of str
+        Coordinates held at their guessed values during the correction: ``"elastic"`` (default)
+        holds every elastic coordinate (so an undeformed guess stays undeformed), ``None`` holds
+        none, or give coordinate names such as ``"crank.theta"``; ``"elastic"`` may be combined
+        with names in a list.
+    position_tol : float
+        Newton stops when ``max |Phi| <= position_tol`` (absolute, m and rad).
+    velocity_tol : float
+        Accepted ``max |A qd + Phi_t|`` after the velocity projection (absolute).
+    max_iterations : int
+        Newton iteration limit.
+    t0 : float
+        Initial time (drivers are evaluated there).
+
+    Attributes
+    ----------
+    description : dict
+        The validated description.
+    q0, qd0 : ndarray, shape (n,)
+        Consistent initial positions and velocities.
+    initial_correction : InitialCorrection
+        What the correction changed.
+    core : ukflex._core.System
+        The compiled object.
+
+    Notes
+    -----
+    Per-step methods are the bound methods of the compiled object (no Python wrapper):
+    ``M(q)`` (n, n); ``Q(t, q, qd)`` (n,); ``phi(t, q)`` (m,); ``A(q)`` (m, n);
+    ``phi_t(t)`` (m,); ``b(t, q, qd)`` (m,); ``qdd(t, q, qd)`` (n,); ``rhs(t, y)`` (2n,);
+    ``multipliers(t, q, qd)`` (m,) with ``M qdd + A^T lam = Q``; ``residuals(t, q, qd)`` ->
+    (position, velocity, acceleration), each (m,); ``rank()``; ``beam_shape(body, xi)``;
+    ``kinetic_energy(q, qd)``; ``potential_energy(q)``.
+
+    Raises
+    ------
+    InvalidSceneError
+        Malformed description (Python or Rust validation).
+    SingularMassError
+        The mass matrix is not positive definite at the initial guess.
+    InconsistentInitialStateError
+        The guess cannot be corrected onto ``Phi = 0`` / ``A qd = -Phi_t``.
+    """
+
+    def __init__(
+        self,
+        description: Union[Scene, Dict[str, Any]],
+        *,
+        correct: bool = True,
+        hold: Union[str, None, Sequence[str]] = "elastic",
+        position_tol: float = 1e-12,
+        velocity_tol: float = 1e-10,
+        max_iterations: int = 50,
+        t0: float = 0.0,
+    ):
+        if isinstance(description, Scene):
+            scene = description
+        elif isinstance(description, dict):
+            scene = Scene.from_dict(description)
+        else:
+            raise TypeError(f"System needs a Scene or a description dict, got {type(description).__name__}")
+        scene.validate()
+        self.description: Dict[str, Any] = scene.to_dict()
+        core = _core_module().System(json.dumps(self.description))
+        self.core = core
+
+        # hot per-step methods: the compiled object's bound methods, no Python layer
+        self.rhs = core.rhs
+        self.qdd = core.qdd
+        self.M = core.M
+        self.Q = core.Q
+        self.phi = core.phi
+        self.A = core.A
+        self.phi_t = core.phi_t
+        self.b = core.b
+        self.multipliers = core.multipliers
+        self.residuals = core.residuals
+        self.rank = core.rank
+        self.beam_shape = core.beam_shape
+        self.kinetic_energy = core.kinetic_energy
+        self.potential_energy = core.potential_energy
+
+        self.n_coords: int = int(core.n_coords)
+        self.n_constraints: int = int(core.n_constraints)
+        self.body_names: List[str] = list(core.body_names)
+        self.body_slices: Dict[str, Tuple[int, int]] = {k: (int(v[0]), int(v[1])) for k, v in dict(core.body_slices).items()}
+        self.coordinate_names: List[str] = list(core.coordinate_names)
+        self.constraint_names: List[str] = list(core.constraint_names)
+        self._kinds = {b["name"]: b["kind"] for b in self.description["bodies"]}
+
+        self.t0 = float(t0)
+        q_guess, qd_guess = core.initial_guess()
+        self.q_guess = np.asarray(q_guess, dtype=float)
+        self.qd_guess = np.asarray(qd_guess, dtype=float)
+        # Let the core check the mass matrix (and everything else a step needs) at the guess:
+        # raises SingularMassError if M is not positive definite.
+        core.qdd(self.t0, self.q_guess, self.qd_guess)
+
+        if correct:
+            self.q0, self.qd0, self.initial_correction = self._correct(
+                self.q_guess, self.qd_guess, hold, position_tol, velocity_tol, max_iterations
+            )
+        else:
+            self.q0, self.qd0 = self.q_guess.copy(), self.qd_guess.copy()
+            rp = self._max_abs(core.phi(self.t0, self.q0))
+            rv = self._max_abs(core.A(self.q0) @ self.qd0 + core.phi_t(self.t0))
+            self.initial_correction = InitialCorrection(
+                0, rp, rp, rv, rv, np.zeros(self.n_coords), np.zeros(self.n_coords), [], self.coordinate_names
+            )
+
+    # ------------------------------------------------------------------------------ info
+    @property
+    def y0(self) -> np.ndarray:
+        """Initial integrator state ``[q0, qd0]``, shape (2n,)."""
+        return np.concatenate([self.q0, self.qd0])
+
+    @property
+    def n_dof(self) -> int:
+        """``n - rank(A(q0))``: degrees of freedom at the initial state."""
+        if self.n_constraints == 0:
+            return self.n_coords
+        return self.n_coords - int(np.linalg.matrix_rank(self.A(self.q0)))
+
+    def __repr__(self) -> str:
+        return f"System(bodies={self.body_names}, n_coords={self.n_coords}, n_constraints={self.n_constraints})"
+
+    def coordinate_index(self, name: str) -> int:
+        """Index in ``q`` of coordinate ``name`` (e.g. ``"crank.theta"``, ``"coupler.qf0"``)."""
+        try:
+            return self.coordinate_names.index(name)
+        except ValueError:
+            raise KeyError(f"unknown coordinate {name!r}; coordinates are {self.coordinate_names}") from None
+
+    def body_slice(self, body: str) -> slice:
+        """Slice of ``q`` holding body ``body``'s coordinates ``[x, y, theta, q_f...]``."""
+        if body not in self.body_slices:
+            raise KeyError(f"unknown body {body!r}; bodies are {self.body_names}")
+        start, stop = self.body_slices[body]
+        return slice(start, stop)
+
+    def elastic_slice(self, body: str) -> slice:
+        """Slice of ``q`` holding beam ``body``'s elastic coordinates ``q_f``."""
+        s = self.body_slice(body)
+        if self._kinds[body] != "beam":
+            raise KeyError(f"body {body!r} is rigid: it has no elastic coordinates")
+        return slice(s.start + 3, s.stop)
+
+    def elastic_mask(self) -> np.ndarray:
+        """Boolean mask (n,) of the elastic coordinates of every beam."""
+        mask = np.zeros(self.n_coords, dtype=bool)
+        for name, kind in self._kinds.items():
+            if kind == "beam":
+                mask[self.elastic_slice(name)] = True
+        return mask
+
+    def energy(self, q: np.ndarray, qd: np.ndarray) -> float:
+        """Total mechanical energy ``T + V`` (gravity, elastic, springs)."""
+        return float(self.kinetic_energy(q, qd) + self.potential_energy(q))
+
+    def stiffness_matrix(self, body: str, h: float = 1e-7) -> np.ndarray:
+        """Elastic stiffness ``K_ff`` of beam ``body``, shape (n_f, n_f).
+
+        Uses the core's ``stiffness_matrix`` if it has one, otherwise central differences of
+        ``-Q`` with respect to ``q_f`` at ``q_f = 0``, zero velocities, reference coordinates of
+        ``q0``.  The elastic force ``-K_ff q_f`` is linear; gravity, point forces and torques give
+        generalized forces on ``q_f`` that do not depend on ``q_f`` and cancel in the difference;
+        spring-dampers attached to the beam would not (leave them out for a clean ``K_ff``).
+        """
+        core_k = getattr(self.core, "stiffness_matrix", None)
+        if core_k is not None:
+            return np.asarray(core_k(body), dtype=float)
+        sl = self.elastic_slice(body)
+        q = self.q0.copy()
+        q[sl] = 0.0
+        qd = np.zeros(self.n_coords)
+        idx = np.arange(sl.start, sl.stop)
+        K = np.empty((idx.size, idx.size))
+        for j, k in enumerate(idx):
+            qp, qm = q.copy(), q.copy()
+            qp[k] += h
+            qm[k] -= h
+            K[:, j] = -(self.Q(self.t0, qp, qd)[idx] - self.Q(self.t0, qm, qd)[idx]) / (2.0 * h)
+        return 0.5 * (K + K.T)
+
+    def mass_matrix_elastic(self, body: str, q: Optional[np.ndarray] = None) -> np.ndarray:
+        """Elastic block ``M_ff`` of beam ``body`` at ``q`` (default ``q0``), shape (n_f, n_f)."""
+        sl = self.elastic_slice(body)
+        M = self.M(self.q0 if q is None else np.asarray(q, dtype=float))
+        return M[sl, sl]
+
+    # ------------------------------------------------------------------------------ correction
+    @staticmethod
+    def _max_abs(v: np.ndarray) -> float:
+        v = np.asarray(v)
+        return float(np.max(np.abs(v))) if v.size else 0.0
+
+    def _held_mask(self, hold: Union[str, None, Sequence[str]]) -> np.ndarray:
+        mask = np.zeros(self.n_coords, dtype=bool)
+        if hold is None:
+            return mask
+        items = [hold] if isinstance(hold, str) else list(hold)
+        for h in items:
+            if h == "elastic":
+                mask |= self.elastic_mask()
+            else:
+                mask[self.coordinate_index(h)] = True
+        return mask
+
+    def _metric_step(self, M: np.ndarray, A: np.ndarray, r: np.ndarray, free: np.ndarray) -> np.ndarray:
+        """Minimum-norm solution of ``A[:, free] dx = r`` in the metric ``M[free, free]``.
+
+        ``dx_free = L^-T (A_f L^-T)^+ r`` with ``M_ff = L L^T`` (the UK/Gauss projection).
+        """
+        dx = np.zeros(self.n_coords)
+        if not np.any(free) or A.shape[0] == 0:
+            return dx
+        W = M[np.ix_(free, free)]
+        try:
+            L = np.linalg.cholesky(W)
+        except np.linalg.LinAlgError:
+            raise SingularMassError(
+                "mass matrix block of the corrected coordinates is not positive definite"
+            ) from None
+        Af = A[:, free]
+        # B = A_f L^-T  <=>  L B^T = A_f^T
+        B = np.linalg.solve(L, Af.T).T
+        y, *_ = np.linalg.lstsq(B, r, rcond=None)
+        dx[free] = np.linalg.solve(L.T, y)
+        return dx
+
+    def _worst_rows(self, residual: np.ndarray, k: int = 3) -> List[str]:
+        order = np.argsort(-np.abs(residual))[:k]
+        return [self.constraint_names[i] for i in order if abs(residual[i]) > 0.0]
+
+    def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations):
+        core, t0 = self.core, self.t0
+        held = self._held_mask(hold)
+        free = ~held
+        q = q_guess.copy()
+        phi = np.asarray(core.phi(t0, q))
+        r0 = self._max_abs(phi)
+        res = r0
+        it = 0
+        best = res
+        stall = 0
+        while res > position_tol and it < max_iterations:
+            it += 1
+            dq = self._metric_step(core.M(q), core.A(q), -phi, free)
+            # damped Newton: halve the step while the residual grows
+            step = 1.0
+            for _ in range(30):
+                q_try = q + step * dq
+                phi_try = np.asarray(core.phi(t0, q_try))
+                if self._max_abs(phi_try) < res or step < 1e-6:
+                    break
+                step *= 0.5
+            q, phi = q_try, phi_try
+            res = self._max_abs(phi)
+            if res < 0.5 * best:
+                best, stall = res, 0
+            else:
+                stall += 1
+                if stall >= 5:
+                    break
+        if not res <= position_tol:
+            rows = self._worst_rows(phi)
+            detail = ", ".join(f"{self.constraint_names[i]} = {phi[i]:.3e}" for i in np.argsort(-np.abs(phi))[:3])
+            raise InconsistentInitialStateError(
+                f"initial positions cannot be corrected onto the constraints Phi(q, t0) = 0: after {it} "
+                f"Newton iteration(s) max |Phi| = {res:.3e} (tolerance {position_tol:.1e}); largest residual "
+                f"rows: {detail}" + (" (held coordinates: elastic)" if np.any(held) else ""),
+                rows=rows,
+                residuals=phi,
+            )
+
+        A = core.A(q)
+        vres = A @ qd_guess + core.phi_t(t0)
+        v0 = self._max_abs(vres)
+        dqd = self._metric_step(core.M(q), A, -vres, free)
+        qd = qd_guess + dqd
+        vres = A @ qd + core.phi_t(t0)
+        v1 = self._max_abs(vres)
+        scale = max(1.0, self._max_abs(qd))
+        if not v1 <= velocity_tol * scale:
+            rows = self._worst_rows(vres)
+            detail = ", ".join(f"{self.constraint_names[i]} = {vres[i]:.3e}" for i in np.argsort(-np.abs(vres))[:3])
+            raise InconsistentInitialStateError(
+                f"initial velocities cannot be projected onto A qd = -Phi_t with the held coordinates fixed: "
+                f"max |A qd + Phi_t| = {v1:.3e}; largest residual rows: {detail}",
+                rows=rows,
+                residuals=vres,
+            )
+        report = InitialCorrection(
+            iterations=it,
+            position_residual_before=r0,
+            position_residual_after=res,
+            velocity_residual_before=v0,
+            velocity_residual_after=v1,
+            dq=q - q_guess,
+            dqd=qd - qd_guess,
+            held=[n for n, h in zip(self.coordinate_names, held) if h],
+            coordinate_names=self.coordinate_names,
+        )
+        return q, qd, report
