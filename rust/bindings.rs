@@ -1,0 +1,406 @@
+//! Python bindings (feature `python`): the only module that knows Python. Maps `Error` to
+//! exception classes under `ukflex.UkflexError`, reads strided NumPy inputs, returns fresh
+//! arrays, and never lets a panic cross into Python.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Mutex;
+
+use numpy::ndarray::ArrayView1;
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyKeyError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::body::BodyKind;
+use crate::data::{Data, RankTolerance};
+use crate::dynamics;
+use crate::error::Error;
+use crate::model::Model;
+use crate::uk;
+
+create_exception!(_core, UkflexError, PyException, "Base class of every ukflex error.");
+create_exception!(_core, InvalidSceneError, UkflexError, "Malformed or non-physical scene description.");
+create_exception!(_core, SingularMassError, UkflexError, "The mass matrix is not positive definite.");
+create_exception!(_core, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
+create_exception!(_core, SolverError, UkflexError, "A solver kernel failed.");
+
+fn to_py(e: Error) -> PyErr {
+    let msg = e.to_string();
+    match e {
+        Error::Description(_) | Error::InvalidProperty { .. } | Error::UnknownBody { .. } => InvalidSceneError::new_err(msg),
+        Error::Shape { .. } => PyValueError::new_err(msg),
+        Error::NonFinite { .. } => NonFiniteError::new_err(msg),
+        Error::SingularMass { .. } => SingularMassError::new_err(msg),
+        Error::Solver(_) => SolverError::new_err(msg),
+    }
+}
+
+/// Workspace behind the lock: the kernel buffers plus contiguous copies of the inputs.
+struct Workspace {
+    data: Data,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+}
+
+/// Copy a (possibly strided) NumPy vector into `dst`, checking length and finiteness.
+fn read_into(what: &str, src: &ArrayView1<f64>, dst: &mut [f64]) -> Result<(), Error> {
+    if src.len() != dst.len() {
+        return Err(Error::Shape { what: what.to_string(), expected: dst.len(), got: src.len() });
+    }
+    for (i, (d, s)) in dst.iter_mut().zip(src.iter()).enumerate() {
+        if !s.is_finite() {
+            return Err(Error::NonFinite { what: what.to_string(), index: i });
+        }
+        *d = *s;
+    }
+    Ok(())
+}
+
+fn check_time(t: f64) -> Result<(), Error> {
+    if t.is_finite() { Ok(()) } else { Err(Error::NonFinite { what: "t".into(), index: 0 }) }
+}
+
+/// A compiled scene: the immutable model and its workspace. Safe to share between threads
+/// (the workspace is behind a lock; run independent simulations on separate Systems to run
+/// them in parallel).
+#[pyclass(name = "System", module = "ukflex._core", frozen)]
+pub struct PySystem {
+    model: Model,
+    ws: Mutex<Workspace>,
+}
+
+impl PySystem {
+    /// Run `f` on the workspace; panics become `SolverError`, never a Python panic.
+    fn with_ws<R>(&self, f: impl FnOnce(&Model, &mut Workspace) -> Result<R, Error>) -> PyResult<R> {
+        let mut guard = match self.ws.lock() {
+            Ok(g) => g,
+            Err(poisoned) => poisoned.into_inner(),
+        };
+        let model = &self.model;
+        match catch_unwind(AssertUnwindSafe(|| f(model, &mut guard))) {
+            Ok(r) => r.map_err(to_py),
+            Err(_) => Err(SolverError::new_err("internal error in the ukflex core (a bug: please report it)")),
+        }
+    }
+
+    fn load(ws: &mut Workspace, q: &PyReadonlyArray1<f64>, qd: Option<&PyReadonlyArray1<f64>>) -> Result<(), Error> {
+        read_into("q", &q.as_array(), &mut ws.q)?;
+        match qd {
+            Some(qd) => read_into("qd", &qd.as_array(), &mut ws.qd),
+            None => {
+                ws.qd.fill(0.0);
+                Ok(())
+            }
+        }
+    }
+
+    fn body(&self, name: &str) -> PyResult<usize> {
+        self.model
+            .body_index(name)
+            .ok_or_else(|| PyKeyError::new_err(format!("unknown body '{name}' (bodies: {:?})", self.body_names())))
+    }
+
+    fn body_names(&self) -> Vec<String> {
+        self.model.bodies.iter().map(|b| b.name.clone()).collect()
+    }
+}
+
+fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    PyArray1::from_vec(py, v).reshape([rows, cols])
+}
+
+#[pymethods]
+impl PySystem {
+    /// Build the model from a JSON scene description (see docs/scene-format.md).
+    #[new]
+    fn new(description_json: &str) -> PyResult<Self> {
+        let model = catch_unwind(|| Model::from_json(description_json))
+            .map_err(|_| SolverError::new_err("internal error while building the model"))?
+            .map_err(to_py)?;
+        let data = Data::new(&model);
+        let ws = Workspace { data, q: vec![0.0; model.n], qd: vec![0.0; model.n] };
+        Ok(PySystem { model, ws: Mutex::new(ws) })
+    }
+
+    /// Number of coordinates n.
+    #[getter]
+    fn n_coords(&self) -> usize {
+        self.model.n
+    }
+
+    /// Number of constraint rows m.
+    #[getter]
+    fn n_constraints(&self) -> usize {
+        self.model.m
+    }
+
+    #[getter(body_names)]
+    fn py_body_names(&self) -> Vec<String> {
+        self.body_names()
+    }
+
+    /// name -> (start, stop) of the body's coordinates in q.
+    #[getter]
+    fn body_slices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for b in &self.model.bodies {
+            d.set_item(&b.name, (b.offset, b.offset + b.n_coords))?;
+        }
+        Ok(d)
+    }
+
+    #[getter]
+    fn coordinate_names(&self) -> Vec<String> {
+        self.model.coordinate_names.clone()
+    }
+
+    /// One name per constraint row.
+    #[getter]
+    fn constraint_names(&self) -> Vec<String> {
+        self.model.constraint_row_names.clone()
+    }
+
+    /// (q0, qd0) as given by the description (not corrected).
+    fn initial_guess<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>) {
+        (PyArray1::from_slice(py, &self.model.q0), PyArray1::from_slice(py, &self.model.qd0))
+    }
+
+    /// Mass matrix M(q), shape (n, n).
+    #[allow(non_snake_case)]
+    fn M<'py>(&self, py: Python<'py>, q: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.model.n;
+        let m = self.with_ws(|model, ws| {
+            Self::load(ws, &q, None)?;
+            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            Ok(dynamics::dense_mass(model, &ws.data))
+        })?;
+        mat(py, m, n, n)
+    }
+
+    /// Generalized forces Q(t, q, qd) = applied + quadratic velocity + elastic, shape (n,).
+    #[allow(non_snake_case)]
+    fn Q<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let v = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            Ok(ws.data.force.clone())
+        })?;
+        Ok(PyArray1::from_vec(py, v))
+    }
+
+    /// Constraint Jacobian A = Phi_q(q), shape (m, n).
+    #[allow(non_snake_case)]
+    fn A<'py>(&self, py: Python<'py>, q: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (m, n) = (self.model.m, self.model.n);
+        let v = self.with_ws(|model, ws| {
+            Self::load(ws, &q, None)?;
+            dynamics::constraints(model, &mut ws.data, 0.0, &ws.q, &ws.qd, false);
+            Ok(ws.data.jac.clone())
+        })?;
+        mat(py, v, m, n)
+    }
+
+    /// Constraint values Phi(q, t), shape (m,).
+    fn phi<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let v = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, None)?;
+            dynamics::constraints(model, &mut ws.data, t, &ws.q, &ws.qd, true);
+            Ok(ws.data.phi.clone())
+        })?;
+        Ok(PyArray1::from_vec(py, v))
+    }
+
+    /// Partial time derivative Phi_t(t), shape (m,) (nonzero only for drivers).
+    fn phi_t<'py>(&self, py: Python<'py>, t: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let v = self.with_ws(|model, ws| {
+            check_time(t)?;
+            ws.q.copy_from_slice(&model.q0);
+            ws.qd.fill(0.0);
+            dynamics::constraints(model, &mut ws.data, t, &ws.q, &ws.qd, false);
+            Ok(ws.data.phi_t.clone())
+        })?;
+        Ok(PyArray1::from_vec(py, v))
+    }
+
+    /// b = gamma(t, q, qd) (paper eq. 43), shape (m,).
+    fn b<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let v = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            dynamics::constraints(model, &mut ws.data, t, &ws.q, &ws.qd, false);
+            Ok(ws.data.gamma.clone())
+        })?;
+        Ok(PyArray1::from_vec(py, v))
+    }
+
+    /// UK acceleration qdd(t, q, qd), shape (n,).
+    fn qdd<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let out = PyArray1::<f64>::zeros(py, self.model.n, false);
+        self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+            let mut w = out.readwrite();
+            w.as_slice_mut().expect("fresh array is contiguous").copy_from_slice(&ws.data.qdd);
+            Ok(())
+        })?;
+        Ok(out)
+    }
+
+    /// Right-hand side for integrators: y = [q, qd] -> [qd, qdd], shape (2n,).
+    fn rhs<'py>(&self, py: Python<'py>, t: f64, y: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.model.n;
+        let out = PyArray1::<f64>::zeros(py, 2 * n, false);
+        self.with_ws(|model, ws| {
+            check_time(t)?;
+            let ya = y.as_array();
+            if ya.len() != 2 * n {
+                return Err(Error::Shape { what: "y".into(), expected: 2 * n, got: ya.len() });
+            }
+            read_into("y[:n]", &ya.slice(numpy::ndarray::s![..n]), &mut ws.q)?;
+            read_into("y[n:]", &ya.slice(numpy::ndarray::s![n..]), &mut ws.qd)?;
+            uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+            let mut w = out.readwrite();
+            let o = w.as_slice_mut().expect("fresh array is contiguous");
+            o[..n].copy_from_slice(&ws.qd);
+            o[n..].copy_from_slice(&ws.data.qdd);
+            Ok(())
+        })?;
+        Ok(out)
+    }
+
+    /// Lagrange multipliers (M qdd + A^T lambda = Q), shape (m,).
+    fn multipliers<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let v = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+            Ok(ws.data.lambda.clone())
+        })?;
+        Ok(PyArray1::from_vec(py, v))
+    }
+
+    /// (position Phi, velocity A qd + Phi_t, acceleration A qdd - b), each shape (m,).
+    #[allow(clippy::type_complexity)]
+    fn residuals<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        let m = self.model.m;
+        let (p, v, a) = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            let (mut p, mut v, mut a) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+            let (q, qd) = (ws.q.clone(), ws.qd.clone());
+            uk::residuals(model, &mut ws.data, t, &q, &qd, &mut p, &mut v, &mut a)?;
+            Ok((p, v, a))
+        })?;
+        Ok((PyArray1::from_vec(py, p), PyArray1::from_vec(py, v), PyArray1::from_vec(py, a)))
+    }
+
+    /// (rank, smallest kept singular value) of the last UK pseudoinverse.
+    fn rank(&self) -> PyResult<(usize, f64)> {
+        self.with_ws(|_, ws| Ok((ws.data.rank_info.rank, ws.data.rank_info.sigma_min_kept)))
+    }
+
+    /// Everything the last pseudoinverse decided: rank, sigma_max, sigma_min_kept,
+    /// sigma_max_dropped, tolerance.
+    fn rank_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let info = self.with_ws(|_, ws| Ok(ws.data.rank_info))?;
+        let d = PyDict::new(py);
+        d.set_item("rank", info.rank)?;
+        d.set_item("sigma_max", info.sigma_max)?;
+        d.set_item("sigma_min_kept", info.sigma_min_kept)?;
+        d.set_item("sigma_max_dropped", info.sigma_max_dropped)?;
+        d.set_item("tolerance", info.tolerance)?;
+        Ok(d)
+    }
+
+    /// Set the pseudoinverse rank tolerance: drop singular values below
+    /// max(atol, rcond * sigma_max); rcond=None means max(m, n) * eps.
+    #[pyo3(signature = (rcond=None, atol=0.0))]
+    fn set_rank_tolerance(&self, rcond: Option<f64>, atol: f64) -> PyResult<()> {
+        if let Some(r) = rcond {
+            if !r.is_finite() || r < 0.0 {
+                return Err(PyValueError::new_err(format!("rcond must be >= 0 and finite, got {r}")));
+            }
+        }
+        if !atol.is_finite() || atol < 0.0 {
+            return Err(PyValueError::new_err(format!("atol must be >= 0 and finite, got {atol}")));
+        }
+        self.with_ws(|_, ws| {
+            ws.data.tolerance = RankTolerance { rcond, atol };
+            Ok(())
+        })
+    }
+
+    /// Elastic shape of a beam at xi in [0, 1]: (S (2, n_f), N_psi (n_f,)) with
+    /// u_f = S q_f in the beam frame and psi = N_psi q_f.
+    #[allow(clippy::type_complexity)]
+    fn beam_shape<'py>(&self, py: Python<'py>, body: &str, xi: f64) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+        let bi = self.body(body)?;
+        let BodyKind::Beam(beam) = &self.model.bodies[bi].kind else {
+            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+        };
+        if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
+            return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {xi}")));
+        }
+        let nf = beam.n_f;
+        let ps = beam.point_shape(xi);
+        let (mut s, mut npsi) = (vec![0.0; 2 * nf], vec![0.0; nf]);
+        for &(i, su, sv, sp) in &ps.entries {
+            s[i] = su;
+            s[nf + i] = sv;
+            npsi[i] = sp;
+        }
+        Ok((mat(py, s, 2, nf)?, PyArray1::from_vec(py, npsi)))
+    }
+
+    /// Constant elastic blocks of a beam: (M_ff, K_ff), each (n_f, n_f).
+    #[allow(clippy::type_complexity)]
+    fn beam_matrices<'py>(&self, py: Python<'py>, body: &str) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+        let bi = self.body(body)?;
+        let BodyKind::Beam(beam) = &self.model.bodies[bi].kind else {
+            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+        };
+        let nf = beam.n_f;
+        Ok((mat(py, beam.m_ff.to_dense(), nf, nf)?, mat(py, beam.k_ff.to_dense(), nf, nf)?))
+    }
+
+    /// Kinetic energy 1/2 qd^T M(q) qd.
+    fn kinetic_energy(&self, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<f64> {
+        let n = self.model.n;
+        self.with_ws(|model, ws| {
+            Self::load(ws, &q, Some(&qd))?;
+            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            let m = dynamics::dense_mass(model, &ws.data);
+            let mut e = 0.0;
+            for i in 0..n {
+                for j in 0..n {
+                    e += ws.qd[i] * m[i * n + j] * ws.qd[j];
+                }
+            }
+            Ok(0.5 * e)
+        })
+    }
+
+    /// Potential energy: gravity + elastic strain + springs (and -F.r of constant loads).
+    fn potential_energy(&self, q: PyReadonlyArray1<f64>) -> PyResult<f64> {
+        self.with_ws(|model, ws| {
+            Self::load(ws, &q, None)?;
+            Ok(dynamics::potential_energy(model, &ws.q))
+        })
+    }
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add_class::<PySystem>()?;
+    m.add("UkflexError", py.get_type::<UkflexError>())?;
+    m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
+    m.add("SingularMassError", py.get_type::<SingularMassError>())?;
+    m.add("NonFiniteError", py.get_type::<NonFiniteError>())?;
+    m.add("SolverError", py.get_type::<SolverError>())?;
+    Ok(())
+}

@@ -1,0 +1,53 @@
+//! One error type for the whole core. `bindings.rs` maps each variant to a Python exception
+//! class under `ukflex.UkflexError`; nothing in the core panics on user input.
+
+use thiserror::Error;
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum Error {
+    /// The scene description is malformed (parse error, missing key, wrong type).
+    #[error("malformed scene description: {0}")]
+    Description(String),
+    /// A property is non-physical (zero or negative length, mass, modulus, NaN, ...).
+    #[error("{item}: {message}")]
+    InvalidProperty { item: String, message: String },
+    /// A joint, driver or force names a body that does not exist.
+    #[error("{item}: unknown body '{body}'")]
+    UnknownBody { item: String, body: String },
+    /// An input array has the wrong length.
+    #[error("{what}: expected length {expected}, got {got}")]
+    Shape { what: String, expected: usize, got: usize },
+    /// An input array holds NaN or infinity.
+    #[error("{what}: contains NaN or infinity at index {index}")]
+    NonFinite { what: String, index: usize },
+    /// The mass matrix (or a body block of it) is not positive definite.
+    #[error("mass matrix is not positive definite ({item})")]
+    SingularMass { item: String },
+    /// A solver kernel could not produce a result (e.g. SVD did not converge).
+    #[error("solver failure: {0}")]
+    Solver(String),
+}
+
+impl Error {
+    pub(crate) fn invalid(item: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::InvalidProperty { item: item.into(), message: message.into() }
+    }
+}
+
+/// Check that every entry of `values` is finite.
+pub fn check_finite(what: &str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(Error::NonFinite { what: what.to_string(), index }),
+        None => Ok(()),
+    }
+}
+
+/// Check that `values` has length `expected`.
+pub fn check_len(what: &str, values: &[f64], expected: usize) -> Result<()> {
+    if values.len() != expected {
+        return Err(Error::Shape { what: what.to_string(), expected, got: values.len() });
+    }
+    Ok(())
+}

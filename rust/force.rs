@@ -1,0 +1,72 @@
+//! Applied forces other than gravity (which is a body-level term in `dynamics.rs`).
+//! Each adds its generalized force `J^T F` to `Q` (paper eqs. 34-37).
+
+use crate::body::{Body, Marker};
+
+#[derive(Debug, Clone)]
+pub enum ForceKind {
+    /// Constant world-frame force at a marker: `Q += r_q^T F`.
+    PointForce { point: Marker, force: [f64; 2] },
+    /// Constant torque on a marker frame: `Q += phi_q^T tau`.
+    Torque { frame: Marker, torque: f64 },
+    /// Linear spring-damper between two markers:
+    /// `Q -= (k (l - l0) + c l_dot) (r_a - r_b)_q^T e`, `e = (r_a - r_b) / l`.
+    SpringDamper { a: Marker, b: Marker, stiffness: f64, damping: f64, rest_length: f64 },
+}
+
+#[derive(Debug, Clone)]
+pub struct Force {
+    pub name: String,
+    pub kind: ForceKind,
+}
+
+impl Force {
+    /// Add this force's generalized force to `qvec` (length n).
+    #[inline]
+    pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], qvec: &mut [f64]) {
+        match &self.kind {
+            ForceKind::PointForce { point, force } => {
+                let s = point.state(bodies, q, qd);
+                point.add_point_jacobian(bodies, &s, *force, qvec);
+            }
+            ForceKind::Torque { frame, torque } => frame.add_angle_jacobian(bodies, *torque, qvec),
+            ForceKind::SpringDamper { a, b, stiffness, damping, rest_length } => {
+                let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
+                let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];
+                let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                if l == 0.0 {
+                    // direction undefined at zero length: no force (documented limitation)
+                    return;
+                }
+                let e = [d[0] / l, d[1] / l];
+                let ldot = e[0] * (sa.v[0] - sb.v[0]) + e[1] * (sa.v[1] - sb.v[1]);
+                let f = stiffness * (l - rest_length) + damping * ldot;
+                a.add_point_jacobian(bodies, &sa, [-f * e[0], -f * e[1]], qvec);
+                b.add_point_jacobian(bodies, &sb, [f * e[0], f * e[1]], qvec);
+            }
+        }
+    }
+
+    /// Potential energy stored in this force element (springs only).
+    pub fn potential(&self, bodies: &[Body], q: &[f64]) -> f64 {
+        match &self.kind {
+            ForceKind::SpringDamper { a, b, stiffness, rest_length, .. } => {
+                let zeros = vec![0.0; q.len()];
+                let (sa, sb) = (a.state(bodies, q, &zeros), b.state(bodies, q, &zeros));
+                let l = ((sa.r[0] - sb.r[0]).powi(2) + (sa.r[1] - sb.r[1]).powi(2)).sqrt();
+                0.5 * stiffness * (l - rest_length).powi(2)
+            }
+            // constant forces are not potential-free in general (follower frames); they are
+            // world-fixed here, so their potential is -F . r
+            ForceKind::PointForce { point, force } => {
+                let zeros = vec![0.0; q.len()];
+                let s = point.state(bodies, q, &zeros);
+                -(force[0] * s.r[0] + force[1] * s.r[1])
+            }
+            ForceKind::Torque { frame, torque } => {
+                let zeros = vec![0.0; q.len()];
+                -torque * frame.state(bodies, q, &zeros).phi
+            }
+        }
+    }
+}

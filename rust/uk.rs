@@ -1,0 +1,126 @@
+//! The Udwadia-Kalaba acceleration (paper eqs. 70-74) with any factor `M = F F^T`:
+//!
+//! `qdd = a + F^-T B^+ (b - A a)`, `a = M^-1 Q`, `B = A F^-T`.
+//!
+//! With `F` the symmetric root this is the paper's eq. 70; every factor gives the same
+//! Gauss-principle minimizer, and the block Cholesky factor of `dynamics::factor_mass` is the
+//! cheap one. `B^+` comes from a thin faer SVD of `B^T = F^-1 A^T` (n x m) with an explicit rank
+//! tolerance. Multipliers (sign of eq. 42: `M qdd + A^T lambda = Q`):
+//! `lambda = (A M^-1 A^T)^+ (A a - b) = (B B^T)^+ (A a - b)`.
+
+use faer::dyn_stack::MemStack;
+use faer::linalg::svd::svd;
+use faer::Par;
+
+use crate::data::{Data, RankInfo};
+use crate::dynamics::{apply_finv, apply_finv_sparse, apply_finvt, constraints, factor_mass, mass_and_forces};
+use crate::error::{Error, Result};
+use crate::model::Model;
+
+/// Evaluate every model term at `(t, q, qd)`: mass blocks and factor, `Q`, `A`, `Phi_t`,
+/// `gamma` (and `Phi` when `with_phi`).
+pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], with_phi: bool) -> Result<()> {
+    mass_and_forces(model, data, q, qd);
+    factor_mass(model, data)?;
+    constraints(model, data, t, q, qd, with_phi);
+    Ok(())
+}
+
+/// UK acceleration into `data.qdd` and multipliers into `data.lambda`, from the terms already
+/// in `data` (see `evaluate`).
+pub fn solve(model: &Model, data: &mut Data) -> Result<()> {
+    let (n, m) = (model.n, model.m);
+    // y = F^-1 Q ; a = F^-T y
+    data.y.copy_from_slice(&data.force);
+    apply_finv(model, &data.bodies, &mut data.y);
+    data.qdd_free.copy_from_slice(&data.y);
+    apply_finvt(model, &data.bodies, &mut data.qdd_free);
+    if m == 0 {
+        data.qdd.copy_from_slice(&data.qdd_free);
+        data.rank_info = RankInfo::default();
+        return Ok(());
+    }
+    // B^T = F^-1 A^T, column by column
+    for i in 0..m {
+        let col = data.bt.col_as_slice_mut(i);
+        col.copy_from_slice(&data.jac[i * n..(i + 1) * n]);
+        apply_finv_sparse(model, &data.bodies, col);
+    }
+    let stack = MemStack::new(&mut data.mem);
+    svd(
+        data.bt.as_ref(),
+        data.svd_s.as_mut(),
+        Some(data.svd_u.as_mut()),
+        Some(data.svd_v.as_mut()),
+        Par::Seq,
+        stack,
+        Default::default(),
+    )
+    .map_err(|e| Error::Solver(format!("SVD of A F^-T did not converge: {e:?}")))?;
+    let k = n.min(m);
+    let s = data.svd_s.column_vector();
+    let sigma_max = if k > 0 { s[0] } else { 0.0 };
+    let rcond = data.tolerance.rcond.unwrap_or((n.max(m) as f64) * f64::EPSILON);
+    let tol = data.tolerance.atol.max(rcond * sigma_max);
+    // residual r = b - A a
+    for i in 0..m {
+        let row = &data.jac[i * n..(i + 1) * n];
+        let aa: f64 = row.iter().zip(&data.qdd_free).map(|(x, y)| x * y).sum();
+        data.residual[i] = data.gamma[i] - aa;
+    }
+    let mut info = RankInfo { sigma_max, tolerance: tol, ..Default::default() };
+    // coeff = S^+ V^T r ; y += U coeff ; lambda = -V S^+ coeff
+    for j in 0..k {
+        let sj = s[j];
+        if sj > tol && sj > 0.0 {
+            let vj = data.svd_v.col_as_slice(j);
+            let dot: f64 = vj.iter().zip(&data.residual).map(|(x, y)| x * y).sum();
+            data.coeff[j] = dot / sj;
+            info.rank += 1;
+            info.sigma_min_kept = sj;
+        } else {
+            data.coeff[j] = 0.0;
+            if sj > info.sigma_max_dropped {
+                info.sigma_max_dropped = sj;
+            }
+        }
+    }
+    data.rank_info = info;
+    data.lambda.fill(0.0);
+    for j in 0..info.rank {
+        let cj = data.coeff[j];
+        let uj = data.svd_u.col_as_slice(j);
+        for (yi, ui) in data.y.iter_mut().zip(uj) {
+            *yi += ui * cj;
+        }
+        let lj = -cj / s[j];
+        let vj = data.svd_v.col_as_slice(j);
+        for (li, vi) in data.lambda.iter_mut().zip(vj) {
+            *li += vi * lj;
+        }
+    }
+    data.qdd.copy_from_slice(&data.y);
+    apply_finvt(model, &data.bodies, &mut data.qdd);
+    Ok(())
+}
+
+/// `qdd = UK(t, q, qd)` into `data.qdd` (and `data.lambda`). Allocation free.
+pub fn acceleration(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) -> Result<()> {
+    evaluate(model, data, t, q, qd, false)?;
+    solve(model, data)
+}
+
+/// Residuals at `(t, q, qd)` with the UK acceleration: position `Phi`, velocity
+/// `A qd + Phi_t`, acceleration `A qdd - b`, written into the three slices (length m).
+pub fn residuals(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], pos: &mut [f64], vel: &mut [f64], acc: &mut [f64]) -> Result<()> {
+    evaluate(model, data, t, q, qd, true)?;
+    solve(model, data)?;
+    let n = model.n;
+    for i in 0..model.m {
+        let row = &data.jac[i * n..(i + 1) * n];
+        pos[i] = data.phi[i];
+        vel[i] = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i];
+        acc[i] = row.iter().zip(&data.qdd).map(|(a, b)| a * b).sum::<f64>() - data.gamma[i];
+    }
+    Ok(())
+}

@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Create .venv with the Python build and runtime dependencies (idempotent).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[ -x .venv/bin/python ] || python3 -m venv .venv
+.venv/bin/python -m pip install --quiet --upgrade pip
+.venv/bin/python -m pip install --quiet "maturin>=1.9.4,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" "pytest>=8"
