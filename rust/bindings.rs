@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::body::BodyKind;
-use crate::data::{Data, RankTolerance};
+use crate::data::{Data, RankTolerance, Stabilization};
 use crate::dynamics;
 use crate::error::Error;
 use crate::model::Model;
@@ -332,6 +332,51 @@ impl PySystem {
             ws.data.tolerance = RankTolerance { rcond, atol };
             Ok(())
         })
+    }
+
+    /// Constraint stabilization inside qdd/rhs: kind "none" or "baumgarte" with alpha, beta
+    /// (b <- gamma - 2 alpha (A qd + Phi_t) - beta^2 Phi).
+    #[pyo3(signature = (kind="none", alpha=0.0, beta=0.0))]
+    fn set_stabilization(&self, kind: &str, alpha: f64, beta: f64) -> PyResult<()> {
+        let st = match kind {
+            "none" => Stabilization::None,
+            "baumgarte" => {
+                if !alpha.is_finite() || !beta.is_finite() || alpha < 0.0 || beta < 0.0 {
+                    return Err(PyValueError::new_err(format!("Baumgarte alpha and beta must be >= 0 and finite, got {alpha}, {beta}")));
+                }
+                Stabilization::Baumgarte { alpha, beta }
+            }
+            other => return Err(PyValueError::new_err(format!("unknown stabilization '{other}' (use 'none' or 'baumgarte')"))),
+        };
+        self.with_ws(|_, ws| {
+            ws.data.stabilization = st;
+            Ok(())
+        })
+    }
+
+    /// Project (q, qd) onto Phi = 0 and A qd + Phi_t = 0 in the mass metric. Returns
+    /// (q, qd, report dict: iterations, position_residual, velocity_residual,
+    /// position_correction, velocity_correction).
+    #[pyo3(signature = (t, q, qd, tol=1e-12, max_iter=20))]
+    #[allow(clippy::type_complexity)]
+    fn project<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>, tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+        if !tol.is_finite() || tol <= 0.0 {
+            return Err(PyValueError::new_err(format!("tol must be positive and finite, got {tol}")));
+        }
+        let (qn, qdn, rep) = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            let (mut qn, mut qdn) = (ws.q.clone(), ws.qd.clone());
+            let rep = uk::project(model, &mut ws.data, t, &mut qn, &mut qdn, tol, max_iter)?;
+            Ok((qn, qdn, rep))
+        })?;
+        let d = PyDict::new(py);
+        d.set_item("iterations", rep.iterations)?;
+        d.set_item("position_residual", rep.position_residual)?;
+        d.set_item("velocity_residual", rep.velocity_residual)?;
+        d.set_item("position_correction", rep.position_correction)?;
+        d.set_item("velocity_correction", rep.velocity_correction)?;
+        Ok((PyArray1::from_vec(py, qn), PyArray1::from_vec(py, qdn), d))
     }
 
     /// Elastic shape of a beam at xi in [0, 1]: (S (2, n_f), N_psi (n_f,)) with

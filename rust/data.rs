@@ -24,6 +24,18 @@ impl Default for RankTolerance {
     }
 }
 
+/// Constraint stabilization applied inside the acceleration kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Stabilization {
+    /// Plain UK (the paper): position and velocity drift are left alone.
+    #[default]
+    None,
+    /// Baumgarte (1972): enforce `Phi_dd + 2 alpha Phi_d + beta^2 Phi = 0`, i.e.
+    /// `b <- gamma - 2 alpha (A qd + Phi_t) - beta^2 Phi`. `alpha = beta` gives critical damping
+    /// of the drift; values of order 1/(time scale of interest) are usual.
+    Baumgarte { alpha: f64, beta: f64 },
+}
+
 /// What the last pseudoinverse found.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct RankInfo {
@@ -83,6 +95,7 @@ pub struct Data {
     pub coeff: Vec<f64>,
     pub mem: MemBuffer,
     pub tolerance: RankTolerance,
+    pub stabilization: Stabilization,
     pub rank_info: RankInfo,
 }
 
@@ -131,6 +144,7 @@ impl Data {
             coeff: vec![0.0; k],
             mem: MemBuffer::new(req),
             tolerance: RankTolerance::default(),
+            stabilization: Stabilization::None,
             rank_info: RankInfo::default(),
         }
     }

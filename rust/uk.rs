@@ -12,7 +12,7 @@ use faer::dyn_stack::MemStack;
 use faer::linalg::svd::svd;
 use faer::Par;
 
-use crate::data::{Data, RankInfo};
+use crate::data::{Data, RankInfo, Stabilization};
 use crate::dynamics::{apply_finv, apply_finv_sparse, apply_finvt, constraints, factor_mass, mass_and_forces};
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -105,9 +105,101 @@ pub fn solve(model: &Model, data: &mut Data) -> Result<()> {
 }
 
 /// `qdd = UK(t, q, qd)` into `data.qdd` (and `data.lambda`). Allocation free.
+/// With Baumgarte stabilization the right-hand side becomes
+/// `b = gamma - 2 alpha (A qd + Phi_t) - beta^2 Phi`.
 pub fn acceleration(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) -> Result<()> {
-    evaluate(model, data, t, q, qd, false)?;
+    match data.stabilization {
+        Stabilization::None => {
+            evaluate(model, data, t, q, qd, false)?;
+        }
+        Stabilization::Baumgarte { alpha, beta } => {
+            evaluate(model, data, t, q, qd, true)?;
+            let n = model.n;
+            for i in 0..model.m {
+                let row = &data.jac[i * n..(i + 1) * n];
+                let vel = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i];
+                data.gamma[i] -= 2.0 * alpha * vel + beta * beta * data.phi[i];
+            }
+        }
+    }
     solve(model, data)
+}
+
+/// Outcome of a projection onto the constraint manifold.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Projection {
+    /// Newton iterations used for the positions.
+    pub iterations: usize,
+    /// max |Phi| after the position correction.
+    pub position_residual: f64,
+    /// max |A qd + Phi_t| after the velocity correction.
+    pub velocity_residual: f64,
+    /// Mass-norm of the position and velocity corrections, `sqrt(dq^T M dq)`.
+    pub position_correction: f64,
+    pub velocity_correction: f64,
+}
+
+/// `sqrt(v^T M v)` from the dense body blocks (reporting only).
+fn mass_norm(model: &Model, data: &Data, v: &[f64]) -> f64 {
+    let m = crate::dynamics::dense_mass(model, data);
+    let n = model.n;
+    let mut s = 0.0;
+    for i in 0..n {
+        let row = &m[i * n..(i + 1) * n];
+        s += v[i] * row.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
+    }
+    s.max(0.0).sqrt()
+}
+
+/// Project `(q, qd)` onto `Phi(q, t) = 0` and `A qd + Phi_t = 0` along the mass metric
+/// (the closest consistent state in kinetic-energy norm; Gauss's principle applied to the
+/// correction): Newton steps `dq = -M^-1 A^T (A M^-1 A^T)^+ Phi` until `max |Phi| <= tol`,
+/// then `dqd = -M^-1 A^T (A M^-1 A^T)^+ (A qd + Phi_t)`. Each step is the UK kernel with
+/// `Q = 0` and `b = -residual`.
+/// Allocates its report buffers: meant for between-step use, not the acceleration hot path.
+pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], qd: &mut [f64], tol: f64, max_iter: usize) -> Result<Projection> {
+    let n = model.n;
+    let zeros = vec![0.0; n];
+    let mut dq_total = vec![0.0; n];
+    let mut iterations = 0;
+    let mut pos_res;
+    loop {
+        evaluate(model, data, t, q, &zeros, true)?;
+        pos_res = data.phi.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if pos_res <= tol || iterations >= max_iter {
+            break;
+        }
+        data.force.fill(0.0);
+        for i in 0..model.m {
+            data.gamma[i] = -data.phi[i];
+        }
+        solve(model, data)?;
+        for i in 0..n {
+            q[i] += data.qdd[i];
+            dq_total[i] += data.qdd[i];
+        }
+        iterations += 1;
+    }
+    let position_correction = mass_norm(model, data, &dq_total);
+    // velocities at the corrected positions
+    evaluate(model, data, t, q, qd, false)?;
+    data.force.fill(0.0);
+    for i in 0..model.m {
+        let row = &data.jac[i * n..(i + 1) * n];
+        data.gamma[i] = -(row.iter().zip(qd.iter()).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i]);
+    }
+    solve(model, data)?;
+    let dqd = data.qdd.clone();
+    for i in 0..n {
+        qd[i] += dqd[i];
+    }
+    let velocity_correction = mass_norm(model, data, &dqd);
+    let mut vel_res = 0.0f64;
+    for i in 0..model.m {
+        let row = &data.jac[i * n..(i + 1) * n];
+        vel_res = vel_res.max((row.iter().zip(qd.iter()).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i]).abs());
+    }
+    Ok(Projection { iterations, position_residual: pos_res, velocity_residual: vel_res, position_correction, velocity_correction })
 }
 
 /// Residuals at `(t, q, qd)` with the UK acceleration: position `Phi`, velocity

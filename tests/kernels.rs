@@ -179,3 +179,44 @@ fn redundant_constraint_is_detected_by_rank_and_still_satisfied() {
     let err = data.qdd.iter().zip(&d1.qdd).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / max_abs(&d1.qdd);
     assert!(err < 1e-9, "redundant vs single declaration: {err:e}");
 }
+
+#[test]
+fn projection_restores_consistency_and_leaves_consistent_states_alone() {
+    let (model, mut data) = build(&paper_scene("timoshenko", 4, true));
+    let (mut q, mut qd) = (model.q0.clone(), model.qd0.clone());
+    let (q_ref, qd_ref) = (q.clone(), qd.clone());
+    let rep = uk::project(&model, &mut data, 0.0, &mut q, &mut qd, 1e-13, 10).unwrap();
+    assert_eq!(rep.iterations, 0);
+    assert!(max_abs(&q.iter().zip(&q_ref).map(|(a, b)| a - b).collect::<Vec<_>>()) < 1e-15);
+    assert!(max_abs(&qd.iter().zip(&qd_ref).map(|(a, b)| a - b).collect::<Vec<_>>()) < 1e-9);
+    let mut rng = Lcg(9);
+    for i in 0..model.n {
+        q[i] += 1e-3 * rng.next() * if i < 6 { 1.0 } else { 1e-3 };
+        qd[i] += 0.1 * rng.next();
+    }
+    let rep = uk::project(&model, &mut data, 0.2, &mut q, &mut qd, 1e-13, 20).unwrap();
+    assert!(rep.position_residual <= 1e-13, "{rep:?}");
+    assert!(rep.velocity_residual <= 1e-9, "{rep:?}");
+    assert!(rep.iterations >= 2 && rep.iterations <= 6, "Newton should converge quadratically: {rep:?}");
+}
+
+#[test]
+fn baumgarte_modifies_the_acceleration_right_hand_side() {
+    let (model, mut data) = build(&paper_scene("euler-bernoulli", 2, true));
+    let n = model.n;
+    let mut rng = Lcg(21);
+    let (q, qd) = random_state(&model, &mut rng);
+    let (alpha, beta) = (5.0, 7.0);
+    data.stabilization = ukflex::data::Stabilization::Baumgarte { alpha, beta };
+    uk::acceleration(&model, &mut data, 0.3, &q, &qd).unwrap();
+    let qdd = data.qdd.clone();
+    dynamics::constraints(&model, &mut data, 0.3, &q, &qd, true);
+    for i in 0..model.m {
+        let row = &data.jac[i * n..(i + 1) * n];
+        let vel: f64 = row.iter().zip(&qd).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i];
+        let want = data.gamma[i] - 2.0 * alpha * vel - beta * beta * data.phi[i];
+        let got: f64 = row.iter().zip(&qdd).map(|(a, b)| a * b).sum();
+        let scale = max_abs(row) * max_abs(&qdd) + want.abs();
+        assert!((got - want).abs() < 1e-12 * scale, "row {i}: {got} vs {want}");
+    }
+}
