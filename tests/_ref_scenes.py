@@ -180,7 +180,7 @@ def line_and_beam_scene():
     }
 
 
-def pendulum(length=4.0, theta0=-math.pi / 2, omega0=2.2):
+def pendulum(length=4.0, theta0=-math.pi / 2, omega0=3.5):
     """Rigid bar with its frame at the centre of mass, pinned to ground at its end (-l/2, 0).
 
     With l/2 > 1 the column-pivoted QR of A puts theta and y among the dependent coordinates

@@ -290,7 +290,8 @@ class _Marker:
         Arot, Ath = _rot(th)
         u = self.point.copy()
         phi = th + self.angle
-        J[:, o:o + 2] = np.eye(2)
+        J[0, o] = 1.0
+        J[1, o + 1] = 1.0
         Jp[o + 2] = 1.0
         av = -(Arot @ u) * thd * thd
         if b.kind == "beam":
@@ -315,7 +316,7 @@ class _Motion:
             self.c = [float(d.get("initial", 0.0)), float(d["speed"])]
             self.kind = "polynomial"
         elif kind == "polynomial":
-            self.c = [float(c) for c in d["coefficients"]]
+            self.c = [float(c) for c in d["coefficients"]] or [0.0]
         elif kind == "harmonic":
             self.off = float(d.get("offset", 0.0))
             self.amp = float(d["amplitude"])
@@ -324,10 +325,18 @@ class _Motion:
         else:
             raise ModelError(f"unknown motion kind {kind!r}")
 
+        if self.kind == "polynomial":      # coefficients of f, f', f'' (ascending powers)
+            c0 = list(self.c)
+            c1 = [k * c0[k] for k in range(1, len(c0))] or [0.0]
+            c2 = [k * c1[k] for k in range(1, len(c1))] or [0.0]
+            self.cs = (c0, c1, c2)
+
     def __call__(self, t, der=0):
         if self.kind == "polynomial":
-            c = np.polynomial.polynomial.Polynomial(self.c)
-            return float(c.deriv(der)(t)) if der else float(c(t))
+            v = 0.0
+            for ck in reversed(self.cs[der]):       # Horner
+                v = v * t + ck
+            return v
         arg = self.w * t + self.ph
         if der == 0:
             return self.off + self.amp * math.sin(arg)
@@ -665,6 +674,11 @@ class ReferenceModel:
     def phi(self, t, q):
         """Constraint residual Phi(t, q), (m,)."""
         return self._constraints(t, q, None)[0]
+
+    def phi_A(self, t, q):
+        """(Phi, A) in one pass."""
+        Phi, A, _, _ = self._constraints(t, q, None)
+        return Phi, A
 
     def A(self, q):
         """Constraint Jacobian Phi_q, (m, n) (independent of t)."""

@@ -11,6 +11,8 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.integrate import solve_ivp
 
+from ._blas import single_blas_thread
+
 __all__ = ["uk_qdd", "uk_multipliers", "augmented_qdd", "inv_sqrt_spd", "uk_rank",
            "simulate_uk_numpy", "SimulationResult", "correct_initial_state"]
 
@@ -77,7 +79,7 @@ def augmented_qdd(M, Q, A, b):
     rhs = np.concatenate([Q, b])
     full_rank = m == 0 or np.linalg.matrix_rank(A) == m
     if full_rank:
-        x = sla.solve(K, rhs, assume_a="sym")
+        x = np.linalg.solve(K, rhs)
     else:
         x = np.linalg.lstsq(K, rhs, rcond=None)[0]
     return x[:n], x[n:]
@@ -188,8 +190,9 @@ def simulate_uk_numpy(description_or_model, t_end, method="BDF", rtol=1e-6, atol
 
     y0 = np.concatenate([np.asarray(q0, float), np.asarray(qd0, float)])
     tic = time.perf_counter()
-    sol = solve_ivp(rhs, (t0, t_end), y0, method=method, rtol=rtol, atol=atol, t_eval=t_eval,
-                    **solve_ivp_kwargs)
+    with single_blas_thread():
+        sol = solve_ivp(rhs, (t0, t_end), y0, method=method, rtol=rtol, atol=atol,
+                        t_eval=t_eval, **solve_ivp_kwargs)
     wall = time.perf_counter() - tic
     return SimulationResult(t=sol.t, q=sol.y[:n], qd=sol.y[n:], status=sol.status,
                             message=sol.message, nfev=nfev[0], wall_time=wall,
