@@ -11,16 +11,11 @@
 from .model import ReferenceModel, ModelError, element_matrices, element_shape, section_properties
 from .uk import (uk_qdd, uk_multipliers, augmented_qdd, inv_sqrt_spd, uk_rank,
                  simulate_uk_numpy, correct_initial_state, SimulationResult)
+from .cp import simulate_cp, choose_partition, CPPartition
 
 __all__ = [
     "ReferenceModel", "ModelError", "element_matrices", "element_shape", "section_properties",
     "uk_qdd", "uk_multipliers", "augmented_qdd", "inv_sqrt_spd", "uk_rank",
     "simulate_uk_numpy", "simulate_cp", "correct_initial_state", "SimulationResult",
+    "choose_partition", "CPPartition",
 ]
-
-
-def __getattr__(name):          # lazy: cp.py is imported on first use
-    if name in ("simulate_cp", "CPPartition"):
-        from . import cp
-        return getattr(cp, name)
-    raise AttributeError(name)
