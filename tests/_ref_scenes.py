@@ -41,8 +41,8 @@ def slider_crank(theory="timoshenko", elements=1, gravity=True, frame="pinned-pi
             coupler,
         ],
         "joints": [
-            {"kind": "revolute", "name": "pivot", "a": {"body": "ground", "point": [0.0, 0.0]},
-             "b": {"body": "crank", "point": [0.0, 0.0]}},
+            {"kind": "revolute", "name": "pivot", "a": {"body": "crank", "point": [0.0, 0.0]},
+             "b": {"body": "ground", "point": [0.0, 0.0]}},
             {"kind": "revolute", "name": "crankpin", "a": {"body": "crank", "point": [L_CRANK, 0.0]},
              "b": {"body": "coupler", "xi": 0.0}},
             {"kind": "point_on_line", "name": "slot", "point": {"body": "coupler", "xi": 1.0},
