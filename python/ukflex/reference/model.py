@@ -394,8 +394,12 @@ class ReferenceModel:
                 E = float(bd["youngs_modulus"])
                 if bd.get("shear_modulus") is not None:
                     G = float(bd["shear_modulus"])
-                else:
+                elif bd.get("poisson_ratio") is not None:
                     G = E / (2.0 * (1.0 + float(bd["poisson_ratio"])))
+                elif theory == "euler-bernoulli":
+                    G = float("nan")                     # not used: no shear strain
+                else:
+                    raise ModelError(f"beam {name!r}: poisson_ratio or shear_modulus required")
                 ks = bd.get("shear_factor")
                 if theory == "timoshenko" and ks is None:
                     raise ModelError(f"beam {name!r}: shear_factor required for Timoshenko")
