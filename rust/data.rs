@@ -8,6 +8,39 @@ use faer::{Mat, Par};
 
 use crate::body::BodyKind;
 use crate::model::Model;
+use crate::small_svd::QrJacobi;
+
+/// How the UK pseudoinverse `(A F^-T)^+` is computed. Every choice is allocation free per
+/// call and gives the `scipy.linalg.pinv` semantics (singular values at or below
+/// `max(atol, rcond sigma_max)` dropped); see `docs/performance.md` for the measurements.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SvdBackend {
+    /// Householder QR `B^T = Q R`; when `1/|R^-1|_F > max(atol, rcond |R|_F)` (a certificate
+    /// that no singular value can fall below the tolerance) the pseudoinverse is the full-rank
+    /// `B^+ = Q R^-T` (triangular solves); otherwise the Jacobi SVD of R as in `QrJacobi`.
+    /// `rank_info` then holds the exact rank with bounds for the singular values
+    /// (`RankInfo::exact == false`); `uk::exact_rank_info` computes the exact values on demand.
+    #[default]
+    Auto,
+    /// Householder QR of `B^T` then one-sided Jacobi SVD of the m x m factor (`small_svd`),
+    /// every call. Used when `m <= n`; otherwise the faer path runs.
+    QrJacobi,
+    /// faer's bidiagonal SVD through its scratch (`MemBuffer`) API, every call.
+    Faer,
+}
+
+/// Which factorization of `B^T` is currently held in `Data` (set by `uk::factor_constraints`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Factored {
+    #[default]
+    None,
+    /// Certified full rank: QR with `R^-1` in `qrj`.
+    FullRankQr,
+    /// Jacobi SVD in `qrj` (sorted values and V also in `svd_s`, `svd_v`).
+    Jacobi,
+    /// faer SVD in `svd_u`, `svd_s`, `svd_v`.
+    Faer,
+}
 
 /// Rank decision of the pseudoinverse: singular values below
 /// `max(atol, rcond * sigma_max)` are dropped; `rcond = None` means `max(m, n) * eps`
@@ -46,17 +79,35 @@ pub struct RankInfo {
     /// Largest singular value dropped (0 if none dropped).
     pub sigma_max_dropped: f64,
     pub tolerance: f64,
+    /// `false` when the certified full-rank path ran: `rank` is exact, `sigma_max` is the upper
+    /// bound `|R|_F`, `sigma_min_kept` the lower bound `1/|R^-1|_F`, `tolerance` the bound
+    /// `max(atol, rcond |R|_F)`; `uk::exact_rank_info` gives the exact values.
+    pub exact: bool,
 }
 
 /// Per-body mass blocks and factor, in body coordinates `[x, y, theta, q_f]`.
+///
+/// Beam factor `F_b = [[L_s, X], [0, L_ff]]` with `X = M_rf L_ff^-T` (3 x n_f). Its first two
+/// rows are the rotation of constants: `M_Rf = A S_bar`, so `X_0 = c a - s b`,
+/// `X_1 = s a + c b` with `a = L_ff^-1 S_bar_x^T`, `b = L_ff^-1 S_bar_y^T` fixed at model build
+/// (here, once per workspace). Only `X_2 = L_ff^-1 m_thetaf^T` needs a banded solve per call,
+/// and the 3x3 Schur complement `m_rr - X X^T` needs only `X_2 . (a, b, X_2)` besides the
+/// constant products `a.a`, `a.b`, `b.b`.
 #[derive(Debug, Clone)]
 pub struct BodyData {
     /// Reference block `[[m_RR, m_Rtheta], [., m_thetatheta]]` (symmetric 3x3).
     pub m_rr: [[f64; 3]; 3],
-    /// `[m_Rf; m_thetaf]`, 3 x n_f row-major (beams).
-    pub m_rf: Vec<f64>,
-    /// `X = M_rf L_ff^-T`, 3 x n_f row-major (beams).
-    pub x: Vec<f64>,
+    /// `(cos theta, sin theta)` of the last `mass_and_forces`.
+    pub cs: [f64; 2],
+    /// `m_thetaf = i_thf - S_tilde q_f` (n_f, beams).
+    pub m_thf: Vec<f64>,
+    /// Constants `a = L_ff^-1 S_bar_x^T`, `b = L_ff^-1 S_bar_y^T` (n_f each) and
+    /// `[a.a, a.b, b.b]`.
+    pub a: Vec<f64>,
+    pub b: Vec<f64>,
+    pub ab: [f64; 3],
+    /// `X_2 = L_ff^-1 m_thetaf^T` (n_f).
+    pub x2: Vec<f64>,
     /// Lower Cholesky factor of the reference block's Schur complement `m_rr - X X^T`
     /// (rigid bodies: of the whole 3x3 mass matrix).
     pub ls: [[f64; 3]; 3],
@@ -94,6 +145,11 @@ pub struct Data {
     pub residual: Vec<f64>,
     pub coeff: Vec<f64>,
     pub mem: MemBuffer,
+    /// QR + Jacobi SVD workspace (present when `0 < m <= n`).
+    pub qrj: Option<QrJacobi>,
+    pub svd_backend: SvdBackend,
+    /// Which factorization is current (set by `uk::factor_constraints`).
+    pub factored_with: Factored,
     pub tolerance: RankTolerance,
     pub stabilization: Stabilization,
     pub rank_info: RankInfo,
@@ -107,14 +163,24 @@ impl Data {
             .bodies
             .iter()
             .map(|b| {
-                let n_f = match &b.kind {
-                    BodyKind::Rigid(_) => 0,
-                    BodyKind::Beam(beam) => beam.n_f,
+                let (n_f, a, bv) = match &b.kind {
+                    BodyKind::Rigid(_) => (0, Vec::new(), Vec::new()),
+                    BodyKind::Beam(beam) => {
+                        let (mut a, mut bv) = (beam.s_bar[0].clone(), beam.s_bar[1].clone());
+                        beam.l_ff.solve_lower(&mut a);
+                        beam.l_ff.solve_lower(&mut bv);
+                        (beam.n_f, a, bv)
+                    }
                 };
+                let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(p, q)| p * q).sum::<f64>();
                 BodyData {
                     m_rr: [[0.0; 3]; 3],
-                    m_rf: vec![0.0; 3 * n_f],
-                    x: vec![0.0; 3 * n_f],
+                    cs: [1.0, 0.0],
+                    m_thf: vec![0.0; n_f],
+                    ab: [dot(&a, &a), dot(&a, &bv), dot(&bv, &bv)],
+                    a,
+                    b: bv,
+                    x2: vec![0.0; n_f],
                     ls: [[0.0; 3]; 3],
                     w: vec![0.0; n_f],
                 }
@@ -143,6 +209,9 @@ impl Data {
             residual: vec![0.0; m],
             coeff: vec![0.0; k],
             mem: MemBuffer::new(req),
+            qrj: if m > 0 && m <= n { Some(QrJacobi::new(n, m)) } else { None },
+            svd_backend: SvdBackend::default(),
+            factored_with: Factored::None,
             tolerance: RankTolerance::default(),
             stabilization: Stabilization::None,
             rank_info: RankInfo::default(),

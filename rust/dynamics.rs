@@ -33,6 +33,7 @@ pub fn mass_and_forces(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
                 let asig = [c * sig[0] - s * sig[1], s * sig[0] + c * sig[1]];
                 let ajsig = [-asig[1], asig[0]];
                 bd.m_rr = [[r.mass, 0.0, ajsig[0]], [0.0, r.mass, ajsig[1]], [ajsig[0], ajsig[1], r.j_ref]];
+                bd.cs = [c, s];
                 qv[0] = thd * thd * asig[0];
                 qv[1] = thd * thd * asig[1];
                 qv[2] = 0.0;
@@ -67,15 +68,11 @@ pub fn mass_and_forces(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
                     qd_w += qfd[j] * bd.w[j];
                 }
                 bd.m_rr = [[b.mass, 0.0, ajsig[0]], [0.0, b.mass, ajsig[1]], [ajsig[0], ajsig[1], m_thth]];
-                let (rx, rest) = bd.m_rf.split_at_mut(nf);
-                let (ry, rth) = rest.split_at_mut(nf);
-                for j in 0..nf {
-                    rx[j] = c * b.s_bar[0][j] - s * b.s_bar[1][j];
-                    ry[j] = s * b.s_bar[0][j] + c * b.s_bar[1][j];
-                }
-                // m_thetaf = i_thf + S_tilde^T q_f = i_thf - S_tilde q_f
-                rth.copy_from_slice(&b.i_thf);
-                b.s_tilde.mul_add(-1.0, qf, rth);
+                bd.cs = [c, s];
+                // m_thetaf = i_thf + S_tilde^T q_f = i_thf - S_tilde q_f  (M_Rf = A S_bar is not
+                // formed: the factor uses the rotated constants, `dense_mass` rebuilds it)
+                bd.m_thf.copy_from_slice(&b.i_thf);
+                b.s_tilde.mul_add(-1.0, qf, &mut bd.m_thf);
 
                 qv[0] = thd * thd * asig[0] + 2.0 * thd * asigd[1];
                 qv[1] = thd * thd * asig[1] - 2.0 * thd * asigd[0];
@@ -108,23 +105,29 @@ pub fn mass_and_forces(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
 
 /// Factor each body block `M_b = F_b F_b^T`. For a beam, in the order `[r; f]`,
 /// `F_b = [[L_s, X], [0, L_ff]]` with the constant `L_ff L_ff^T = M_ff`, `X = M_rf L_ff^-T`
-/// and `L_s L_s^T = m_rr - X X^T`: only three banded solves and a 3x3 Cholesky per call.
+/// and `L_s L_s^T = m_rr - X X^T`. The translational rows of `X` are rotated constants (see
+/// `BodyData`), so a call costs one banded solve (`X_2`), three dot products and a 3x3
+/// Cholesky per beam.
 pub fn factor_mass(model: &Model, data: &mut Data) -> Result<()> {
     for (body, bd) in model.bodies.iter().zip(data.bodies.iter_mut()) {
         let mut ls = bd.m_rr;
         if let BodyKind::Beam(b) = &body.kind {
-            let nf = b.n_f;
-            bd.x.copy_from_slice(&bd.m_rf);
-            for r in 0..3 {
-                b.l_ff.solve_lower(&mut bd.x[r * nf..(r + 1) * nf]);
+            bd.x2.copy_from_slice(&bd.m_thf);
+            b.l_ff.solve_lower(&mut bd.x2);
+            let (mut ax, mut bx, mut xx) = (0.0, 0.0, 0.0);
+            for ((x, a), bb) in bd.x2.iter().zip(&bd.a).zip(&bd.b) {
+                ax += a * x;
+                bx += bb * x;
+                xx += x * x;
             }
-            for r in 0..3 {
-                for c in 0..=r {
-                    let (xr, xc) = (&bd.x[r * nf..(r + 1) * nf], &bd.x[c * nf..(c + 1) * nf]);
-                    let dot: f64 = xr.iter().zip(xc).map(|(a, b)| a * b).sum();
-                    ls[r][c] -= dot;
-                }
-            }
+            let [c, s] = bd.cs;
+            let [aa, ab, bb] = bd.ab;
+            ls[0][0] -= c * c * aa - 2.0 * c * s * ab + s * s * bb;
+            ls[1][0] -= s * c * (aa - bb) + (c * c - s * s) * ab;
+            ls[1][1] -= s * s * aa + 2.0 * s * c * ab + c * c * bb;
+            ls[2][0] -= c * ax - s * bx;
+            ls[2][1] -= s * ax + c * bx;
+            ls[2][2] -= xx;
         }
         if !cholesky3(&mut ls) {
             return Err(Error::SingularMass { item: format!("body '{}'", body.name) });
@@ -134,33 +137,37 @@ pub fn factor_mass(model: &Model, data: &mut Data) -> Result<()> {
     Ok(())
 }
 
-/// `v <- F^-1 v` on one body's segment.
+/// `v <- F^-1 v` on one body's segment: `v_f <- L_ff^-1 v_f`, `v_r <- L_s^-1 (v_r - X v_f)`.
 #[inline]
 fn body_finv(body: &Body, bd: &BodyData, v: &mut [f64]) {
     let (vr, vf) = v.split_at_mut(3);
     if let BodyKind::Beam(b) = &body.kind {
-        let nf = b.n_f;
         b.l_ff.solve_lower(vf);
-        for r in 0..3 {
-            let xr = &bd.x[r * nf..(r + 1) * nf];
-            vr[r] -= xr.iter().zip(vf.iter()).map(|(a, b)| a * b).sum::<f64>();
+        let (mut pa, mut pb, mut px) = (0.0, 0.0, 0.0);
+        for (((f, a), bb), x) in vf.iter().zip(&bd.a).zip(&bd.b).zip(&bd.x2) {
+            pa += a * f;
+            pb += bb * f;
+            px += x * f;
         }
+        let [c, s] = bd.cs;
+        vr[0] -= c * pa - s * pb;
+        vr[1] -= s * pa + c * pb;
+        vr[2] -= px;
     }
     solve_lower3(&bd.ls, vr);
 }
 
-/// `v <- F^-T v` on one body's segment.
+/// `v <- F^-T v` on one body's segment: `v_r <- L_s^-T v_r`, `v_f <- L_ff^-T (v_f - X^T v_r)`.
 #[inline]
 fn body_finvt(body: &Body, bd: &BodyData, v: &mut [f64]) {
     let (vr, vf) = v.split_at_mut(3);
     solve_upper3(&bd.ls, vr);
     if let BodyKind::Beam(b) = &body.kind {
-        let nf = b.n_f;
-        for r in 0..3 {
-            let xr = &bd.x[r * nf..(r + 1) * nf];
-            for (f, x) in vf.iter_mut().zip(xr) {
-                *f -= x * vr[r];
-            }
+        let [c, s] = bd.cs;
+        // X^T v_r = (c v0 + s v1) a + (-s v0 + c v1) b + v2 X_2
+        let (ka, kb, kx) = (c * vr[0] + s * vr[1], -s * vr[0] + c * vr[1], vr[2]);
+        for (((f, a), bb), x) in vf.iter_mut().zip(&bd.a).zip(&bd.b).zip(&bd.x2) {
+            *f -= ka * a + kb * bb + kx * x;
         }
         b.l_ff.solve_upper(vf);
     }
@@ -221,9 +228,15 @@ pub fn dense_mass(model: &Model, data: &Data) -> Vec<f64> {
         }
         if let BodyKind::Beam(b) = &body.kind {
             let nf = b.n_f;
+            let [c, s] = bd.cs;
             for i in 0..3 {
                 for j in 0..nf {
-                    let v = bd.m_rf[i * nf + j];
+                    // M_Rf = A S_bar, m_thetaf
+                    let v = match i {
+                        0 => c * b.s_bar[0][j] - s * b.s_bar[1][j],
+                        1 => s * b.s_bar[0][j] + c * b.s_bar[1][j],
+                        _ => bd.m_thf[j],
+                    };
                     m[(o + i) * n + o + 3 + j] = v;
                     m[(o + 3 + j) * n + o + i] = v;
                 }

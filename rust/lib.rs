@@ -12,13 +12,16 @@ pub mod description;
 pub mod dynamics;
 pub mod error;
 pub mod force;
+pub mod integrate;
+pub mod jacobian;
 pub mod linalg;
 pub mod model;
+pub mod small_svd;
 pub mod uk;
 
 #[cfg(feature = "python")]
 mod bindings;
 
-pub use data::{Data, RankInfo, RankTolerance};
+pub use data::{Data, RankInfo, RankTolerance, SvdBackend};
 pub use error::{Error, Result};
 pub use model::Model;

@@ -45,16 +45,14 @@ impl Banded {
     /// `y += alpha * self * x`
     #[inline]
     pub fn mul_add(&self, alpha: f64, x: &[f64], y: &mut [f64]) {
-        let w = 2 * self.hb + 1;
-        for i in 0..self.n {
-            let lo = i.saturating_sub(self.hb);
-            let hi = (i + self.hb + 1).min(self.n);
-            let row = &self.data[i * w..(i + 1) * w];
-            let mut s = 0.0;
-            for j in lo..hi {
-                s += row[j + self.hb - i] * x[j];
-            }
-            y[i] += alpha * s;
+        let (n, hb) = (self.n, self.hb);
+        let w = 2 * hb + 1;
+        let x = &x[..n];
+        for (i, (yi, row)) in y[..n].iter_mut().zip(self.data.chunks_exact(w)).enumerate() {
+            let lo = i.saturating_sub(hb);
+            let hi = (i + hb + 1).min(n);
+            let s: f64 = row[lo + hb - i..hi + hb - i].iter().zip(&x[lo..hi]).map(|(a, b)| a * b).sum();
+            *yi += alpha * s;
         }
     }
 
@@ -87,65 +85,84 @@ impl Banded {
     }
 }
 
-/// Lower-triangular banded Cholesky factor `L` (M = L L^T): entry (i, j), i - hb <= j <= i,
-/// at `data[i * (hb + 1) + (i - j)]`.
+/// Lower-triangular banded Cholesky factor `L` (M = L L^T). Row `i` is stored contiguously as
+/// `[L(i, i-hb), ..., L(i, i-1), L(i, i)]` at `data[i * (hb + 1)..]` (entries before column 0
+/// are zero), so both triangular solves run over contiguous row slices; the reciprocals of the
+/// diagonal are kept so the solves do no division.
 #[derive(Debug, Clone)]
 pub struct BandedCholesky {
     pub n: usize,
     pub hb: usize,
     pub data: Vec<f64>,
+    pub inv_diag: Vec<f64>,
 }
 
 impl BandedCholesky {
+    /// Entry `L(i, j)`, `i - hb <= j <= i`.
+    #[inline]
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        if j > i || i - j > self.hb {
+            0.0
+        } else {
+            self.data[i * (self.hb + 1) + (j + self.hb - i)]
+        }
+    }
+
     /// Factor a symmetric positive-definite banded matrix. `Err(i)` names the failing pivot.
     pub fn factor(m: &Banded) -> std::result::Result<Self, usize> {
         let (n, hb) = (m.n, m.hb);
         let w = hb + 1;
         let mut l = vec![0.0; n * w];
+        let at = |i: usize, j: usize| i * w + (j + hb - i);
         for i in 0..n {
             let lo = i.saturating_sub(hb);
             for j in lo..=i {
                 let mut s = m.get(i, j);
                 let klo = lo.max(j.saturating_sub(hb));
                 for k in klo..j {
-                    s -= l[i * w + (i - k)] * l[j * w + (j - k)];
+                    s -= l[at(i, k)] * l[at(j, k)];
                 }
                 if i == j {
                     if !(s > 0.0) || !s.is_finite() {
                         return Err(i);
                     }
-                    l[i * w] = s.sqrt();
+                    l[at(i, i)] = s.sqrt();
                 } else {
-                    l[i * w + (i - j)] = s / l[j * w];
+                    l[at(i, j)] = s / l[at(j, j)];
                 }
             }
         }
-        Ok(BandedCholesky { n, hb, data: l })
+        let inv_diag = (0..n).map(|i| 1.0 / l[at(i, i)]).collect();
+        Ok(BandedCholesky { n, hb, data: l, inv_diag })
     }
 
     /// Solve `L x = v` in place.
     #[inline]
     pub fn solve_lower(&self, x: &mut [f64]) {
-        let w = self.hb + 1;
-        for i in 0..self.n {
-            let mut s = x[i];
-            for k in i.saturating_sub(self.hb)..i {
-                s -= self.data[i * w + (i - k)] * x[k];
-            }
-            x[i] = s / self.data[i * w];
+        let (n, hb) = (self.n, self.hb);
+        let w = hb + 1;
+        for i in 0..n {
+            let lo = i.saturating_sub(hb);
+            let row = &self.data[i * w + (lo + hb - i)..i * w + hb];
+            let (done, rest) = x.split_at_mut(i);
+            let s: f64 = row.iter().zip(&done[lo..]).map(|(a, b)| a * b).sum();
+            rest[0] = (rest[0] - s) * self.inv_diag[i];
         }
     }
 
-    /// Solve `L^T x = v` in place.
+    /// Solve `L^T x = v` in place (column sweep over the rows of `L`).
     #[inline]
     pub fn solve_upper(&self, x: &mut [f64]) {
-        let w = self.hb + 1;
-        for i in (0..self.n).rev() {
-            let mut s = x[i];
-            for k in (i + 1)..(i + self.hb + 1).min(self.n) {
-                s -= self.data[k * w + (k - i)] * x[k];
+        let (n, hb) = (self.n, self.hb);
+        let w = hb + 1;
+        for i in (0..n).rev() {
+            let xi = x[i] * self.inv_diag[i];
+            x[i] = xi;
+            let lo = i.saturating_sub(hb);
+            let row = &self.data[i * w + (lo + hb - i)..i * w + hb];
+            for (a, b) in x[lo..i].iter_mut().zip(row) {
+                *a -= b * xi;
             }
-            x[i] = s / self.data[i * w];
         }
     }
 }

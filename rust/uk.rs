@@ -12,7 +12,8 @@ use faer::dyn_stack::MemStack;
 use faer::linalg::svd::svd;
 use faer::Par;
 
-use crate::data::{Data, RankInfo, Stabilization};
+use crate::data::{Data, Factored, RankInfo, Stabilization, SvdBackend};
+use crate::dynamics;
 use crate::dynamics::{apply_finv, apply_finv_sparse, apply_finvt, constraints, factor_mass, mass_and_forces};
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -27,102 +28,240 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], w
 }
 
 /// UK acceleration into `data.qdd` and multipliers into `data.lambda`, from the terms already
-/// in `data` (see `evaluate`).
+/// in `data` (see `evaluate`). The three stages below can also be called separately: the
+/// factorization of `B^T` depends on `q` only (through `M` and `A`), so a caller that changes
+/// only `Q` and `b` (velocity columns of a Jacobian) may reuse it.
 pub fn solve(model: &Model, data: &mut Data) -> Result<()> {
-    let (n, m) = (model.n, model.m);
-    // y = F^-1 Q ; a = F^-T y
+    free_acceleration(model, data);
+    if model.m == 0 {
+        data.qdd.copy_from_slice(&data.qdd_free);
+        data.rank_info = RankInfo { exact: true, ..Default::default() };
+        return Ok(());
+    }
+    factor_constraints(model, data)?;
+    correct(model, data);
+    Ok(())
+}
+
+/// `y = F^-1 Q`, `a = F^-T y` (the unconstrained acceleration `qdd_free`).
+pub fn free_acceleration(model: &Model, data: &mut Data) {
     data.y.copy_from_slice(&data.force);
     apply_finv(model, &data.bodies, &mut data.y);
     data.qdd_free.copy_from_slice(&data.y);
     apply_finvt(model, &data.bodies, &mut data.qdd_free);
-    if m == 0 {
-        data.qdd.copy_from_slice(&data.qdd_free);
-        data.rank_info = RankInfo::default();
-        return Ok(());
-    }
+}
+
+/// `B^T = F^-1 A^T` and its thin SVD with the rank decision (into `data.rank_info`).
+/// Needs `m > 0` and the mass factor of `dynamics::factor_mass`.
+pub fn factor_constraints(model: &Model, data: &mut Data) -> Result<()> {
+    let (n, m) = (model.n, model.m);
     // B^T = F^-1 A^T, column by column
     for i in 0..m {
         let col = data.bt.col_as_slice_mut(i);
         col.copy_from_slice(&data.jac[i * n..(i + 1) * n]);
         apply_finv_sparse(model, &data.bodies, col);
     }
-    let stack = MemStack::new(&mut data.mem);
-    svd(
-        data.bt.as_ref(),
-        data.svd_s.as_mut(),
-        Some(data.svd_u.as_mut()),
-        Some(data.svd_v.as_mut()),
-        Par::Seq,
-        stack,
-        Default::default(),
-    )
-    .map_err(|e| Error::Solver(format!("SVD of A F^-T did not converge: {e:?}")))?;
+    let rcond = data.tolerance.rcond.unwrap_or((n.max(m) as f64) * f64::EPSILON);
+    let atol = data.tolerance.atol;
+    let backend = if data.qrj.is_some() { data.svd_backend } else { SvdBackend::Faer };
+    match backend {
+        SvdBackend::Auto | SvdBackend::QrJacobi => {
+            let qrj = data.qrj.as_mut().expect("checked");
+            let bt = &data.bt;
+            qrj.qr_cols(|j| bt.col_as_slice(j));
+            if backend == SvdBackend::Auto {
+                let (upper, lower) = qrj.full_rank_bounds();
+                let tol_bound = atol.max(rcond * upper);
+                if upper.is_finite() && lower > tol_bound && lower > 0.0 {
+                    data.factored_with = Factored::FullRankQr;
+                    data.rank_info = RankInfo { rank: m, sigma_max: upper, sigma_min_kept: lower, sigma_max_dropped: 0.0, tolerance: tol_bound, exact: false };
+                    return Ok(());
+                }
+            }
+            jacobi_of_r(model, data)?;
+        }
+        SvdBackend::Faer => {
+            let stack = MemStack::new(&mut data.mem);
+            svd(
+                data.bt.as_ref(),
+                data.svd_s.as_mut(),
+                Some(data.svd_u.as_mut()),
+                Some(data.svd_v.as_mut()),
+                Par::Seq,
+                stack,
+                Default::default(),
+            )
+            .map_err(|e| Error::Solver(format!("SVD of A F^-T did not converge: {e:?}")))?;
+            data.factored_with = Factored::Faer;
+        }
+    }
+    data.rank_info = rank_from_singular_values(data, n, m, rcond, atol)?;
+    Ok(())
+}
+
+/// Jacobi SVD of the R in `data.qrj` (after `qr_cols`); sorted values and right vectors are
+/// copied to `svd_s`, `svd_v`.
+fn jacobi_of_r(model: &Model, data: &mut Data) -> Result<()> {
+    let k = model.n.min(model.m);
+    let qrj = data.qrj.as_mut().expect("QR workspace");
+    if !qrj.svd_of_r() {
+        return Err(Error::Solver(format!("Jacobi SVD of A F^-T did not converge in {} sweeps", crate::small_svd::MAX_SWEEPS)));
+    }
+    let mut s = data.svd_s.column_vector_mut();
+    for j in 0..k {
+        s[j] = qrj.sigma(j);
+        data.svd_v.col_as_slice_mut(j).copy_from_slice(qrj.v_col(j));
+    }
+    data.factored_with = Factored::Jacobi;
+    Ok(())
+}
+
+fn rank_from_singular_values(data: &Data, n: usize, m: usize, rcond: f64, atol: f64) -> Result<RankInfo> {
     let k = n.min(m);
     let s = data.svd_s.column_vector();
     let sigma_max = if k > 0 { s[0] } else { 0.0 };
-    let rcond = data.tolerance.rcond.unwrap_or((n.max(m) as f64) * f64::EPSILON);
-    let tol = data.tolerance.atol.max(rcond * sigma_max);
-    // residual r = b - A a
+    if !sigma_max.is_finite() {
+        return Err(Error::Solver("SVD of A F^-T: non-finite singular values".into()));
+    }
+    let tol = atol.max(rcond * sigma_max);
+    let mut info = RankInfo { sigma_max, tolerance: tol, exact: true, ..Default::default() };
+    for j in 0..k {
+        let sj = s[j];
+        if sj > tol && sj > 0.0 {
+            info.rank += 1;
+            info.sigma_min_kept = sj;
+        } else if sj > info.sigma_max_dropped {
+            info.sigma_max_dropped = sj;
+        }
+    }
+    Ok(info)
+}
+
+/// Exact rank information of the current factorization: after the certified full-rank path
+/// this runs the Jacobi SVD of the stored R (the singular values of `B`) -- O(m^3), not part of
+/// the acceleration hot path -- and stores the exact `RankInfo` in `data.rank_info`. The
+/// current correction stays valid (it needs only the QR part).
+pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
+    if data.factored_with == Factored::FullRankQr && !data.rank_info.exact {
+        let (n, m) = (model.n, model.m);
+        let qrj = data.qrj.as_mut().expect("QR workspace");
+        // keep R^-1 (in the Jacobi buffers) intact for the correction: work on a copy
+        let mut tmp = qrj.clone();
+        if !tmp.svd_of_r() {
+            return Err(Error::Solver("Jacobi SVD of A F^-T did not converge".into()));
+        }
+        let rcond = data.tolerance.rcond.unwrap_or((n.max(m) as f64) * f64::EPSILON);
+        let sigma_max = tmp.sigma(0);
+        let tol = data.tolerance.atol.max(rcond * sigma_max);
+        let mut info = RankInfo { sigma_max, tolerance: tol, exact: true, ..Default::default() };
+        for j in 0..n.min(m) {
+            let sj = tmp.sigma(j);
+            if sj > tol && sj > 0.0 {
+                info.rank += 1;
+                info.sigma_min_kept = sj;
+            } else if sj > info.sigma_max_dropped {
+                info.sigma_max_dropped = sj;
+            }
+        }
+        data.rank_info = info;
+    }
+    Ok(data.rank_info)
+}
+
+/// The constraint correction with the current factorization: `r = b - A a`,
+/// `y += U S^+ V^T r`, `lambda = -V S^+ S^+ V^T r`, `qdd = F^-T y`.
+pub fn correct(model: &Model, data: &mut Data) {
+    let (n, m) = (model.n, model.m);
+    let k = n.min(m);
+    let rank = data.rank_info.rank;
     for i in 0..m {
         let row = &data.jac[i * n..(i + 1) * n];
         let aa: f64 = row.iter().zip(&data.qdd_free).map(|(x, y)| x * y).sum();
         data.residual[i] = data.gamma[i] - aa;
     }
-    let mut info = RankInfo { sigma_max, tolerance: tol, ..Default::default() };
-    // coeff = S^+ V^T r ; y += U coeff ; lambda = -V S^+ coeff
+    if data.factored_with == Factored::FullRankQr {
+        let qrj = data.qrj.as_mut().expect("factored with QR");
+        qrj.full_rank_solve(&data.residual, &mut data.y, &mut data.lambda);
+        data.qdd.copy_from_slice(&data.y);
+        apply_finvt(model, &data.bodies, &mut data.qdd);
+        return;
+    }
+    let s = data.svd_s.column_vector();
+    // coeff = S^+ V^T r (kept singular values are the leading `rank`)
     for j in 0..k {
-        let sj = s[j];
-        if sj > tol && sj > 0.0 {
+        if j < rank {
             let vj = data.svd_v.col_as_slice(j);
             let dot: f64 = vj.iter().zip(&data.residual).map(|(x, y)| x * y).sum();
-            data.coeff[j] = dot / sj;
-            info.rank += 1;
-            info.sigma_min_kept = sj;
+            data.coeff[j] = dot / s[j];
         } else {
             data.coeff[j] = 0.0;
-            if sj > info.sigma_max_dropped {
-                info.sigma_max_dropped = sj;
-            }
         }
     }
-    data.rank_info = info;
     data.lambda.fill(0.0);
-    for j in 0..info.rank {
-        let cj = data.coeff[j];
-        let uj = data.svd_u.col_as_slice(j);
-        for (yi, ui) in data.y.iter_mut().zip(uj) {
-            *yi += ui * cj;
-        }
-        let lj = -cj / s[j];
+    for j in 0..rank {
+        let lj = -data.coeff[j] / s[j];
         let vj = data.svd_v.col_as_slice(j);
         for (li, vi) in data.lambda.iter_mut().zip(vj) {
             *li += vi * lj;
         }
     }
+    match data.factored_with {
+        Factored::Jacobi => {
+            let qrj = data.qrj.as_mut().expect("factored with QrJacobi");
+            qrj.add_u_times(&data.coeff, rank, &mut data.y);
+        }
+        _ => {
+            for j in 0..rank {
+                let cj = data.coeff[j];
+                let uj = data.svd_u.col_as_slice(j);
+                for (yi, ui) in data.y.iter_mut().zip(uj) {
+                    *yi += ui * cj;
+                }
+            }
+        }
+    }
     data.qdd.copy_from_slice(&data.y);
     apply_finvt(model, &data.bodies, &mut data.qdd);
-    Ok(())
 }
 
 /// `qdd = UK(t, q, qd)` into `data.qdd` (and `data.lambda`). Allocation free.
 /// With Baumgarte stabilization the right-hand side becomes
 /// `b = gamma - 2 alpha (A qd + Phi_t) - beta^2 Phi`.
 pub fn acceleration(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) -> Result<()> {
-    match data.stabilization {
-        Stabilization::None => {
-            evaluate(model, data, t, q, qd, false)?;
-        }
-        Stabilization::Baumgarte { alpha, beta } => {
-            evaluate(model, data, t, q, qd, true)?;
-            let n = model.n;
-            for i in 0..model.m {
-                let row = &data.jac[i * n..(i + 1) * n];
-                let vel = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i];
-                data.gamma[i] -= 2.0 * alpha * vel + beta * beta * data.phi[i];
-            }
+    let with_phi = matches!(data.stabilization, Stabilization::Baumgarte { .. });
+    evaluate(model, data, t, q, qd, with_phi)?;
+    stabilize_rhs(model, data, qd);
+    solve(model, data)
+}
+
+/// `qdd` at `(t, q, qd)` reusing the mass factor and the SVD of `B^T` already in `data`, which
+/// must come from a full `acceleration` at the same `q` (and `t` for rheonomic rows): `M`, `A`
+/// and `B` depend on `q` only, so a change of `qd` changes just `Q` and `b`. Used for the
+/// velocity columns of the finite-difference Jacobian.
+pub fn acceleration_same_q(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) -> Result<()> {
+    dynamics::mass_and_forces(model, data, q, qd);
+    let with_phi = matches!(data.stabilization, Stabilization::Baumgarte { .. });
+    constraints(model, data, t, q, qd, with_phi);
+    stabilize_rhs(model, data, qd);
+    free_acceleration(model, data);
+    if model.m == 0 {
+        data.qdd.copy_from_slice(&data.qdd_free);
+    } else {
+        correct(model, data);
+    }
+    Ok(())
+}
+
+/// Baumgarte: `b <- gamma - 2 alpha (A qd + Phi_t) - beta^2 Phi` (needs `Phi`).
+fn stabilize_rhs(model: &Model, data: &mut Data, qd: &[f64]) {
+    if let Stabilization::Baumgarte { alpha, beta } = data.stabilization {
+        let n = model.n;
+        for i in 0..model.m {
+            let row = &data.jac[i * n..(i + 1) * n];
+            let vel = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i];
+            data.gamma[i] -= 2.0 * alpha * vel + beta * beta * data.phi[i];
         }
     }
-    solve(model, data)
 }
 
 /// Outcome of a projection onto the constraint manifold.

@@ -1,0 +1,60 @@
+//! Scenes shared by the benches: the paper's slider-crank (from the cargo tests' builders)
+//! and a chain of K rigid links (a K-link pendulum).
+#![allow(dead_code)]
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+pub use common::{paper_scene, Lcg};
+
+use ukflex::{Data, Model};
+
+/// K rigid links of length 0.2 m hanging in a chain from a ground pivot, laid out
+/// horizontally at rest; gravity -Y. n = 3K coordinates, m = 2K constraint rows.
+pub fn chain_scene(k: usize) -> String {
+    let len = 0.2;
+    let mut bodies = Vec::new();
+    let mut joints = vec![format!(
+        r#"{{"kind": "revolute", "a": {{"body": "ground"}}, "b": {{"body": "link0", "point": [0.0, 0.0]}}}}"#
+    )];
+    for i in 0..k {
+        bodies.push(format!(
+            r#"{{"name": "link{i}", "kind": "rigid", "mass": 1.0, "inertia": {inertia}, "com": [{half}, 0.0], "position": [{x}, 0.0]}}"#,
+            inertia = len * len / 12.0,
+            half = len / 2.0,
+            x = i as f64 * len
+        ));
+        if i > 0 {
+            joints.push(format!(
+                r#"{{"kind": "revolute", "a": {{"body": "link{p}", "point": [{len}, 0.0]}}, "b": {{"body": "link{i}", "point": [0.0, 0.0]}}}}"#,
+                p = i - 1
+            ));
+        }
+    }
+    format!(r#"{{"gravity": [0.0, -9.81], "bodies": [{}], "joints": [{}]}}"#, bodies.join(","), joints.join(","))
+}
+
+/// A representative (not exactly consistent) state: the initial guess with a small elastic
+/// deformation, a small elastic rate and, for chains, a bent configuration. The cost of a call
+/// does not depend on consistency; the SVD's work depends mildly on the matrix.
+pub fn bench_state(model: &Model) -> (Vec<f64>, Vec<f64>) {
+    let mut rng = Lcg(42);
+    let (mut q, mut qd) = (model.q0.clone(), model.qd0.clone());
+    for b in &model.bodies {
+        let o = b.offset;
+        if b.n_coords == 3 && model.constraints.iter().all(|c| !c.kind.is_driver()) {
+            q[o + 2] += 0.3 * rng.next();
+            qd[o + 2] += rng.next();
+        }
+        for j in 3..b.n_coords {
+            q[o + j] += 1e-5 * rng.next();
+            qd[o + j] += 1e-2 * rng.next();
+        }
+    }
+    (q, qd)
+}
+
+pub fn build(json: &str) -> (Model, Data) {
+    let model = Model::from_json(json).expect("scene builds");
+    let data = Data::new(&model);
+    (model, data)
+}

@@ -1,0 +1,1 @@
+//! Native integrators (work in progress).

@@ -1,0 +1,388 @@
+//! Thin SVD of a small tall matrix `G` (n x m, m <= n) for the UK pseudoinverse:
+//! Householder QR `G = Q R` (R is m x m), then one-sided (Hestenes) Jacobi on `R`:
+//! `R V = W`, columns of `W` mutually orthogonal, `sigma_j = |w_j|`, `U_r = W S^-1`, so
+//! `G = (Q U_r) S V^T`. `Q U_r` is never formed: the UK kernel needs only `U c` for one vector
+//! `c`, which is `Q [U_r c; 0]` (m reflector applications, O(n m)).
+//!
+//! Why this and not a bidiagonal SVD: for the m x m core (m = 6 for the paper's slider-crank,
+//! whatever the number of beam elements) the Jacobi sweeps are short, branch-light loops over
+//! contiguous columns, and one-sided Jacobi is at least as accurate as the bidiagonal QR
+//! (relative accuracy of the singular values for column-scaled well-conditioned matrices,
+//! Demmel & Veselic 1992). The QR step first makes the cost O(n m^2) + O(m^3 sweeps), linear in
+//! the number of coordinates n. Everything is allocation free after `QrJacobi::new`.
+//!
+//! The eigen-decomposition of `B B^T = R^T R` would be cheaper still but squares the condition
+//! number: singular values below `sqrt(eps) sigma_max` come out as noise, which would break the
+//! pseudoinverse's rank decision at its default tolerance `max(m, n) eps sigma_max`. Rejected.
+
+/// Column-major workspace for the QR + Jacobi SVD of an n x m matrix with m <= n.
+#[derive(Debug, Clone)]
+pub struct QrJacobi {
+    pub n: usize,
+    pub m: usize,
+    /// Householder vectors below the diagonal (unit leading entry implicit), R on and above.
+    qr: Vec<f64>,
+    tau: Vec<f64>,
+    /// `W = R V` (m x m column-major), orthogonal columns at convergence.
+    w: Vec<f64>,
+    /// Right singular vectors, unsorted (m x m column-major).
+    v: Vec<f64>,
+    /// Column norms of `W` (unsorted singular values).
+    norms: Vec<f64>,
+    /// `order[j]` = unsorted index of the j-th largest singular value.
+    order: Vec<usize>,
+    /// Scratch: m and n long.
+    tm: Vec<f64>,
+    tn: Vec<f64>,
+    /// Jacobi sweeps used by the last factorization (including the final clean sweep).
+    pub sweeps: usize,
+}
+
+/// Maximum number of Jacobi sweeps before giving up (quadratic convergence: ~5 usually).
+pub const MAX_SWEEPS: usize = 60;
+
+impl QrJacobi {
+    pub fn new(n: usize, m: usize) -> QrJacobi {
+        assert!(m <= n, "QrJacobi needs a tall matrix (m <= n)");
+        QrJacobi {
+            n,
+            m,
+            qr: vec![0.0; n * m],
+            tau: vec![0.0; m],
+            w: vec![0.0; m * m],
+            v: vec![0.0; m * m],
+            norms: vec![0.0; m],
+            order: (0..m).collect(),
+            tm: vec![0.0; m],
+            tn: vec![0.0; n],
+            sweeps: 0,
+        }
+    }
+
+    /// Factor `G` (column `j` given by `col(j)`, at least n long): QR, then Jacobi SVD of R.
+    /// Returns `false` if Jacobi did not converge within `MAX_SWEEPS` (or the input is not
+    /// finite).
+    pub fn factor_cols<'a>(&mut self, col: impl Fn(usize) -> &'a [f64]) -> bool {
+        self.qr_cols(col);
+        self.svd_of_r()
+    }
+
+    /// Householder QR of `G` only (R and the reflectors stay in the workspace).
+    pub fn qr_cols<'a>(&mut self, col: impl Fn(usize) -> &'a [f64]) {
+        let n = self.n;
+        for j in 0..self.m {
+            self.qr[j * n..(j + 1) * n].copy_from_slice(&col(j)[..n]);
+        }
+        self.householder_qr();
+    }
+
+    /// Certified full rank test after `qr_cols`: computes `R^-1` (kept for `full_rank_solve`)
+    /// and returns `(|R|_F, 1 / |R^-1|_F)`, an upper bound of `sigma_max` and a lower bound of
+    /// `sigma_min` (both of `G`). The lower bound is 0 (and `R^-1` unusable) when R has a zero
+    /// or non-finite pivot.
+    pub fn full_rank_bounds(&mut self) -> (f64, f64) {
+        let (n, m) = (self.n, self.m);
+        let mut rf = 0.0;
+        for j in 0..m {
+            for i in 0..=j {
+                let x = self.qr[j * n + i];
+                rf += x * x;
+            }
+        }
+        // R^-1 column by column (upper triangular), stored in `w` (column-major)
+        self.w.fill(0.0);
+        let mut invf = 0.0;
+        for j in 0..m {
+            // solve R x = e_j, x[i] = 0 for i > j
+            for i in (0..=j).rev() {
+                let mut s = if i == j { 1.0 } else { 0.0 };
+                for k in i + 1..=j {
+                    s -= self.qr[k * n + i] * self.w[j * m + k];
+                }
+                let x = s / self.qr[i * n + i];
+                self.w[j * m + i] = x;
+                invf += x * x;
+            }
+        }
+        let lower = if invf.is_finite() && invf > 0.0 { 1.0 / invf.sqrt() } else { 0.0 };
+        (rf.sqrt(), lower)
+    }
+
+    /// With `R^-1` from `full_rank_bounds` (full rank): `y += Q [R^-T r; 0]` (that is
+    /// `y += B^+ r` for `B = G^T`) and `lambda = -R^-1 R^-T r` (`-(B B^T)^-1 r`).
+    pub fn full_rank_solve(&mut self, r: &[f64], y: &mut [f64], lambda: &mut [f64]) {
+        let m = self.m;
+        // z = R^-T r: z_j = (column j of R^-1) . r
+        for j in 0..m {
+            let cj = &self.w[j * m..(j + 1) * m];
+            self.tm[j] = cj[..=j].iter().zip(r).map(|(a, b)| a * b).sum();
+        }
+        // lambda = -R^-1 z
+        lambda[..m].fill(0.0);
+        for j in 0..m {
+            let zj = self.tm[j];
+            let cj = &self.w[j * m..(j + 1) * m];
+            for (l, c) in lambda[..=j].iter_mut().zip(cj) {
+                *l -= c * zj;
+            }
+        }
+        self.apply_q_tm(y);
+    }
+
+    /// Jacobi SVD of the R left by `qr_cols` (overwrites the `R^-1` of `full_rank_bounds`).
+    pub fn svd_of_r(&mut self) -> bool {
+        let (n, m) = (self.n, self.m);
+        // W = R (upper triangle), V = I
+        self.w.fill(0.0);
+        self.v.fill(0.0);
+        for j in 0..m {
+            for i in 0..=j {
+                self.w[j * m + i] = self.qr[j * n + i];
+            }
+            self.v[j * m + j] = 1.0;
+        }
+        let ok = self.jacobi();
+        for j in 0..m {
+            let wj = &self.w[j * m..(j + 1) * m];
+            self.norms[j] = wj.iter().map(|x| x * x).sum::<f64>().sqrt();
+        }
+        // insertion sort of the order by decreasing norm (m is small)
+        for j in 0..m {
+            self.order[j] = j;
+        }
+        for j in 1..m {
+            let mut k = j;
+            while k > 0 && self.norms[self.order[k - 1]] < self.norms[self.order[k]] {
+                self.order.swap(k - 1, k);
+                k -= 1;
+            }
+        }
+        ok && self.norms.iter().all(|x| x.is_finite())
+    }
+
+    fn householder_qr(&mut self) {
+        let (n, m) = (self.n, self.m);
+        for k in 0..m {
+            let (head, tail) = self.qr.split_at_mut((k + 1) * n);
+            let ck = &mut head[k * n..];
+            let alpha = ck[k];
+            let xnorm2: f64 = ck[k + 1..n].iter().map(|x| x * x).sum();
+            if xnorm2 == 0.0 {
+                self.tau[k] = 0.0;
+                continue;
+            }
+            let norm = (alpha * alpha + xnorm2).sqrt();
+            let beta = if alpha >= 0.0 { -norm } else { norm };
+            self.tau[k] = (beta - alpha) / beta;
+            let scale = 1.0 / (alpha - beta);
+            for x in ck[k + 1..n].iter_mut() {
+                *x *= scale;
+            }
+            ck[k] = beta;
+            let vk = &ck[k + 1..n];
+            let tau = self.tau[k];
+            for j in 0..(m - k - 1) {
+                let cj = &mut tail[j * n..(j + 1) * n];
+                let mut s = cj[k];
+                for (a, b) in cj[k + 1..n].iter().zip(vk) {
+                    s += a * b;
+                }
+                s *= tau;
+                cj[k] -= s;
+                for (a, b) in cj[k + 1..n].iter_mut().zip(vk) {
+                    *a -= s * b;
+                }
+            }
+        }
+    }
+
+    fn jacobi(&mut self) -> bool {
+        let m = self.m;
+        let tol = (m as f64) * f64::EPSILON;
+        self.sweeps = 0;
+        if m < 2 {
+            return true;
+        }
+        for j in 0..m {
+            let wj = &self.w[j * m..(j + 1) * m];
+            self.norms[j] = wj.iter().map(|x| x * x).sum::<f64>();
+        }
+        while self.sweeps < MAX_SWEEPS {
+            self.sweeps += 1;
+            let mut rotated = false;
+            for p in 0..m - 1 {
+                for q in p + 1..m {
+                    let (a, b) = (self.norms[p], self.norms[q]);
+                    if a == 0.0 || b == 0.0 {
+                        continue;
+                    }
+                    let (lo, hi) = self.w.split_at_mut(q * m);
+                    let wp = &mut lo[p * m..(p + 1) * m];
+                    let wq = &mut hi[..m];
+                    let c: f64 = wp.iter().zip(wq.iter()).map(|(x, y)| x * y).sum();
+                    if c.abs() <= tol * (a * b).sqrt() {
+                        continue;
+                    }
+                    rotated = true;
+                    let zeta = (b - a) / (2.0 * c);
+                    let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
+                    let cs = 1.0 / (1.0 + t * t).sqrt();
+                    let sn = cs * t;
+                    for (x, y) in wp.iter_mut().zip(wq.iter_mut()) {
+                        let (xp, yq) = (*x, *y);
+                        *x = cs * xp - sn * yq;
+                        *y = sn * xp + cs * yq;
+                    }
+                    // exact norms of the rotated pair (recomputed: no drift)
+                    self.norms[p] = wp.iter().map(|x| x * x).sum::<f64>();
+                    self.norms[q] = wq.iter().map(|x| x * x).sum::<f64>();
+                    let (lo, hi) = self.v.split_at_mut(q * m);
+                    let vp = &mut lo[p * m..(p + 1) * m];
+                    let vq = &mut hi[..m];
+                    for (x, y) in vp.iter_mut().zip(vq.iter_mut()) {
+                        let (xp, yq) = (*x, *y);
+                        *x = cs * xp - sn * yq;
+                        *y = sn * xp + cs * yq;
+                    }
+                }
+            }
+            if !rotated {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// j-th largest singular value.
+    #[inline]
+    pub fn sigma(&self, j: usize) -> f64 {
+        self.norms[self.order[j]]
+    }
+
+    /// Right singular vector of the j-th largest singular value (length m).
+    #[inline]
+    pub fn v_col(&self, j: usize) -> &[f64] {
+        let k = self.order[j];
+        &self.v[k * self.m..(k + 1) * self.m]
+    }
+
+    /// `y += U c` where `c[j]` multiplies the j-th (sorted) left singular vector; entries of
+    /// `c` beyond `rank` must be zero or `rank` given: only the first `rank` are used.
+    pub fn add_u_times(&mut self, c: &[f64], rank: usize, y: &mut [f64]) {
+        let m = self.m;
+        // t = U_r c  (m-vector): U_r column k = w_k / sigma_k
+        self.tm.fill(0.0);
+        for (j, &cj) in c.iter().enumerate().take(rank) {
+            let k = self.order[j];
+            let f = cj / self.norms[k];
+            let wk = &self.w[k * m..(k + 1) * m];
+            for (t, w) in self.tm.iter_mut().zip(wk) {
+                *t += f * w;
+            }
+        }
+        self.apply_q_tm(y);
+    }
+
+    /// `y += Q [tm; 0]` = `H_0 H_1 ... H_{m-1} [tm; 0]`.
+    fn apply_q_tm(&mut self, y: &mut [f64]) {
+        let (n, m) = (self.n, self.m);
+        self.tn[..m].copy_from_slice(&self.tm);
+        self.tn[m..].fill(0.0);
+        for k in (0..m).rev() {
+            let tau = self.tau[k];
+            if tau == 0.0 {
+                continue;
+            }
+            let vk = &self.qr[k * n + k + 1..(k + 1) * n];
+            let mut s = self.tn[k];
+            for (a, b) in self.tn[k + 1..].iter().zip(vk) {
+                s += a * b;
+            }
+            s *= tau;
+            self.tn[k] -= s;
+            for (a, b) in self.tn[k + 1..].iter_mut().zip(vk) {
+                *a -= s * b;
+            }
+        }
+        for (a, b) in y.iter_mut().zip(&self.tn) {
+            *a += b;
+        }
+    }
+
+    /// Explicit thin `U` (n x m, column-major, sorted) -- for tests and benchmarks, not the
+    /// hot path.
+    pub fn u_explicit(&mut self, out: &mut [f64]) {
+        let n = self.n;
+        let mut c = vec![0.0; self.m];
+        for j in 0..self.m {
+            c.fill(0.0);
+            c[j] = 1.0;
+            let col = &mut out[j * n..(j + 1) * n];
+            col.fill(0.0);
+            if self.sigma(j) > 0.0 {
+                self.add_u_times(&c, j + 1, col);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(n: usize, m: usize, g: &[f64]) {
+        let mut s = QrJacobi::new(n, m);
+        assert!(s.factor_cols(|j| &g[j * n..(j + 1) * n]));
+        let mut u = vec![0.0; n * m];
+        s.u_explicit(&mut u);
+        // G = U S V^T
+        let scale = g.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        for i in 0..n {
+            for j in 0..m {
+                let mut x = 0.0;
+                for k in 0..m {
+                    x += u[k * n + i] * s.sigma(k) * s.v_col(k)[j];
+                }
+                assert!((x - g[j * n + i]).abs() < 1e-13 * scale, "({i},{j}): {x} vs {}", g[j * n + i]);
+            }
+        }
+        for k in 1..m {
+            assert!(s.sigma(k - 1) >= s.sigma(k));
+        }
+        // U, V orthonormal
+        for a in 0..m {
+            for b in 0..m {
+                let uu: f64 = (0..n).map(|i| u[a * n + i] * u[b * n + i]).sum();
+                let vv: f64 = s.v_col(a).iter().zip(s.v_col(b)).map(|(x, y)| x * y).sum();
+                let want = if a == b { 1.0 } else { 0.0 };
+                assert!((vv - want).abs() < 1e-13);
+                if s.sigma(a) > 0.0 && s.sigma(b) > 0.0 {
+                    assert!((uu - want).abs() < 1e-13, "U^T U [{a},{b}] = {uu}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn reconstructs_random_and_rank_deficient() {
+        let mut st = 12345u64;
+        let mut rnd = || {
+            st = st.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((st >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        for &(n, m) in &[(9usize, 6usize), (20, 6), (6, 6), (5, 1), (40, 12)] {
+            let g: Vec<f64> = (0..n * m).map(|_| rnd()).collect();
+            check(n, m, &g);
+            // duplicate a column: rank m - 1
+            if m > 1 {
+                let mut g2 = g.clone();
+                let c0 = g2[..n].to_vec();
+                g2[(m - 1) * n..].copy_from_slice(&c0);
+                check(n, m, &g2);
+                let mut s = QrJacobi::new(n, m);
+                s.factor_cols(|j| &g2[j * n..(j + 1) * n]);
+                assert!(s.sigma(m - 1) < 1e-14 * s.sigma(0));
+            }
+        }
+    }
+}
