@@ -13,9 +13,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::body::BodyKind;
-use crate::data::{Data, RankTolerance, Stabilization};
+use crate::data::{Data, RankTolerance, Stabilization, SvdBackend};
 use crate::dynamics;
 use crate::error::Error;
+use crate::integrate::{integrate_uk, Method, Options};
+use crate::jacobian::{Differences, JacobianWorkspace};
 use crate::model::Model;
 use crate::uk;
 
@@ -41,6 +43,10 @@ struct Workspace {
     data: Data,
     q: Vec<f64>,
     qd: Vec<f64>,
+    /// Finite-difference Jacobian workspace and its two n x n blocks.
+    jws: JacobianWorkspace,
+    jq: Vec<f64>,
+    jv: Vec<f64>,
 }
 
 /// Copy a (possibly strided) NumPy vector into `dst`, checking length and finiteness.
@@ -119,7 +125,8 @@ impl PySystem {
             .map_err(|_| SolverError::new_err("internal error while building the model"))?
             .map_err(to_py)?;
         let data = Data::new(&model);
-        let ws = Workspace { data, q: vec![0.0; model.n], qd: vec![0.0; model.n] };
+        let n = model.n;
+        let ws = Workspace { data, q: vec![0.0; n], qd: vec![0.0; n], jws: JacobianWorkspace::new(&model), jq: vec![0.0; n * n], jv: vec![0.0; n * n] };
         Ok(PySystem { model, ws: Mutex::new(ws) })
     }
 
@@ -300,13 +307,17 @@ impl PySystem {
 
     /// (rank, smallest kept singular value) of the last UK pseudoinverse.
     fn rank(&self) -> PyResult<(usize, f64)> {
-        self.with_ws(|_, ws| Ok((ws.data.rank_info.rank, ws.data.rank_info.sigma_min_kept)))
+        self.with_ws(|model, ws| {
+            let info = uk::exact_rank_info(model, &mut ws.data)?;
+            Ok((info.rank, info.sigma_min_kept))
+        })
     }
 
     /// Everything the last pseudoinverse decided: rank, sigma_max, sigma_min_kept,
-    /// sigma_max_dropped, tolerance.
+    /// sigma_max_dropped, tolerance (exact singular values: when the acceleration took the
+    /// certified full-rank path they are computed here, on demand).
     fn rank_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let info = self.with_ws(|_, ws| Ok(ws.data.rank_info))?;
+        let info = self.with_ws(|model, ws| uk::exact_rank_info(model, &mut ws.data))?;
         let d = PyDict::new(py);
         d.set_item("rank", info.rank)?;
         d.set_item("sigma_max", info.sigma_max)?;
@@ -332,6 +343,169 @@ impl PySystem {
             ws.data.tolerance = RankTolerance { rcond, atol };
             Ok(())
         })
+    }
+
+    /// How the UK pseudoinverse is computed: "auto" (default: certified full-rank QR, Jacobi
+    /// SVD otherwise), "qr-jacobi" (QR + Jacobi SVD every call) or "faer" (faer's SVD).
+    /// Same results to rounding; see docs/performance.md.
+    #[pyo3(signature = (kind="auto"))]
+    fn set_pseudoinverse(&self, kind: &str) -> PyResult<()> {
+        let b = match kind {
+            "auto" => SvdBackend::Auto,
+            "qr-jacobi" => SvdBackend::QrJacobi,
+            "faer" => SvdBackend::Faer,
+            other => return Err(PyValueError::new_err(format!("unknown pseudoinverse kind '{other}' (use 'auto', 'qr-jacobi' or 'faer')"))),
+        };
+        self.with_ws(|_, ws| {
+            ws.data.svd_backend = b;
+            Ok(())
+        })
+    }
+
+    /// Jacobian of rhs: d[qd, qdd]/d[q, qd] at (t, y), shape (2n, 2n) = [[0, I], [Jq, Jv]].
+    /// Central finite differences in Rust (step eps^(1/3) max(|y_j|, 1e-2)); the velocity
+    /// columns reuse the mass factor and the pseudoinverse of the base point. Runs with the GIL
+    /// released. `scheme="forward"` halves the cost.
+    #[pyo3(signature = (t, y, scheme="central"))]
+    fn jac<'py>(&self, py: Python<'py>, t: f64, y: PyReadonlyArray1<f64>, scheme: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.model.n;
+        let scheme = match scheme {
+            "central" => Differences::Central,
+            "forward" => Differences::Forward,
+            other => return Err(PyValueError::new_err(format!("unknown scheme '{other}' (use 'central' or 'forward')"))),
+        };
+        let mut yv = vec![0.0; 2 * n];
+        read_into("y", &y.as_array(), &mut yv).map_err(to_py)?;
+        check_time(t).map_err(to_py)?;
+        let out = py.detach(|| {
+            self.with_ws(|model, ws| {
+                ws.jws.scheme = scheme;
+                let Workspace { data, jws, jq, jv, .. } = ws;
+                crate::jacobian::uk_jacobian(model, data, jws, t, &yv[..n], &yv[n..], jq, jv)?;
+                let mut out = vec![0.0; 4 * n * n];
+                for i in 0..n {
+                    out[i * 2 * n + n + i] = 1.0;
+                    out[(n + i) * 2 * n..(n + i) * 2 * n + n].copy_from_slice(&jq[i * n..(i + 1) * n]);
+                    out[(n + i) * 2 * n + n..(n + i + 1) * 2 * n].copy_from_slice(&jv[i * n..(i + 1) * n]);
+                }
+                Ok(out)
+            })
+        })?;
+        mat(py, out, 2 * n, 2 * n)
+    }
+
+    /// Integrate natively (Rust, GIL released) from (t0, y0) to t_end.
+    ///
+    /// method: "DOPRI5" (Dormand-Prince 5(4), dense output) or "RADAU5" (Radau IIA order 5,
+    /// Rust finite-difference Jacobian). atol: float or (2n,) array. t_eval: output times
+    /// (dense output) or None for every accepted step. projection_tol: if given, project onto
+    /// the constraint manifold after every accepted step (uk::project). The run uses its own
+    /// workspace (copying this System's pseudoinverse tolerance, stabilization and backend), so
+    /// several threads can integrate the same System concurrently.
+    ///
+    /// Returns a dict: t (nt,), y (2n, nt), status (0 ok, -1 failed), message, nfev, njev, nlu,
+    /// naccept, nreject, jac_evals (UK calls inside Jacobians), wall_time [s].
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn integrate<'py>(
+        &self,
+        py: Python<'py>,
+        t0: f64,
+        y0: PyReadonlyArray1<f64>,
+        t_end: f64,
+        method: &str,
+        rtol: f64,
+        atol: Option<PyReadonlyArray1<f64>>,
+        t_eval: Option<PyReadonlyArray1<f64>>,
+        first_step: Option<f64>,
+        max_step: Option<f64>,
+        max_steps: usize,
+        projection_tol: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let n = self.model.n;
+        let method = Method::from_name(method)
+            .ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5' or 'RADAU5')")))?;
+        let mut y = vec![0.0; 2 * n];
+        read_into("y0", &y0.as_array(), &mut y).map_err(to_py)?;
+        check_time(t0).map_err(to_py)?;
+        check_time(t_end).map_err(to_py)?;
+        let atol = match atol {
+            None => vec![1e-3 * rtol],
+            Some(a) => {
+                let a = a.as_array();
+                let v: Vec<f64> = a.iter().copied().collect();
+                if v.len() != 1 && v.len() != 2 * n {
+                    return Err(PyValueError::new_err(format!("atol: expected a scalar or length {}, got {}", 2 * n, v.len())));
+                }
+                v
+            }
+        };
+        let t_eval: Option<Vec<f64>> = t_eval.map(|a| a.as_array().iter().copied().collect());
+        if !(t_end > t0) {
+            return Err(PyValueError::new_err(format!("t_end must be greater than t0 = {t0}, got {t_end}")));
+        }
+        if !(rtol > 0.0) || !rtol.is_finite() || atol.iter().any(|a| !(*a >= 0.0) || !a.is_finite()) {
+            return Err(PyValueError::new_err("rtol must be positive and finite, atol >= 0 and finite"));
+        }
+        if let Some(te) = &t_eval {
+            if te.windows(2).any(|w| !(w[1] > w[0])) || te.iter().any(|x| !(*x >= t0 && *x <= t_end)) {
+                return Err(PyValueError::new_err(format!("t_eval must be strictly increasing within [t0, t_end] = [{t0}, {t_end}]")));
+            }
+        }
+        if let Some(h) = first_step {
+            if !(h > 0.0) || !h.is_finite() {
+                return Err(PyValueError::new_err(format!("first_step must be positive and finite, got {h}")));
+            }
+        }
+        let max_step = max_step.unwrap_or(f64::INFINITY);
+        if !(max_step > 0.0) {
+            return Err(PyValueError::new_err(format!("max_step must be positive, got {max_step}")));
+        }
+        if let Some(p) = projection_tol {
+            if !(p > 0.0) || !p.is_finite() {
+                return Err(PyValueError::new_err(format!("projection_tol must be positive and finite, got {p}")));
+            }
+        }
+        let opts = Options { rtol, atol, first_step, max_step, max_steps };
+        // a fresh workspace with this System's settings: the run does not hold the lock
+        let (tolerance, stabilization, backend) = self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.stabilization, ws.data.svd_backend)))?;
+        let model = &self.model;
+        let result = py.detach(|| {
+            catch_unwind(AssertUnwindSafe(|| {
+                let mut data = Data::new(model);
+                data.tolerance = tolerance;
+                data.stabilization = stabilization;
+                data.svd_backend = backend;
+                let tic = std::time::Instant::now();
+                let r = integrate_uk(model, data, method, opts, t0, &y, t_end, t_eval.as_deref(), projection_tol.map(|p| (p, 20)));
+                r.map(|(sol, full, cheap)| (sol, full + cheap, tic.elapsed().as_secs_f64()))
+            }))
+        });
+        let (sol, jac_evals, wall) = match result {
+            Ok(r) => r.map_err(to_py)?,
+            Err(_) => return Err(SolverError::new_err("internal error in the ukflex core (a bug: please report it)")),
+        };
+        let nt = sol.t.len();
+        let dim = sol.dim;
+        let mut yt = vec![0.0; dim * nt];
+        for k in 0..nt {
+            for i in 0..dim {
+                yt[i * nt + k] = sol.y[k * dim + i];
+            }
+        }
+        let d = PyDict::new(py);
+        d.set_item("t", PyArray1::from_vec(py, sol.t))?;
+        d.set_item("y", mat(py, yt, dim, nt)?)?;
+        d.set_item("status", sol.status)?;
+        d.set_item("message", sol.message)?;
+        d.set_item("nfev", sol.stats.nfev)?;
+        d.set_item("njev", sol.stats.njev)?;
+        d.set_item("nlu", sol.stats.nlu)?;
+        d.set_item("naccept", sol.stats.naccept)?;
+        d.set_item("nreject", sol.stats.nreject)?;
+        d.set_item("jac_evals", jac_evals)?;
+        d.set_item("wall_time", wall)?;
+        Ok(d)
     }
 
     /// Constraint stabilization inside qdd/rhs: kind "none" or "baumgarte" with alpha, beta
