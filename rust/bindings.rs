@@ -279,6 +279,30 @@ impl PySystem {
         Ok(out)
     }
 
+    /// Benchmark helper (not API): seconds per call of the Rust UK acceleration alone at
+    /// (t, q, qd), the minimum over `batches` batches of `reps` calls, GIL released. Lets a
+    /// Python benchmark separate the core's time from the binding's overhead in one run.
+    #[pyo3(signature = (t, q, qd, reps=1000, batches=21))]
+    fn _time_acceleration(&self, py: Python<'_>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>, reps: usize, batches: usize) -> PyResult<f64> {
+        let n = self.model.n;
+        let (mut qv, mut qdv) = (vec![0.0; n], vec![0.0; n]);
+        read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
+        read_into("qd", &qd.as_array(), &mut qdv).map_err(to_py)?;
+        py.detach(|| {
+            self.with_ws(|model, ws| {
+                let mut best = f64::INFINITY;
+                for _ in 0..batches.max(1) {
+                    let tic = std::time::Instant::now();
+                    for _ in 0..reps.max(1) {
+                        uk::acceleration(model, &mut ws.data, std::hint::black_box(t), std::hint::black_box(&qv), std::hint::black_box(&qdv))?;
+                    }
+                    best = best.min(tic.elapsed().as_secs_f64() / reps.max(1) as f64);
+                }
+                Ok(best)
+            })
+        })
+    }
+
     /// Lagrange multipliers (M qdd + A^T lambda = Q), shape (m,).
     fn multipliers<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let v = self.with_ws(|model, ws| {
