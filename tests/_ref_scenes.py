@@ -211,3 +211,47 @@ def free_beam(theory="timoshenko", elements=3, frame="clamped", youngs_modulus=7
          "section": {"shape": "rectangular", "width": 0.01, "height": 0.01}, "frame": frame,
          "position": [0.1, 0.2], "angle": 0.4, "velocity": [0.3, -0.2], "angular_velocity": 6.0}
     return {"bodies": [b]}
+
+
+def misc_scene():
+    """Remaining options: shear_modulus instead of poisson_ratio, Timoshenko without rotary
+    inertia, a coordinate driver along y with a phased harmonic motion, a spring-damper and
+    a weld between two beams, a rigid body with an offset centre of mass, gravity null."""
+    beam = dict(density=2700.0, youngs_modulus=7e10, shear_factor=0.85,
+                section={"shape": "rectangular", "width": 0.012, "height": 0.005})
+    return {
+        "gravity": None,
+        "bodies": [
+            {"name": "b1", "kind": "beam", "length": 0.4, "elements": 3, "theory": "timoshenko",
+             "shear_modulus": 2.6e10, "rotary_inertia": False, "frame": "clamped",
+             "position": [0.0, 0.0], "angle": 0.5, **beam},
+            {"name": "b2", "kind": "beam", "length": 0.3, "elements": 2, "theory": "timoshenko",
+             "poisson_ratio": 0.33, "frame": "pinned-pinned", "damping": 2e-5,
+             "position": [0.4 * math.cos(0.5), 0.4 * math.sin(0.5)], "angle": -0.4,
+             "elastic": [1e-3, -2e-5, 1e-3, 5e-4, -1e-5, 2e-4, 1e-5, 0.0, -3e-4][:6],
+             **beam},
+            {"name": "box", "kind": "rigid", "mass": 0.7, "inertia": 3e-3, "com": [0.02, -0.01],
+             "position": [0.1, -0.3], "angle": 0.2, "velocity": [0.1, 0.0],
+             "angular_velocity": -1.0},
+        ],
+        "joints": [
+            {"kind": "revolute", "a": {"body": "ground", "point": [0.0, 0.0]},
+             "b": {"body": "b1", "xi": 0.0}},
+            {"kind": "weld", "a": {"body": "b1", "xi": 1.0, "angle": 0.1},
+             "b": {"body": "b2", "xi": 0.0, "angle": 0.2}},
+            {"kind": "point_on_line", "point": {"body": "box", "point": [0.05, 0.0]},
+             "line": {"body": "b2", "xi": 0.6, "angle": 0.3}},
+        ],
+        "drivers": [
+            {"kind": "coordinate", "point": {"body": "box", "point": [0.0, 0.02]}, "axis": "y",
+             "motion": {"kind": "harmonic", "offset": -0.28, "amplitude": 0.02,
+                        "frequency": 9.0, "phase": 1.3}},
+        ],
+        "forces": [
+            {"kind": "spring_damper", "a": {"body": "b1", "xi": 0.5}, "b": {"body": "b2", "xi": 1.0},
+             "stiffness": 80.0, "damping": 0.2, "rest_length": 0.05},
+            {"kind": "torque", "frame": {"body": "b2", "xi": 0.3}, "torque": 0.05},
+            {"kind": "point_force", "point": {"body": "box", "point": [0.0, 0.05], "angle": 0.3},
+             "force": [1.0, 2.0]},
+        ],
+    }

@@ -41,6 +41,7 @@ SCENES = {
     "every-joint-swapped": scenes.every_joint_scene("euler-bernoulli", "timoshenko"),
     "line-and-beam": scenes.line_and_beam_scene(),
     "free-beam": scenes.free_beam(),
+    "misc": scenes.misc_scene(),
 }
 
 
