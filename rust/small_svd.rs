@@ -89,7 +89,11 @@ impl QrJacobi {
                 rf += x * x;
             }
         }
-        // R^-1 column by column (upper triangular), stored in `w` (column-major)
+        // R^-1 column by column (upper triangular), stored in `w` (column-major); the
+        // reciprocals of the diagonal go to `tm` (m divisions instead of m (m + 1) / 2)
+        for i in 0..m {
+            self.tm[i] = 1.0 / self.qr[i * n + i];
+        }
         self.w.fill(0.0);
         let mut invf = 0.0;
         for j in 0..m {
@@ -99,7 +103,7 @@ impl QrJacobi {
                 for k in i + 1..=j {
                     s -= self.qr[k * n + i] * self.w[j * m + k];
                 }
-                let x = s / self.qr[i * n + i];
+                let x = s * self.tm[i];
                 self.w[j * m + i] = x;
                 invf += x * x;
             }
