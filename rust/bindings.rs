@@ -54,6 +54,13 @@ fn read_into(what: &str, src: &ArrayView1<f64>, dst: &mut [f64]) -> Result<(), E
     if src.len() != dst.len() {
         return Err(Error::Shape { what: what.to_string(), expected: dst.len(), got: src.len() });
     }
+    // contiguous fast path (the common case): plain copy, one finiteness pass
+    if let Some(sl) = src.as_slice() {
+        dst.copy_from_slice(sl);
+        if dst.iter().all(|x| x.is_finite()) {
+            return Ok(());
+        }
+    }
     for (i, (d, s)) in dst.iter_mut().zip(src.iter()).enumerate() {
         if !s.is_finite() {
             return Err(Error::NonFinite { what: what.to_string(), index: i });

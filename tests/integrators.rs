@@ -271,3 +271,52 @@ fn jacobian_matches_directional_differences() {
         }
     }
 }
+
+// ---------------------------------------------------------------- pseudoinverse backends
+#[test]
+fn pseudoinverse_backends_agree_including_redundant_rows() {
+    // a chain with one joint declared twice: m = 2K + 2 dependent rows; small and large m
+    let redundant = |k: usize| {
+        chain_scene(k).replace(
+            r#""joints": ["#,
+            r#""joints": [{"kind": "revolute", "a": {"body": "ground"}, "b": {"body": "l0", "point": [0.0, 0.0]}},"#,
+        )
+    };
+    let cases = [
+        (paper_scene("timoshenko", 4, true), false),
+        (every_kind_scene(), false),
+        (redundant(3), true),
+        (redundant(10), true), // m = 22 > AUTO_JACOBI_MAX_ROWS: Auto falls back to faer
+    ];
+    for (json, is_redundant) in cases {
+        let (model, mut data) = build(&json);
+        let mut rng = Lcg(41);
+        let (q, qd) = random_state(&model, &mut rng);
+        let mut results = Vec::new();
+        for backend in [ukflex::SvdBackend::Faer, ukflex::SvdBackend::QrJacobi, ukflex::SvdBackend::Auto] {
+            data.svd_backend = backend;
+            uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
+            let info = uk::exact_rank_info(&model, &mut data).unwrap();
+            assert!(info.exact);
+            results.push((backend, data.qdd.clone(), data.lambda.clone(), info));
+        }
+        let (_, qdd0, lam0, info0) = &results[0];
+        let expected_rank = if is_redundant { model.m - 2 } else { model.m };
+        for (backend, qdd, lam, info) in &results {
+            assert_eq!(info.rank, expected_rank, "{backend:?}");
+            assert!((info.sigma_min_kept - info0.sigma_min_kept).abs() <= 1e-10 * info0.sigma_max, "{backend:?}: {info:?} vs {info0:?}");
+            let e = qdd.iter().zip(qdd0).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / max_abs(qdd0);
+            assert!(e < 1e-10, "{backend:?}: qdd differs by {e:e}");
+            // multipliers of dependent rows are not unique: compare A^T lambda (the forces)
+            let n = model.n;
+            let force = |l: &[f64]| -> Vec<f64> { (0..n).map(|j| (0..model.m).map(|i| data.jac[i * n + j] * l[i]).sum()).collect() };
+            let (f, f0) = (force(lam), force(lam0));
+            let e = f.iter().zip(&f0).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / max_abs(&f0);
+            assert!(e < 1e-9, "{backend:?}: constraint forces differ by {e:e}");
+            if !is_redundant {
+                let e = lam.iter().zip(lam0).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / max_abs(lam0);
+                assert!(e < 1e-9, "{backend:?}: lambda differs by {e:e}");
+            }
+        }
+    }
+}
