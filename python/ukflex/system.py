@@ -270,18 +270,23 @@ class System:
         """Total mechanical energy ``T + V`` (gravity, elastic, springs)."""
         return float(self.kinetic_energy(q, qd) + self.potential_energy(q))
 
-    def stiffness_matrix(self, body: str, h: float = 1e-7) -> np.ndarray:
+    def beam_matrices(self, body: str) -> Tuple[np.ndarray, np.ndarray]:
+        """Constant elastic blocks ``(M_ff, K_ff)`` of beam ``body`` from the core, each (n_f, n_f)."""
+        M_ff, K_ff = self.core.beam_matrices(body)
+        return np.asarray(M_ff), np.asarray(K_ff)
+
+    def stiffness_matrix(self, body: str, finite_difference: bool = False, h: float = 1e-7) -> np.ndarray:
         """Elastic stiffness ``K_ff`` of beam ``body``, shape (n_f, n_f).
 
-        Uses the core's ``stiffness_matrix`` if it has one, otherwise central differences of
-        ``-Q`` with respect to ``q_f`` at ``q_f = 0``, zero velocities, reference coordinates of
-        ``q0``.  The elastic force ``-K_ff q_f`` is linear; gravity, point forces and torques give
-        generalized forces on ``q_f`` that do not depend on ``q_f`` and cancel in the difference;
-        spring-dampers attached to the beam would not (leave them out for a clean ``K_ff``).
+        By default the core's constant ``K_ff``.  With ``finite_difference=True``: central
+        differences of ``-Q`` with respect to ``q_f`` at ``q_f = 0``, zero velocities, reference
+        coordinates of ``q0`` (an independent check of the elastic force).  The elastic force
+        ``-K_ff q_f`` is linear; gravity, point forces and torques give generalized forces on
+        ``q_f`` that do not depend on ``q_f`` and cancel in the difference; spring-dampers attached
+        to the beam would not (leave them out for a clean ``K_ff``).
         """
-        core_k = getattr(self.core, "stiffness_matrix", None)
-        if core_k is not None:
-            return np.asarray(core_k(body), dtype=float)
+        if not finite_difference:
+            return self.beam_matrices(body)[1]
         sl = self.elastic_slice(body)
         q = self.q0.copy()
         q[sl] = 0.0
@@ -293,7 +298,7 @@ class System:
             qp[k] += h
             qm[k] -= h
             K[:, j] = -(self.Q(self.t0, qp, qd)[idx] - self.Q(self.t0, qm, qd)[idx]) / (2.0 * h)
-        return 0.5 * (K + K.T)
+        return K
 
     def mass_matrix_elastic(self, body: str, q: Optional[np.ndarray] = None) -> np.ndarray:
         """Elastic block ``M_ff`` of beam ``body`` at ``q`` (default ``q0``), shape (n_f, n_f)."""
@@ -345,6 +350,10 @@ class System:
         order = np.argsort(-np.abs(residual))[:k]
         return [self.constraint_names[i] for i in order if abs(residual[i]) > 0.0]
 
+    def _detail(self, residual: np.ndarray, k: int = 3) -> str:
+        order = [i for i in np.argsort(-np.abs(residual))[:k] if abs(residual[i]) > 0.0]
+        return ", ".join(f"{self.constraint_names[i]} = {residual[i]:.3e}" for i in order)
+
     def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations):
         core, t0 = self.core, self.t0
         held = self._held_mask(hold)
@@ -377,7 +386,7 @@ class System:
                     break
         if not res <= position_tol:
             rows = self._worst_rows(phi)
-            detail = ", ".join(f"{self.constraint_names[i]} = {phi[i]:.3e}" for i in np.argsort(-np.abs(phi))[:3])
+            detail = self._detail(phi)
             raise InconsistentInitialStateError(
                 f"initial positions cannot be corrected onto the constraints Phi(q, t0) = 0: after {it} "
                 f"Newton iteration(s) max |Phi| = {res:.3e} (tolerance {position_tol:.1e}); largest residual "
@@ -396,7 +405,7 @@ class System:
         scale = max(1.0, self._max_abs(qd))
         if not v1 <= velocity_tol * scale:
             rows = self._worst_rows(vres)
-            detail = ", ".join(f"{self.constraint_names[i]} = {vres[i]:.3e}" for i in np.argsort(-np.abs(vres))[:3])
+            detail = self._detail(vres)
             raise InconsistentInitialStateError(
                 f"initial velocities cannot be projected onto A qd = -Phi_t with the held coordinates fixed: "
                 f"max |A qd + Phi_t| = {v1:.3e}; largest residual rows: {detail}",
