@@ -4,6 +4,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
@@ -120,3 +121,42 @@ def test_paper_scene_cp_matches_uk_numpy_short():
         assert np.abs(v_cp).max() > 1e-4
         np.testing.assert_allclose(v_cp, v_uk, rtol=0, atol=1e-8 * np.abs(v_uk).max())
         assert cp.accel_time > 0 and cp.nfev > 0 and cp.wall_time >= cp.accel_time
+
+
+def test_scipy_num_jac_step_overflows_on_a_dead_column_and_fd_jacobian_does_not():
+    """Root cause of NaN states in long implicit runs: scipy's num_jac multiplies the step of
+    a column that the rhs does not depend on (translation invariance: the crank pivot's x, y)
+    by 10 at every Jacobian evaluation, without bound."""
+    import warnings
+    from scipy.integrate._ivp.common import num_jac
+    from ukflex.reference.uk import fd_jacobian
+    m = ReferenceModel(scenes.slider_crank("euler-bernoulli", 1))
+    q, qd = correct_initial_state(m)
+    n = m.n
+
+    def rhs(t, y):
+        M, Q, A, b = m.terms(t, y[:n], y[n:])
+        from ukflex.reference import uk_qdd
+        return np.concatenate([y[n:], uk_qdd(M, Q, A, b)])
+
+    def vec(t, Y):
+        return np.column_stack([rhs(t, Y[:, k]) for k in range(Y.shape[1])])
+
+    y = np.r_[q, qd]
+    y[0], y[n] = 1e-12, 1e-13              # the few-ulp drift of a UK run: f[0] != 0
+    f = rhs(0.0, y)
+    _, factor = num_jac(vec, 0.0, y, f, 1e-9, None)
+    for _ in range(3):                      # the pivot's x, y steps: x10 per Jacobian
+        prev = factor.copy()
+        _, factor = num_jac(vec, 0.0, y, f, 1e-9, factor)
+        np.testing.assert_allclose(factor[:2] / prev[:2], 10.0)
+    assert np.all(factor[n + 6:] <= 1.5e-6)    # live (elastic rate) columns do not keep growing
+    factor[:2] = 1.49e308                   # where it is after ~316 Jacobians
+    with warnings.catch_warnings(), pytest.raises(ValueError, match="infs or NaNs"):
+        warnings.simplefilter("ignore")
+        num_jac(vec, 0.0, y, f, 1e-9, factor)
+    J = fd_jacobian(rhs, 1e-9)(0.0, y)
+    assert np.all(np.isfinite(J)) and np.all(J[:, 0] == 0) and np.all(J[:, 1] == 0)
+    Jn, _ = num_jac(vec, 0.0, y, f, 1e-9, None)
+    live = np.abs(Jn).max(axis=0) > 0
+    np.testing.assert_allclose(J[:, live], Jn[:, live], rtol=1e-4, atol=1e-6 * np.abs(Jn).max())

@@ -40,7 +40,7 @@ import scipy.linalg as sla
 from scipy.integrate import solve_ivp
 
 from ._blas import single_blas_thread
-from .uk import SimulationResult, _as_model, correct_initial_state
+from .uk import SimulationResult, _as_model, correct_initial_state, fd_jacobian
 
 __all__ = ["simulate_cp", "choose_partition", "CPPartition", "NewtonFailure"]
 
@@ -217,10 +217,13 @@ def _simulate_once(model, t0, t_end, q0, qd0, method, rtol, atol, t_eval, factor
         cond_event.direction = 1.0
 
         y0 = np.concatenate([qcur[part.ind], qdcur[part.ind]])
+        kws = dict(kw)
+        if method in ("BDF", "Radau") and "jac" not in kws:
+            kws["jac"] = fd_jacobian(rhs, atol)
         try:
             sol = solve_ivp(rhs, (tcur, t_end), y0, method=method, rtol=rtol, atol=atol,
                             events=cond_event if part.dep.size else None, dense_output=True,
-                            **kw)
+                            **kws)
         except NewtonFailure as exc:        # cannot restart from an unknown state: give up
             status, message = -1, str(exc)
             break
@@ -291,6 +294,8 @@ def _simulate_every_call(model, t0, t_end, q0, qd0, method, rtol, atol, t_eval, 
         nfev[0] += 1
         return np.concatenate([qd, qdd])
 
+    if method in ("BDF", "Radau") and "jac" not in kw:
+        kw = dict(kw, jac=fd_jacobian(rhs, atol))
     tic = time.perf_counter()
     sol = solve_ivp(rhs, (t0, t_end), np.concatenate([q0, qd0]), method=method, rtol=rtol,
                     atol=atol, t_eval=t_eval, **kw)

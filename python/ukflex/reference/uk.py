@@ -14,7 +14,7 @@ from scipy.integrate import solve_ivp
 from ._blas import single_blas_thread
 
 __all__ = ["uk_qdd", "uk_multipliers", "augmented_qdd", "inv_sqrt_spd", "uk_rank",
-           "simulate_uk_numpy", "SimulationResult", "correct_initial_state"]
+           "simulate_uk_numpy", "SimulationResult", "correct_initial_state", "fd_jacobian"]
 
 
 def inv_sqrt_spd(M):
@@ -149,6 +149,32 @@ class SimulationResult:
         return np.vstack([self.q, self.qd])
 
 
+def fd_jacobian(fun, atol=1e-9):
+    """A plain forward-difference Jacobian ``jac(t, y)`` for scipy's implicit methods.
+
+    Why not scipy's own ``num_jac``: it multiplies the difference step of a column by 10 at
+    every Jacobian evaluation in which that column shows no response, without an upper
+    bound. Multibody right-hand sides have such columns exactly (the rhs is translation
+    invariant: e.g. the crank pivot's x, y enter it nowhere), so after ~300 Jacobian
+    evaluations (long BDF runs, tight tolerances) the step overflows to inf and the state
+    passed to ``fun`` contains NaN/inf. Here the step is fixed:
+    ``h_j = sqrt(eps) * max(|y_j|, atol_j)``.
+    """
+    atol = np.asarray(atol, dtype=float)
+    sq = np.sqrt(np.finfo(float).eps)
+
+    def jac(t, y):
+        f0 = np.asarray(fun(t, y), dtype=float)
+        h = sq * np.maximum(np.abs(y), np.broadcast_to(atol, y.shape))
+        J = np.empty((f0.size, y.size))
+        for j in range(y.size):
+            yj = y.copy()
+            yj[j] += h[j]
+            J[:, j] = (np.asarray(fun(t, yj), dtype=float) - f0) / (yj[j] - y[j])
+        return J
+    return jac
+
+
 def _as_model(description_or_model):
     if hasattr(description_or_model, "M") and hasattr(description_or_model, "gamma"):
         return description_or_model
@@ -189,6 +215,8 @@ def simulate_uk_numpy(description_or_model, t_end, method="BDF", rtol=1e-6, atol
         return np.concatenate([qd, qdd])
 
     y0 = np.concatenate([np.asarray(q0, float), np.asarray(qd0, float)])
+    if method in ("BDF", "Radau") and "jac" not in solve_ivp_kwargs:
+        solve_ivp_kwargs = dict(solve_ivp_kwargs, jac=fd_jacobian(rhs, atol))
     tic = time.perf_counter()
     with single_blas_thread():
         sol = solve_ivp(rhs, (t0, t_end), y0, method=method, rtol=rtol, atol=atol,
