@@ -152,9 +152,12 @@ def test_scipy_num_jac_step_overflows_on_a_dead_column_and_fd_jacobian_does_not(
         np.testing.assert_allclose(factor[:2] / prev[:2], 10.0)
     assert np.all(factor[n + 6:] <= 1.5e-6)    # live (elastic rate) columns do not keep growing
     factor[:2] = 1.49e308                   # where it is after ~316 Jacobians
-    with warnings.catch_warnings(), pytest.raises(ValueError, match="infs or NaNs"):
+    with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        num_jac(vec, 0.0, y, f, 1e-9, factor)
+        _, factor = num_jac(vec, 0.0, y, f, 1e-9, factor)
+        assert np.all(np.isinf(factor[:2]))
+        with pytest.raises(ValueError, match="infs or NaNs"):    # the rhs sees y = inf
+            num_jac(vec, 0.0, y, f, 1e-9, factor)
     J = fd_jacobian(rhs, 1e-9)(0.0, y)
     assert np.all(np.isfinite(J)) and np.all(J[:, 0] == 0) and np.all(J[:, 1] == 0)
     Jn, _ = num_jac(vec, 0.0, y, f, 1e-9, None)
