@@ -60,7 +60,7 @@ fn main() {
             if !filter.is_empty() && !name.to_lowercase().contains(&filter) && !theory.contains(&filter) {
                 continue;
             }
-            for rtol in [1e-3, 1e-4, 1e-5, 1e-6] {
+            for rtol in [1e-3, 1e-4, 5e-5, 1e-5, 1e-6] {
                 let atol = 1e-3 * rtol;
                 let mut times = Vec::new();
                 let mut last = None;
