@@ -3,6 +3,7 @@
     python -m ukflex.reference.studies errata   [--t-end 0.07] [--rtol 1e-8]
     python -m ukflex.reference.studies sweep    [--t-end 0.07]     (needs ukflex._core)
     python -m ukflex.reference.studies timing   [--t-end 0.02]
+    python -m ukflex.reference.studies bdf                         (needs ukflex._core)
 
 Pure NumPy/SciPy except ``sweep``, which imports the compiled core lazily (inside the
 function) to compare Rust UK against NumPy CP.
@@ -155,9 +156,54 @@ def timing(beam="timoshenko", t_end=0.02, rtol=1e-6, method="DOP853"):
     return out
 
 
+def bdf_study(t_end=0.07):
+    """Paper-like integrator (BDF, rtol 1e-6): Rust UK vs NumPy CP vs a DOP853 1e-10 reference;
+    E-B vs Timoshenko; and scipy's num_jac overflow on raw System.rhs at rtol 1e-8."""
+    import warnings
+    from scipy.integrate import solve_ivp
+    from ukflex import _core                     # lazy: only this study needs the core
+    from .uk import fd_jacobian
+
+    t = np.linspace(0.0, t_end, 701)
+    ref = {}
+    for beam in ("euler-bernoulli", "timoshenko"):
+        d = paper_description(beam)
+        r, m = _core.System(json.dumps(d)), ReferenceModel(d)
+        q0, qd0 = correct_initial_state(m)
+        S, _ = m.beam_shape("coupler", 0.5)
+        y0 = np.r_[q0, qd0]
+        sr = solve_ivp(r.rhs, (0, t_end), y0, method="DOP853", rtol=1e-10, atol=1e-13, t_eval=t)
+        ref[beam] = (S @ sr.y[6:9])[1] / 0.3048
+        pk = np.abs(ref[beam]).max()
+        sb = solve_ivp(r.rhs, (0, t_end), y0, method="BDF", rtol=1e-6, atol=1e-9, t_eval=t)
+        vb = (S @ sb.y[6:9])[1] / 0.3048
+        cp = simulate_cp(m, t_end, method="BDF", rtol=1e-6, atol=1e-9, t_eval=t[::10], q0=q0,
+                         qd0=qd0)
+        vc = (S @ cp.q[6:9])[1] / 0.3048
+        print(f"{beam}: BDF rtol 1e-6, atol 1e-9 (max abs dv / peak): Rust UK vs reference "
+              f"{np.abs(vb - ref[beam]).max() / pk:.2e}, NumPy CP vs reference "
+              f"{np.abs(vc - ref[beam][::10]).max() / pk:.2e}, Rust UK vs CP "
+              f"{np.abs(vb[::10] - vc).max() / pk:.2e}; nfev Rust {sb.nfev}, CP {cp.nfev}")
+        for jac in ("scipy num_jac", "fd_jacobian"):
+            kw = {} if jac.startswith("scipy") else {"jac": fd_jacobian(r.rhs, 1e-11)}
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                try:
+                    s2 = solve_ivp(r.rhs, (0, t_end), y0, method="BDF", rtol=1e-8, atol=1e-11,
+                                   **kw)
+                    print(f"  raw System.rhs, BDF rtol 1e-8, {jac}: status {s2.status}, "
+                          f"njev {s2.njev}")
+                except Exception as exc:            # noqa: BLE001 (report what happened)
+                    print(f"  raw System.rhs, BDF rtol 1e-8, {jac}: {type(exc).__name__}: {exc}")
+    dv = np.abs(ref["euler-bernoulli"] - ref["timoshenko"])
+    pk = np.abs(ref["timoshenko"]).max()
+    print(f"E-B vs Timoshenko: max abs dv/Lb = {dv.max():.3e} ({dv.max() / pk:.2e} of the peak); "
+          f"peaks {np.abs(ref['euler-bernoulli']).max():.6e}, {pk:.6e}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="python -m ukflex.reference.studies")
-    ap.add_argument("study", choices=["errata", "sweep", "timing"])
+    ap.add_argument("study", choices=["errata", "sweep", "timing", "bdf"])
     ap.add_argument("--t-end", type=float, default=None)
     ap.add_argument("--rtol", type=float, default=1e-8)
     ap.add_argument("--beam", default=None)
@@ -167,6 +213,8 @@ def main(argv=None):
         for beam in beams:
             _print_errata(beam, errata_effects(beam, t_end=args.t_end or 0.07, rtol=args.rtol,
                                                atol=1e-3 * args.rtol))
+    elif args.study == "bdf":
+        bdf_study(t_end=args.t_end or 0.07)
     elif args.study == "sweep":
         for beam in beams:
             for gravity in (True, False):
