@@ -45,16 +45,25 @@ fn run(model: &Model, method: Method, rtol: f64, atol: f64, te: &[f64]) -> Run {
 fn main() {
     let filter = std::env::args().skip(1).find(|a| !a.starts_with('-')).unwrap_or_default();
     let te: Vec<f64> = (0..=100).map(|k| 1e-3 * k as f64).collect();
-    for theory in ["timoshenko", "euler-bernoulli"] {
+    // the paper's scene (undamped) for both theories, then with stiffness-proportional beam
+    // damping beta = 1e-5 s (N = 1 and 4): the case a stiff method is for
+    let damped = |n_el: usize| paper_scene("timoshenko", n_el, true).replace(r#""frame": "pinned-pinned""#, r#""frame": "pinned-pinned", "damping": 1e-5"#);
+    let cases = [
+        ("timoshenko", paper_scene("timoshenko", 1, true), 1),
+        ("euler-bernoulli", paper_scene("euler-bernoulli", 1, true), 1),
+        ("timoshenko, beam damping 1e-5 s", damped(1), 1),
+        ("timoshenko, beam damping 1e-5 s", damped(4), 4),
+    ];
+    for (theory, json, n_el) in cases {
         if !theory.contains(&filter) && !filter.is_empty() && !"dopri5 radau5".contains(&filter) {
             continue;
         }
-        let model = Model::from_json(&paper_scene(theory, 1, true)).unwrap();
+        let model = Model::from_json(&json).unwrap();
         let reference = run(&model, Method::Dopri5, 1e-11, 1e-14, &te);
         let check = run(&model, Method::Radau5, 1e-10, 1e-13, &te);
         let d = reference.v.iter().zip(&check.v).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         let vmax = reference.v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        println!("paper scene, {theory}, N = 1: max |v(0.5)/Lb| = {vmax:.4e}; reference DOPRI5 rtol 1e-11 vs RADAU5 rtol 1e-10 differ by {d:.2e}");
+        println!("paper scene, {theory}, N = {n_el}: max |v(0.5)/Lb| = {vmax:.4e}; reference DOPRI5 rtol 1e-11 vs RADAU5 rtol 1e-10 differ by {d:.2e}");
         println!("{:<8} {:>7} {:>9} {:>10} {:>10} {:>8} {:>7} {:>7} {:>7} {:>9} {:>11}", "method", "rtol", "atol", "min [ms]", "med [ms]", "steps", "nfev", "njev", "nlu", "jac evals", "max err");
         for (method, name) in [(Method::Radau5, "RADAU5"), (Method::Dopri5, "DOPRI5")] {
             if !filter.is_empty() && !name.to_lowercase().contains(&filter) && !theory.contains(&filter) {
