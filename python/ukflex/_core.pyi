@@ -1,6 +1,6 @@
 """Type stubs of the compiled Rust extension ``ukflex._core`` (private; use ``ukflex.System``)."""
 
-from typing import Dict, List, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -43,6 +43,34 @@ class System:
         """(q, qd) from the description's state fields, each shape (n,)."""
     def beam_shape(self, body_name: str, xi: float) -> Tuple[F64, F64]:
         """(S (2, n_f), N_psi (n_f,)) at x = xi * length of a beam."""
+    def beam_matrices(self, body_name: str) -> Tuple[F64, F64]:
+        """Constant elastic blocks (M_ff, K_ff) of a beam, each (n_f, n_f)."""
+    def rank_info(self) -> Dict[str, Any]:
+        """rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the last UK solve."""
+    def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None: ...
+    def set_pseudoinverse(self, kind: str) -> None: ...
+    def set_stabilization(self, kind: str = "none", alpha: float = 0.0, beta: float = 0.0) -> None: ...
+    def jac(self, t: float, y: F64, scheme: str = "central") -> F64:
+        """d[qd, qdd]/d[q, qd], shape (2n, 2n) (finite differences in Rust)."""
+    def integrate(
+        self,
+        t0: float,
+        y0: F64,
+        t_end: float,
+        method: str = "RADAU5",
+        rtol: float = 1e-6,
+        atol: Union[None, float, F64] = None,
+        t_eval: Optional[Sequence[float]] = None,
+        first_step: Optional[float] = None,
+        max_step: Optional[float] = None,
+        max_steps: int = 1_000_000,
+        projection_tol: Optional[float] = None,
+    ) -> Dict[str, Any]:
+        """Native integration; dict with t (nt,), y (2n, nt), status, message, statistics."""
+    def project(
+        self, t: float, q: F64, qd: F64, tol: float = 1e-12, max_iter: int = 20
+    ) -> Tuple[F64, F64, Dict[str, Any]]:
+        """Project (q, qd) onto Phi = 0, A qd + Phi_t = 0 in the mass metric."""
     def kinetic_energy(self, q: F64, qd: F64) -> float: ...
     def potential_energy(self, q: F64) -> float: ...
     @property

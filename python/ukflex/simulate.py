@@ -144,8 +144,10 @@ def simulate(
         Passed to the ``"cp"`` reference integrator.
     **options
         Further ``solve_ivp`` options (``max_step``, ``first_step``, ``jac``, ...).  For
-        ``"Radau"`` and ``"BDF"`` the default ``jac`` is :func:`fd_jacobian` (pass ``jac=None``
-        for scipy's own finite differences).
+        ``"Radau"`` and ``"BDF"`` the default ``jac`` is the core's finite-difference Jacobian
+        ``System.core.jac`` (or :func:`fd_jacobian` if the core lacks it); pass ``jac=None`` for
+        scipy's own ``num_jac``, which overflows on the exactly-zero columns of these systems.
+        ``nfev`` counts only the integrator's ``rhs`` calls, not those inside Jacobians.
 
     Returns
     -------
@@ -203,7 +205,8 @@ def simulate(
 
     y0 = np.concatenate([q_init, qd_init])
     if method in ("Radau", "BDF") and "jac" not in options:
-        options["jac"] = fd_jacobian(system)
+        core_jac = getattr(system.core, "jac", None)  # Rust finite differences, GIL released
+        options["jac"] = core_jac if core_jac is not None else fd_jacobian(system)
     start = time.perf_counter()
     sol = solve_ivp(system.rhs, (t0, t_end_f), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol_v, **options)
     wall = time.perf_counter() - start
