@@ -18,6 +18,9 @@
 //! after every accepted step -- the place for a projection onto the constraint manifold; when
 //! the hook changes `y` the stepper re-evaluates `f` there (`Stepper::restart_at`).
 
+// Hairer's constants are kept with all their printed digits; index loops mirror the papers.
+#![allow(clippy::excessive_precision, clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
+
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::jacobian::{uk_jacobian, JacobianWorkspace};
@@ -122,7 +125,7 @@ impl Options {
         if !(self.rtol >= 0.0) || !self.rtol.is_finite() || v.iter().any(|a| !(*a >= 0.0) || !a.is_finite()) {
             return Err(Error::invalid("integrator", "tolerances must be >= 0 and finite"));
         }
-        if self.rtol == 0.0 && v.iter().any(|a| *a == 0.0) {
+        if self.rtol == 0.0 && v.contains(&0.0) {
             return Err(Error::invalid("integrator", "rtol and atol cannot both be zero"));
         }
         Ok(v)
