@@ -270,3 +270,11 @@ def test_cli_run(tmp_path):
     assert out.returncode == 0, out.stderr
     assert "energy" in out.stdout and "max ||Phi||" in out.stdout
     assert (tmp_path / "pendulum.csv").exists() and (tmp_path / "pendulum.npz").exists()
+    bad = subprocess.run(
+        [sys.executable, "-m", "ukflex", "run", "slider_crank", "--param", "beam=eb"],
+        capture_output=True,
+        text=True,
+        env=env,
+    )
+    assert bad.returncode == 2
+    assert "InvalidSceneError" in bad.stderr and "'eb'" in bad.stderr and "Traceback" not in bad.stderr

@@ -259,9 +259,16 @@ def _build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Optional[List[str]] = None) -> int:
     """Entry point of the ``ukflex`` console script."""
+    from .errors import UkflexError
+
     parser = _build_parser()
     args = parser.parse_args(argv)
-    return int(args.func(args) or 0)
+    try:
+        return int(args.func(args) or 0)
+    except (UkflexError, ValueError, TypeError, NotImplementedError) as exc:
+        # user-facing problems (bad scene parameters, inconsistent scenes): one line, exit 2
+        print(f"ukflex {args.command}: error: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":  # pragma: no cover
