@@ -5,7 +5,7 @@ from __future__ import annotations
 import inspect
 import math
 import time
-from typing import Any, Dict, Optional, Sequence, Union
+from typing import Any, Callable, Dict, Optional, Sequence, Union
 
 import numpy as np
 from scipy.integrate import OdeSolver, solve_ivp
@@ -116,6 +116,7 @@ def simulate(
     q0: Optional[Sequence[float]] = None,
     qd0: Optional[Sequence[float]] = None,
     partition: Any = None,
+    progress: Optional[Callable[[float], None]] = None,
     **options: Any,
 ) -> SimulationResult:
     """Integrate the equations of motion from the system's consistent initial state to ``t_end``.
@@ -142,6 +143,11 @@ def simulate(
         Override the system's corrected initial state (not corrected again).
     partition : optional
         Passed to the ``"cp"`` reference integrator.
+    progress : callable, optional
+        ``progress(t)`` is called at the start and after every accepted step of a scipy
+        integrator (formulations ``"uk"`` and ``"uk-numpy"``; the ``"cp"`` reference integrator
+        takes no step hook, so there it is called only at the end).  Keep it cheap (throttle
+        output yourself); used by the CLI's progress display.
     **options
         Further ``solve_ivp`` options (``max_step``, ``first_step``, ``jac``, ...).  For
         ``"Radau"`` and ``"BDF"`` the default ``jac`` is the core's finite-difference Jacobian
@@ -197,11 +203,16 @@ def simulate(
             raise ValueError(f"t_eval must lie within [t0, t_end] = [{t0}, {t_end_f}]")
     q_init = system.q0 if q0 is None else _finite_array("q0", q0, (n,))
     qd_init = system.qd0 if qd0 is None else _finite_array("qd0", qd0, (n,))
+    if progress is not None and formulation != "cp":
+        options = _with_progress_event(options, progress)
 
     if formulation != "uk":
-        return _simulate_reference(
+        res = _simulate_reference(
             system, formulation, t_end_f, method, rtol, atol_v, t_eval, q_init, qd_init, partition, options
         )
+        if progress is not None and formulation == "cp" and res.t.size:
+            progress(float(res.t[-1]))
+        return res
 
     y0 = np.concatenate([q_init, qd_init])
     if method in ("Radau", "BDF") and "jac" not in options:
@@ -211,6 +222,18 @@ def simulate(
     sol = solve_ivp(system.rhs, (t0, t_end_f), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol_v, **options)
     wall = time.perf_counter() - start
     return _make_result(system, sol.t, sol.y, sol, wall, method, "uk", rtol, atol_v)
+
+
+def _with_progress_event(options: Dict[str, Any], progress: Callable[[float], None]) -> Dict[str, Any]:
+    """Add a never-triggering, non-terminal solve_ivp event that reports the step end time."""
+
+    def _progress_event(t: float, y: np.ndarray) -> float:
+        progress(float(t))
+        return 1.0  # constant sign: solve_ivp never searches for a root
+
+    user = options.get("events")
+    events = [] if user is None else (list(user) if isinstance(user, (list, tuple)) else [user])
+    return dict(options, events=events + [_progress_event])
 
 
 def _make_result(system, t, y, sol, wall, method, formulation, rtol, atol, extra=None) -> SimulationResult:
