@@ -6,7 +6,8 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
 use numpy::ndarray::ArrayView1;
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
+use pyo3::Borrowed;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyKeyError, PyValueError};
 use pyo3::prelude::*;
@@ -21,11 +22,50 @@ use crate::jacobian::{Differences, JacobianWorkspace};
 use crate::model::Model;
 use crate::uk;
 
-create_exception!(_core, UkflexError, PyException, "Base class of every ukflex error.");
-create_exception!(_core, InvalidSceneError, UkflexError, "Malformed or non-physical scene description.");
-create_exception!(_core, SingularMassError, UkflexError, "The mass matrix is not positive definite.");
-create_exception!(_core, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
-create_exception!(_core, SolverError, UkflexError, "A solver kernel failed.");
+create_exception!(ukflex, UkflexError, PyException, "Base class of every ukflex error.");
+create_exception!(ukflex, InvalidSceneError, UkflexError, "Malformed or non-physical scene description.");
+create_exception!(ukflex, SingularMassError, UkflexError, "The mass matrix is not positive definite.");
+create_exception!(ukflex, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
+create_exception!(ukflex, SolverError, UkflexError, "A solver kernel failed.");
+
+/// A 1-D float64 input. float64 vectors (what scipy passes) are read in place, strided or
+/// not; anything else array-like is converted once with `numpy.asarray(x, dtype=float64)`, and
+/// a wrong dimension or a non-numeric input is a `ValueError` naming what was expected.
+pub struct Vector<'py>(PyReadonlyArray1<'py, f64>);
+
+impl<'py> std::ops::Deref for Vector<'py> {
+    type Target = PyReadonlyArray1<'py, f64>;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Vector<'py> {
+    type Error = PyErr;
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Ok(a) = obj.extract::<PyReadonlyArray1<'py, f64>>() {
+            return Ok(Vector(a));
+        }
+        let py = obj.py();
+        let converted = py
+            .import("numpy")?
+            .call_method1("asarray", (obj, "float64"))
+            .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?;
+        let arr = converted
+            .cast_into::<numpy::PyArrayDyn<f64>>()
+            .map_err(|_| PyValueError::new_err("expected a 1-D array of floats"))?;
+        if arr.ndim() != 1 {
+            return Err(PyValueError::new_err(format!("expected a 1-D array of floats, got an array of shape {:?}", arr.shape())));
+        }
+        let a = arr.readonly();
+        let a1 = a
+            .as_array()
+            .into_dimensionality::<numpy::ndarray::Ix1>()
+            .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?
+            .to_owned();
+        Ok(Vector(PyArray1::from_owned_array(py, a1).readonly()))
+    }
+}
 
 fn to_py(e: Error) -> PyErr {
     let msg = e.to_string();
@@ -97,7 +137,7 @@ impl PySystem {
         }
     }
 
-    fn load(ws: &mut Workspace, q: &PyReadonlyArray1<f64>, qd: Option<&PyReadonlyArray1<f64>>) -> Result<(), Error> {
+    fn load(ws: &mut Workspace, q: &Vector<'_>, qd: Option<&Vector<'_>>) -> Result<(), Error> {
         read_into("q", &q.as_array(), &mut ws.q)?;
         match qd {
             Some(qd) => read_into("qd", &qd.as_array(), &mut ws.qd),
@@ -182,7 +222,7 @@ impl PySystem {
 
     /// Mass matrix M(q), shape (n, n).
     #[allow(non_snake_case)]
-    fn M<'py>(&self, py: Python<'py>, q: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn M<'py>(&self, py: Python<'py>, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.model.n;
         let m = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
@@ -194,7 +234,7 @@ impl PySystem {
 
     /// Generalized forces Q(t, q, qd) = applied + quadratic velocity + elastic, shape (n,).
     #[allow(non_snake_case)]
-    fn Q<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn Q<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
@@ -206,7 +246,7 @@ impl PySystem {
 
     /// Constraint Jacobian A = Phi_q(q), shape (m, n).
     #[allow(non_snake_case)]
-    fn A<'py>(&self, py: Python<'py>, q: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn A<'py>(&self, py: Python<'py>, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let (m, n) = (self.model.m, self.model.n);
         let v = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
@@ -217,7 +257,7 @@ impl PySystem {
     }
 
     /// Constraint values Phi(q, t), shape (m,).
-    fn phi<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn phi<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, None)?;
@@ -240,7 +280,7 @@ impl PySystem {
     }
 
     /// b = gamma(t, q, qd) (paper eq. 43), shape (m,).
-    fn b<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn b<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
@@ -251,7 +291,7 @@ impl PySystem {
     }
 
     /// UK acceleration qdd(t, q, qd), shape (n,).
-    fn qdd<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn qdd<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let out = PyArray1::<f64>::zeros(py, self.model.n, false);
         self.with_ws(|model, ws| {
             check_time(t)?;
@@ -265,7 +305,7 @@ impl PySystem {
     }
 
     /// Right-hand side for integrators: y = [q, qd] -> [qd, qdd], shape (2n,).
-    fn rhs<'py>(&self, py: Python<'py>, t: f64, y: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn rhs<'py>(&self, py: Python<'py>, t: f64, y: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.model.n;
         let out = PyArray1::<f64>::zeros(py, 2 * n, false);
         self.with_ws(|model, ws| {
@@ -290,7 +330,7 @@ impl PySystem {
     /// (t, q, qd), the minimum over `batches` batches of `reps` calls, GIL released. Lets a
     /// Python benchmark separate the core's time from the binding's overhead in one run.
     #[pyo3(signature = (t, q, qd, reps=1000, batches=21))]
-    fn _time_acceleration(&self, py: Python<'_>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>, reps: usize, batches: usize) -> PyResult<f64> {
+    fn _time_acceleration(&self, py: Python<'_>, t: f64, q: Vector<'_>, qd: Vector<'_>, reps: usize, batches: usize) -> PyResult<f64> {
         let n = self.model.n;
         let (mut qv, mut qdv) = (vec![0.0; n], vec![0.0; n]);
         read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
@@ -311,7 +351,7 @@ impl PySystem {
     }
 
     /// Lagrange multipliers (M qdd + A^T lambda = Q), shape (m,).
-    fn multipliers<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn multipliers<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
@@ -323,7 +363,7 @@ impl PySystem {
 
     /// (position Phi, velocity A qd + Phi_t, acceleration A qdd - b), each shape (m,).
     #[allow(clippy::type_complexity)]
-    fn residuals<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn residuals<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
         let m = self.model.m;
         let (p, v, a) = self.with_ws(|model, ws| {
             check_time(t)?;
@@ -398,7 +438,7 @@ impl PySystem {
     /// columns reuse the mass factor and the pseudoinverse of the base point. Runs with the GIL
     /// released. `scheme="forward"` halves the cost.
     #[pyo3(signature = (t, y, scheme="central"))]
-    fn jac<'py>(&self, py: Python<'py>, t: f64, y: PyReadonlyArray1<f64>, scheme: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn jac<'py>(&self, py: Python<'py>, t: f64, y: Vector<'py>, scheme: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.model.n;
         let scheme = match scheme {
             "central" => Differences::Central,
@@ -442,12 +482,12 @@ impl PySystem {
         &self,
         py: Python<'py>,
         t0: f64,
-        y0: PyReadonlyArray1<f64>,
+        y0: Vector<'py>,
         t_end: f64,
         method: &str,
         rtol: f64,
-        atol: Option<PyReadonlyArray1<f64>>,
-        t_eval: Option<PyReadonlyArray1<f64>>,
+        atol: Option<Vector<'py>>,
+        t_eval: Option<Vector<'py>>,
         first_step: Option<f64>,
         max_step: Option<f64>,
         max_steps: usize,
@@ -564,7 +604,7 @@ impl PySystem {
     /// position_correction, velocity_correction).
     #[pyo3(signature = (t, q, qd, tol=1e-12, max_iter=20))]
     #[allow(clippy::type_complexity)]
-    fn project<'py>(&self, py: Python<'py>, t: f64, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>, tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+    fn project<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         if !tol.is_finite() || tol <= 0.0 {
             return Err(PyValueError::new_err(format!("tol must be positive and finite, got {tol}")));
         }
@@ -618,7 +658,7 @@ impl PySystem {
     }
 
     /// Kinetic energy 1/2 qd^T M(q) qd.
-    fn kinetic_energy(&self, q: PyReadonlyArray1<f64>, qd: PyReadonlyArray1<f64>) -> PyResult<f64> {
+    fn kinetic_energy(&self, q: Vector<'_>, qd: Vector<'_>) -> PyResult<f64> {
         let n = self.model.n;
         self.with_ws(|model, ws| {
             Self::load(ws, &q, Some(&qd))?;
@@ -635,7 +675,7 @@ impl PySystem {
     }
 
     /// Potential energy: gravity + elastic strain + springs (and -F.r of constant loads).
-    fn potential_energy(&self, q: PyReadonlyArray1<f64>) -> PyResult<f64> {
+    fn potential_energy(&self, q: Vector<'_>) -> PyResult<f64> {
         self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
             Ok(dynamics::potential_energy(model, &ws.q))

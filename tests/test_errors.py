@@ -113,15 +113,19 @@ def test_wrong_shapes_raise_value_error(crank):
         simulate(crank, 0.01, atol=np.ones(3))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="core gap: a 2-D or non-float64 array raises TypeError(\"'ndarray' object is not an instance of "
-    "'ndarray'\") from the PyReadonlyArray1<f64> extraction instead of ValueError",
-)
-@pytest.mark.parametrize("bad", [np.zeros((9, 1)), np.zeros(9, dtype=np.int64)], ids=["2d", "int64"])
-def test_wrong_dimension_or_dtype_raises_value_error(crank, bad):
-    with pytest.raises(ValueError, match="q"):
+@pytest.mark.parametrize("bad", [np.zeros((9, 1)), np.zeros((3, 3)), np.array(["a"] * 9)], ids=["2d-column", "2d", "strings"])
+def test_wrong_dimension_or_type_raises_value_error_naming_the_argument(crank, bad):
+    with pytest.raises(ValueError, match="1-D array of floats") as info:
         crank.phi(0.0, bad)
+    # pyo3 attaches the argument name as an exception note (shown in every traceback)
+    assert any("'q'" in note for note in getattr(info.value, "__notes__", [])), info.value
+
+
+def test_integer_and_list_inputs_are_converted_like_numpy(crank):
+    q = crank.q0
+    as_int = np.round(q * 1000).astype(np.int64)
+    np.testing.assert_array_equal(crank.phi(0.0, as_int), crank.phi(0.0, as_int.astype(float)))
+    np.testing.assert_array_equal(crank.phi(0.0, list(q)), crank.phi(0.0, q))
 
 
 @pytest.mark.parametrize("bad", [float("nan"), float("inf")])
