@@ -5,6 +5,7 @@ from __future__ import annotations
 import inspect
 import math
 import time
+from types import SimpleNamespace
 from typing import Any, Callable, Dict, Optional, Sequence, Union
 
 import numpy as np
@@ -15,9 +16,13 @@ from .results import SimulationResult
 from .scene import Scene
 from .system import System
 
-__all__ = ["simulate", "METHODS", "FORMULATIONS", "as_system", "fd_jacobian"]
+__all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "fd_jacobian"]
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+#: Integrators that run entirely in Rust with the GIL released (``System.core.integrate``):
+#: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
+NATIVE_METHODS = ("DOPRI5", "RADAU5")
+_NATIVE_OPTIONS = ("first_step", "max_step", "max_steps", "projection_tol")
 FORMULATIONS = ("uk", "uk-numpy", "cp")
 
 
@@ -129,7 +134,11 @@ def simulate(
         End time [s], ``> t0`` (the system's initial time, normally 0).
     method : str or scipy OdeSolver subclass
         Any ``solve_ivp`` method: ``"Radau"`` (default, implicit, for the stiff elastic modes),
-        ``"BDF"``, ``"LSODA"``, ``"RK45"``, ``"RK23"``, ``"DOP853"``.
+        ``"BDF"``, ``"LSODA"``, ``"RK45"``, ``"RK23"``, ``"DOP853"``; or a native Rust integrator
+        (all steps in Rust, GIL released, same result object): ``"DOPRI5"`` (Dormand-Prince 5(4),
+        dense output) or ``"RADAU5"`` (Radau IIA order 5, Rust Jacobian). Native methods take the
+        options ``first_step``, ``max_step``, ``max_steps`` and ``projection_tol`` (project onto
+        the constraints after every accepted step); see docs/performance.md.
     rtol : float
         Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s).
     atol : float or array of shape (2n,), optional
@@ -171,8 +180,13 @@ def simulate(
     if formulation not in FORMULATIONS:
         raise ValueError(f"unknown formulation {formulation!r}; expected one of {FORMULATIONS}")
     if isinstance(method, str):
-        if method not in METHODS:
-            raise ValueError(f"unknown method {method!r}; expected one of {METHODS} or an OdeSolver subclass")
+        if method not in METHODS and method not in NATIVE_METHODS:
+            raise ValueError(
+                f"unknown method {method!r}; expected one of {METHODS}, a native method {NATIVE_METHODS} "
+                "or an OdeSolver subclass"
+            )
+        if method in NATIVE_METHODS and formulation != "uk":
+            raise ValueError(f"native method {method!r} integrates the Rust UK formulation only, not {formulation!r}")
     elif not (inspect.isclass(method) and issubclass(method, OdeSolver)):
         raise ValueError(f"method must be one of {METHODS} or an OdeSolver subclass, got {method!r}")
     system = as_system(scene_or_system)
@@ -203,6 +217,12 @@ def simulate(
             raise ValueError(f"t_eval must lie within [t0, t_end] = [{t0}, {t_end_f}]")
     q_init = system.q0 if q0 is None else _finite_array("q0", q0, (n,))
     qd_init = system.qd0 if qd0 is None else _finite_array("qd0", qd0, (n,))
+    if isinstance(method, str) and method in NATIVE_METHODS:
+        res = _simulate_native(system, method, t0, t_end_f, np.concatenate([q_init, qd_init]), rtol, atol_v, t_eval,
+                               options)
+        if progress is not None and res.t.size:
+            progress(float(res.t[-1]))
+        return res
     if progress is not None and formulation != "cp":
         options = _with_progress_event(options, progress)
 
@@ -234,6 +254,27 @@ def _with_progress_event(options: Dict[str, Any], progress: Callable[[float], No
     user = options.get("events")
     events = [] if user is None else (list(user) if isinstance(user, (list, tuple)) else [user])
     return dict(options, events=events + [_progress_event])
+
+
+def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options) -> SimulationResult:
+    """Run a native Rust integrator (``System.core.integrate``: all steps in Rust, GIL released)."""
+    unknown = sorted(set(options) - set(_NATIVE_OPTIONS))
+    if unknown:
+        raise TypeError(f"native method {method!r} does not take option(s) {unknown}; it accepts {_NATIVE_OPTIONS}")
+    kwargs: Dict[str, Any] = {}
+    for key in ("first_step", "max_step", "projection_tol"):
+        if options.get(key) is not None:
+            kwargs[key] = _positive_scalar(key, options[key])
+    if options.get("max_steps") is not None:
+        kwargs["max_steps"] = int(options["max_steps"])
+    atol_arr = np.atleast_1d(np.asarray(atol, dtype=float))
+    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
+    out = system.core.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),
+                                atol_arr, te, **kwargs)
+    info = SimpleNamespace(nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], status=out["status"],
+                           message=out["message"])
+    extra = {k: out[k] for k in ("naccept", "nreject", "jac_evals")}
+    return _make_result(system, out["t"], out["y"], info, out["wall_time"], method, "uk", rtol, atol, extra=extra)
 
 
 def _make_result(system, t, y, sol, wall, method, formulation, rtol, atol, extra=None) -> SimulationResult:

@@ -192,6 +192,8 @@ class System:
         self.beam_shape = core.beam_shape
         self.kinetic_energy = core.kinetic_energy
         self.potential_energy = core.potential_energy
+        # Jacobian of rhs, d[qd, qdd]/d[q, qd], shape (2n, 2n): finite differences in Rust (GIL released)
+        self.jac = core.jac
 
         self.n_coords: int = int(core.n_coords)
         self.n_constraints: int = int(core.n_constraints)
