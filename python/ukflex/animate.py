@@ -1,0 +1,304 @@
+"""Headless drawings and GIF animations of a simulated mechanism.
+
+Beams are drawn as their deformed axis, ``r(x) = R + A(theta) (x e_1 + s S(x) q_f)`` sampled
+along the beam from the element shape functions (``System.beam_shape``), with an optional
+magnification ``s`` of the elastic displacement (``deform_scale``).  Rigid bodies are drawn as
+lines from their centre of mass to every point where a joint, driver or force attaches to them
+(a crank becomes a bar from its pivot to its tip); joints are circles, ground attachments
+triangles, and ground lines of point-on-line and prismatic joints dashed lines.
+
+Rendering uses matplotlib's Agg canvas directly (no pyplot, no display needed) and Pillow (a
+matplotlib dependency) to write the GIF.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+__all__ = ["MechanismDrawer", "animate", "snapshots"]
+
+GROUND = "ground"
+
+
+def _markers_of(description: Dict[str, Any]) -> List[Tuple[str, Dict[str, Any], str]]:
+    """Every marker of the description as ``(item kind, marker dict, role)``."""
+    out = []
+    for j in description.get("joints") or []:
+        for role in ("a", "b", "point", "line"):
+            if role in j:
+                out.append((j["kind"], j[role], role))
+    for d in description.get("drivers") or []:
+        for role in ("a", "b", "point"):
+            if role in d:
+                out.append(("driver", d[role], role))
+    for f in description.get("forces") or []:
+        for role in ("a", "b", "point", "frame"):
+            if role in f:
+                out.append((f["kind"], f[role], role))
+    return out
+
+
+class MechanismDrawer:
+    """World-frame geometry of every body for a given ``q``.
+
+    Parameters
+    ----------
+    system : ukflex.System
+    deform_scale : float
+        Magnification of the elastic displacements in the drawing (1 = true scale).
+    points_per_element : int
+        Samples of each beam element's axis.
+    """
+
+    def __init__(self, system, deform_scale: float = 1.0, points_per_element: int = 8):
+        self.system = system
+        self.scale = float(deform_scale)
+        desc = system.description
+        self.bodies = {b["name"]: b for b in desc["bodies"]}
+        self.markers = _markers_of(desc)
+        self._beam_S: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
+        for name, b in self.bodies.items():
+            if b["kind"] == "beam":
+                k = max(2, points_per_element * int(b["elements"])) + 1
+                xi = np.linspace(0.0, 1.0, k)
+                S = np.array([np.asarray(system.beam_shape(name, float(x))[0]) for x in xi])  # (k, 2, n_f)
+                self._beam_S[name] = (xi * b["length"], S)
+        self._marker_S: Dict[int, np.ndarray] = {}
+        for i, (_, m, _) in enumerate(self.markers):
+            body = m["body"]
+            if body != GROUND and self.bodies[body]["kind"] == "beam":
+                self._marker_S[i] = np.asarray(system.beam_shape(body, float(m["xi"]))[0])
+        # rigid bodies: the attachment points in the body frame (+ the centre of mass)
+        self._rigid_points: Dict[str, np.ndarray] = {}
+        for name, b in self.bodies.items():
+            if b["kind"] == "rigid":
+                pts = [tuple(m["point"]) for _, m, _ in self.markers if m["body"] == name]
+                uniq = []
+                for p in pts:
+                    if all(math.hypot(p[0] - u[0], p[1] - u[1]) > 1e-12 for u in uniq):
+                        uniq.append(p)
+                self._rigid_points[name] = np.array(uniq, dtype=float).reshape(-1, 2)
+
+    def _frame(self, q: np.ndarray, name: str):
+        sl = self.system.body_slice(name)
+        qb = q[sl]
+        c, s = math.cos(qb[2]), math.sin(qb[2])
+        return qb, np.array([[c, -s], [s, c]])
+
+    def body_polyline(self, q: np.ndarray, name: str) -> np.ndarray:
+        """World points (k, 2) drawing body ``name`` at ``q``."""
+        b = self.bodies[name]
+        qb, R = self._frame(q, name)
+        if b["kind"] == "beam":
+            x, S = self._beam_S[name]
+            disp = S @ qb[3:]  # (k, 2)
+            local = np.column_stack([x + self.scale * disp[:, 0], self.scale * disp[:, 1]])
+            return qb[:2] + local @ R.T
+        com = np.asarray(b.get("com", (0.0, 0.0)), dtype=float)
+        pts = self._rigid_points[name]
+        if pts.shape[0] == 0:
+            local = com[None, :]
+        elif pts.shape[0] == 1:  # one attachment: a bar symmetric about the centre of mass
+            local = np.array([pts[0], 2.0 * com - pts[0]])
+        else:
+            seq = []
+            for p in pts:  # a star: com -> p -> com -> next point ...
+                seq += [com, p, com]
+            local = np.array(seq)
+        return qb[:2] + local @ R.T
+
+    def marker_position(self, q: np.ndarray, i: int) -> np.ndarray:
+        """World position (2,) of marker ``i`` (index into ``self.markers``)."""
+        _, m, _ = self.markers[i]
+        body = m["body"]
+        if body == GROUND:
+            return np.asarray(m["point"], dtype=float)
+        qb, R = self._frame(q, body)
+        if i in self._marker_S:
+            d = self._marker_S[i] @ qb[3:]
+            local = np.array([m["xi"] * self.bodies[body]["length"] + self.scale * d[0], self.scale * d[1]])
+        else:
+            local = np.asarray(m["point"], dtype=float)
+        return qb[:2] + R @ local
+
+    def joint_positions(self, q: np.ndarray) -> np.ndarray:
+        """World positions (k, 2) of the joints' first markers (revolute, weld) and of points on lines."""
+        out = [self.marker_position(q, i) for i, (kind, _, role) in enumerate(self.markers)
+               if (kind in ("revolute", "weld") and role == "a") or (kind == "point_on_line" and role == "point")]
+        return np.array(out).reshape(-1, 2)
+
+    def ground_points(self) -> np.ndarray:
+        pts = [m["point"] for kind, m, role in self.markers
+               if m["body"] == GROUND and kind in ("revolute", "weld", "spring_damper")]
+        return np.array(pts, dtype=float).reshape(-1, 2)
+
+    def ground_lines(self) -> List[Tuple[np.ndarray, float]]:
+        """(point, angle) of every line on the ground (point-on-line and prismatic joints)."""
+        return [(np.asarray(m["point"], dtype=float), float(m.get("angle", 0.0)))
+                for kind, m, role in self.markers
+                if m["body"] == GROUND and ((kind == "point_on_line" and role == "line") or (kind == "prismatic" and role == "b"))]
+
+    def bounds(self, qs: Sequence[np.ndarray]) -> Tuple[float, float, float, float]:
+        pts = [self.body_polyline(q, n) for q in qs for n in self.bodies]
+        pts.append(self.ground_points())
+        allp = np.vstack([p for p in pts if p.size])
+        lo, hi = allp.min(axis=0), allp.max(axis=0)
+        span = max(hi[0] - lo[0], hi[1] - lo[1], 1e-3)
+        pad = 0.08 * span
+        return lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad
+
+
+def _new_figure(size: Tuple[float, float], dpi: int):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=size, dpi=dpi)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+class _Scene2D:
+    """Artists of one axes, updated in place for every frame."""
+
+    COLORS = ("C0", "C3", "C2", "C1", "C4", "C5", "C6", "C8", "C9")
+
+    def __init__(self, ax, drawer: MechanismDrawer, limits, title: str):
+        self.ax, self.d = ax, drawer
+        x0, x1, y0, y1 = limits
+        ax.set_xlim(x0, x1)
+        ax.set_ylim(y0, y1)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_title(title, fontsize=10)
+        ax.grid(True, lw=0.3, color="0.85")
+        for p, ang in drawer.ground_lines():
+            L = 2.0 * max(x1 - x0, y1 - y0)
+            e = np.array([math.cos(ang), math.sin(ang)])
+            ax.plot([p[0] - L * e[0], p[0] + L * e[0]], [p[1] - L * e[1], p[1] + L * e[1]], "--", color="0.6", lw=0.8)
+        gp = drawer.ground_points()
+        if gp.size:
+            ax.plot(gp[:, 0], gp[:, 1], "^", color="0.3", ms=9, zorder=1)
+        self.lines = {}
+        for k, (name, b) in enumerate(drawer.bodies.items()):
+            lw = 2.5 if b["kind"] == "beam" else 4.0
+            (ln,) = ax.plot([], [], "-", lw=lw, color=self.COLORS[k % len(self.COLORS)], label=name,
+                            solid_capstyle="round", zorder=2, marker="o" if b["kind"] == "rigid" else None,
+                            ms=3)
+            self.lines[name] = ln
+        (self.joints,) = ax.plot([], [], "o", ms=6, mfc="white", mec="k", mew=1.2, zorder=3)
+        self.text = ax.text(0.02, 0.96, "", transform=ax.transAxes, va="top", fontsize=9)
+        ax.legend(loc="upper right", fontsize=8)
+
+    def animated(self) -> List[Any]:
+        return list(self.lines.values()) + [self.joints, self.text]
+
+    def update(self, q: np.ndarray, t: float) -> None:
+        for name, ln in self.lines.items():
+            p = self.d.body_polyline(q, name)
+            ln.set_data(p[:, 0], p[:, 1])
+        jp = self.d.joint_positions(q)
+        self.joints.set_data(jp[:, 0], jp[:, 1])
+        self.text.set_text(f"t = {t:.4f} s")
+
+
+def _title(res, deform_scale: float, title: Optional[str]) -> str:
+    base = title or "ukflex"
+    if any(b["kind"] == "beam" for b in res.system.description["bodies"]):
+        base += f" (elastic displacements x{deform_scale:g})" if deform_scale != 1.0 else " (true scale)"
+    return base
+
+
+def animate(
+    res,
+    path: str,
+    fps: int = 25,
+    frames: int = 150,
+    deform_scale: float = 1.0,
+    title: Optional[str] = None,
+    size: Tuple[float, float] = (6.4, 4.0),
+    dpi: int = 90,
+) -> int:
+    """Write a GIF of the mechanism over the result's output times.
+
+    Parameters
+    ----------
+    res : SimulationResult
+    path : str
+        Output ``.gif`` file.
+    fps : int
+        Frames per second of the GIF.
+    frames : int
+        Maximum number of frames (output times are subsampled evenly).
+    deform_scale : float
+        Magnification of the elastic displacements (drawing only).
+
+    Returns
+    -------
+    int
+        Number of frames written.
+    """
+    from PIL import Image
+
+    if res.t.size == 0:
+        raise ValueError("the result has no output times to animate")
+    idx = np.unique(np.linspace(0, res.t.size - 1, min(int(frames), res.t.size)).round().astype(int))
+    drawer = MechanismDrawer(res.system, deform_scale=deform_scale)
+    fig = _new_figure(size, dpi)
+    ax = fig.add_subplot(1, 1, 1)
+    sc = _Scene2D(ax, drawer, drawer.bounds([res.q[i] for i in idx]), _title(res, deform_scale, title))
+    fig.tight_layout()
+    # blitting: the static background (axes, ground, legend) is drawn once
+    for a in sc.animated():
+        a.set_animated(True)
+    canvas = fig.canvas
+    canvas.draw()
+    background = canvas.copy_from_bbox(fig.bbox)
+    images = []
+    for i in idx:
+        sc.update(res.q[i], float(res.t[i]))
+        canvas.restore_region(background)
+        for a in sc.animated():
+            ax.draw_artist(a)
+        rgba = np.asarray(canvas.buffer_rgba())
+        images.append(Image.fromarray(rgba[:, :, :3].copy()).quantize(colors=64, method=Image.Quantize.FASTOCTREE))
+    duration = max(int(round(1000.0 / max(int(fps), 1))), 20)
+    images[0].save(path, save_all=True, append_images=images[1:], duration=duration, loop=0, optimize=True)
+    return len(images)
+
+
+def snapshots(
+    res,
+    path: str,
+    times: Optional[Sequence[float]] = None,
+    deform_scale: float = 1.0,
+    title: Optional[str] = None,
+    size: Tuple[float, float] = (6.4, 4.0),
+    dpi: int = 120,
+) -> None:
+    """Write a PNG with the mechanism drawn at several times (default: 6 evenly spaced),
+    later instants darker."""
+    drawer = MechanismDrawer(res.system, deform_scale=deform_scale)
+    if times is None:
+        idx = np.unique(np.linspace(0, res.t.size - 1, min(6, res.t.size)).round().astype(int))
+    else:
+        idx = np.unique([int(np.argmin(np.abs(res.t - tt))) for tt in times])
+    fig = _new_figure(size, dpi)
+    ax = fig.add_subplot(1, 1, 1)
+    sc = _Scene2D(ax, drawer, drawer.bounds([res.q[i] for i in idx]), _title(res, deform_scale, title))
+    for ln in sc.lines.values():
+        ln.remove()
+    sc.joints.remove()
+    for k, i in enumerate(idx):
+        alpha = 0.25 + 0.75 * (k + 1) / len(idx)
+        for c, name in enumerate(drawer.bodies):
+            p = drawer.body_polyline(res.q[i], name)
+            ax.plot(p[:, 0], p[:, 1], "-", color=_Scene2D.COLORS[c % len(_Scene2D.COLORS)], alpha=alpha,
+                    lw=2.0, label=name if k == len(idx) - 1 else None)
+    sc.text.set_text("t = " + ", ".join(f"{res.t[i]:.3g}" for i in idx) + " s")
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
