@@ -3,16 +3,20 @@
 Commands
 --------
 ``ukflex paper --out DIR``
-    The paper's slider-crank with Timoshenko and Euler-Bernoulli couplers (gravity on):
-    ``DIR/fig4.csv`` and ``DIR/fig4.png`` (midpoint deflection / Lb vs time, the paper's Fig. 4),
-    peak deflection in 0..0.07 s and the position-constraint drift at ``t_end``.
+    Reproduce the paper: Fig. 4 (``fig4.csv``, ``fig4.png``) for the Timoshenko and the
+    Euler-Bernoulli coupler, and the Table 1 analogue (``table1.md``, ``table1.csv``).
 ``ukflex run SCENE``
-    Simulate a built-in scene (``ukflex list`` shows them) and print a summary.
+    Simulate a built-in scene or a TOML scene file; write CSV, NPZ, a plot of chosen outputs
+    and (``--animate``) a GIF.
 ``ukflex list``
     List the built-in scenes.
+``ukflex export NAME``
+    Write a built-in scene as a TOML scene file (a starting point for your own).
+``ukflex bench work-precision|elements|table1 --out DIR``
+    Error against run time for every integrator and formulation; the same over element
+    counts; the Table 1 analogue alone.
 
-Each command is a ``_cmd_<name>(args)`` function registered in ``_build_parser``; new commands
-(scene files, benchmarks) plug in the same way.
+Each command is a ``_cmd_<name>(args)`` function registered in ``_build_parser``.
 """
 
 from __future__ import annotations
@@ -23,15 +27,21 @@ import csv
 import os
 import sys
 import time
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Callable, Dict, List, Optional, Sequence, TextIO
 
 import numpy as np
 
-__all__ = ["main"]
+from .paper import PAPER_WINDOW, run_fig4
 
-PAPER_WINDOW = 0.07  # s, the time span of the paper's Fig. 4
+__all__ = ["main", "run_paper"]
+
+#: Backwards-compatible name of :func:`ukflex.paper.run_fig4`.
+run_paper = run_fig4
+
+RUN_DEFAULTS = {"t_end": 1.0, "method": "Radau", "rtol": 1e-6, "atol": None, "formulation": "uk", "samples": 201}
 
 
+# ----------------------------------------------------------------------------------- helpers
 def _positive_float(text: str) -> float:
     try:
         x = float(text)
@@ -52,135 +62,147 @@ def _positive_int(text: str) -> int:
     return x
 
 
-def _add_integrator_options(p: argparse.ArgumentParser, t_end: float) -> None:
-    from .simulate import METHODS
+def _float_list(text: str) -> List[float]:
+    return [_positive_float(t) for t in text.replace(" ", "").split(",") if t]
 
-    p.add_argument("--t-end", type=_positive_float, default=t_end, help=f"end time [s] (default {t_end})")
-    p.add_argument("--method", default="Radau", choices=METHODS, help="solve_ivp method (default Radau)")
-    p.add_argument("--rtol", type=_positive_float, default=1e-6, help="relative tolerance (default 1e-6)")
-    p.add_argument("--atol", type=_positive_float, default=None, help="absolute tolerance (default 1e-3 rtol)")
-    p.add_argument(
-        "--formulation", default="uk", choices=("uk", "uk-numpy", "cp"), help="acceleration formulation (default uk)"
-    )
+
+def _int_list(text: str) -> List[int]:
+    return [_positive_int(t) for t in text.replace(" ", "").split(",") if t]
+
+
+def _str_list(choices: Sequence[str]) -> Callable[[str], List[str]]:
+    def parse(text: str) -> List[str]:
+        items = [t for t in text.replace(" ", "").split(",") if t]
+        for it in items:
+            if it not in choices:
+                raise argparse.ArgumentTypeError(f"{it!r} is not one of {', '.join(choices)}")
+        return items
+
+    return parse
+
+
+class Progress:
+    """Simulated time / end time on one terminal line (stderr), only when it is a terminal.
+
+    ``callback(label, t_end)`` returns a ``progress(t)`` function for :func:`ukflex.simulate`;
+    the line appears after ``delay`` seconds (short runs stay quiet) and is refreshed at most
+    every ``interval`` seconds; :meth:`done` clears it.
+    """
+
+    def __init__(self, enabled: Optional[bool] = None, stream: Optional[TextIO] = None, delay: float = 0.5,
+                 interval: float = 0.2):
+        self.stream = stream or sys.stderr
+        if enabled is None:
+            enabled = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.enabled = enabled
+        self.delay, self.interval = delay, interval
+        self._shown = False
+
+    def callback(self, label: str, t_end: float) -> Optional[Callable[[float], None]]:
+        if not self.enabled:
+            return None
+        start = time.perf_counter()
+        last = [start]
+
+        def progress(t: float) -> None:
+            now = time.perf_counter()
+            if now - start < self.delay or now - last[0] < self.interval:
+                return
+            last[0] = now
+            frac = min(max(t / t_end, 0.0), 1.0) if t_end > 0 else 1.0
+            self.stream.write(f"\r{label}: t = {t:.6g} / {t_end:g} s ({100 * frac:5.1f} %), "
+                              f"{now - start:.1f} s elapsed ")
+            self.stream.flush()
+            self._shown = True
+
+        return progress
+
+    def done(self) -> None:
+        if self._shown:
+            self.stream.write("\r" + " " * 79 + "\r")
+            self.stream.flush()
+            self._shown = False
+
+
+def _progress_from(args: argparse.Namespace) -> Progress:
+    return Progress(enabled=getattr(args, "progress", None))
+
+
+def _add_progress_option(p: argparse.ArgumentParser) -> None:
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--progress", dest="progress", action="store_true", default=None,
+                   help="always show progress on stderr (default: only when stderr is a terminal)")
+    g.add_argument("--no-progress", dest="progress", action="store_false", help="never show progress")
+
+
+def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[str, Any]]) -> None:
+    """--t-end, --method, --rtol, --atol, --formulation.
+
+    With ``defaults=None`` the options default to None, so that a scene file's ``[solver]``
+    values fill in what the command line does not give (then :data:`RUN_DEFAULTS`).
+    """
+    from .simulate import FORMULATIONS, METHODS
+
+    def hint(key: str) -> str:
+        if defaults is not None:
+            v = defaults.get(key)
+        else:
+            v = RUN_DEFAULTS[key]
+        shown = "1e-3 rtol" if v is None else f"{v:g}" if isinstance(v, float) else str(v)
+        if defaults is None:
+            return f" (default: the scene file's [solver] {key}, else {shown})"
+        return f" (default {shown})"
+
+    d = defaults or {}
+    native = [m for m in METHODS if m in ("DOPRI5", "RADAU5")]
+    p.add_argument("--t-end", type=_positive_float, default=d.get("t_end"), help="end time [s]" + hint("t_end"))
+    p.add_argument("--method", default=d.get("method"), choices=METHODS,
+                   help="integrator: a scipy solve_ivp method"
+                        + (f" or a native Rust integrator ({', '.join(native)})" if native else "") + hint("method"))
+    p.add_argument("--rtol", type=_positive_float, default=d.get("rtol"), help="relative tolerance" + hint("rtol"))
+    p.add_argument("--atol", type=_positive_float, default=d.get("atol"), help="absolute tolerance" + hint("atol"))
+    p.add_argument("--formulation", default=d.get("formulation"), choices=FORMULATIONS,
+                   help="accelerations: uk (Rust Udwadia-Kalaba), uk-numpy (NumPy reference), cp (NumPy "
+                        "coordinate partitioning)" + hint("formulation"))
 
 
 # ----------------------------------------------------------------------------------- paper
-def run_paper(
-    out: str,
-    elements: int = 1,
-    t_end: float = 0.1,
-    method: str = "Radau",
-    rtol: float = 1e-6,
-    atol: Optional[float] = None,
-    samples: int = 5001,
-    formulation: str = "uk",
-    gravity: bool = True,
-    plot: bool = True,
-    stream=None,
-) -> Dict[str, Dict[str, float]]:
-    """Run the paper's slider-crank for both beam models and write ``fig4.csv`` / ``fig4.png``.
-
-    Returns
-    -------
-    dict
-        Per beam model: ``peak`` (max |v(0.5)|/Lb in 0..0.07 s), ``t_peak``, ``drift`` (||Phi||
-        at ``t_end``), ``wall_time``, ``nfev``.
-    """
-    from . import scenes
-    from .simulate import simulate
-
-    stream = stream or sys.stdout
-    os.makedirs(out, exist_ok=True)
-    t_eval = np.linspace(0.0, t_end, samples)
-    Lb = scenes.PAPER["coupler_length"]
-    curves: Dict[str, np.ndarray] = {}
-    summary: Dict[str, Dict[str, float]] = {}
-    for beam in ("timoshenko", "euler-bernoulli"):
-        scene = scenes.slider_crank(beam=beam, elements=elements, gravity=gravity)
-        res = simulate(scene, t_end, method=method, rtol=rtol, atol=atol, t_eval=t_eval, formulation=formulation)
-        if not res.success:
-            raise RuntimeError(f"{beam}: integration failed: {res.message}")
-        _, v = res.beam_displacement("coupler", 0.5)
-        w = v / Lb
-        curves[beam] = w
-        window = res.t <= PAPER_WINDOW + 1e-12
-        i = int(np.argmax(np.abs(w[window])))
-        summary[beam] = {
-            "peak": float(abs(w[window][i])),
-            "peak_signed": float(w[window][i]),
-            "t_peak": float(res.t[window][i]),
-            "drift": float(res.residuals["position"][-1]),
-            "max_drift": float(res.max_residual("position")),
-            "wall_time": res.wall_time,
-            "nfev": res.nfev,
-        }
-        s = summary[beam]
-        print(
-            f"{beam:16s} N={elements}: peak |v(0.5)|/Lb in 0..{min(PAPER_WINDOW, t_end):g} s = {s['peak']:.6e} "
-            f"(v/Lb = {s['peak_signed']:+.6e}) at t = {s['t_peak']:.5f} s; "
-            f"||Phi(t_end = {t_end:g} s)|| = {s['drift']:.3e} (max {s['max_drift']:.3e}); "
-            f"nfev {s['nfev']}, integration {s['wall_time']:.2f} s",
-            file=stream,
-        )
-    csv_path = os.path.join(out, "fig4.csv")
-    with open(csv_path, "w", newline="") as fh:
-        wr = csv.writer(fh)
-        wr.writerow(["t", "v_mid_over_Lb_timoshenko", "v_mid_over_Lb_euler_bernoulli"])
-        for row in zip(t_eval, curves["timoshenko"], curves["euler-bernoulli"]):
-            wr.writerow([repr(float(x)) for x in row])
-    print(f"wrote {csv_path}", file=stream)
-    if plot:
-        png_path = os.path.join(out, "fig4.png")
-        _plot_fig4(png_path, t_eval, curves, elements, gravity)
-        print(f"wrote {png_path}", file=stream)
-    return summary
-
-
-def _plot_fig4(path: str, t: np.ndarray, curves: Dict[str, np.ndarray], elements: int, gravity: bool) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7.0, 4.2))
-    ax.plot(t, curves["euler-bernoulli"], "-", lw=1.2, label="Euler-Bernoulli")
-    ax.plot(t, curves["timoshenko"], "--", lw=1.2, label="Timoshenko")
-    if t[-1] > PAPER_WINDOW:
-        ax.axvline(PAPER_WINDOW, color="0.6", lw=0.8, ls=":")
-    ax.axhline(0.0, color="0.8", lw=0.6)
-    ax.set_xlabel("Time (s)")
-    ax.set_ylabel("Midpoint deflection / $L_b$")
-    ax.set_title(f"Flexible slider-crank, coupler {elements} element(s){', gravity' if gravity else ''}")
-    ax.set_xlim(t[0], t[-1])
-    ax.legend()
-    ax.grid(True, lw=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-
-
 def _cmd_paper(args: argparse.Namespace) -> int:
-    run_paper(
-        args.out,
-        elements=args.elements,
-        t_end=args.t_end,
-        method=args.method,
-        rtol=args.rtol,
-        atol=args.atol,
-        samples=args.samples,
-        formulation=args.formulation,
-        gravity=not args.no_gravity,
-        plot=not args.no_plot,
-    )
+    from .paper import table1
+
+    prog = _progress_from(args)
+
+    def cb(label: str):
+        return prog.callback(label, args.t_end)
+
+    try:
+        run_fig4(
+            args.out,
+            elements=args.elements,
+            t_end=args.t_end,
+            method=args.method,
+            rtol=args.rtol,
+            atol=args.atol,
+            samples=args.samples,
+            formulation=args.formulation,
+            gravity=not args.no_gravity,
+            plot=not args.no_plot,
+            progress=cb,
+        )
+    finally:
+        prog.done()
+    if args.table != "none":
+        span = args.table_t_end if args.table_t_end is not None else min(args.t_end, PAPER_WINDOW)
+        table1(args.out, mode=args.table, elements=args.elements, t_end=span, repeats=args.repeats)
     return 0
 
 
-# ----------------------------------------------------------------------------------- run / list
+# ----------------------------------------------------------------------------------- run
 def _parse_params(items: Sequence[str]) -> Dict[str, Any]:
     params: Dict[str, Any] = {}
     for it in items:
         if "=" not in it:
-            raise SystemExit(f"ukflex: error: --param expects KEY=VALUE, got {it!r}")
+            raise ValueError(f"--param expects KEY=VALUE, got {it!r}")
         k, v = it.split("=", 1)
         try:
             params[k] = ast.literal_eval(v)
@@ -189,31 +211,109 @@ def _parse_params(items: Sequence[str]) -> Dict[str, Any]:
     return params
 
 
-def _cmd_run(args: argparse.Namespace) -> int:
+def _load_scene(scene: str, params: Sequence[str]):
+    """(name, System, solver settings, output settings) for a built-in name or a scene file."""
+    from .scenefile import SceneFileError, load
     from .scenes import SCENES
+
+    looks_like_file = scene.endswith(".toml") or os.sep in scene or os.path.exists(scene)
+    if scene in SCENES and not os.path.exists(scene):
+        system = SCENES[scene](**_parse_params(params)).build()
+        return scene, system, {}, {}
+    if not looks_like_file:
+        raise SceneFileError(f"{scene!r} is neither a built-in scene ({', '.join(SCENES)}) nor a scene file")
+    if params:
+        raise ValueError("--param applies to built-in scenes only; edit the scene file instead")
+    sf = load(scene)
+    return sf.name, sf.build(), sf.solver, sf.output
+
+
+def _write_outputs_csv(path: str, t: np.ndarray, names: Sequence[str], values: Sequence[np.ndarray]) -> None:
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["t"] + list(names))
+        for k in range(t.size):
+            w.writerow([repr(float(t[k]))] + [repr(float(v[k])) for v in values])
+
+
+def _plot_outputs(path: str, name: str, t: np.ndarray, labels: Sequence[str], values: Sequence[np.ndarray],
+                  subtitle: str) -> None:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    k = len(values)
+    fig = Figure(figsize=(7.0, 1.2 + 2.0 * k))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(k, 1, sharex=True, squeeze=False)[:, 0]
+    for ax, lab, v in zip(axes, labels, values):
+        ax.plot(t, v, lw=1.1)
+        ax.set_ylabel(lab, fontsize=8)
+        ax.grid(True, lw=0.3)
+    axes[-1].set_xlabel("t [s]")
+    axes[0].set_title(f"{name}: {subtitle}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from . import outputs
     from .simulate import simulate
 
-    scene = SCENES[args.scene](**_parse_params(args.param))
-    t0 = time.perf_counter()
-    system = scene.build()
-    build_time = time.perf_counter() - t0
-    print(f"scene {args.scene}: n = {system.n_coords} coordinates, m = {system.n_constraints} constraints, "
-          f"{system.n_dof} degree(s) of freedom; built in {build_time * 1e3:.1f} ms")
+    name, system, file_solver, file_output = _load_scene(args.scene, args.param)
+    solver = dict(RUN_DEFAULTS)
+    solver.update(file_solver)
+    for key in ("t_end", "method", "rtol", "atol", "formulation", "samples"):
+        v = getattr(args, key)
+        if v is not None:
+            solver[key] = v
+    extra = {k: file_solver[k] for k in ("max_step", "first_step") if k in file_solver}
+    exprs = args.plot or file_output.get("plot") or outputs.default_outputs(system)
+    for e in exprs:  # fail before a long run
+        outputs.validate(system, e)
+    animate = args.animate or file_output.get("animate", False)
+    deform_scale = args.deform_scale if args.deform_scale is not None else file_output.get("deform_scale", 1.0)
+    fps = args.fps if args.fps is not None else file_output.get("fps", 25)
+    frames = args.frames if args.frames is not None else file_output.get("frames", 150)
+    out = args.out or os.path.join("results", name)
+
+    print(f"scene {name}: n = {system.n_coords} coordinates, m = {system.n_constraints} constraints, "
+          f"{system.n_dof} degree(s) of freedom")
     print(system.initial_correction)
-    t_eval = np.linspace(0.0, args.t_end, args.samples)
-    res = simulate(system, args.t_end, method=args.method, rtol=args.rtol, atol=args.atol, t_eval=t_eval,
-                   formulation=args.formulation)
+    t_eval = np.linspace(system.t0, solver["t_end"], solver["samples"])
+    prog = _progress_from(args)
+    try:
+        res = simulate(system, solver["t_end"], method=solver["method"], rtol=solver["rtol"], atol=solver["atol"],
+                       t_eval=t_eval, formulation=solver["formulation"],
+                       progress=prog.callback(name, solver["t_end"]), **extra)
+    finally:
+        prog.done()
     e = res.energy()
-    print(f"{res.method} rtol={res.rtol:g}: status {res.status} ({res.message}); nfev {res.nfev}, njev {res.njev}, "
-          f"nlu {res.nlu}; integration {res.wall_time:.3f} s")
+    print(f"{res.method} rtol={res.rtol:g} ({res.formulation}): status {res.status} ({res.message}); nfev {res.nfev}, "
+          f"njev {res.njev}, nlu {res.nlu}; integration {res.wall_time:.3f} s")
     print(f"max ||Phi|| = {res.max_residual('position'):.3e}, max ||A qd + Phi_t|| = "
           f"{res.max_residual('velocity'):.3e}, max ||A qdd - b|| = {res.max_residual('acceleration'):.3e}")
     print(f"energy T + V: {e[0]:.9g} -> {e[-1]:.9g} (change {e[-1] - e[0]:+.3e})")
-    if args.out:
-        os.makedirs(args.out, exist_ok=True)
-        res.to_csv(os.path.join(args.out, f"{args.scene}.csv"))
-        res.save_npz(os.path.join(args.out, f"{args.scene}.npz"))
-        print(f"wrote {args.out}/{args.scene}.csv and .npz")
+
+    os.makedirs(out, exist_ok=True)
+    base = os.path.join(out, name)
+    res.to_csv(base + ".csv")
+    res.save_npz(base + ".npz")
+    written = [base + ".csv", base + ".npz"]
+    evaluated = [outputs.evaluate(res, x) for x in exprs]
+    for x, (_, v) in zip(exprs, evaluated):
+        print(f"{x}: min {np.min(v):.6g}, max {np.max(v):.6g}, final {v[-1]:.6g}")
+    _write_outputs_csv(base + "_outputs.csv", res.t, exprs, [v for _, v in evaluated])
+    written.append(base + "_outputs.csv")
+    if not args.no_plot:
+        _plot_outputs(base + ".png", name, res.t, [lab for lab, _ in evaluated], [v for _, v in evaluated],
+                      f"{res.method}, rtol {res.rtol:g}, {res.formulation}")
+        written.append(base + ".png")
+    if animate:
+        from .animate import animate as write_gif
+
+        nfr = write_gif(res, base + ".gif", fps=fps, frames=frames, deform_scale=deform_scale, title=name)
+        written.append(f"{base}.gif ({nfr} frames)")
+    print("wrote " + ", ".join(written))
     return 0 if res.success else 1
 
 
@@ -226,34 +326,249 @@ def _cmd_list(args: argparse.Namespace) -> int:
     return 0
 
 
-# ----------------------------------------------------------------------------------- parser
-def _build_parser() -> argparse.ArgumentParser:
+def _cmd_export(args: argparse.Namespace) -> int:
+    from .scenefile import dumps
     from .scenes import SCENES
 
-    parser = argparse.ArgumentParser(prog="ukflex", description="Planar flexible multibody dynamics (Udwadia-Kalaba).")
+    scene = SCENES[args.scene](**_parse_params(args.param))
+    doc = (SCENES[args.scene].__doc__ or "").strip().splitlines()[0]
+    params = " ".join(f"--param {p}" for p in args.param)
+    text = dumps(scene, name=args.scene, description=doc,
+                 solver={"t_end": args.t_end, "method": args.method, "rtol": args.rtol},
+                 header=f"ukflex scene file: built-in scene '{args.scene}' (ukflex export {args.scene}"
+                        f"{' ' + params if params else ''}).\nFormat: docs/scene-format.md; run with: ukflex run FILE")
+    if args.output in (None, "-"):
+        sys.stdout.write(text)
+    else:
+        with open(args.output, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        print(f"wrote {args.output}")
+    return 0
+
+
+# ----------------------------------------------------------------------------------- bench
+def _cmd_bench_wp(args: argparse.Namespace) -> int:
+    from .workprecision import run_work_precision
+
+    rtols = args.rtols or ([1e-3, 1e-5, 1e-7] if args.quick else None)
+    kw: Dict[str, Any] = {}
+    if rtols:
+        kw["rtols"] = rtols
+    if args.methods is not None:
+        kw["methods"] = args.methods
+    if args.formulations is not None:
+        kw["formulations"] = args.formulations
+    if args.native is not None:
+        kw["native"] = args.native
+    run_work_precision(args.out, beam=args.beam, elements=args.elements, t_end=args.t_end, samples=args.samples,
+                       budget=args.budget, ref_rtol=args.ref_rtol, skip_after_timeout=not args.no_skip,
+                       plot=not args.no_plot, **kw)
+    return 0
+
+
+def _cmd_bench_elements(args: argparse.Namespace) -> int:
+    from .workprecision import run_elements
+
+    cases = []
+    for c in args.cases.split(","):
+        if ":" not in c:
+            raise ValueError(f"--cases expects FORMULATION:METHOD items, got {c!r}")
+        f, m = c.split(":", 1)
+        cases.append((f.strip(), m.strip()))
+    kw: Dict[str, Any] = {}
+    if args.rtols:
+        kw["rtols"] = args.rtols
+    run_elements(args.out, elements=args.elements, cases=cases, beam=args.beam, t_end=args.t_end,
+                 samples=args.samples, budget=args.budget, ref_rtol=args.ref_rtol,
+                 skip_after_timeout=not args.no_skip, plot=not args.no_plot, **kw)
+    return 0
+
+
+def _cmd_bench_table1(args: argparse.Namespace) -> int:
+    from .paper import table1
+
+    table1(args.out, mode=args.mode, elements=args.elements, t_end=args.t_end, method=args.method, rtol=args.rtol,
+           repeats=args.repeats, max_states=args.max_states, whole=args.whole or None,
+           whole_repeats=args.whole_repeats)
+    return 0
+
+
+# ----------------------------------------------------------------------------------- parser
+_FMT = argparse.RawDescriptionHelpFormatter
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    from .outputs import OUTPUT_HELP
+    from .scenes import SCENES
+    from .workprecision import DEFAULT_RTOLS, FORMULATIONS as WP_FORMS, NATIVE_METHODS, SCIPY_METHODS
+
+    parser = argparse.ArgumentParser(
+        prog="ukflex",
+        formatter_class=_FMT,
+        description="Planar flexible multibody dynamics with the Udwadia-Kalaba formulation (Rust core), "
+                    "cross-checked against coordinate partitioning (NumPy).",
+        epilog="examples:\n"
+               "  ukflex paper --out results/paper          # Fig. 4 and the Table 1 analogue\n"
+               "  ukflex run examples/slider_crank.toml --animate\n"
+               "  ukflex run pendulum --t-end 2 --method DOP853 --plot rod.theta --plot energy\n"
+               "  ukflex export four_bar > my_scene.toml    # start a scene file from a built-in scene\n"
+               "  ukflex bench work-precision --out results/wp --quick\n"
+               "\nRun 'ukflex COMMAND --help' for the options of a command.",
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
 
-    p = sub.add_parser("paper", help="reproduce the paper's Fig. 4 (flexible slider-crank)")
-    p.add_argument("--out", required=True, help="output directory for fig4.csv and fig4.png")
+    # paper ---------------------------------------------------------------------------------
+    p = sub.add_parser(
+        "paper", formatter_class=_FMT,
+        help="reproduce the paper: Fig. 4 and the Table 1 analogue",
+        description="Reproduce Pennestri, Valentini, de Falco (2010) on the flexible slider-crank.\n\n"
+                    "Fig. 4: coupler midpoint deflection v(Lb/2)/Lb vs time, Timoshenko and Euler-Bernoulli\n"
+                    "coupler (DIR/fig4.csv, DIR/fig4.png; peak in 0..0.07 s and constraint drift printed).\n\n"
+                    "Table 1 analogue (DIR/table1.md, DIR/table1.csv): time spent computing accelerations over a\n"
+                    "whole simulation (scipy BDF, rtol 1e-6, over 0..min(t-end, 0.07) s), UK (Rust kernel,\n"
+                    "Rust via Python, NumPy) and CP (NumPy, partition once / every call), all evaluated on the\n"
+                    "same recorded states, best of --repeats, with the ratios next to the paper's 3.1x and the\n"
+                    "machine's name. --table quick (default, about a minute) times at most 1000 of the states\n"
+                    "and projects the total; --table full times all of them and adds whole-simulation runs of\n"
+                    "every formulation (tens of minutes).",
+    )
+    p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--elements", type=_positive_int, default=1, help="coupler elements (default 1, as in the paper)")
-    _add_integrator_options(p, 0.1)
+    _add_integrator_options(p, {"t_end": 0.1, "method": "Radau", "rtol": 1e-6, "atol": None, "formulation": "uk"})
     p.add_argument("--samples", type=_positive_int, default=5001, help="output points in [0, t_end] (default 5001)")
     p.add_argument("--no-gravity", action="store_true", help="switch gravity off")
     p.add_argument("--no-plot", action="store_true", help="skip fig4.png")
+    p.add_argument("--table", choices=("quick", "full", "none"), default="quick",
+                   help="Table 1 analogue: quick (default), full, or none")
+    p.add_argument("--table-t-end", type=_positive_float, default=None,
+                   help="simulated span of the Table 1 run [s] (default min(t-end, 0.07))")
+    p.add_argument("--repeats", type=_positive_int, default=5, help="timing repeats, best kept (default 5)")
+    _add_progress_option(p)
     p.set_defaults(func=_cmd_paper)
 
-    p = sub.add_parser("run", help="simulate a built-in scene and print a summary")
-    p.add_argument("scene", choices=sorted(SCENES), help="built-in scene")
-    _add_integrator_options(p, 1.0)
-    p.add_argument("--samples", type=_positive_int, default=201, help="output points (default 201)")
+    # run -----------------------------------------------------------------------------------
+    p = sub.add_parser(
+        "run", formatter_class=_FMT,
+        help="simulate a built-in scene or a TOML scene file",
+        description="Simulate SCENE and write, into --out (default results/NAME):\n"
+                    "  NAME.csv          t, every coordinate and rate\n"
+                    "  NAME.npz          t, q, qd, residual histories, statistics, names\n"
+                    "  NAME_outputs.csv  t and the chosen outputs (--plot)\n"
+                    "  NAME.png          plot of the chosen outputs (unless --no-plot)\n"
+                    "  NAME.gif          animation of the mechanism (--animate)\n\n"
+                    "SCENE is a built-in scene (ukflex list) or a TOML scene file (docs/scene-format.md,\n"
+                    "examples/*.toml). Options given here override the file's [solver] and [output] tables.\n\n"
+                    f"Output expressions (--plot): {OUTPUT_HELP}.\n"
+                    "Default: v(BEAM, 0.5)/L of every beam, else the bodies' angles.",
+    )
+    p.add_argument("scene", metavar="SCENE", help=f"built-in scene ({', '.join(SCENES)}) or path to a .toml file")
+    _add_integrator_options(p, None)
+    p.add_argument("--samples", type=_positive_int, default=None,
+                   help="output points in [t0, t_end] (default: the file's [solver] samples, else 201)")
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
-                   help="scene function argument, e.g. --param elements=4 (repeatable)")
-    p.add_argument("--out", default=None, help="write SCENE.csv and SCENE.npz to this directory")
+                   help="built-in scene argument, e.g. --param elements=4 (repeatable)")
+    p.add_argument("--out", default=None, help="output directory (default results/NAME)")
+    p.add_argument("--plot", action="append", default=None, metavar="EXPR",
+                   help="output to plot and write, e.g. 'v(coupler, 0.5)/L' or crank.theta (repeatable)")
+    p.add_argument("--no-plot", action="store_true", help="do not write NAME.png")
+    p.add_argument("--animate", action="store_true", help="write NAME.gif (headless)")
+    p.add_argument("--deform-scale", type=_positive_float, default=None,
+                   help="magnification of the elastic displacements in the animation (default 1)")
+    p.add_argument("--fps", type=_positive_int, default=None, help="GIF frames per second (default 25)")
+    p.add_argument("--frames", type=_positive_int, default=None, help="maximum number of GIF frames (default 150)")
+    _add_progress_option(p)
     p.set_defaults(func=_cmd_run)
 
-    p = sub.add_parser("list", help="list the built-in scenes")
+    # list / export -------------------------------------------------------------------------
+    p = sub.add_parser("list", help="list the built-in scenes", description="List the built-in scenes.")
     p.set_defaults(func=_cmd_list)
+
+    p = sub.add_parser("export", help="write a built-in scene as a TOML scene file",
+                       description="Write built-in scene NAME (with --param arguments) as a TOML scene file, "
+                                   "to stdout or -o FILE.")
+    p.add_argument("scene", metavar="NAME", choices=sorted(SCENES), help=f"built-in scene ({', '.join(SCENES)})")
+    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                   help="scene function argument, e.g. --param elements=4 (repeatable)")
+    p.add_argument("-o", "--output", default=None, help="output file (default stdout)")
+    p.add_argument("--t-end", type=_positive_float, default=0.1, help="[solver] t_end to write (default 0.1)")
+    p.add_argument("--method", default="DOP853", help="[solver] method to write (default DOP853)")
+    p.add_argument("--rtol", type=_positive_float, default=1e-6, help="[solver] rtol to write (default 1e-6)")
+    p.set_defaults(func=_cmd_export)
+
+    # bench ---------------------------------------------------------------------------------
+    p = sub.add_parser("bench", help="work-precision studies and the Table 1 analogue",
+                       description="Benchmarks on the paper's slider-crank: 'work-precision', 'elements', 'table1'.")
+    bsub = p.add_subparsers(dest="bench", metavar="BENCH")
+    bsub.required = True
+    rt = ",".join(f"{r:.0e}" for r in DEFAULT_RTOLS)
+
+    def common(q: argparse.ArgumentParser, ref_rtol: float) -> None:
+        q.add_argument("--out", required=True, help="output directory")
+        q.add_argument("--beam", choices=("timoshenko", "euler-bernoulli"), default="timoshenko",
+                       help="coupler beam theory (default timoshenko)")
+        q.add_argument("--t-end", type=_positive_float, default=0.1, help="end time [s] (default 0.1)")
+        q.add_argument("--samples", type=_positive_int, default=1001,
+                       help="output times where the error is measured (default 1001)")
+        q.add_argument("--rtols", type=_float_list, default=None, help=f"comma-separated rtols (default {rt})")
+        q.add_argument("--budget", type=_positive_float, default=60.0, help="wall-time budget per run [s] (default 60)")
+        q.add_argument("--ref-rtol", type=_positive_float, default=ref_rtol,
+                       help=f"rtol of the reference solutions (default {ref_rtol:g})")
+        q.add_argument("--no-skip", action="store_true",
+                       help="run tighter tolerances even after a looser one of the same line exceeded the budget")
+        q.add_argument("--no-plot", action="store_true", help="skip the PNG")
+
+    q = bsub.add_parser(
+        "work-precision", formatter_class=_FMT,
+        help="error vs wall time for every method x formulation x rtol",
+        description="Simulate the paper's scene with every solve_ivp method x formulation (UK Rust, UK NumPy,\n"
+                    "CP NumPy) and the native Rust integrators, at every rtol (atol = 1e-3 rtol); measure the\n"
+                    "error of v(0.5)/Lb over the trajectory and of its peak against a tight reference (native\n"
+                    "DOPRI5 checked by native RADAU5), the constraint drift at the end, the wall time and the\n"
+                    "rhs evaluations. Writes work_precision.csv, work_precision.png (log-log error vs time,\n"
+                    "over-budget runs marked) and work_precision.md (best method per accuracy level).\n"
+                    "The full grid takes an hour or more; --quick runs 3 tolerances.",
+    )
+    common(q, 1e-13)
+    q.add_argument("--elements", type=_positive_int, default=1, help="coupler elements (default 1)")
+    q.add_argument("--methods", type=_str_list(SCIPY_METHODS + ("RK23",)), default=None,
+                   help=f"comma-separated scipy methods (default {','.join(SCIPY_METHODS)})")
+    q.add_argument("--formulations", type=_str_list(WP_FORMS), default=None,
+                   help=f"comma-separated formulations (default {','.join(WP_FORMS)})")
+    q.add_argument("--native", type=_str_list(NATIVE_METHODS), default=None,
+                   help=f"comma-separated native integrators (default {','.join(NATIVE_METHODS)}; '' for none)")
+    q.add_argument("--quick", action="store_true", help="rtols 1e-3, 1e-5, 1e-7 only")
+    q.set_defaults(func=_cmd_bench_wp)
+
+    q = bsub.add_parser(
+        "elements", formatter_class=_FMT,
+        help="the work-precision study over coupler element counts",
+        description="Work-precision for N = 1, 2, 4, 8 coupler elements with the best methods. Two errors:\n"
+                    "against the tight reference of the same N (integration error) and against the tight\n"
+                    "reference of the largest N (discretization + integration: what a budget buys for the\n"
+                    "physical problem). Writes elements.csv, elements.png, elements.md.",
+    )
+    common(q, 1e-12)
+    q.add_argument("--elements", type=_int_list, default=[1, 2, 4, 8], help="comma-separated N (default 1,2,4,8)")
+    q.add_argument("--cases", default="native:DOPRI5,native:RADAU5,uk:DOP853",
+                   help="comma-separated FORMULATION:METHOD (default native:DOPRI5,native:RADAU5,uk:DOP853)")
+    q.set_defaults(func=_cmd_bench_elements)
+
+    q = bsub.add_parser("table1", formatter_class=_FMT, help="the Table 1 analogue alone",
+                        description="Time spent computing accelerations, UK vs CP, both beam models (see "
+                                    "'ukflex paper --help'). Writes table1.md and table1.csv.")
+    q.add_argument("--out", required=True, help="output directory")
+    q.add_argument("--mode", choices=("quick", "full"), default="full", help="quick or full (default full)")
+    q.add_argument("--elements", type=_positive_int, default=1, help="coupler elements (default 1)")
+    q.add_argument("--t-end", type=_positive_float, default=PAPER_WINDOW, help="simulated span [s] (default 0.07)")
+    q.add_argument("--method", default="BDF", help="scipy method of the recording run (default BDF, like ode15s)")
+    q.add_argument("--rtol", type=_positive_float, default=1e-6, help="rtol of the runs (default 1e-6)")
+    q.add_argument("--repeats", type=_positive_int, default=5, help="timing sweeps, best kept (default 5)")
+    q.add_argument("--max-states", type=_positive_int, default=1000, help="states timed in quick mode (default 1000)")
+    q.add_argument("--whole", action="store_true", help="also whole-simulation runs in quick mode")
+    q.add_argument("--whole-repeats", type=_positive_int, default=None,
+                   help="repeats of each whole-simulation run (default --repeats)")
+    q.set_defaults(func=_cmd_bench_table1)
     return parser
 
 
@@ -265,10 +580,14 @@ def main(argv: Optional[List[str]] = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
-    except (UkflexError, ValueError, TypeError, NotImplementedError) as exc:
-        # user-facing problems (bad scene parameters, inconsistent scenes): one line, exit 2
-        print(f"ukflex {args.command}: error: {type(exc).__name__}: {exc}", file=sys.stderr)
+    except (UkflexError, ValueError, TypeError, NotImplementedError, KeyError) as exc:
+        # user-facing problems (bad scene files or parameters, inconsistent scenes): one line, exit 2
+        msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+        print(f"ukflex {args.command}: error: {type(exc).__name__}: {msg}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"ukflex {args.command}: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover
