@@ -135,3 +135,10 @@ def test_dumps_values():
     text = scenefile.dumps({"bodies": [{"name": "a b", "kind": "rigid", "mass": np.float64(2), "inertia": 1,
                                         "com": [0.0, 1e-300]}]}, initial={"hold": None})
     assert 'name = "a b"' in text and "mass = 2.0" in text and "1e-300" in text and 'hold = "none"' in text
+
+
+def test_native_integrator_names_are_accepted():
+    from ukflex.simulate import NATIVE_METHODS
+
+    for m in NATIVE_METHODS:
+        assert scenefile.loads(TINY.replace('method = "DOP853"', f'method = "{m}"')).solver["method"] == m

@@ -143,6 +143,12 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
     """
     from .simulate import FORMULATIONS, METHODS
 
+    try:
+        from .simulate import NATIVE_METHODS as native
+    except ImportError:  # pragma: no cover - older simulate.py
+        native = ()
+    native = list(native)
+
     def hint(key: str) -> str:
         if defaults is not None:
             v = defaults.get(key)
@@ -154,9 +160,8 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
         return f" (default {shown})"
 
     d = defaults or {}
-    native = [m for m in METHODS if m in ("DOPRI5", "RADAU5")]
     p.add_argument("--t-end", type=_positive_float, default=d.get("t_end"), help="end time [s]" + hint("t_end"))
-    p.add_argument("--method", default=d.get("method"), choices=METHODS,
+    p.add_argument("--method", default=d.get("method"), choices=list(METHODS) + native,
                    help="integrator: a scipy solve_ivp method"
                         + (f" or a native Rust integrator ({', '.join(native)})" if native else "") + hint("method"))
     p.add_argument("--rtol", type=_positive_float, default=d.get("rtol"), help="relative tolerance" + hint("rtol"))

@@ -243,6 +243,11 @@ def _initial(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
 def _solver(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
     from .simulate import FORMULATIONS, METHODS
 
+    try:
+        from .simulate import NATIVE_METHODS
+    except ImportError:  # pragma: no cover - older simulate.py
+        NATIVE_METHODS = ()
+    METHODS = tuple(METHODS) + tuple(NATIVE_METHODS)
     _check_keys(path, "[solver]", d, SOLVER_KEYS)
     out: Dict[str, Any] = {}
     for key in ("t_end", "rtol", "atol", "max_step", "first_step"):
