@@ -80,8 +80,14 @@ pub fn factor_constraints(model: &Model, data: &mut Data) -> Result<()> {
             }
             if backend == SvdBackend::Auto && m > AUTO_JACOBI_MAX_ROWS {
                 faer_svd(data)?;
-            } else {
-                jacobi_of_r(model, data)?;
+            } else if jacobi_of_r(model, data).is_err() {
+                if backend == SvdBackend::QrJacobi {
+                    return Err(Error::Solver(format!("Jacobi SVD of A F^-T did not converge in {} sweeps", crate::small_svd::MAX_SWEEPS)));
+                }
+                // The one-sided Jacobi sweeps can stall on a rank-deficient B (redundant
+                // constraint rows: columns of rounding-level norm keep being rotated); faer's
+                // bidiagonal SVD of the same B^T (still in `data.bt`) is the robust fallback.
+                faer_svd(data)?;
             }
         }
         SvdBackend::Faer => faer_svd(data)?,
