@@ -5,7 +5,9 @@ Rust core (``ukflex._core``, private) + Python API:
 * :class:`Scene` -- scene description builder (bodies, joints, drivers, forces, initial guess);
 * :class:`System` -- compiled Rust-backed system with a consistent initial state;
 * :func:`simulate` -- time integration with ``scipy.integrate.solve_ivp``;
-* :mod:`ukflex.scenes` -- built-in scenes (the paper's slider-crank, pendulums, ...).
+* :mod:`ukflex.scenes` -- built-in scenes (the paper's slider-crank, pendulums, ...);
+* :mod:`ukflex.extreme` -- catalogue of stiff and extreme scenes; :mod:`ukflex.stability` --
+  stabilization, diagnostics (rank loss, drift, buckling, FFRF validity) and the stability report.
 """
 
 from .errors import (
@@ -33,6 +35,7 @@ from .system import InitialCorrection, System
 from .results import SimulationResult
 from .simulate import simulate
 from . import scenes
+from . import extreme
 
 __version__ = "0.1.0"
 
@@ -53,6 +56,7 @@ __all__ = [
     "SimulationResult",
     "simulate",
     "scenes",
+    "extreme",
     "UkflexError",
     "InvalidSceneError",
     "SingularMassError",
