@@ -42,11 +42,41 @@ from scipy.integrate import solve_ivp
 from ._blas import single_blas_thread
 from .uk import SimulationResult, _as_model, correct_initial_state, fd_jacobian
 
-__all__ = ["simulate_cp", "choose_partition", "CPPartition", "NewtonFailure"]
+__all__ = ["simulate_cp", "choose_partition", "CPPartition", "NewtonFailure", "SingularDependentBlock"]
 
 
 class NewtonFailure(RuntimeError):
     pass
+
+
+class SingularDependentBlock(RuntimeError):
+    """The dependent block ``A_D`` of the partition is singular: coordinate partitioning cannot
+    express the dependent coordinates through the independent ones (a kinematic singularity,
+    or redundant rows the rank decision did not catch). Raised instead of returning garbage."""
+
+
+def _solve_dependent(AD, rhs, t, part, what):
+    try:
+        x = np.linalg.solve(AD, rhs)
+    except np.linalg.LinAlgError as exc:
+        raise SingularDependentBlock(
+            f"coordinate partitioning broke down at t={t:.6g} while solving for {what}: the dependent "
+            f"block A_D (rows {part.rows.tolist()}, coordinates {part.dep.tolist()}) is singular ({exc}); "
+            "the mechanism is at a kinematic singularity or has redundant constraints") from exc
+    # growth |A_D| |x| / |rhs| is a cheap lower bound of cond(A_D): above 1e12 fewer than ~4
+    # significant digits of x survive, i.e. the partition is numerically singular
+    scale = np.abs(rhs).max() if np.size(rhs) else 0.0
+    growth = np.abs(AD).max() * np.abs(x).max() / scale if scale > 0 else 0.0
+    if not np.all(np.isfinite(x)) or growth > _SINGULAR_GROWTH:
+        raise SingularDependentBlock(
+            f"coordinate partitioning broke down at t={t:.6g} while solving for {what}: the dependent "
+            f"block A_D (rows {part.rows.tolist()}, coordinates {part.dep.tolist()}) is numerically singular "
+            f"(cond = {np.linalg.cond(AD):.3e}); the mechanism is at a kinematic singularity of this "
+            "partition (repartition) or has redundant constraints")
+    return x
+
+
+_SINGULAR_GROWTH = 1e12
 
 
 class CPPartition:
@@ -107,13 +137,13 @@ class _CPSystem:
             if it == self.maxit:
                 raise NewtonFailure(f"Newton-Raphson on Phi=0 did not converge at t={t:.6g} "
                                     f"(|Phi|={np.abs(r).max():.3e})")
-            q[dep] -= np.linalg.solve(AD, r)
+            q[dep] -= _solve_dependent(AD, r, t, p, "the dependent positions (Newton)")
         self.q = q
         qd = np.zeros(m.n)
         qd[p.ind] = qdI
         if dep.size:
             rhs = -(A[np.ix_(rows, p.ind)] @ qdI + m.phi_t(t)[rows])
-            qd[dep] = np.linalg.solve(AD, rhs)
+            qd[dep] = _solve_dependent(AD, rhs, t, p, "the dependent velocities")
         else:
             AD = np.zeros((0, 0))
         return q, qd, AD
@@ -134,7 +164,7 @@ def reduced_accelerations(model, p, t, q, qd):
     Bm[p.ind, np.arange(p.ind.size)] = 1.0
     c = np.zeros(n)
     if p.dep.size:
-        X = np.linalg.solve(AD, np.column_stack([AI, br]))
+        X = _solve_dependent(AD, np.column_stack([AI, br]), t, p, "the reduced equations")
         Bm[p.dep] = -X[:, :-1]
         c[p.dep] = X[:, -1]
     Mh = Bm.T @ M @ Bm
