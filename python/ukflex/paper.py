@@ -32,7 +32,9 @@ call.  Here:
      velocities, then the reduced equations -- what ``simulate(formulation="cp")`` does per
      call);
    * CP, NumPy, partition every call (the paper's implementation: pivoted QR of ``A`` at every
-     call, then the reduced equations; no recovery, the full state is integrated).
+     call, then the reduced equations; no recovery, the full state is integrated);
+   * for reference, the NumPy model terms ``M, Q, A, gamma`` alone (``ReferenceModel.terms``),
+     which both NumPy formulations evaluate first: the rest is the formulation's own work.
 
    All NumPy code runs with one BLAS thread (as in the reference integrators).  The ratios
    UK/CP are taken within this one run.  In ``mode="quick"`` (the default) only an evenly
@@ -77,6 +79,7 @@ TABLE_ROWS = {
     "uk-numpy": "UK, NumPy reference (eq. 70)",
     "cp-once": "CP, NumPy, partition once (Newton recovery + reduced equations)",
     "cp-every": "CP, NumPy, partition every call (the paper's implementation)",
+    "terms-numpy": "(part of both NumPy rows: model terms M, Q, A, gamma alone)",
 }
 
 
@@ -346,7 +349,15 @@ def _accel_functions(system) -> Dict[str, Callable]:
             sysm.accelerations(t, q, qd)
         return clock() - tic
 
-    fns = {"uk-rust": uk_rust, "uk-numpy": uk_numpy, "cp-once": cp_once, "cp-every": cp_every}
+    def terms_numpy(T, Y):
+        terms = ref.terms
+        tic = clock()
+        for t, y in zip(T, Y):
+            terms(t, y[:n], y[n:])
+        return clock() - tic
+
+    fns = {"uk-rust": uk_rust, "uk-numpy": uk_numpy, "cp-once": cp_once, "cp-every": cp_every,
+           "terms-numpy": terms_numpy}
     if kernel is not None:
         fns = {"uk-rust-kernel": uk_rust_kernel, **fns}
     return fns
@@ -523,6 +534,12 @@ def _write_table1(out: str, r: Dict[str, Any], beams: Sequence[str]) -> None:
         if a in keys and b_ in keys:
             L.append(f"| {TABLE_ROWS[a].split(' (')[0]} / {TABLE_ROWS[b_].split(' (')[0]} | "
                      + " | ".join(_ratio(r[b]['total'][a], r[b]['total'][b_]) for b in beams) + f" | {pap} |")
+    if "terms-numpy" in keys:
+        def solve_ratio(b):
+            t = r[b]["total"]
+            return _ratio(t["cp-every"] - t["terms-numpy"], t["uk-numpy"] - t["terms-numpy"])
+        L.append("| CP every call / UK, NumPy, without the shared model terms (solution stage only) | "
+                 + " | ".join(solve_ratio(b) for b in beams) + " | - |")
     L.append("")
     rec_line = ", ".join(f"{BEAM_LABEL[b]}: wall {r[b]['record']['wall_time']:.2f} s, {r[b]['record']['nfev']} rhs "
                          f"calls, {r[b]['record']['njev']} Jacobians, {r[b]['record']['accel_time']:.3f} s inside "
