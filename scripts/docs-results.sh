@@ -21,7 +21,7 @@ for part in "${parts[@]}"; do
     wp)
       $U bench work-precision --out docs/results/work-precision ;;
     elements)
-      $U bench elements --out docs/results/elements ;;
+      $U bench elements --out docs/results/elements --reference-elements 16 ;;
     *) echo "unknown part $part" >&2; exit 2 ;;
   esac
 done

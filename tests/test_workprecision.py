@@ -116,6 +116,22 @@ def test_elements_study(tmp_path):
         assert (tmp_path / f).exists()
 
 
+def test_elements_study_with_a_finer_reference_only_model(tmp_path):
+    # N = 2 is only the reference: the studied N = 1 rows carry their discretization error
+    res = wp.run_elements(str(tmp_path), elements=(1,), cases=(("native", "DOPRI5"),), t_end=0.002,
+                          samples=21, rtols=(1e-4,), budget=60.0, ref_rtol=1e-10, reference_elements=2)
+    (row,) = res["rows"]
+    assert row["elements"] == 1 and row["status"] == "ok"
+    model_error = res["settings"]["model_error"]
+    assert set(model_error) == {1, 2} and model_error[2] == 0.0 and res["settings"]["finest"] == 2
+    assert model_error[1] > 10 * row["err_max"]
+    assert abs(row["err_vs_finest"] - model_error[1]) <= row["err_max"]
+    assert "Reference (N = 2)" in (tmp_path / "elements.md").read_text()
+    with pytest.raises(ValueError, match="reference_elements"):
+        wp.run_elements(str(tmp_path), elements=(1, 2), cases=(("native", "DOPRI5"),), t_end=0.002,
+                        samples=21, rtols=(1e-4,), reference_elements=2)
+
+
 def test_cli_bench_work_precision(tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg")
     r = subprocess.run([sys.executable, "-m", "ukflex", "bench", "work-precision", "--out", str(tmp_path), "--t-end",

@@ -382,12 +382,15 @@ def run_elements(
     levels: Sequence[float] = DEFAULT_LEVELS,
     plot: bool = True,
     stream: Optional[TextIO] = None,
+    reference_elements: Optional[int] = None,
 ) -> Dict[str, Any]:
     """The same study over coupler element counts (``elements.csv``, ``elements.png``,
     ``elements.md``).
 
     Besides ``err_max`` (against the tight reference of the same N: the integration error),
-    each row has ``err_vs_finest``: the error against the tight reference of the largest N
+    each row has ``err_vs_finest``: the error against the tight reference of the finest model,
+    N = ``reference_elements`` if given (a finer mesh that is only used as the reference, so
+    the largest studied N also shows its discretization error), else the largest studied N
     (discretization + integration error: what a user gets for the physical problem).
     """
     from .paper import machine_info
@@ -400,13 +403,17 @@ def run_elements(
     info = machine_info()
     print(f"elements study: paper slider-crank, {beam}, N = {elements}, 0..{t_end:g} s, cases {list(cases)}, "
           f"budget {budget} s per run", file=stream, flush=True)
-    systems = {N: _paper_system(beam, N) for N in elements}
+    if reference_elements is not None and int(reference_elements) <= elements[-1]:
+        raise ValueError(f"reference_elements ({reference_elements}) must exceed the largest studied N "
+                         f"({elements[-1]})")
+    ref_ns = elements + ([int(reference_elements)] if reference_elements is not None else [])
+    systems = {N: _paper_system(beam, N) for N in ref_ns}
     t_eval = np.linspace(0.0, t_end, samples)
     refs = {}
-    for N in elements:
+    for N in ref_ns:
         print(f"N = {N}:", file=stream, end=" ")
         refs[N] = reference_solution(systems[N], t_end, t_eval, rtol=ref_rtol, stream=stream)
-    finest = refs[elements[-1]]
+    finest = refs[ref_ns[-1]]
     rows: List[Dict[str, Any]] = []
     writer = _CsvWriter(os.path.join(out, "elements.csv"))
     t0 = time.perf_counter()
@@ -429,15 +436,15 @@ def run_elements(
         writer.close()
     total = time.perf_counter() - t0
     info["load_average_end"] = machine_info()["load_average"]
-    model_err = {N: float(np.max(np.abs(refs[N]["v"] - finest["v"]))) for N in elements}
+    model_err = {N: float(np.max(np.abs(refs[N]["v"] - finest["v"]))) for N in ref_ns}
     settings = {"beam": beam, "elements": elements, "t_end": t_end, "samples": samples, "budget": budget,
                 "rtols": list(rtols), "total_time": total, "model_error": model_err,
-                "peaks": {N: refs[N]["peak"] for N in elements}}
+                "peaks": {N: refs[N]["peak"] for N in ref_ns}, "finest": ref_ns[-1]}
     best = best_per_level(rows, levels, key="err_vs_finest", group=lambda r: f"N={r['elements']}")
     if plot:
-        plot_elements(rows, os.path.join(out, "elements.png"), budget, beam)
+        plot_elements(rows, os.path.join(out, "elements.png"), budget, beam, finest=ref_ns[-1])
     _write_md(os.path.join(out, "elements.md"), "Work-precision over coupler element counts", rows,
-              {N: refs[N] for N in elements}, best, settings, info, key="err_vs_finest")
+              {N: refs[N] for N in ref_ns}, best, settings, info, key="err_vs_finest")
     print(f"wrote {out}/elements.csv, .png, .md ({total:.0f} s)", file=stream)
     return {"rows": rows, "references": refs, "best": best, "machine": info, "settings": settings}
 
@@ -619,18 +626,21 @@ def plot_work_precision(rows: Sequence[Dict[str, Any]], path: str, budget: Optio
     fig.savefig(path, dpi=130)
 
 
-def plot_elements(rows: Sequence[Dict[str, Any]], path: str, budget: Optional[float], beam: str) -> None:
+def plot_elements(rows: Sequence[Dict[str, Any]], path: str, budget: Optional[float], beam: str,
+                  finest: Optional[int] = None) -> None:
     """Two panels: integration error (vs the same-N reference) and error against the finest
-    model, both vs wall time; colour = N, line style = method."""
+    model (N = ``finest``, default the largest N of the rows), both vs wall time; colour = N,
+    line style = method."""
     fig = _figure((13.0, 5.6))
     Ns = sorted({r["elements"] for r in rows})
+    finest = finest if finest is not None else Ns[-1]
     colors = {N: f"C{i}" for i, N in enumerate(Ns)}
     styles = {}
     for r in rows:
         styles.setdefault((r["formulation"], r["method"]), (["-", "--", ":", "-."][len(styles) % 4],
                                                               ["o", "s", "^", "D"][len(styles) % 4]))
     for k, (key, ylab) in enumerate((("err_max", "integration error: max |v - v_ref(same N)| / Lb"),
-                                     ("err_vs_finest", f"error vs the N = {Ns[-1]} model: max |v - v_ref(N={Ns[-1]})| / Lb"))):
+                                     ("err_vs_finest", f"error vs the N = {finest} model: max |v - v_ref(N={finest})| / Lb"))):
         ax = fig.add_subplot(1, 2, k + 1)
         _draw_lines(ax, rows, key,
                     color_of=lambda r: colors[r["elements"]],
