@@ -194,6 +194,13 @@ class System:
         self.potential_energy = core.potential_energy
         # Jacobian of rhs, d[qd, qdd]/d[q, qd], shape (2n, 2n): finite differences in Rust (GIL released)
         self.jac = core.jac
+        # solver settings, diagnostics and native integration (the compiled object's methods)
+        self.set_stabilization = core.set_stabilization
+        self.set_rank_tolerance = core.set_rank_tolerance
+        self.set_pseudoinverse = core.set_pseudoinverse
+        self.rank_info = core.rank_info
+        self.project = core.project
+        self.integrate = core.integrate
 
         self.n_coords: int = int(core.n_coords)
         self.n_constraints: int = int(core.n_constraints)
@@ -238,6 +245,22 @@ class System:
 
     def __repr__(self) -> str:
         return f"System(bodies={self.body_names}, n_coords={self.n_coords}, n_constraints={self.n_constraints})"
+
+    def body_kind(self, body: str) -> str:
+        """Kind of body ``body`` (``"rigid"``, ``"beam"``, ...)."""
+        if body not in self._kinds:
+            raise KeyError(f"unknown body {body!r}; bodies are {self.body_names}")
+        return self._kinds[body]
+
+    def body_info(self, body: str) -> Dict[str, Any]:
+        """Properties of body ``body`` as the core derived them (kind, mass, and for beams
+        length, elements, n_f, section area, second moment, material)."""
+        kind = self.body_kind(body)
+        d = next(b for b in self.description["bodies"] if b["name"] == body)
+        info: Dict[str, Any] = {"kind": kind}
+        if kind == "beam":
+            info.update({k: d[k] for k in ("length", "elements", "theory", "density", "youngs_modulus", "frame")})
+        return info
 
     def coordinate_index(self, name: str) -> int:
         """Index in ``q`` of coordinate ``name`` (e.g. ``"crank.theta"``, ``"coupler.qf0"``)."""
