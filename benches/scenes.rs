@@ -41,7 +41,7 @@ pub fn bench_state(model: &Model) -> (Vec<f64>, Vec<f64>) {
     let (mut q, mut qd) = (model.q0.clone(), model.qd0.clone());
     for b in &model.bodies {
         let o = b.offset;
-        if b.n_coords == 3 && model.constraints.iter().all(|c| !c.kind.is_driver()) {
+        if b.n_coords == 3 && model.constraints.iter().all(|c| !c.is_driver()) {
             q[o + 2] += 0.3 * rng.next();
             qd[o + 2] += rng.next();
         }

@@ -6,7 +6,7 @@ use faer::linalg::svd::{svd_scratch, ComputeSvdVectors};
 use faer::diag::Diag;
 use faer::{Mat, Par};
 
-use crate::body::BodyKind;
+use crate::body::BodyData;
 use crate::model::Model;
 use crate::small_svd::QrJacobi;
 
@@ -85,36 +85,6 @@ pub struct RankInfo {
     pub exact: bool,
 }
 
-/// Per-body mass blocks and factor, in body coordinates `[x, y, theta, q_f]`.
-///
-/// Beam factor `F_b = [[L_s, X], [0, L_ff]]` with `X = M_rf L_ff^-T` (3 x n_f). Its first two
-/// rows are the rotation of constants: `M_Rf = A S_bar`, so `X_0 = c a - s b`,
-/// `X_1 = s a + c b` with `a = L_ff^-1 S_bar_x^T`, `b = L_ff^-1 S_bar_y^T` fixed at model build
-/// (here, once per workspace). Only `X_2 = L_ff^-1 m_thetaf^T` needs a banded solve per call,
-/// and the 3x3 Schur complement `m_rr - X X^T` needs only `X_2 . (a, b, X_2)` besides the
-/// constant products `a.a`, `a.b`, `b.b`.
-#[derive(Debug, Clone)]
-pub struct BodyData {
-    /// Reference block `[[m_RR, m_Rtheta], [., m_thetatheta]]` (symmetric 3x3).
-    pub m_rr: [[f64; 3]; 3],
-    /// `(cos theta, sin theta)` of the last `mass_and_forces`.
-    pub cs: [f64; 2],
-    /// `m_thetaf = i_thf - S_tilde q_f` (n_f, beams).
-    pub m_thf: Vec<f64>,
-    /// Constants `a = L_ff^-1 S_bar_x^T`, `b = L_ff^-1 S_bar_y^T` (n_f each) and
-    /// `[a.a, a.b, b.b]`.
-    pub a: Vec<f64>,
-    pub b: Vec<f64>,
-    pub ab: [f64; 3],
-    /// `X_2 = L_ff^-1 m_thetaf^T` (n_f).
-    pub x2: Vec<f64>,
-    /// Lower Cholesky factor of the reference block's Schur complement `m_rr - X X^T`
-    /// (rigid bodies: of the whole 3x3 mass matrix).
-    pub ls: [[f64; 3]; 3],
-    /// Scratch of length n_f: `i_rf + M_ff^tr q_f`.
-    pub w: Vec<f64>,
-}
-
 pub struct Data {
     pub bodies: Vec<BodyData>,
     /// Generalized forces `Q(t, q, qd)` (n).
@@ -159,33 +129,7 @@ impl Data {
     pub fn new(model: &Model) -> Data {
         let (n, m) = (model.n, model.m);
         let k = n.min(m);
-        let bodies = model
-            .bodies
-            .iter()
-            .map(|b| {
-                let (n_f, a, bv) = match &b.kind {
-                    BodyKind::Rigid(_) => (0, Vec::new(), Vec::new()),
-                    BodyKind::Beam(beam) => {
-                        let (mut a, mut bv) = (beam.s_bar[0].clone(), beam.s_bar[1].clone());
-                        beam.l_ff.solve_lower(&mut a);
-                        beam.l_ff.solve_lower(&mut bv);
-                        (beam.n_f, a, bv)
-                    }
-                };
-                let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(p, q)| p * q).sum::<f64>();
-                BodyData {
-                    m_rr: [[0.0; 3]; 3],
-                    cs: [1.0, 0.0],
-                    m_thf: vec![0.0; n_f],
-                    ab: [dot(&a, &a), dot(&a, &bv), dot(&bv, &bv)],
-                    a,
-                    b: bv,
-                    x2: vec![0.0; n_f],
-                    ls: [[0.0; 3]; 3],
-                    w: vec![0.0; n_f],
-                }
-            })
-            .collect();
+        let bodies = model.bodies.iter().map(|b| b.new_data()).collect();
         let req = if m > 0 {
             svd_scratch::<f64>(n, m, ComputeSvdVectors::Thin, ComputeSvdVectors::Thin, Par::Seq, Default::default())
         } else {

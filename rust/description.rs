@@ -1,14 +1,81 @@
 //! Scene description: plain data, parsed from the JSON-compatible dict documented in
-//! `docs/scene-format.md`. Validation happens in `Model::new`, not here.
+//! `docs/scene-format.md`. Validation happens in `model::ModelBuilder` (each kind's
+//! `from_desc`), not here.
+//!
+//! In the description a tagged object carries its variant inside: `{"kind": "revolute", "a":
+//! ..}`, `{"shape": "circular", "diameter": ..}`. The Rust types use serde's external tagging
+//! (`{"revolute": {"a": ..}}`), into which `to_external` turns the description before parsing:
+//! that keeps the path of every field in error messages (serde loses it inside internally
+//! tagged enums). `to_internal` turns it back.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value};
+
+/// Keys that name the variant of a tagged object.
+const TAGS: [&str; 2] = ["kind", "shape"];
+
+/// `{"kind": k, rest..}` -> `{k: {rest..}}`, recursively (see the module docs).
+pub fn to_external(v: Value) -> Value {
+    match v {
+        Value::Object(map) => {
+            let mut map: Map<String, Value> = map.into_iter().map(|(k, v)| (k, to_external(v))).collect();
+            for tag in TAGS {
+                if let Some(Value::String(variant)) = map.get(tag).cloned() {
+                    map.remove(tag);
+                    let mut outer = Map::new();
+                    outer.insert(variant, Value::Object(map));
+                    return Value::Object(outer);
+                }
+            }
+            Value::Object(map)
+        }
+        Value::Array(a) => Value::Array(a.into_iter().map(to_external).collect()),
+        other => other,
+    }
+}
+
+/// The inverse of `to_external` for serialized descriptions: a one-key object whose value is
+/// an object, at a place where `is_tagged` says an enum stands, becomes `{tag: key, ..}`.
+pub fn to_internal(v: Value, tag: &str) -> Value {
+    match v {
+        Value::Object(map) if map.len() == 1 => {
+            let (variant, inner) = map.into_iter().next().expect("one entry");
+            match inner {
+                Value::Object(fields) => {
+                    let mut out = Map::new();
+                    out.insert(tag.to_string(), Value::String(variant));
+                    for (k, v) in fields {
+                        out.insert(k.clone(), internal_field(&k, v));
+                    }
+                    Value::Object(out)
+                }
+                // unit variants serialize as plain strings; other shapes do not occur
+                other => {
+                    let mut out = Map::new();
+                    out.insert(variant, other);
+                    Value::Object(out)
+                }
+            }
+        }
+        other => other,
+    }
+}
+
+/// Fields that hold tagged enums inside an item: `section` (by `shape`), `motion` (by `kind`).
+fn internal_field(key: &str, v: Value) -> Value {
+    match key {
+        "section" => to_internal(v, "shape"),
+        "motion" => to_internal(v, "kind"),
+        _ => v,
+    }
+}
 
 pub type Vec2 = [f64; 2];
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Description {
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gravity: Option<Vec2>,
     pub bodies: Vec<BodyDesc>,
     #[serde(default)]
@@ -19,11 +86,12 @@ pub struct Description {
     pub forces: Vec<ForceDesc>,
 }
 
-#[derive(Debug, Clone, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum BodyDesc {
     Rigid(RigidDesc),
     Beam(BeamDesc),
+    PointMass(PointMassDesc),
 }
 
 impl BodyDesc {
@@ -31,11 +99,33 @@ impl BodyDesc {
         match self {
             BodyDesc::Rigid(r) => &r.name,
             BodyDesc::Beam(b) => &b.name,
+            BodyDesc::PointMass(p) => &p.name,
+        }
+    }
+
+    /// The `kind` tag as written in the description.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            BodyDesc::Rigid(_) => "rigid",
+            BodyDesc::Beam(_) => "beam",
+            BodyDesc::PointMass(_) => "point_mass",
         }
     }
 }
 
-#[derive(Debug, Clone, Deserialize)]
+/// A particle: coordinates `(x, y)`, no orientation.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointMassDesc {
+    pub name: String,
+    pub mass: f64,
+    #[serde(default)]
+    pub position: Vec2,
+    #[serde(default)]
+    pub velocity: Vec2,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigidDesc {
     pub name: String,
@@ -55,14 +145,14 @@ pub struct RigidDesc {
     pub angular_velocity: f64,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum BeamTheory {
     Timoshenko,
     EulerBernoulli,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReferenceConditions {
     /// u_1 = v_1 = 0, v_{N+1} = 0 (the paper's choice).
@@ -71,8 +161,8 @@ pub enum ReferenceConditions {
     Clamped,
 }
 
-#[derive(Debug, Clone, Deserialize)]
-#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum SectionDesc {
     Circular { diameter: f64 },
     /// `height` lies in the bending plane.
@@ -80,7 +170,7 @@ pub enum SectionDesc {
     Custom { area: f64, second_moment: f64 },
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BeamDesc {
     pub name: String,
@@ -90,15 +180,15 @@ pub struct BeamDesc {
     pub theory: BeamTheory,
     pub density: f64,
     pub youngs_modulus: f64,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub poisson_ratio: Option<f64>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shear_modulus: Option<f64>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shear_factor: Option<f64>,
     pub section: SectionDesc,
     pub frame: ReferenceConditions,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotary_inertia: Option<bool>,
     #[serde(default)]
     pub damping: f64,
@@ -110,9 +200,9 @@ pub struct BeamDesc {
     pub velocity: Vec2,
     #[serde(default)]
     pub angular_velocity: f64,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub elastic: Option<Vec<f64>>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub elastic_rates: Option<Vec<f64>>,
 }
 
@@ -121,71 +211,132 @@ fn one() -> usize {
 }
 
 /// A point and a frame on a body (or on the ground).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MarkerDesc {
     pub body: String,
     /// Point in the body frame (rigid bodies and ground).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub point: Option<Vec2>,
     /// Abscissa along a beam, in [0, 1].
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub xi: Option<f64>,
     /// Orientation of the marker frame relative to the body frame.
     #[serde(default)]
     pub angle: f64,
 }
 
-#[derive(Debug, Clone, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum JointDesc {
-    Revolute { #[serde(default)] name: Option<String>, a: MarkerDesc, b: MarkerDesc },
-    PointOnLine { #[serde(default)] name: Option<String>, point: MarkerDesc, line: MarkerDesc },
-    Prismatic { #[serde(default)] name: Option<String>, a: MarkerDesc, b: MarkerDesc },
-    Weld { #[serde(default)] name: Option<String>, a: MarkerDesc, b: MarkerDesc },
+    Revolute { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, a: MarkerDesc, b: MarkerDesc },
+    PointOnLine { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, point: MarkerDesc, line: MarkerDesc },
+    Prismatic { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, a: MarkerDesc, b: MarkerDesc },
+    Weld { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, a: MarkerDesc, b: MarkerDesc },
+    /// `|r_a - r_b| = length` (a massless rod); `length` defaults to the distance at the
+    /// initial guess.
+    Distance { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, a: MarkerDesc, b: MarkerDesc, #[serde(default, skip_serializing_if = "Option::is_none")] length: Option<f64> },
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+impl JointDesc {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            JointDesc::Revolute { .. } => "revolute",
+            JointDesc::PointOnLine { .. } => "point_on_line",
+            JointDesc::Prismatic { .. } => "prismatic",
+            JointDesc::Weld { .. } => "weld",
+            JointDesc::Distance { .. } => "distance",
+        }
+    }
+
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            JointDesc::Revolute { name, .. }
+            | JointDesc::PointOnLine { name, .. }
+            | JointDesc::Prismatic { name, .. }
+            | JointDesc::Weld { name, .. }
+            | JointDesc::Distance { name, .. } => name.as_deref(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Axis {
     X,
     Y,
 }
 
-#[derive(Debug, Clone, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum MotionDesc {
     ConstantSpeed { #[serde(default)] initial: f64, speed: f64 },
     Polynomial { coefficients: Vec<f64> },
     Harmonic { #[serde(default)] offset: f64, amplitude: f64, frequency: f64, #[serde(default)] phase: f64 },
 }
 
-#[derive(Debug, Clone, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum DriverDesc {
-    Angle { #[serde(default)] name: Option<String>, a: MarkerDesc, #[serde(default)] b: Option<MarkerDesc>, motion: MotionDesc },
-    Coordinate { #[serde(default)] name: Option<String>, point: MarkerDesc, axis: Axis, motion: MotionDesc },
+    Angle { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, a: MarkerDesc, #[serde(default, skip_serializing_if = "Option::is_none")] b: Option<MarkerDesc>, motion: MotionDesc },
+    Coordinate { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, point: MarkerDesc, axis: Axis, motion: MotionDesc },
 }
 
-#[derive(Debug, Clone, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+impl DriverDesc {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            DriverDesc::Angle { .. } => "angle",
+            DriverDesc::Coordinate { .. } => "coordinate",
+        }
+    }
+
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            DriverDesc::Angle { name, .. } | DriverDesc::Coordinate { name, .. } => name.as_deref(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum ForceDesc {
-    PointForce { #[serde(default)] name: Option<String>, point: MarkerDesc, force: Vec2 },
-    Torque { #[serde(default)] name: Option<String>, frame: MarkerDesc, torque: f64 },
+    PointForce { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, point: MarkerDesc, force: Vec2 },
+    Torque { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, frame: MarkerDesc, torque: f64 },
     SpringDamper {
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         name: Option<String>,
         a: MarkerDesc,
         b: MarkerDesc,
         stiffness: f64,
         #[serde(default)]
         damping: f64,
-        rest_length: f64,
+        /// Default: the distance between the markers at the initial guess (unloaded start).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rest_length: Option<f64>,
     },
+}
+
+impl ForceDesc {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            ForceDesc::PointForce { .. } => "point_force",
+            ForceDesc::Torque { .. } => "torque",
+            ForceDesc::SpringDamper { .. } => "spring_damper",
+        }
+    }
+
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            ForceDesc::PointForce { name, .. } | ForceDesc::Torque { name, .. } | ForceDesc::SpringDamper { name, .. } => {
+                name.as_deref()
+            }
+        }
+    }
 }
 
 impl Description {
     pub fn from_json(text: &str) -> crate::error::Result<Self> {
-        serde_json::from_str(text).map_err(|e| crate::error::Error::Description(e.to_string()))
+        let v: Value = serde_json::from_str(text).map_err(|e| crate::error::Error::Description(e.to_string()))?;
+        serde_json::from_value(to_external(v)).map_err(|e| crate::error::Error::Description(e.to_string()))
     }
 }

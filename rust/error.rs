@@ -14,8 +14,8 @@ pub enum Error {
     #[error("{item}: {message}")]
     InvalidProperty { item: String, message: String },
     /// A joint, driver or force names a body that does not exist.
-    #[error("{item}: unknown body '{body}'")]
-    UnknownBody { item: String, body: String },
+    #[error("{item}: unknown body '{body}'; bodies are [{known}]")]
+    UnknownBody { item: String, body: String, known: String },
     /// An input array has the wrong length.
     #[error("{what}: expected length {expected}, got {got}")]
     Shape { what: String, expected: usize, got: usize },
@@ -25,13 +25,20 @@ pub enum Error {
     /// The mass matrix (or a body block of it) is not positive definite.
     #[error("mass matrix is not positive definite ({item})")]
     SingularMass { item: String },
+    /// A function argument (not the scene) is out of range: tolerances, times, options.
+    #[error("{what}: {message}")]
+    Argument { what: String, message: String },
     /// A solver kernel could not produce a result (e.g. SVD did not converge).
     #[error("solver failure: {0}")]
     Solver(String),
 }
 
 impl Error {
-    pub(crate) fn invalid(item: impl Into<String>, message: impl Into<String>) -> Self {
+    pub fn argument(what: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Argument { what: what.into(), message: message.into() }
+    }
+
+    pub fn invalid(item: impl Into<String>, message: impl Into<String>) -> Self {
         Error::InvalidProperty { item: item.into(), message: message.into() }
     }
 }
@@ -42,6 +49,27 @@ pub fn check_finite(what: &str, values: &[f64]) -> Result<()> {
         Some(index) => Err(Error::NonFinite { what: what.to_string(), index }),
         None => Ok(()),
     }
+}
+
+/// Check that every entry of `v` is finite, as a property of a scene item.
+pub fn check_finite_item(item: &str, what: &str, v: &[f64]) -> Result<()> {
+    check_finite(what, v).map_err(|_| Error::invalid(item, format!("{what} must be finite, got {v:?}")))
+}
+
+/// A positive, finite property.
+pub fn positive(item: &str, what: &str, v: f64) -> Result<f64> {
+    if !v.is_finite() || v <= 0.0 {
+        return Err(Error::invalid(item, format!("{what} must be positive and finite, got {v}")));
+    }
+    Ok(v)
+}
+
+/// A non-negative, finite property.
+pub fn non_negative(item: &str, what: &str, v: f64) -> Result<f64> {
+    if !v.is_finite() || v < 0.0 {
+        return Err(Error::invalid(item, format!("{what} must be >= 0 and finite, got {v}")));
+    }
+    Ok(v)
 }
 
 /// Check that `values` has length `expected`.

@@ -2,6 +2,9 @@
 //! Each adds its generalized force `J^T F` to `Q` (paper eqs. 34-37).
 
 use crate::body::{Body, Marker};
+use crate::constraint::BuildContext;
+use crate::description::ForceDesc;
+use crate::error::{check_finite_item, non_negative, Result};
 
 #[derive(Debug, Clone)]
 pub enum ForceKind {
@@ -21,6 +24,38 @@ pub struct Force {
 }
 
 impl Force {
+    /// Build a force element; `item` names it in errors.
+    pub fn from_desc(ctx: &BuildContext, item: &str, name: String, d: &ForceDesc) -> Result<Force> {
+        let kind = match d {
+            ForceDesc::PointForce { point, force, .. } => {
+                check_finite_item(item, "force", force)?;
+                ForceKind::PointForce { point: ctx.marker(item, point)?, force: *force }
+            }
+            ForceDesc::Torque { frame, torque, .. } => {
+                check_finite_item(item, "torque", &[*torque])?;
+                ForceKind::Torque { frame: ctx.oriented_marker(item, frame)?, torque: *torque }
+            }
+            ForceDesc::SpringDamper { a, b, stiffness, damping, rest_length, .. } => {
+                let (a, b) = (ctx.marker(item, a)?, ctx.marker(item, b)?);
+                let rest_length = match rest_length {
+                    Some(l) => *l,
+                    None => {
+                        let (sa, sb) = (ctx.state0(&a), ctx.state0(&b));
+                        (sa.r[0] - sb.r[0]).hypot(sa.r[1] - sb.r[1])
+                    }
+                };
+                ForceKind::SpringDamper {
+                    a,
+                    b,
+                    stiffness: non_negative(item, "stiffness", *stiffness)?,
+                    damping: non_negative(item, "damping", *damping)?,
+                    rest_length: non_negative(item, "rest_length", rest_length)?,
+                }
+            }
+        };
+        Ok(Force { name, kind })
+    }
+
     /// Add this force's generalized force to `qvec` (length n).
     #[inline]
     pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], qvec: &mut [f64]) {

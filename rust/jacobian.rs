@@ -130,3 +130,14 @@ pub fn uk_jacobian(model: &Model, data: &mut Data, ws: &mut JacobianWorkspace, t
     }
     Ok(())
 }
+
+/// The full Jacobian of `f(t, y) = [qd, qdd]`: `[[0, I], [Jq, Jv]]` (2n x 2n, row-major) from
+/// the two n x n blocks.
+pub fn assemble_first_order(n: usize, jq: &[f64], jv: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for i in 0..n {
+        out[i * 2 * n + n + i] = 1.0;
+        out[(n + i) * 2 * n..(n + i) * 2 * n + n].copy_from_slice(&jq[i * n..(i + 1) * n]);
+        out[(n + i) * 2 * n + n..(n + i + 1) * 2 * n].copy_from_slice(&jv[i * n..(i + 1) * n]);
+    }
+}

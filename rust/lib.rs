@@ -2,11 +2,18 @@
 //! Udwadia-Kalaba formulation.
 //!
 //! Data flows one way: description (`description`) -> model (`model`, `body`, `constraint`,
-//! `force`) -> workspace (`data`) -> kernels (`dynamics`, `uk`) -> results. `bindings` (feature
-//! `python`) is the only module that knows Python.
+//! `force`) -> workspace (`data`) -> kernels (`dynamics`, `uk`, `jacobian`) -> drivers
+//! (`integrate`, `correct`) -> results. `bindings` (feature `python`) is the only module that
+//! knows Python. Each body kind owns its code in `body/`, each joint kind in `constraint/`;
+//! see `docs/architecture.md`.
+
+// Numeric kernels index like the papers they follow; `!(x > 0.0)` is the deliberate NaN-rejecting
+// form of a positivity check; kernels take the state slices and the outputs they write.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord, clippy::too_many_arguments)]
 
 pub mod body;
 pub mod constraint;
+pub mod correct;
 pub mod data;
 pub mod description;
 pub mod dynamics;

@@ -1,15 +1,24 @@
-//! The precomputed model: immutable after `Model::new`, validated once. Holds the coordinate
+//! The precomputed model: immutable after it is built, validated once. Holds the coordinate
 //! layout, the bodies with their constant shape integrals, the resolved markers, the
 //! constraint rows and the forces. A scene pays only for what it declares: no gravity field
 //! means no gravity term, a rigid-only scene has no elastic blocks, no driver no time terms.
+//!
+//! `ModelBuilder` is the one place that validates a scene: it adds items one at a time (each
+//! kind validates itself in its `from_desc`), names the offending item in every error, and is
+//! used both for a whole description (`Model::from_json`) and item by item by the Python scene
+//! builder (so Python never re-derives a rule).
 
 use std::collections::HashMap;
 
-use crate::body::{Beam, Body, BodyKind, Marker, MarkerShape, Rigid};
-use crate::constraint::{Constraint, ConstraintKind, Motion};
-use crate::description::{BodyDesc, Description, DriverDesc, ForceDesc, JointDesc, MarkerDesc};
-use crate::error::{check_finite, Error, Result};
-use crate::force::{Force, ForceKind};
+use serde::de::DeserializeOwned;
+use serde::Deserialize;
+use serde_json::Value;
+
+use crate::body::{Body, BodyKind};
+use crate::constraint::{BuildContext, Constraint};
+use crate::description::{to_external, to_internal, BodyDesc, Description, DriverDesc, ForceDesc, JointDesc, Vec2};
+use crate::error::{check_finite_item, Error, Result};
+use crate::force::Force;
 
 #[derive(Debug, Clone)]
 pub struct Model {
@@ -21,8 +30,6 @@ pub struct Model {
     pub n: usize,
     /// Number of constraint rows `m`.
     pub m: usize,
-    /// Any beam with stiffness-proportional damping.
-    pub has_beam_damping: bool,
     pub coordinate_names: Vec<String>,
     pub constraint_row_names: Vec<String>,
     /// Initial guess from the description.
@@ -30,244 +37,338 @@ pub struct Model {
     pub qd0: Vec<f64>,
 }
 
-fn check_finite_item(item: &str, what: &str, v: &[f64]) -> Result<()> {
-    check_finite(what, v).map_err(|_| Error::invalid(item, format!("{what} must be finite, got {v:?}")))
-}
-
 impl Model {
+    /// Parse and validate a JSON scene description (`docs/scene-format.md`).
     pub fn from_json(text: &str) -> Result<Model> {
-        Model::new(&Description::from_json(text)?)
+        let raw: RawDescription = parse_json("scene", text)?;
+        let mut b = ModelBuilder::new(raw.gravity)?;
+        for v in raw.bodies {
+            b.add_body(&parse_item(Section::Body, b.bodies.len(), v)?)?;
+        }
+        for v in raw.joints {
+            b.add_joint(&parse_item(Section::Joint, b.joints.len(), v)?)?;
+        }
+        for v in raw.drivers {
+            b.add_driver(&parse_item(Section::Driver, b.drivers.len(), v)?)?;
+        }
+        for v in raw.forces {
+            b.add_force(&parse_item(Section::Force, b.forces.len(), v)?)?;
+        }
+        b.finish()
     }
 
+    /// Validate and build from a parsed description.
     pub fn new(d: &Description) -> Result<Model> {
-        if d.bodies.is_empty() {
-            return Err(Error::Description("a scene needs at least one body".into()));
+        let mut b = ModelBuilder::new(d.gravity)?;
+        for x in &d.bodies {
+            b.add_body(x)?;
         }
-        if let Some(g) = d.gravity {
-            check_finite_item("gravity", "gravity", &g)?;
+        for x in &d.joints {
+            b.add_joint(x)?;
         }
-        let mut bodies = Vec::with_capacity(d.bodies.len());
-        let mut index: HashMap<String, usize> = HashMap::new();
-        let mut offset = 0;
-        let (mut q0, mut qd0) = (Vec::new(), Vec::new());
-        let mut coordinate_names = Vec::new();
-        for bd in &d.bodies {
-            let name = bd.name().to_string();
-            if name.is_empty() || name == "ground" {
-                return Err(Error::invalid(format!("body '{name}'"), "body names must be non-empty and not 'ground'"));
-            }
-            if index.insert(name.clone(), bodies.len()).is_some() {
-                return Err(Error::invalid(format!("body '{name}'"), "duplicate body name"));
-            }
-            let item = format!("body '{name}'");
-            let (kind, pos, ang, vel, angvel) = match bd {
-                BodyDesc::Rigid(r) => (BodyKind::Rigid(Rigid::new(r)?), r.position, r.angle, r.velocity, r.angular_velocity),
-                BodyDesc::Beam(b) => (BodyKind::Beam(Beam::new(b)?), b.position, b.angle, b.velocity, b.angular_velocity),
-            };
-            check_finite_item(&item, "position", &pos)?;
-            check_finite_item(&item, "angle", &[ang])?;
-            check_finite_item(&item, "velocity", &vel)?;
-            check_finite_item(&item, "angular_velocity", &[angvel])?;
-            q0.extend_from_slice(&[pos[0], pos[1], ang]);
-            qd0.extend_from_slice(&[vel[0], vel[1], angvel]);
-            for c in ["x", "y", "theta"] {
-                coordinate_names.push(format!("{name}.{c}"));
-            }
-            let n_f = match &kind {
-                BodyKind::Rigid(_) => 0,
-                BodyKind::Beam(beam) => {
-                    let BodyDesc::Beam(b) = bd else { unreachable!() };
-                    for (what, v) in [("elastic", &b.elastic), ("elastic_rates", &b.elastic_rates)] {
-                        match v {
-                            Some(v) if v.len() != beam.n_f => {
-                                return Err(Error::invalid(&item, format!("{what} must have {} entries, got {}", beam.n_f, v.len())))
-                            }
-                            Some(v) => check_finite_item(&item, what, v)?,
-                            None => {}
-                        }
-                    }
-                    q0.extend(b.elastic.clone().unwrap_or_else(|| vec![0.0; beam.n_f]));
-                    qd0.extend(b.elastic_rates.clone().unwrap_or_else(|| vec![0.0; beam.n_f]));
-                    for i in 0..beam.n_f {
-                        coordinate_names.push(format!("{name}.qf{i}"));
-                    }
-                    beam.n_f
-                }
-            };
-            bodies.push(Body { name, offset, n_coords: 3 + n_f, kind });
-            offset += 3 + n_f;
+        for x in &d.drivers {
+            b.add_driver(x)?;
         }
-        let n = offset;
-
-        let marker = |item: &str, md: &MarkerDesc| -> Result<Marker> { resolve_marker(&bodies, &index, item, md) };
-        let zeros = vec![0.0; n];
-        let mut constraints = Vec::new();
-        let mut row = 0;
-        let mut row_names = Vec::new();
-        let mut used_names: HashMap<String, usize> = HashMap::new();
-        let mut unique = |given: &Option<String>, default: String| -> String {
-            let base = given.clone().unwrap_or(default);
-            let k = used_names.entry(base.clone()).or_insert(0);
-            *k += 1;
-            if *k == 1 { base } else { format!("{base}#{k}") }
-        };
-        for (j, jd) in d.joints.iter().enumerate() {
-            let (name, kind) = match jd {
-                JointDesc::Revolute { name, a, b } => {
-                    let nm = unique(name, format!("revolute{j}"));
-                    let item = format!("joint '{nm}'");
-                    (nm, ConstraintKind::Revolute { a: marker(&item, a)?, b: marker(&item, b)? })
-                }
-                JointDesc::PointOnLine { name, point, line } => {
-                    let nm = unique(name, format!("point_on_line{j}"));
-                    let item = format!("joint '{nm}'");
-                    (nm, ConstraintKind::PointOnLine { point: marker(&item, point)?, line: marker(&item, line)? })
-                }
-                JointDesc::Prismatic { name, a, b } => {
-                    let nm = unique(name, format!("prismatic{j}"));
-                    let item = format!("joint '{nm}'");
-                    let (a, b) = (marker(&item, a)?, marker(&item, b)?);
-                    let phi0 = a.state(&bodies, &q0, &zeros).phi - b.state(&bodies, &q0, &zeros).phi;
-                    (nm, ConstraintKind::Prismatic { a, b, phi0 })
-                }
-                JointDesc::Weld { name, a, b } => {
-                    let nm = unique(name, format!("weld{j}"));
-                    let item = format!("joint '{nm}'");
-                    let (a, b) = (marker(&item, a)?, marker(&item, b)?);
-                    let phi0 = a.state(&bodies, &q0, &zeros).phi - b.state(&bodies, &q0, &zeros).phi;
-                    (nm, ConstraintKind::Weld { a, b, phi0 })
-                }
-            };
-            constraints.push(Constraint { name, row, kind });
+        for x in &d.forces {
+            b.add_force(x)?;
         }
-        for (j, dd) in d.drivers.iter().enumerate() {
-            let (name, kind) = match dd {
-                DriverDesc::Angle { name, a, b, motion } => {
-                    let nm = unique(name, format!("angle_driver{j}"));
-                    let item = format!("driver '{nm}'");
-                    let b = match b {
-                        Some(b) => marker(&item, b)?,
-                        None => Marker { body: None, angle: 0.0, shape: MarkerShape::Point([0.0, 0.0]) },
-                    };
-                    let motion = Motion::from_desc(motion);
-                    check_finite_item(&item, "motion", &motion.parameters())?;
-                    (nm, ConstraintKind::AngleDriver { a: marker(&item, a)?, b, motion })
-                }
-                DriverDesc::Coordinate { name, point, axis, motion } => {
-                    let nm = unique(name, format!("coordinate_driver{j}"));
-                    let item = format!("driver '{nm}'");
-                    let motion = Motion::from_desc(motion);
-                    check_finite_item(&item, "motion", &motion.parameters())?;
-                    (nm, ConstraintKind::CoordinateDriver { point: marker(&item, point)?, axis: *axis, motion })
-                }
-            };
-            constraints.push(Constraint { name, row, kind });
-        }
-        for c in constraints.iter_mut() {
-            c.row = row;
-            let suffixes: &[&str] = match &c.kind {
-                ConstraintKind::Revolute { .. } => &["x", "y"],
-                ConstraintKind::Weld { .. } => &["x", "y", "angle"],
-                ConstraintKind::Prismatic { .. } => &["line", "angle"],
-                _ => &[""],
-            };
-            for s in suffixes {
-                row_names.push(if s.is_empty() { c.name.clone() } else { format!("{}.{s}", c.name) });
-            }
-            row += c.kind.rows();
-        }
-        let m = row;
-
-        let mut forces = Vec::new();
-        for (j, fd) in d.forces.iter().enumerate() {
-            let (name, kind) = match fd {
-                ForceDesc::PointForce { name, point, force } => {
-                    let nm = name.clone().unwrap_or(format!("point_force{j}"));
-                    let item = format!("force '{nm}'");
-                    check_finite_item(&item, "force", force)?;
-                    (nm, ForceKind::PointForce { point: marker(&item, point)?, force: *force })
-                }
-                ForceDesc::Torque { name, frame, torque } => {
-                    let nm = name.clone().unwrap_or(format!("torque{j}"));
-                    let item = format!("force '{nm}'");
-                    check_finite_item(&item, "torque", &[*torque])?;
-                    (nm, ForceKind::Torque { frame: marker(&item, frame)?, torque: *torque })
-                }
-                ForceDesc::SpringDamper { name, a, b, stiffness, damping, rest_length } => {
-                    let nm = name.clone().unwrap_or(format!("spring_damper{j}"));
-                    let item = format!("force '{nm}'");
-                    for (what, v) in [("stiffness", stiffness), ("damping", damping), ("rest_length", rest_length)] {
-                        if !v.is_finite() || *v < 0.0 {
-                            return Err(Error::invalid(&item, format!("{what} must be >= 0 and finite, got {v}")));
-                        }
-                    }
-                    let kind = ForceKind::SpringDamper {
-                        a: marker(&item, a)?,
-                        b: marker(&item, b)?,
-                        stiffness: *stiffness,
-                        damping: *damping,
-                        rest_length: *rest_length,
-                    };
-                    (nm, kind)
-                }
-            };
-            forces.push(Force { name, kind });
-        }
-        let has_beam_damping = bodies.iter().any(|b| matches!(&b.kind, BodyKind::Beam(beam) if beam.damping > 0.0));
-        Ok(Model {
-            bodies,
-            constraints,
-            forces,
-            gravity: d.gravity.filter(|g| g[0] != 0.0 || g[1] != 0.0),
-            n,
-            m,
-            has_beam_damping,
-            coordinate_names,
-            constraint_row_names: row_names,
-            q0,
-            qd0,
-        })
+        b.finish()
     }
 
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
     }
+
+    /// Any body with stiffness-proportional damping (the scene is then truly stiff).
+    pub fn has_damping(&self) -> bool {
+        self.bodies.iter().any(|b| matches!(&b.kind, BodyKind::Beam(beam) if beam.damping > 0.0))
+    }
 }
 
-fn resolve_marker(bodies: &[Body], index: &HashMap<String, usize>, item: &str, md: &MarkerDesc) -> Result<Marker> {
-    if !md.angle.is_finite() {
-        return Err(Error::invalid(item, format!("marker angle must be finite, got {}", md.angle)));
+/// The top level of a description, items kept raw so that each is parsed with its own context.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDescription {
+    #[serde(default)]
+    gravity: Option<Vec2>,
+    bodies: Vec<Value>,
+    #[serde(default)]
+    joints: Vec<Value>,
+    #[serde(default)]
+    drivers: Vec<Value>,
+    #[serde(default)]
+    forces: Vec<Value>,
+}
+
+/// The four lists of a description.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Section {
+    Body,
+    Joint,
+    Driver,
+    Force,
+}
+
+impl Section {
+    pub fn from_name(s: &str) -> Option<Section> {
+        match s {
+            "body" | "bodies" => Some(Section::Body),
+            "joint" | "joints" => Some(Section::Joint),
+            "driver" | "drivers" => Some(Section::Driver),
+            "force" | "forces" => Some(Section::Force),
+            _ => None,
+        }
     }
-    if md.body == "ground" {
-        let p = md.point.unwrap_or([0.0, 0.0]);
-        if md.xi.is_some() {
-            return Err(Error::invalid(item, "a ground marker takes 'point', not 'xi'"));
+
+    fn word(self) -> &'static str {
+        match self {
+            Section::Body => "body",
+            Section::Joint => "joint",
+            Section::Driver => "driver",
+            Section::Force => "force",
         }
-        check_finite_item(item, "marker point", &p)?;
-        return Ok(Marker { body: None, angle: md.angle, shape: MarkerShape::Point(p) });
     }
-    let Some(&bi) = index.get(&md.body) else {
-        return Err(Error::UnknownBody { item: item.to_string(), body: md.body.clone() });
+}
+
+/// How errors name an item: `body 'crank'`, `joint revolute 'pivot'`, `driver angle #0`.
+pub fn item_name(section: Section, kind: &str, name: Option<&str>, index: usize) -> String {
+    match (section, name) {
+        (Section::Body, n) => format!("body '{}'", n.unwrap_or("")),
+        (_, Some(n)) => format!("{} {kind} '{n}'", section.word()),
+        (_, None) => format!("{} {kind} #{index}", section.word()),
+    }
+}
+
+pub fn parse_json<T: DeserializeOwned>(item: &str, text: &str) -> Result<T> {
+    let de = &mut serde_json::Deserializer::from_str(text);
+    serde_path_to_error::deserialize(de).map_err(|e| describe(item, e))
+}
+
+fn describe(item: &str, e: serde_path_to_error::Error<serde_json::Error>) -> Error {
+    let path = clean_path(&e.path().to_string());
+    let inner = e.into_inner().to_string();
+    // "unknown field `x`, expected one of ..." / "invalid type: ... at line 1 column 9"
+    let msg = match inner.find(" at line ") {
+        Some(i) => inner[..i].to_string(),
+        None => inner,
+    }
+    .replace('`', "'");
+    // an unknown field names itself: the path of its parent is the context
+    let path = if msg.starts_with("unknown field") {
+        path.rsplit_once('.').map(|(p, _)| p.to_string()).unwrap_or_default()
+    } else {
+        path
     };
-    let shape = match &bodies[bi].kind {
-        BodyKind::Rigid(_) => {
-            if md.xi.is_some() {
-                return Err(Error::invalid(item, format!("marker on rigid body '{}' takes 'point', not 'xi'", md.body)));
-            }
-            let p = md.point.unwrap_or([0.0, 0.0]);
-            check_finite_item(item, "marker point", &p)?;
-            MarkerShape::Point(p)
+    if path == "." || path.is_empty() {
+        Error::invalid(item, msg)
+    } else {
+        Error::invalid(item, format!("{path}: {msg}"))
+    }
+}
+
+/// A field path as the user wrote it: the variant keys that `to_external` introduced (the
+/// item's own, and those after `section` and `motion`) are dropped.
+fn clean_path(path: &str) -> String {
+    if path == "." || path.is_empty() {
+        return String::new();
+    }
+    let segs: Vec<&str> = path.split('.').collect();
+    let mut out: Vec<&str> = Vec::new();
+    let mut skip_next = false;
+    for (i, s) in segs.iter().enumerate() {
+        if skip_next {
+            skip_next = false;
+            continue;
         }
-        BodyKind::Beam(beam) => {
-            if md.point.is_some() {
-                return Err(Error::invalid(item, format!("marker on beam '{}' takes 'xi' in [0, 1], not 'point'", md.body)));
-            }
-            let xi = md.xi.unwrap_or(0.0);
-            if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
-                return Err(Error::invalid(item, format!("marker xi on beam '{}' must be in [0, 1], got {xi}", md.body)));
-            }
-            MarkerShape::Beam(beam.point_shape(xi))
+        out.push(s);
+        skip_next = i > 0 && (*s == "section" || *s == "motion");
+    }
+    out.join(".")
+}
+
+/// Check the top level of a description (its keys, gravity, that the item lists are lists).
+pub fn check_top_level(text: &str) -> Result<()> {
+    let raw: RawDescription = parse_json("scene", text)?;
+    if let Some(g) = raw.gravity {
+        check_finite_item("scene", "gravity", &g)?;
+    }
+    Ok(())
+}
+
+/// Parse one item of a section, errors naming the item (`index` is its position in the list).
+pub fn parse_item<T: DeserializeOwned>(section: Section, index: usize, v: Value) -> Result<T> {
+    let kind = v.get("kind").and_then(Value::as_str).unwrap_or("?").to_string();
+    let name = v.get("name").and_then(Value::as_str).map(str::to_string);
+    let item = item_name(section, &kind, name.as_deref(), index);
+    if !v.is_object() {
+        return Err(Error::invalid(&item, format!("expected a table/dict, got {v}")));
+    }
+    let what = if section == Section::Body { "kind".to_string() } else { format!("{} kind", section.word()) };
+    if v.get("kind").is_none() {
+        return Err(Error::invalid(&item, format!("missing {what}")));
+    }
+    serde_path_to_error::deserialize(to_external(v)).map_err(|e| {
+        let inner = e.inner().to_string().replace('`', "'");
+        if e.path().to_string() == "." && inner.starts_with("unknown variant") {
+            let expected = inner.split("expected ").nth(1).unwrap_or("").to_string();
+            return Error::invalid(&item, format!("unknown {what} '{kind}'; expected {expected}"));
         }
-    };
-    Ok(Marker { body: Some(bi), angle: md.angle, shape })
+        describe(&item, e)
+    })
+    .map_err(|err| match err {
+        // the first path segment is the item's own variant key
+        Error::InvalidProperty { item, message } => {
+            let message = match message.split_once('.') {
+                Some((first, rest)) if first == kind && rest.contains(": ") => rest.to_string(),
+                _ => message.strip_prefix(&format!("{kind}: ")).map(str::to_string).unwrap_or(message),
+            };
+            Error::InvalidProperty { item, message }
+        }
+        other => other,
+    })
+}
+
+/// An item as it stands in a description (`{"kind": .., ..}`), from its parsed form.
+pub fn item_to_json<T: serde::Serialize>(d: &T) -> Result<Value> {
+    let v = serde_json::to_value(d).map_err(|e| Error::Description(e.to_string()))?;
+    Ok(to_internal(v, "kind"))
+}
+
+/// Parse one item from JSON text (the Python scene builder's entry point).
+pub fn parse_item_json<T: DeserializeOwned>(section: Section, index: usize, text: &str) -> Result<T> {
+    let v: Value = serde_json::from_str(text).map_err(|e| Error::Description(e.to_string()))?;
+    parse_item(section, index, v)
+}
+
+/// Builds a `Model` item by item; the only place where a scene is validated.
+#[derive(Debug, Clone)]
+pub struct ModelBuilder {
+    gravity: Option<[f64; 2]>,
+    pub bodies: Vec<Body>,
+    index: HashMap<String, usize>,
+    q0: Vec<f64>,
+    qd0: Vec<f64>,
+    coordinate_names: Vec<String>,
+    pub joints: Vec<Constraint>,
+    pub drivers: Vec<Constraint>,
+    pub forces: Vec<Force>,
+    /// Names of joints, drivers and forces (given or made up), for uniqueness.
+    used_names: HashMap<String, usize>,
+}
+
+impl ModelBuilder {
+    pub fn new(gravity: Option<[f64; 2]>) -> Result<ModelBuilder> {
+        if let Some(g) = gravity {
+            check_finite_item("scene", "gravity", &g)?;
+        }
+        Ok(ModelBuilder {
+            gravity: gravity.filter(|g| g[0] != 0.0 || g[1] != 0.0),
+            bodies: Vec::new(),
+            index: HashMap::new(),
+            q0: Vec::new(),
+            qd0: Vec::new(),
+            coordinate_names: Vec::new(),
+            joints: Vec::new(),
+            drivers: Vec::new(),
+            forces: Vec::new(),
+            used_names: HashMap::new(),
+        })
+    }
+
+    pub fn add_body(&mut self, d: &BodyDesc) -> Result<&Body> {
+        let name = d.name();
+        if self.index.contains_key(name) {
+            return Err(Error::invalid(format!("body '{name}'"), "duplicate body name"));
+        }
+        let (body, init) = Body::from_desc(d, self.q0.len())?;
+        self.q0.extend_from_slice(&init.q);
+        self.qd0.extend_from_slice(&init.qd);
+        self.coordinate_names.extend(init.names.iter().map(|c| format!("{name}.{c}")));
+        self.index.insert(name.to_string(), self.bodies.len());
+        self.bodies.push(body);
+        Ok(self.bodies.last().expect("just pushed"))
+    }
+
+    /// The name of a joint/driver/force: the given one (unique, else an error) or a made-up
+    /// `kind{index}` (made unique with `#k`).
+    fn take_name(&mut self, item: &str, given: Option<&str>, default: String) -> Result<String> {
+        if let Some(n) = given {
+            if n.is_empty() {
+                return Err(Error::invalid(item, "name must be a non-empty string"));
+            }
+            if self.used_names.contains_key(n) {
+                return Err(Error::invalid(item, "duplicate name (joint, driver and force names must be unique)"));
+            }
+            self.used_names.insert(n.to_string(), 1);
+            return Ok(n.to_string());
+        }
+        let k = self.used_names.entry(default.clone()).or_insert(0);
+        *k += 1;
+        Ok(if *k == 1 { default } else { format!("{default}#{k}") })
+    }
+
+    fn context(&self) -> BuildContext<'_> {
+        BuildContext { bodies: &self.bodies, index: &self.index, q0: &self.q0 }
+    }
+
+    pub fn add_joint(&mut self, d: &JointDesc) -> Result<&Constraint> {
+        let j = self.joints.len();
+        let item = item_name(Section::Joint, d.kind(), d.name(), j);
+        let c = Constraint::from_joint(&self.context(), &item, String::new(), d)?;
+        let name = self.take_name(&item, d.name(), format!("{}{j}", d.kind()))?;
+        self.joints.push(Constraint { name, ..c });
+        Ok(self.joints.last().expect("just pushed"))
+    }
+
+    pub fn add_driver(&mut self, d: &DriverDesc) -> Result<&Constraint> {
+        let j = self.drivers.len();
+        let item = item_name(Section::Driver, d.kind(), d.name(), j);
+        let c = Constraint::from_driver(&self.context(), &item, String::new(), d)?;
+        let name = self.take_name(&item, d.name(), format!("{}_driver{j}", d.kind()))?;
+        self.drivers.push(Constraint { name, ..c });
+        Ok(self.drivers.last().expect("just pushed"))
+    }
+
+    pub fn add_force(&mut self, d: &ForceDesc) -> Result<&Force> {
+        let j = self.forces.len();
+        let item = item_name(Section::Force, d.kind(), d.name(), j);
+        let f = Force::from_desc(&self.context(), &item, String::new(), d)?;
+        let name = self.take_name(&item, d.name(), format!("{}{j}", d.kind()))?;
+        self.forces.push(Force { name, ..f });
+        Ok(self.forces.last().expect("just pushed"))
+    }
+
+    /// Number of coordinates so far.
+    pub fn n_coords(&self) -> usize {
+        self.q0.len()
+    }
+
+    pub fn finish(self) -> Result<Model> {
+        if self.bodies.is_empty() {
+            return Err(Error::Description("a scene needs at least one body".into()));
+        }
+        let mut constraints = self.joints;
+        constraints.extend(self.drivers);
+        let mut row = 0;
+        let mut row_names = Vec::new();
+        for c in constraints.iter_mut() {
+            c.row = row;
+            for s in c.row_suffixes() {
+                row_names.push(if s.is_empty() { c.name.clone() } else { format!("{}.{s}", c.name) });
+            }
+            row += c.rows();
+        }
+        Ok(Model {
+            n: self.q0.len(),
+            m: row,
+            bodies: self.bodies,
+            constraints,
+            forces: self.forces,
+            gravity: self.gravity,
+            coordinate_names: self.coordinate_names,
+            constraint_row_names: row_names,
+            q0: self.q0,
+            qd0: self.qd0,
+        })
+    }
 }

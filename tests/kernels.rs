@@ -14,6 +14,7 @@ fn scenes() -> Vec<(String, String)> {
         ("paper euler-bernoulli N=3".into(), paper_scene("euler-bernoulli", 3, false)),
         ("paper timoshenko N=8".into(), paper_scene("timoshenko", 8, true)),
         ("every kind".into(), every_kind_scene()),
+        ("point masses and distances".into(), point_mass_scene()),
     ]
 }
 
@@ -185,7 +186,7 @@ fn projection_restores_consistency_and_leaves_consistent_states_alone() {
     let (model, mut data) = build(&paper_scene("timoshenko", 4, true));
     let (mut q, mut qd) = (model.q0.clone(), model.qd0.clone());
     let (q_ref, qd_ref) = (q.clone(), qd.clone());
-    let rep = uk::project(&model, &mut data, 0.0, &mut q, &mut qd, 1e-13, 10).unwrap();
+    let rep = ukflex::correct::project(&model, &mut data, 0.0, &mut q, &mut qd, 1e-13, 10).unwrap();
     assert_eq!(rep.iterations, 0);
     assert!(max_abs(&q.iter().zip(&q_ref).map(|(a, b)| a - b).collect::<Vec<_>>()) < 1e-15);
     assert!(max_abs(&qd.iter().zip(&qd_ref).map(|(a, b)| a - b).collect::<Vec<_>>()) < 1e-9);
@@ -194,7 +195,7 @@ fn projection_restores_consistency_and_leaves_consistent_states_alone() {
         q[i] += 1e-3 * rng.next() * if i < 6 { 1.0 } else { 1e-3 };
         qd[i] += 0.1 * rng.next();
     }
-    let rep = uk::project(&model, &mut data, 0.2, &mut q, &mut qd, 1e-13, 20).unwrap();
+    let rep = ukflex::correct::project(&model, &mut data, 0.2, &mut q, &mut qd, 1e-13, 20).unwrap();
     assert!(rep.position_residual <= 1e-13, "{rep:?}");
     assert!(rep.velocity_residual <= 1e-9, "{rep:?}");
     assert!(rep.iterations >= 2 && rep.iterations <= 6, "Newton should converge quadratically: {rep:?}");

@@ -3,9 +3,10 @@
 //! `S_tilde`, `M_ff`, `K_ff` and the Cholesky factor of `M_ff` -- is integrated here once, by
 //! Gauss quadrature of the element shape functions (paper eqs. 6-9, 23, 26-33).
 
-use crate::description::{BeamDesc, BeamTheory, ReferenceConditions, SectionDesc};
-use crate::error::{Error, Result};
-use crate::linalg::{Banded, BandedCholesky, GAUSS4};
+use super::{add_frame_gravity, add_frame_point_jacobian, finite_vec2, frame_mass_block, frame_mass_moment, frame_point_state, InitialState, MarkerState};
+use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions, SectionDesc};
+use crate::error::{check_finite_item, non_negative, positive, Error, Result};
+use crate::linalg::{cholesky3, solve_lower3, solve_upper3, Banded, BandedCholesky, GAUSS4};
 
 /// Half-bandwidth of element-coupled matrices in nodal order (6 nodal dofs per element).
 const HB: usize = 5;
@@ -173,59 +174,77 @@ pub struct PointShape {
     pub entries: Vec<(usize, f64, f64, f64)>,
 }
 
-fn positive(item: &str, what: &str, v: f64) -> Result<f64> {
-    if !v.is_finite() || v <= 0.0 {
-        return Err(Error::invalid(item, format!("{what} must be positive and finite, got {v}")));
-    }
-    Ok(v)
+/// Area and second moment `(a, I)` of a section (`I` about the axis normal to the plane).
+pub fn section_properties(item: &str, section: &SectionDesc) -> Result<(f64, f64)> {
+    let (area, second_moment) = match *section {
+        SectionDesc::Circular { diameter } => {
+            let dd = positive(item, "section diameter", diameter)?;
+            (std::f64::consts::PI * dd * dd / 4.0, std::f64::consts::PI * dd.powi(4) / 64.0)
+        }
+        SectionDesc::Rectangular { width, height } => {
+            let b = positive(item, "section width", width)?;
+            let h = positive(item, "section height", height)?;
+            (b * h, b * h * h * h / 12.0)
+        }
+        SectionDesc::Custom { area, second_moment } => {
+            (positive(item, "section area", area)?, positive(item, "section second_moment", second_moment)?)
+        }
+    };
+    positive(item, "section area", area)?;
+    positive(item, "section second_moment", second_moment)?;
+    Ok((area, second_moment))
 }
 
+/// Nodal dofs `(u, v, psi)` per node removed by the reference conditions of the floating frame.
+fn removed_dofs(elements: usize, frame: ReferenceConditions) -> [usize; 3] {
+    match frame {
+        // u_1 = v_1 = 0, v_{N+1} = 0
+        ReferenceConditions::PinnedPinned => [0, 1, 3 * elements + 1],
+        // u_1 = v_1 = psi_1 = 0
+        ReferenceConditions::Clamped => [0, 1, 2],
+    }
+}
+
+/// Number of elastic coordinates: the `3 (N + 1)` nodal dofs less the three removed by the
+/// reference conditions.
+pub fn elastic_dofs(elements: usize, frame: ReferenceConditions) -> usize {
+    3 * (elements + 1) - removed_dofs(elements, frame).len()
+}
+
+/// Largest number of elements of one beam.
+pub const MAX_ELEMENTS: usize = 4096;
+
 impl Beam {
-    pub fn new(d: &BeamDesc) -> Result<Beam> {
-        let item = format!("beam '{}'", d.name);
-        let item = item.as_str();
+    pub fn from_desc(d: &BeamDesc, item: &str) -> Result<Beam> {
         let length = positive(item, "length", d.length)?;
-        if d.elements == 0 || d.elements > 4096 {
-            return Err(Error::invalid(item, format!("elements must be in 1..=4096, got {}", d.elements)));
+        if d.elements == 0 || d.elements > MAX_ELEMENTS {
+            return Err(Error::invalid(item, format!("elements must be in 1..={MAX_ELEMENTS}, got {}", d.elements)));
         }
         let density = positive(item, "density", d.density)?;
         let e = positive(item, "youngs_modulus", d.youngs_modulus)?;
-        let (area, second_moment) = match d.section {
-            SectionDesc::Circular { diameter } => {
-                let dd = positive(item, "section diameter", diameter)?;
-                (std::f64::consts::PI * dd * dd / 4.0, std::f64::consts::PI * dd.powi(4) / 64.0)
+        let (area, second_moment) = section_properties(item, &d.section)?;
+        // shear data: validated whenever given, required by Timoshenko
+        let g = match (d.shear_modulus, d.poisson_ratio) {
+            (Some(_), Some(_)) => return Err(Error::invalid(item, "give either poisson_ratio or shear_modulus, not both")),
+            (Some(g), None) => Some(positive(item, "shear_modulus", g)?),
+            (None, Some(nu)) => {
+                if !nu.is_finite() || nu <= -1.0 || nu >= 0.5 {
+                    return Err(Error::invalid(item, format!("poisson_ratio must be in (-1, 0.5), got {nu}")));
+                }
+                Some(e / (2.0 * (1.0 + nu)))
             }
-            SectionDesc::Rectangular { width, height } => {
-                let b = positive(item, "section width", width)?;
-                let h = positive(item, "section height", height)?;
-                (b * h, b * h * h * h / 12.0)
-            }
-            SectionDesc::Custom { area, second_moment } => {
-                (positive(item, "section area", area)?, positive(item, "section second_moment", second_moment)?)
-            }
+            (None, None) => None,
         };
+        let k = d.shear_factor.map(|k| positive(item, "shear_factor", k)).transpose()?;
         let shear_stiffness = match d.theory {
             BeamTheory::EulerBernoulli => 0.0,
             BeamTheory::Timoshenko => {
-                let g = match (d.shear_modulus, d.poisson_ratio) {
-                    (Some(g), _) => positive(item, "shear_modulus", g)?,
-                    (None, Some(nu)) => {
-                        if !nu.is_finite() || nu <= -1.0 || nu >= 0.5 {
-                            return Err(Error::invalid(item, format!("poisson_ratio must be in (-1, 0.5), got {nu}")));
-                        }
-                        e / (2.0 * (1.0 + nu))
-                    }
-                    (None, None) => {
-                        return Err(Error::invalid(item, "a Timoshenko beam needs poisson_ratio or shear_modulus"))
-                    }
-                };
-                let k = d.shear_factor.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs shear_factor"))?;
-                positive(item, "shear_factor", k)? * g
+                let g = g.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs poisson_ratio or shear_modulus"))?;
+                let k = k.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs shear_factor"))?;
+                k * g
             }
         };
-        if !d.damping.is_finite() || d.damping < 0.0 {
-            return Err(Error::invalid(item, format!("damping must be >= 0 and finite, got {}", d.damping)));
-        }
+        non_negative(item, "damping", d.damping)?;
         let rotary_inertia = d.rotary_inertia.unwrap_or(d.theory == BeamTheory::Timoshenko);
         let section = BeamSection {
             area,
@@ -239,10 +258,7 @@ impl Beam {
         let n_el = d.elements;
         let l = length / n_el as f64;
         let n_nodal = 3 * (n_el + 1);
-        let removed: [usize; 3] = match d.frame {
-            ReferenceConditions::PinnedPinned => [0, 1, 3 * n_el + 1],
-            ReferenceConditions::Clamped => [0, 1, 2],
-        };
+        let removed = removed_dofs(n_el, d.frame);
         let mut dof_map = vec![None; n_nodal];
         let mut dof_of_qf = Vec::new();
         for (k, slot) in dof_map.iter_mut().enumerate() {
@@ -339,5 +355,312 @@ impl Beam {
             }
         }
         PointShape { x: xi * self.length, entries }
+    }
+}
+
+/// Workspace of a beam: per-call mass blocks and the factor `F_b = [[L_s, X], [0, L_ff]]`.
+///
+/// `X = M_rf L_ff^-T` (3 x n_f). Its first two rows are the rotation of constants:
+/// `M_Rf = A S_bar`, so `X_0 = c a - s b`, `X_1 = s a + c b` with `a = L_ff^-1 S_bar_x^T`,
+/// `b = L_ff^-1 S_bar_y^T` fixed at model build (here, once per workspace). Only
+/// `X_2 = L_ff^-1 m_thetaf^T` needs a banded solve per call, and the 3x3 Schur complement
+/// `m_rr - X X^T` needs only `X_2 . (a, b, X_2)` besides the constant products `a.a`, `a.b`,
+/// `b.b`.
+#[derive(Debug, Clone)]
+pub struct BeamData {
+    /// Reference block `[[m_RR, m_Rtheta], [., m_thetatheta]]` (symmetric 3x3).
+    pub m_rr: [[f64; 3]; 3],
+    /// `(cos theta, sin theta)` of the last `mass_and_forces`.
+    pub cs: [f64; 2],
+    /// `m_thetaf = i_thf - S_tilde q_f` (n_f).
+    pub m_thf: Vec<f64>,
+    /// Constants `a = L_ff^-1 S_bar_x^T`, `b = L_ff^-1 S_bar_y^T` (n_f each) and
+    /// `[a.a, a.b, b.b]`.
+    pub a: Vec<f64>,
+    pub b: Vec<f64>,
+    pub ab: [f64; 3],
+    /// `X_2 = L_ff^-1 m_thetaf^T` (n_f).
+    pub x2: Vec<f64>,
+    /// Lower Cholesky factor of the Schur complement `m_rr - X X^T`.
+    pub ls: [[f64; 3]; 3],
+    /// Scratch of length n_f: `i_rf + M_ff^tr q_f`.
+    pub w: Vec<f64>,
+}
+
+#[inline]
+fn dot(x: &[f64], y: &[f64]) -> f64 {
+    x.iter().zip(y).map(|(p, q)| p * q).sum()
+}
+
+impl Beam {
+    /// Initial guess: frame state from the description, elastic coordinates (default zero).
+    pub fn initial_state(&self, d: &BeamDesc, item: &str) -> Result<InitialState> {
+        let p = finite_vec2(item, "position", d.position)?;
+        let v = finite_vec2(item, "velocity", d.velocity)?;
+        let mut q = vec![p[0], p[1], d.angle];
+        let mut qd = vec![v[0], v[1], d.angular_velocity];
+        for (what, given, out) in [("elastic", &d.elastic, &mut q), ("elastic_rates", &d.elastic_rates, &mut qd)] {
+            match given {
+                Some(v) if v.len() != self.n_f => {
+                    return Err(Error::invalid(item, format!("{what} must have length {}, got {}", self.n_f, v.len())))
+                }
+                Some(v) => {
+                    check_finite_item(item, what, v)?;
+                    out.extend_from_slice(v);
+                }
+                None => out.resize(out.len() + self.n_f, 0.0),
+            }
+        }
+        let mut names: Vec<String> = ["x", "y", "theta"].map(String::from).to_vec();
+        names.extend((0..self.n_f).map(|i| format!("qf{i}")));
+        Ok(InitialState { q, qd, names })
+    }
+
+    pub fn new_data(&self) -> BeamData {
+        let (mut a, mut b) = (self.s_bar[0].clone(), self.s_bar[1].clone());
+        self.l_ff.solve_lower(&mut a);
+        self.l_ff.solve_lower(&mut b);
+        let nf = self.n_f;
+        BeamData {
+            m_rr: [[0.0; 3]; 3],
+            cs: [1.0, 0.0],
+            m_thf: vec![0.0; nf],
+            ab: [dot(&a, &a), dot(&a, &b), dot(&b, &b)],
+            a,
+            b,
+            x2: vec![0.0; nf],
+            ls: [[0.0; 3]; 3],
+            w: vec![0.0; nf],
+        }
+    }
+
+    /// `Sigma = s_t + S_bar q_f` (first moment in the body frame).
+    #[inline]
+    fn first_moment(&self, qf: &[f64]) -> [f64; 2] {
+        [self.s_t[0] + dot(&self.s_bar[0], qf), self.s_t[1] + dot(&self.s_bar[1], qf)]
+    }
+
+    /// Mass blocks and generalized forces (paper eqs. 20-40), with `Sigma = s_t + S_bar q_f`,
+    /// `J` = +90 deg turn:
+    /// * `m_RR = m I`, `m_Rtheta = A J Sigma`, `m_Rf = A S_bar`                    (eqs. 21-25)
+    /// * `m_thetatheta = j0 + 2 i_rf . q_f + q_f^T M_ff^tr q_f`                      (eqs. 26-30)
+    /// * `m_thetaf = i_thf + q_f^T S_tilde`                                          (eq. 31)
+    /// * `Q_v,R = thd^2 A Sigma - 2 thd A J S_bar qd_f`
+    /// * `Q_v,theta = -2 thd qd_f . (i_rf + M_ff^tr q_f)`
+    /// * `Q_v,f = thd^2 (i_rf + M_ff^tr q_f) + 2 thd S_tilde qd_f`                   (eq. 40)
+    /// * `Q_el = -K_ff (q_f + beta qd_f)`                                           (eq. 38)
+    /// * gravity: `Q_R = m g`, `Q_theta = g . A J Sigma`, `Q_f = S_bar^T A^T g`     (eq. 37)
+    #[inline]
+    pub fn mass_and_forces(&self, bd: &mut BeamData, q: &[f64], qd: &[f64], gravity: Option<[f64; 2]>, f: &mut [f64]) {
+        let nf = self.n_f;
+        let thd = qd[2];
+        let (s, c) = q[2].sin_cos();
+        let (qf, qfd) = (&q[3..], &qd[3..]);
+        let sig = self.first_moment(qf);
+        let sigd = [dot(&self.s_bar[0], qfd), dot(&self.s_bar[1], qfd)]; // S_bar qd_f
+        let asig = [c * sig[0] - s * sig[1], s * sig[0] + c * sig[1]];
+        let asigd = [c * sigd[0] - s * sigd[1], s * sigd[0] + c * sigd[1]];
+        // w = i_rf + M_ff^tr q_f
+        bd.w.copy_from_slice(&self.i_rf);
+        self.m_ff_tr.mul_add(1.0, qf, &mut bd.w);
+        let mut m_thth = self.j0;
+        let mut qd_w = 0.0;
+        for j in 0..nf {
+            m_thth += qf[j] * (self.i_rf[j] + bd.w[j]);
+            qd_w += qfd[j] * bd.w[j];
+        }
+        bd.m_rr = frame_mass_block(self.mass, sig, m_thth, c, s);
+        bd.cs = [c, s];
+        // m_thetaf = i_thf + S_tilde^T q_f = i_thf - S_tilde q_f  (M_Rf = A S_bar is not
+        // formed: the factor uses the rotated constants, `dense_block` rebuilds it)
+        bd.m_thf.copy_from_slice(&self.i_thf);
+        self.s_tilde.mul_add(-1.0, qf, &mut bd.m_thf);
+
+        f[0] = thd * thd * asig[0] + 2.0 * thd * asigd[1];
+        f[1] = thd * thd * asig[1] - 2.0 * thd * asigd[0];
+        f[2] = -2.0 * thd * qd_w;
+        let ff = &mut f[3..];
+        for j in 0..nf {
+            ff[j] = thd * thd * bd.w[j];
+        }
+        self.s_tilde.mul_add(2.0 * thd, qfd, ff);
+        self.k_ff.mul_add(-1.0, qf, ff);
+        if self.damping > 0.0 {
+            self.k_ff.mul_add(-self.damping, qfd, ff);
+        }
+        if let Some(g) = gravity {
+            add_frame_gravity(self.mass, &bd.m_rr, g, f);
+            let atg = [c * g[0] + s * g[1], -s * g[0] + c * g[1]];
+            for j in 0..nf {
+                f[3 + j] += self.s_bar[0][j] * atg[0] + self.s_bar[1][j] * atg[1];
+            }
+        }
+    }
+
+    /// `M_b = F_b F_b^T` in the order `[r; f]`: `F_b = [[L_s, X], [0, L_ff]]` with the constant
+    /// `L_ff L_ff^T = M_ff`, `X = M_rf L_ff^-T` and `L_s L_s^T = m_rr - X X^T`. A call costs one
+    /// banded solve (`X_2`), three dot products and a 3x3 Cholesky.
+    #[inline]
+    pub fn factor(&self, bd: &mut BeamData) -> bool {
+        let mut ls = bd.m_rr;
+        bd.x2.copy_from_slice(&bd.m_thf);
+        self.l_ff.solve_lower(&mut bd.x2);
+        let (mut ax, mut bx, mut xx) = (0.0, 0.0, 0.0);
+        for ((x, a), bb) in bd.x2.iter().zip(&bd.a).zip(&bd.b) {
+            ax += a * x;
+            bx += bb * x;
+            xx += x * x;
+        }
+        let [c, s] = bd.cs;
+        let [aa, ab, bb] = bd.ab;
+        ls[0][0] -= c * c * aa - 2.0 * c * s * ab + s * s * bb;
+        ls[1][0] -= s * c * (aa - bb) + (c * c - s * s) * ab;
+        ls[1][1] -= s * s * aa + 2.0 * s * c * ab + c * c * bb;
+        ls[2][0] -= c * ax - s * bx;
+        ls[2][1] -= s * ax + c * bx;
+        ls[2][2] -= xx;
+        let ok = cholesky3(&mut ls);
+        bd.ls = ls;
+        ok
+    }
+
+    /// `v <- F^-1 v`: `v_f <- L_ff^-1 v_f`, `v_r <- L_s^-1 (v_r - X v_f)`.
+    #[inline]
+    pub fn finv(&self, bd: &BeamData, v: &mut [f64]) {
+        let (vr, vf) = v.split_at_mut(3);
+        self.l_ff.solve_lower(vf);
+        let (mut pa, mut pb, mut px) = (0.0, 0.0, 0.0);
+        for (((f, a), bb), x) in vf.iter().zip(&bd.a).zip(&bd.b).zip(&bd.x2) {
+            pa += a * f;
+            pb += bb * f;
+            px += x * f;
+        }
+        let [c, s] = bd.cs;
+        vr[0] -= c * pa - s * pb;
+        vr[1] -= s * pa + c * pb;
+        vr[2] -= px;
+        solve_lower3(&bd.ls, vr);
+    }
+
+    /// `v <- F^-T v`: `v_r <- L_s^-T v_r`, `v_f <- L_ff^-T (v_f - X^T v_r)`.
+    #[inline]
+    pub fn finvt(&self, bd: &BeamData, v: &mut [f64]) {
+        let (vr, vf) = v.split_at_mut(3);
+        solve_upper3(&bd.ls, vr);
+        let [c, s] = bd.cs;
+        // X^T v_r = (c v0 + s v1) a + (-s v0 + c v1) b + v2 X_2
+        let (ka, kb, kx) = (c * vr[0] + s * vr[1], -s * vr[0] + c * vr[1], vr[2]);
+        for (((f, a), bb), x) in vf.iter_mut().zip(&bd.a).zip(&bd.b).zip(&bd.x2) {
+            *f -= ka * a + kb * bb + kx * x;
+        }
+        self.l_ff.solve_upper(vf);
+    }
+
+    /// `M_Rf = A S_bar` entry `(i, j)`, `i` in 0..3 (row 2: `m_thetaf`).
+    #[inline]
+    fn m_rf(&self, bd: &BeamData, i: usize, j: usize) -> f64 {
+        let [c, s] = bd.cs;
+        match i {
+            0 => c * self.s_bar[0][j] - s * self.s_bar[1][j],
+            1 => s * self.s_bar[0][j] + c * self.s_bar[1][j],
+            _ => bd.m_thf[j],
+        }
+    }
+
+    pub fn dense_block(&self, bd: &BeamData, put: &mut impl FnMut(usize, usize, f64)) {
+        let nf = self.n_f;
+        for i in 0..3 {
+            for j in 0..3 {
+                put(i, j, bd.m_rr[i][j]);
+            }
+            for j in 0..nf {
+                let v = self.m_rf(bd, i, j);
+                put(i, 3 + j, v);
+                put(3 + j, i, v);
+            }
+        }
+        for i in 0..nf {
+            for j in i.saturating_sub(self.m_ff.hb)..(i + self.m_ff.hb + 1).min(nf) {
+                put(3 + i, 3 + j, self.m_ff.get(i, j));
+            }
+        }
+    }
+
+    /// `1/2 qd^T M_b qd` from the blocks (no dense matrix).
+    pub fn kinetic_energy(&self, bd: &BeamData, qd: &[f64]) -> f64 {
+        let (qr, qf) = qd.split_at(3);
+        let mut e = 0.0;
+        for i in 0..3 {
+            for j in 0..3 {
+                e += qr[i] * bd.m_rr[i][j] * qr[j];
+            }
+            let mut cross = 0.0;
+            for (j, v) in qf.iter().enumerate() {
+                cross += self.m_rf(bd, i, j) * v;
+            }
+            e += 2.0 * qr[i] * cross;
+        }
+        e += self.m_ff.bilinear(qf, qf);
+        0.5 * e
+    }
+
+    /// `1/2 q_f^T K_ff q_f`.
+    pub fn strain_energy(&self, q: &[f64]) -> f64 {
+        let qf = &q[3..];
+        0.5 * self.k_ff.bilinear(qf, qf)
+    }
+
+    /// `int rho r dV = m R + A Sigma`.
+    pub fn mass_moment(&self, q: &[f64]) -> [f64; 2] {
+        frame_mass_moment(self.mass, self.first_moment(&q[3..]), q)
+    }
+
+    /// A marker on a beam is an axis point `xi` in [0, 1].
+    pub fn marker_shape(&self, md: &MarkerDesc, body: &str, item: &str) -> Result<PointShape> {
+        if md.point.is_some() {
+            return Err(Error::invalid(item, format!("a marker on beam '{body}' is given by xi in [0, 1], not by a point")));
+        }
+        let Some(xi) = md.xi else {
+            return Err(Error::invalid(item, format!("a marker on beam '{body}' needs xi in [0, 1]")));
+        };
+        if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
+            return Err(Error::invalid(item, format!("marker xi on beam '{body}' must lie in [0, 1], got {xi}")));
+        }
+        Ok(self.point_shape(xi))
+    }
+}
+
+/// Axis point: body-frame position `(x + u, v)`, elastic velocity, rotation `psi`.
+#[inline]
+pub fn marker_state(ps: &PointShape, angle: f64, q: &[f64], qd: &[f64]) -> MarkerState {
+    let (qf, qfd) = (&q[3..], &qd[3..]);
+    let (mut pl, mut vl, mut psi, mut psid) = ([ps.x, 0.0], [0.0; 2], 0.0, 0.0);
+    for &(i, su, sv, sp) in &ps.entries {
+        pl[0] += su * qf[i];
+        pl[1] += sv * qf[i];
+        vl[0] += su * qfd[i];
+        vl[1] += sv * qfd[i];
+        psi += sp * qf[i];
+        psid += sp * qfd[i];
+    }
+    frame_point_state(pl, vl, angle + psi, psid, q, qd)
+}
+
+#[inline]
+pub fn add_point_jacobian(ps: &PointShape, ms: &MarkerState, w: [f64; 2], row: &mut [f64]) {
+    add_frame_point_jacobian(ms, w, row);
+    let [c, s] = ms.cs;
+    // w . A (S_u, S_v)
+    let (wa0, wa1) = (w[0] * c + w[1] * s, -w[0] * s + w[1] * c);
+    for &(i, su, sv, _) in &ps.entries {
+        row[3 + i] += wa0 * su + wa1 * sv;
+    }
+}
+
+#[inline]
+pub fn add_angle_jacobian(ps: &PointShape, w: f64, row: &mut [f64]) {
+    row[2] += w;
+    for &(i, _, _, sp) in &ps.entries {
+        row[3 + i] += w * sp;
     }
 }

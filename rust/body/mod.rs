@@ -1,15 +1,41 @@
 //! Bodies and markers. A closed set of body kinds, dispatched with `match` in the hot path.
+//!
+//! Each kind is one file that owns every per-body stage: building from its description
+//! (`from_desc`), its workspace (`new_data`), mass blocks and generalized forces
+//! (`mass_and_forces`), the factor `M_b = F_b F_b^T` (`factor`), `F_b^-1` (`finv`), `F_b^-T`
+//! (`finvt`), the dense block (`dense_block`), energies, and the kinematics of the markers it
+//! carries (`marker`, `marker_state`, `add_point_jacobian`, `add_angle_jacobian`). This file
+//! only dispatches; `dynamics.rs` only loops over bodies. Adding a kind = one file here plus
+//! one arm per `match` below (the compiler lists them).
 
 pub mod ffrf_beam;
+pub mod point_mass;
 pub mod rigid;
 
-pub use ffrf_beam::{Beam, PointShape};
-pub use rigid::Rigid;
+pub use ffrf_beam::{Beam, BeamData, PointShape};
+pub use point_mass::{PointMass, PointMassData};
+pub use rigid::{Rigid, RigidData};
 
+use crate::description::{BodyDesc, MarkerDesc};
+use crate::error::{check_finite_item, Error, Result};
+
+/// The closed set of body kinds (a scene has few bodies; the variants stay unboxed so that a
+/// body's constants sit next to each other).
 #[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)]
 pub enum BodyKind {
     Rigid(Rigid),
     Beam(Beam),
+    PointMass(PointMass),
+}
+
+/// Per-body workspace, one variant per kind (sized once in `Data::new`).
+#[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)]
+pub enum BodyData {
+    Rigid(RigidData),
+    Beam(BeamData),
+    PointMass(PointMassData),
 }
 
 #[derive(Debug, Clone)]
@@ -17,24 +43,209 @@ pub struct Body {
     pub name: String,
     /// Index of the body's first coordinate in `q`.
     pub offset: usize,
-    /// 3 + n_f.
     pub n_coords: usize,
     pub kind: BodyKind,
 }
 
+/// Initial guess of one body's coordinates and their names (suffixes after `body.`).
+pub struct InitialState {
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub names: Vec<String>,
+}
+
 impl Body {
+    /// Validate and build one body (constant shape integrals included) from its description.
+    pub fn from_desc(d: &BodyDesc, offset: usize) -> Result<(Body, InitialState)> {
+        let name = d.name().to_string();
+        let item = format!("body '{name}'");
+        if name.is_empty() || name == "ground" {
+            return Err(Error::invalid(&item, "body names must be non-empty and not 'ground' (the name 'ground' is reserved)"));
+        }
+        let (kind, init) = match d {
+            BodyDesc::Rigid(r) => {
+                let k = Rigid::from_desc(r, &item)?;
+                let init = k.initial_state(r, &item)?;
+                (BodyKind::Rigid(k), init)
+            }
+            BodyDesc::Beam(b) => {
+                let k = Beam::from_desc(b, &item)?;
+                let init = k.initial_state(b, &item)?;
+                (BodyKind::Beam(k), init)
+            }
+            BodyDesc::PointMass(p) => {
+                let k = PointMass::from_desc(p, &item)?;
+                let init = k.initial_state(p, &item)?;
+                (BodyKind::PointMass(k), init)
+            }
+        };
+        for (what, v) in [("initial state", &init.q), ("initial rates", &init.qd)] {
+            check_finite_item(&item, what, v)?;
+        }
+        Ok((Body { name, offset, n_coords: init.q.len(), kind }, init))
+    }
+
+    /// The kind's name as in the description (`"rigid"`, `"beam"`, `"point_mass"`).
+    pub fn kind_name(&self) -> &'static str {
+        match &self.kind {
+            BodyKind::Rigid(_) => "rigid",
+            BodyKind::Beam(_) => "beam",
+            BodyKind::PointMass(_) => "point_mass",
+        }
+    }
+
+    /// Coordinates `q[elastic_range]` that describe deformation (empty for rigid kinds).
+    pub fn elastic_range(&self) -> std::ops::Range<usize> {
+        match &self.kind {
+            BodyKind::Beam(_) => self.offset + 3..self.offset + self.n_coords,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) => self.offset..self.offset,
+        }
+    }
+
+    /// Number of elastic coordinates.
     pub fn n_f(&self) -> usize {
-        self.n_coords - 3
+        self.elastic_range().len()
+    }
+
+    pub fn total_mass(&self) -> f64 {
+        match &self.kind {
+            BodyKind::Rigid(k) => k.mass,
+            BodyKind::Beam(k) => k.mass,
+            BodyKind::PointMass(k) => k.mass,
+        }
+    }
+
+    pub fn new_data(&self) -> BodyData {
+        match &self.kind {
+            BodyKind::Rigid(k) => BodyData::Rigid(k.new_data()),
+            BodyKind::Beam(k) => BodyData::Beam(k.new_data()),
+            BodyKind::PointMass(k) => BodyData::PointMass(k.new_data()),
+        }
+    }
+
+    #[inline]
+    fn seg<'a>(&self, v: &'a [f64]) -> &'a [f64] {
+        &v[self.offset..self.offset + self.n_coords]
+    }
+
+    /// Mass blocks at `q` and generalized forces `Q_b(q, qd)` (inertial velocity terms,
+    /// elastic forces, gravity) into `force` (the whole `Q`, this body's segment written).
+    #[inline]
+    pub fn mass_and_forces(&self, bd: &mut BodyData, q: &[f64], qd: &[f64], gravity: Option<[f64; 2]>, force: &mut [f64]) {
+        let (qb, qdb) = (self.seg(q), self.seg(qd));
+        let f = &mut force[self.offset..self.offset + self.n_coords];
+        match (&self.kind, bd) {
+            (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
+            (BodyKind::Beam(k), BodyData::Beam(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
+            (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
+            _ => unreachable!("body data of another kind"),
+        }
+    }
+
+    /// Factor the body block `M_b = F_b F_b^T` (after `mass_and_forces`).
+    #[inline]
+    pub fn factor(&self, bd: &mut BodyData) -> Result<()> {
+        let ok = match (&self.kind, bd) {
+            (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.factor(d),
+            (BodyKind::Beam(k), BodyData::Beam(d)) => k.factor(d),
+            (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.factor(d),
+            _ => unreachable!("body data of another kind"),
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(Error::SingularMass { item: format!("body '{}'", self.name) })
+        }
+    }
+
+    /// `v <- F_b^-1 v` on this body's segment `v` (length `n_coords`).
+    #[inline]
+    pub fn finv(&self, bd: &BodyData, v: &mut [f64]) {
+        match (&self.kind, bd) {
+            (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.finv(d, v),
+            (BodyKind::Beam(k), BodyData::Beam(d)) => k.finv(d, v),
+            (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.finv(d, v),
+            _ => unreachable!("body data of another kind"),
+        }
+    }
+
+    /// `v <- F_b^-T v` on this body's segment.
+    #[inline]
+    pub fn finvt(&self, bd: &BodyData, v: &mut [f64]) {
+        match (&self.kind, bd) {
+            (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.finvt(d, v),
+            (BodyKind::Beam(k), BodyData::Beam(d)) => k.finvt(d, v),
+            (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.finvt(d, v),
+            _ => unreachable!("body data of another kind"),
+        }
+    }
+
+    /// Visit the nonzero entries of the body block `M_b` (after `mass_and_forces`) in body
+    /// coordinates: `put(i, j, M_b[i, j])`.
+    pub fn dense_block(&self, bd: &BodyData, put: &mut impl FnMut(usize, usize, f64)) {
+        match (&self.kind, bd) {
+            (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.dense_block(d, put),
+            (BodyKind::Beam(k), BodyData::Beam(d)) => k.dense_block(d, put),
+            (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.dense_block(d, put),
+            _ => unreachable!("body data of another kind"),
+        }
+    }
+
+    /// `1/2 qd_b^T M_b qd_b` (after `mass_and_forces` at the same `q`).
+    pub fn kinetic_energy(&self, bd: &BodyData, qd: &[f64]) -> f64 {
+        let qdb = self.seg(qd);
+        match (&self.kind, bd) {
+            (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.kinetic_energy(d, qdb),
+            (BodyKind::Beam(k), BodyData::Beam(d)) => k.kinetic_energy(d, qdb),
+            (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.kinetic_energy(d, qdb),
+            _ => unreachable!("body data of another kind"),
+        }
+    }
+
+    /// Elastic strain energy (zero for rigid kinds).
+    pub fn strain_energy(&self, q: &[f64]) -> f64 {
+        match &self.kind {
+            BodyKind::Beam(k) => k.strain_energy(self.seg(q)),
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) => 0.0,
+        }
+    }
+
+    /// Potential of gravity `-g . int rho r dV`.
+    pub fn gravity_energy(&self, q: &[f64], g: [f64; 2]) -> f64 {
+        let qb = self.seg(q);
+        let r = match &self.kind {
+            BodyKind::Rigid(k) => k.mass_moment(qb),
+            BodyKind::Beam(k) => k.mass_moment(qb),
+            BodyKind::PointMass(k) => k.mass_moment(qb),
+        };
+        -(g[0] * r[0] + g[1] * r[1])
+    }
+
+    /// Resolve a marker description on this body (`index` = this body's index).
+    pub fn marker(&self, index: usize, md: &MarkerDesc, item: &str) -> Result<Marker> {
+        let shape = match &self.kind {
+            BodyKind::Rigid(_) => MarkerShape::Rigid(rigid::marker_point(md, &self.name, item)?),
+            BodyKind::Beam(k) => MarkerShape::Beam(k.marker_shape(md, &self.name, item)?),
+            BodyKind::PointMass(_) => {
+                point_mass::check_marker(md, &self.name, item)?;
+                MarkerShape::Particle
+            }
+        };
+        Ok(Marker { body: Some(index), angle: md.angle, shape })
     }
 }
 
-/// Where a marker sits on its body.
+/// Where a marker sits on its body (one variant per kind that carries markers).
 #[derive(Debug, Clone)]
 pub enum MarkerShape {
-    /// A point in the frame of a rigid body or of the ground.
-    Point([f64; 2]),
+    /// A point of the ground (world frame).
+    Ground([f64; 2]),
+    /// A point in the frame of a rigid body.
+    Rigid([f64; 2]),
     /// An axis point of a beam (elastic displacement included).
     Beam(PointShape),
+    /// The particle itself (a point mass has no orientation).
+    Particle,
 }
 
 /// A point and a frame attached to a body (`body == None` for the ground).
@@ -58,6 +269,9 @@ pub struct MarkerState {
     pub omega: f64,
     /// Velocity-dependent part of the acceleration: `r_dd = r_q q_dd + h` (`(r_q qd)_q qd`).
     pub h: [f64; 2],
+    /// Velocity-dependent part of the angular acceleration `phi_dd = phi_q q_dd + h_phi`
+    /// (zero where the angle is linear in `q`).
+    pub h_phi: f64,
     /// `d r / d theta` of the carrying body.
     pub r_theta: [f64; 2],
     /// cos and sin of the body angle.
@@ -65,51 +279,31 @@ pub struct MarkerState {
 }
 
 impl Marker {
+    /// A marker fixed in the world frame.
+    pub fn ground(point: [f64; 2], angle: f64) -> Marker {
+        Marker { body: None, angle, shape: MarkerShape::Ground(point) }
+    }
+
+    /// Whether the marker frame can rotate with its body (false for the ground and particles,
+    /// whose marker angle is a constant).
+    pub fn has_orientation(&self) -> bool {
+        !matches!(self.shape, MarkerShape::Particle)
+    }
+
     /// Evaluate position, velocity and velocity terms at `(q, qd)`.
     #[inline]
     pub fn state(&self, bodies: &[Body], q: &[f64], qd: &[f64]) -> MarkerState {
         let Some(bi) = self.body else {
-            let p = match &self.shape {
-                MarkerShape::Point(p) => *p,
-                MarkerShape::Beam(_) => unreachable!("ground markers are points"),
-            };
+            let MarkerShape::Ground(p) = self.shape else { unreachable!("ground markers are points") };
             return MarkerState { r: p, phi: self.angle, cs: [1.0, 0.0], ..Default::default() };
         };
         let body = &bodies[bi];
-        let o = body.offset;
-        let (th, thd) = (q[o + 2], qd[o + 2]);
-        let (s, c) = th.sin_cos();
-        // local point (body frame) and its elastic velocity in the body frame
-        let mut pl: [f64; 2];
-        let (mut vl, mut psi, mut psid) = ([0.0; 2], 0.0, 0.0);
+        let (qb, qdb) = (body.seg(q), body.seg(qd));
         match &self.shape {
-            MarkerShape::Point(p) => pl = *p,
-            MarkerShape::Beam(ps) => {
-                pl = [ps.x, 0.0];
-                let qf = &q[o + 3..o + body.n_coords];
-                let qfd = &qd[o + 3..o + body.n_coords];
-                for &(i, su, sv, sp) in &ps.entries {
-                    pl[0] += su * qf[i];
-                    pl[1] += sv * qf[i];
-                    vl[0] += su * qfd[i];
-                    vl[1] += sv * qfd[i];
-                    psi += sp * qf[i];
-                    psid += sp * qfd[i];
-                }
-            }
-        }
-        let pw = [c * pl[0] - s * pl[1], s * pl[0] + c * pl[1]];
-        let vw = [c * vl[0] - s * vl[1], s * vl[0] + c * vl[1]];
-        let r_theta = [-pw[1], pw[0]];
-        MarkerState {
-            r: [q[o] + pw[0], q[o + 1] + pw[1]],
-            phi: th + self.angle + psi,
-            v: [qd[o] + thd * r_theta[0] + vw[0], qd[o + 1] + thd * r_theta[1] + vw[1]],
-            omega: thd + psid,
-            // -theta_dot^2 A u + 2 theta_dot A J S qd_f
-            h: [-thd * thd * pw[0] - 2.0 * thd * vw[1], -thd * thd * pw[1] + 2.0 * thd * vw[0]],
-            r_theta,
-            cs: [c, s],
+            MarkerShape::Rigid(p) => rigid::marker_state(p, self.angle, qb, qdb),
+            MarkerShape::Beam(ps) => ffrf_beam::marker_state(ps, self.angle, qb, qdb),
+            MarkerShape::Particle => point_mass::marker_state(self.angle, qb, qdb),
+            MarkerShape::Ground(_) => unreachable!("ground marker on a body"),
         }
     }
 
@@ -117,17 +311,13 @@ impl Marker {
     #[inline]
     pub fn add_point_jacobian(&self, bodies: &[Body], ms: &MarkerState, w: [f64; 2], row: &mut [f64]) {
         let Some(bi) = self.body else { return };
-        let o = bodies[bi].offset;
-        row[o] += w[0];
-        row[o + 1] += w[1];
-        row[o + 2] += w[0] * ms.r_theta[0] + w[1] * ms.r_theta[1];
-        if let MarkerShape::Beam(ps) = &self.shape {
-            let [c, s] = ms.cs;
-            // w . A (S_u, S_v)
-            let (wa0, wa1) = (w[0] * c + w[1] * s, -w[0] * s + w[1] * c);
-            for &(i, su, sv, _) in &ps.entries {
-                row[o + 3 + i] += wa0 * su + wa1 * sv;
-            }
+        let body = &bodies[bi];
+        let rb = &mut row[body.offset..body.offset + body.n_coords];
+        match &self.shape {
+            MarkerShape::Rigid(_) => rigid::add_point_jacobian(ms, w, rb),
+            MarkerShape::Beam(ps) => ffrf_beam::add_point_jacobian(ps, ms, w, rb),
+            MarkerShape::Particle => point_mass::add_point_jacobian(w, rb),
+            MarkerShape::Ground(_) => {}
         }
     }
 
@@ -135,12 +325,72 @@ impl Marker {
     #[inline]
     pub fn add_angle_jacobian(&self, bodies: &[Body], w: f64, row: &mut [f64]) {
         let Some(bi) = self.body else { return };
-        let o = bodies[bi].offset;
-        row[o + 2] += w;
-        if let MarkerShape::Beam(ps) = &self.shape {
-            for &(i, _, _, sp) in &ps.entries {
-                row[o + 3 + i] += w * sp;
-            }
+        let body = &bodies[bi];
+        let rb = &mut row[body.offset..body.offset + body.n_coords];
+        match &self.shape {
+            MarkerShape::Rigid(_) => rigid::add_angle_jacobian(w, rb),
+            MarkerShape::Beam(ps) => ffrf_beam::add_angle_jacobian(ps, w, rb),
+            MarkerShape::Particle | MarkerShape::Ground(_) => {}
         }
     }
+}
+
+/// The planar kinematics shared by the kinds with a floating frame `(x, y, theta)` (rigid
+/// bodies, FFRF beams): a body-frame point `pl` moving with body-frame velocity `vl`, on a
+/// frame at `(q[0], q[1])` with angle `q[2]`.
+#[inline]
+pub(crate) fn frame_point_state(pl: [f64; 2], vl: [f64; 2], phi_local: f64, omega_local: f64, q: &[f64], qd: &[f64]) -> MarkerState {
+    let (th, thd) = (q[2], qd[2]);
+    let (s, c) = th.sin_cos();
+    let pw = [c * pl[0] - s * pl[1], s * pl[0] + c * pl[1]];
+    let vw = [c * vl[0] - s * vl[1], s * vl[0] + c * vl[1]];
+    let r_theta = [-pw[1], pw[0]];
+    MarkerState {
+        r: [q[0] + pw[0], q[1] + pw[1]],
+        phi: th + phi_local,
+        v: [qd[0] + thd * r_theta[0] + vw[0], qd[1] + thd * r_theta[1] + vw[1]],
+        omega: thd + omega_local,
+        // -theta_dot^2 A u + 2 theta_dot A J S qd_f
+        h: [-thd * thd * pw[0] - 2.0 * thd * vw[1], -thd * thd * pw[1] + 2.0 * thd * vw[0]],
+        h_phi: 0.0,
+        r_theta,
+        cs: [c, s],
+    }
+}
+
+/// `row[0..3] += w . d r / d (x, y, theta)` for a frame point.
+#[inline]
+pub(crate) fn add_frame_point_jacobian(ms: &MarkerState, w: [f64; 2], row: &mut [f64]) {
+    row[0] += w[0];
+    row[1] += w[1];
+    row[2] += w[0] * ms.r_theta[0] + w[1] * ms.r_theta[1];
+}
+
+/// The floating-frame mass block of a body with total mass `mass` and first moment `sig`
+/// (body frame) about the frame origin, rotated by `(c, s)`: `[[m I, A J sig], [., j]]`.
+#[inline]
+pub(crate) fn frame_mass_block(mass: f64, sig: [f64; 2], j: f64, c: f64, s: f64) -> [[f64; 3]; 3] {
+    let asig = [c * sig[0] - s * sig[1], s * sig[0] + c * sig[1]];
+    let ajsig = [-asig[1], asig[0]];
+    [[mass, 0.0, ajsig[0]], [0.0, mass, ajsig[1]], [ajsig[0], ajsig[1], j]]
+}
+
+/// Gravity on a floating frame: `Q_R += m g`, `Q_theta += g . A J sig`.
+#[inline]
+pub(crate) fn add_frame_gravity(mass: f64, m_rr: &[[f64; 3]; 3], g: [f64; 2], f: &mut [f64]) {
+    f[0] += mass * g[0];
+    f[1] += mass * g[1];
+    f[2] += g[0] * m_rr[0][2] + g[1] * m_rr[1][2];
+}
+
+/// `m R + A sig` (world first moment of a floating-frame body).
+#[inline]
+pub(crate) fn frame_mass_moment(mass: f64, sig: [f64; 2], q: &[f64]) -> [f64; 2] {
+    let (s, c) = q[2].sin_cos();
+    [mass * q[0] + c * sig[0] - s * sig[1], mass * q[1] + s * sig[0] + c * sig[1]]
+}
+
+pub(crate) fn finite_vec2(item: &str, what: &str, v: [f64; 2]) -> Result<[f64; 2]> {
+    check_finite_item(item, what, &v)?;
+    Ok(v)
 }

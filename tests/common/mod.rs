@@ -89,18 +89,51 @@ pub fn random_state(model: &Model, rng: &mut Lcg) -> (Vec<f64>, Vec<f64>) {
     let (mut q, mut qd) = (vec![0.0; model.n], vec![0.0; model.n]);
     for b in &model.bodies {
         let o = b.offset;
-        q[o] = 0.3 * rng.next();
-        q[o + 1] = 0.3 * rng.next();
-        q[o + 2] = std::f64::consts::PI * rng.next();
-        qd[o] = 2.0 * rng.next();
-        qd[o + 1] = 2.0 * rng.next();
-        qd[o + 2] = 20.0 * rng.next();
-        for j in 3..b.n_coords {
-            q[o + j] = 1e-3 * rng.next();
-            qd[o + j] = 0.5 * rng.next();
+        let elastic = b.elastic_range();
+        for j in 0..b.n_coords {
+            let i = o + j;
+            if elastic.contains(&i) {
+                q[i] = 1e-3 * rng.next();
+                qd[i] = 0.5 * rng.next();
+            } else if j == 2 {
+                // the frame angle of a rigid body or a beam
+                q[i] = std::f64::consts::PI * rng.next();
+                qd[i] = 20.0 * rng.next();
+            } else {
+                q[i] = 0.3 * rng.next();
+                qd[i] = 2.0 * rng.next();
+            }
         }
     }
     (q, qd)
+}
+
+/// Point masses and distance constraints with every other kind: a particle on a massless rod
+/// to the ground, a second one on a rod to a beam point, pinned to a rigid arm and on a line.
+pub fn point_mass_scene() -> String {
+    r#"{
+      "gravity": [0.3, -9.81],
+      "bodies": [
+        {"name": "bob", "kind": "point_mass", "mass": 0.7, "position": [0.4, -0.3]},
+        {"name": "arm", "kind": "rigid", "mass": 0.3, "inertia": 0.002, "com": [0.1, 0.01]},
+        {"name": "beam", "kind": "beam", "length": 0.4, "elements": 2, "theory": "euler-bernoulli",
+         "density": 7800.0, "youngs_modulus": 2e11, "section": {"shape": "circular", "diameter": 0.01},
+         "frame": "pinned-pinned", "position": [0.2, 0.1]},
+        {"name": "bead", "kind": "point_mass", "mass": 0.2, "position": [0.5, 0.2]}],
+      "joints": [
+        {"kind": "distance", "a": {"body": "ground", "point": [0.0, 0.0]}, "b": {"body": "bob"}, "length": 0.5},
+        {"kind": "distance", "a": {"body": "beam", "xi": 0.7}, "b": {"body": "bead"}},
+        {"kind": "revolute", "a": {"body": "arm", "point": [0.2, 0.0]}, "b": {"body": "bob"}},
+        {"kind": "point_on_line", "point": {"body": "bead"}, "line": {"body": "arm", "point": [0.0, 0.05], "angle": 0.3}},
+        {"kind": "point_on_line", "point": {"body": "beam", "xi": 1.0}, "line": {"body": "bob", "angle": 0.2}},
+        {"kind": "distance", "a": {"body": "beam", "xi": 0.0}, "b": {"body": "arm", "point": [0.05, 0.02]}, "length": 0.3}],
+      "drivers": [
+        {"kind": "coordinate", "point": {"body": "bead"}, "axis": "y", "motion": {"kind": "harmonic", "amplitude": 0.01, "frequency": 5.0}}],
+      "forces": [
+        {"kind": "point_force", "point": {"body": "bob"}, "force": [1.0, 0.5]},
+        {"kind": "spring_damper", "a": {"body": "bead"}, "b": {"body": "ground", "point": [1.0, 0.0]}, "stiffness": 50.0, "damping": 0.5}]
+    }"#
+    .to_string()
 }
 
 pub fn build(json: &str) -> (Model, Data) {

@@ -1,82 +1,23 @@
-//! Python bindings (feature `python`): the only module that knows Python. Maps `Error` to
-//! exception classes under `ukflex.UkflexError`, reads strided NumPy inputs, returns fresh
-//! arrays, and never lets a panic cross into Python.
+//! `ukflex._core.System`: a compiled model with its workspace behind a lock.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
-use numpy::ndarray::ArrayView1;
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
-use pyo3::Borrowed;
-use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyKeyError, PyValueError};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use super::{check_time, mat, read_into, to_py, SolverError, Vector};
 use crate::body::BodyKind;
+use crate::correct::{self, CorrectOptions};
 use crate::data::{Data, RankTolerance, Stabilization, SvdBackend};
 use crate::dynamics;
 use crate::error::Error;
 use crate::integrate::{integrate_uk, Method, Options};
-use crate::jacobian::{Differences, JacobianWorkspace};
+use crate::jacobian::{assemble_first_order, Differences, JacobianWorkspace};
 use crate::model::Model;
 use crate::uk;
-
-create_exception!(ukflex, UkflexError, PyException, "Base class of every ukflex error.");
-create_exception!(ukflex, InvalidSceneError, UkflexError, "Malformed or non-physical scene description.");
-create_exception!(ukflex, SingularMassError, UkflexError, "The mass matrix is not positive definite.");
-create_exception!(ukflex, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
-create_exception!(ukflex, SolverError, UkflexError, "A solver kernel failed.");
-
-/// A 1-D float64 input. float64 vectors (what scipy passes) are read in place, strided or
-/// not; anything else array-like is converted once with `numpy.asarray(x, dtype=float64)`, and
-/// a wrong dimension or a non-numeric input is a `ValueError` naming what was expected.
-pub struct Vector<'py>(PyReadonlyArray1<'py, f64>);
-
-impl<'py> std::ops::Deref for Vector<'py> {
-    type Target = PyReadonlyArray1<'py, f64>;
-    fn deref(&self) -> &Self::Target {
-        &self.0
-    }
-}
-
-impl<'a, 'py> FromPyObject<'a, 'py> for Vector<'py> {
-    type Error = PyErr;
-    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        if let Ok(a) = obj.extract::<PyReadonlyArray1<'py, f64>>() {
-            return Ok(Vector(a));
-        }
-        let py = obj.py();
-        let converted = py
-            .import("numpy")?
-            .call_method1("asarray", (obj, "float64"))
-            .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?;
-        let arr = converted
-            .cast_into::<numpy::PyArrayDyn<f64>>()
-            .map_err(|_| PyValueError::new_err("expected a 1-D array of floats"))?;
-        if arr.ndim() != 1 {
-            return Err(PyValueError::new_err(format!("expected a 1-D array of floats, got an array of shape {:?}", arr.shape())));
-        }
-        let a = arr.readonly();
-        let a1 = a
-            .as_array()
-            .into_dimensionality::<numpy::ndarray::Ix1>()
-            .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?
-            .to_owned();
-        Ok(Vector(PyArray1::from_owned_array(py, a1).readonly()))
-    }
-}
-
-fn to_py(e: Error) -> PyErr {
-    let msg = e.to_string();
-    match e {
-        Error::Description(_) | Error::InvalidProperty { .. } | Error::UnknownBody { .. } => InvalidSceneError::new_err(msg),
-        Error::Shape { .. } => PyValueError::new_err(msg),
-        Error::NonFinite { .. } => NonFiniteError::new_err(msg),
-        Error::SingularMass { .. } => SingularMassError::new_err(msg),
-        Error::Solver(_) => SolverError::new_err(msg),
-    }
-}
 
 /// Workspace behind the lock: the kernel buffers plus contiguous copies of the inputs.
 struct Workspace {
@@ -87,31 +28,6 @@ struct Workspace {
     jws: JacobianWorkspace,
     jq: Vec<f64>,
     jv: Vec<f64>,
-}
-
-/// Copy a (possibly strided) NumPy vector into `dst`, checking length and finiteness.
-fn read_into(what: &str, src: &ArrayView1<f64>, dst: &mut [f64]) -> Result<(), Error> {
-    if src.len() != dst.len() {
-        return Err(Error::Shape { what: what.to_string(), expected: dst.len(), got: src.len() });
-    }
-    // contiguous fast path (the common case): plain copy, one finiteness pass
-    if let Some(sl) = src.as_slice() {
-        dst.copy_from_slice(sl);
-        if dst.iter().all(|x| x.is_finite()) {
-            return Ok(());
-        }
-    }
-    for (i, (d, s)) in dst.iter_mut().zip(src.iter()).enumerate() {
-        if !s.is_finite() {
-            return Err(Error::NonFinite { what: what.to_string(), index: i });
-        }
-        *d = *s;
-    }
-    Ok(())
-}
-
-fn check_time(t: f64) -> Result<(), Error> {
-    if t.is_finite() { Ok(()) } else { Err(Error::NonFinite { what: "t".into(), index: 0 }) }
 }
 
 /// A compiled scene: the immutable model and its workspace. Safe to share between threads
@@ -157,10 +73,6 @@ impl PySystem {
     fn body_names(&self) -> Vec<String> {
         self.model.bodies.iter().map(|b| b.name.clone()).collect()
     }
-}
-
-fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    PyArray1::from_vec(py, v).reshape([rows, cols])
 }
 
 #[pymethods]
@@ -454,11 +366,7 @@ impl PySystem {
                 let Workspace { data, jws, jq, jv, .. } = ws;
                 crate::jacobian::uk_jacobian(model, data, jws, t, &yv[..n], &yv[n..], jq, jv)?;
                 let mut out = vec![0.0; 4 * n * n];
-                for i in 0..n {
-                    out[i * 2 * n + n + i] = 1.0;
-                    out[(n + i) * 2 * n..(n + i) * 2 * n + n].copy_from_slice(&jq[i * n..(i + 1) * n]);
-                    out[(n + i) * 2 * n + n..(n + i + 1) * 2 * n].copy_from_slice(&jv[i * n..(i + 1) * n]);
-                }
+                assemble_first_order(n, jq, jv, &mut out);
                 Ok(out)
             })
         })?;
@@ -502,42 +410,17 @@ impl PySystem {
         check_time(t_end).map_err(to_py)?;
         let atol = match atol {
             None => vec![1e-3 * rtol],
-            Some(a) => {
-                let a = a.as_array();
-                let v: Vec<f64> = a.iter().copied().collect();
-                if v.len() != 1 && v.len() != 2 * n {
-                    return Err(PyValueError::new_err(format!("atol: expected a scalar or length {}, got {}", 2 * n, v.len())));
-                }
-                v
-            }
+            Some(a) => a.as_array().iter().copied().collect(),
         };
         let t_eval: Option<Vec<f64>> = t_eval.map(|a| a.as_array().iter().copied().collect());
-        if !(t_end > t0) {
-            return Err(PyValueError::new_err(format!("t_end must be greater than t0 = {t0}, got {t_end}")));
-        }
-        if !(rtol > 0.0) || !rtol.is_finite() || atol.iter().any(|a| !(*a >= 0.0) || !a.is_finite()) {
-            return Err(PyValueError::new_err("rtol must be positive and finite, atol >= 0 and finite"));
-        }
-        if let Some(te) = &t_eval {
-            if te.windows(2).any(|w| !(w[1] > w[0])) || te.iter().any(|x| !(*x >= t0 && *x <= t_end)) {
-                return Err(PyValueError::new_err(format!("t_eval must be strictly increasing within [t0, t_end] = [{t0}, {t_end}]")));
-            }
-        }
-        if let Some(h) = first_step {
-            if !(h > 0.0) || !h.is_finite() {
-                return Err(PyValueError::new_err(format!("first_step must be positive and finite, got {h}")));
-            }
-        }
         let max_step = max_step.unwrap_or(f64::INFINITY);
-        if !(max_step > 0.0) {
-            return Err(PyValueError::new_err(format!("max_step must be positive, got {max_step}")));
-        }
         if let Some(p) = projection_tol {
             if !(p > 0.0) || !p.is_finite() {
                 return Err(PyValueError::new_err(format!("projection_tol must be positive and finite, got {p}")));
             }
         }
         let opts = Options { rtol, atol, first_step, max_step, max_steps };
+        opts.validate(2 * n).map_err(to_py)?;
         // a fresh workspace with this System's settings: the run does not hold the lock
         let (tolerance, stabilization, backend) = self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.stabilization, ws.data.svd_backend)))?;
         let model = &self.model;
@@ -612,7 +495,7 @@ impl PySystem {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
             let (mut qn, mut qdn) = (ws.q.clone(), ws.qd.clone());
-            let rep = uk::project(model, &mut ws.data, t, &mut qn, &mut qdn, tol, max_iter)?;
+            let rep = correct::project(model, &mut ws.data, t, &mut qn, &mut qdn, tol, max_iter)?;
             Ok((qn, qdn, rep))
         })?;
         let d = PyDict::new(py);
@@ -657,20 +540,11 @@ impl PySystem {
         Ok((mat(py, beam.m_ff.to_dense(), nf, nf)?, mat(py, beam.k_ff.to_dense(), nf, nf)?))
     }
 
-    /// Kinetic energy 1/2 qd^T M(q) qd.
+    /// Kinetic energy 1/2 qd^T M(q) qd (from the body blocks).
     fn kinetic_energy(&self, q: Vector<'_>, qd: Vector<'_>) -> PyResult<f64> {
-        let n = self.model.n;
         self.with_ws(|model, ws| {
             Self::load(ws, &q, Some(&qd))?;
-            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
-            let m = dynamics::dense_mass(model, &ws.data);
-            let mut e = 0.0;
-            for i in 0..n {
-                for j in 0..n {
-                    e += ws.qd[i] * m[i * n + j] * ws.qd[j];
-                }
-            }
-            Ok(0.5 * e)
+            Ok(dynamics::kinetic_energy(model, &mut ws.data, &ws.q, &ws.qd))
         })
     }
 
@@ -681,16 +555,93 @@ impl PySystem {
             Ok(dynamics::potential_energy(model, &ws.q))
         })
     }
+
+    /// Kind of a body: "rigid", "beam" or "point_mass".
+    fn body_kind(&self, body: &str) -> PyResult<&'static str> {
+        Ok(self.model.bodies[self.body(body)?].kind_name())
+    }
+
+    /// (start, stop) of a body's elastic coordinates in q (start == stop for rigid kinds).
+    fn elastic_range(&self, body: &str) -> PyResult<(usize, usize)> {
+        let r = self.model.bodies[self.body(body)?].elastic_range();
+        Ok((r.start, r.end))
+    }
+
+    /// Properties of a body as the core derived them: kind, mass, n_coords, n_f, and for
+    /// beams length, elements, element_length, theory, frame, area, second_moment, density,
+    /// youngs_modulus, shear_stiffness (k G), rotary_inertia, damping, shear_parameter (phi).
+    fn body_info<'py>(&self, py: Python<'py>, body: &str) -> PyResult<Bound<'py, PyDict>> {
+        let b = &self.model.bodies[self.body(body)?];
+        let d = PyDict::new(py);
+        d.set_item("kind", b.kind_name())?;
+        d.set_item("mass", b.total_mass())?;
+        d.set_item("n_coords", b.n_coords)?;
+        d.set_item("n_f", b.n_f())?;
+        match &b.kind {
+            BodyKind::Rigid(r) => {
+                d.set_item("inertia", r.inertia)?;
+                d.set_item("com", r.com.to_vec())?;
+            }
+            BodyKind::Beam(beam) => {
+                let sec = &beam.section;
+                d.set_item("length", beam.length)?;
+                d.set_item("elements", beam.elements)?;
+                d.set_item("element_length", beam.element_length)?;
+                d.set_item("theory", match sec.theory {
+                    crate::description::BeamTheory::Timoshenko => "timoshenko",
+                    crate::description::BeamTheory::EulerBernoulli => "euler-bernoulli",
+                })?;
+                d.set_item("frame", match beam.reference {
+                    crate::description::ReferenceConditions::PinnedPinned => "pinned-pinned",
+                    crate::description::ReferenceConditions::Clamped => "clamped",
+                })?;
+                d.set_item("area", sec.area)?;
+                d.set_item("second_moment", sec.second_moment)?;
+                d.set_item("density", sec.density)?;
+                d.set_item("youngs_modulus", sec.youngs_modulus)?;
+                d.set_item("shear_stiffness", sec.shear_stiffness)?;
+                d.set_item("rotary_inertia", sec.rotary_inertia)?;
+                d.set_item("damping", beam.damping)?;
+                d.set_item("shear_parameter", beam.phi)?;
+            }
+            BodyKind::PointMass(_) => {}
+        }
+        Ok(d)
+    }
+
+    /// Correct (q, qd) onto Phi(q, t) = 0 and A qd + Phi_t = 0 in the mass metric, holding the
+    /// coordinates where `hold` is true: damped Newton on the positions, then one velocity
+    /// projection (the initial-state correction). Returns a dict: q, qd, iterations,
+    /// position_residual_before/after, velocity_residual_before/after (NaN when the positions
+    /// failed), phi (m,), velocity (m,), positions_ok, velocities_ok.
+    #[pyo3(signature = (t, q, qd, hold, position_tol=1e-12, velocity_tol=1e-10, max_iterations=50))]
+    #[allow(clippy::too_many_arguments)]
+    fn correct<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize) -> PyResult<Bound<'py, PyDict>> {
+        for (what, v) in [("position_tol", position_tol), ("velocity_tol", velocity_tol)] {
+            if !(v > 0.0) || !v.is_finite() {
+                return Err(PyValueError::new_err(format!("{what} must be positive and finite, got {v}")));
+            }
+        }
+        let opts = CorrectOptions { hold, position_tol, velocity_tol, max_iterations };
+        let c = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            let (qv, qdv) = (ws.q.clone(), ws.qd.clone());
+            correct::correct(model, &mut ws.data, t, &qv, &qdv, &opts)
+        })?;
+        let d = PyDict::new(py);
+        d.set_item("q", PyArray1::from_vec(py, c.q))?;
+        d.set_item("qd", PyArray1::from_vec(py, c.qd))?;
+        d.set_item("iterations", c.iterations)?;
+        d.set_item("position_residual_before", c.position_residual_before)?;
+        d.set_item("position_residual_after", c.position_residual_after)?;
+        d.set_item("velocity_residual_before", c.velocity_residual_before)?;
+        d.set_item("velocity_residual_after", c.velocity_residual_after)?;
+        d.set_item("phi", PyArray1::from_vec(py, c.phi))?;
+        d.set_item("velocity", PyArray1::from_vec(py, c.velocity))?;
+        d.set_item("positions_ok", c.positions_ok)?;
+        d.set_item("velocities_ok", c.velocities_ok)?;
+        Ok(d)
+    }
 }
 
-#[pymodule]
-fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    let py = m.py();
-    m.add_class::<PySystem>()?;
-    m.add("UkflexError", py.get_type::<UkflexError>())?;
-    m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
-    m.add("SingularMassError", py.get_type::<SingularMassError>())?;
-    m.add("NonFiniteError", py.get_type::<NonFiniteError>())?;
-    m.add("SolverError", py.get_type::<SolverError>())?;
-    Ok(())
-}

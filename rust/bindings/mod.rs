@@ -1,0 +1,119 @@
+//! Python bindings (feature `python`): the only module that knows Python. Maps `Error` to
+//! exception classes under `ukflex.UkflexError`, reads strided NumPy inputs, returns fresh
+//! arrays, and never lets a panic cross into Python. `system.rs`: the compiled `System`;
+//! `scene.rs`: the item-by-item scene checker used by the Python `Scene` builder.
+
+mod scene;
+mod system;
+
+use numpy::ndarray::ArrayView1;
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use pyo3::Borrowed;
+
+use crate::error::Error;
+use scene::{beam_elastic_dofs, item_name, PySceneChecker};
+use system::PySystem;
+
+create_exception!(ukflex, UkflexError, PyException, "Base class of every ukflex error.");
+create_exception!(ukflex, InvalidSceneError, UkflexError, "Malformed or non-physical scene description.");
+create_exception!(ukflex, SingularMassError, UkflexError, "The mass matrix is not positive definite.");
+create_exception!(ukflex, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
+create_exception!(ukflex, SolverError, UkflexError, "A solver kernel failed.");
+
+/// A 1-D float64 input. float64 vectors (what scipy passes) are read in place, strided or
+/// not; anything else array-like is converted once with `numpy.asarray(x, dtype=float64)`, and
+/// a wrong dimension or a non-numeric input is a `ValueError` naming what was expected.
+pub struct Vector<'py>(PyReadonlyArray1<'py, f64>);
+
+impl<'py> std::ops::Deref for Vector<'py> {
+    type Target = PyReadonlyArray1<'py, f64>;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Vector<'py> {
+    type Error = PyErr;
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Ok(a) = obj.extract::<PyReadonlyArray1<'py, f64>>() {
+            return Ok(Vector(a));
+        }
+        let py = obj.py();
+        let converted = py
+            .import("numpy")?
+            .call_method1("asarray", (obj, "float64"))
+            .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?;
+        let arr = converted
+            .cast_into::<numpy::PyArrayDyn<f64>>()
+            .map_err(|_| PyValueError::new_err("expected a 1-D array of floats"))?;
+        if arr.ndim() != 1 {
+            return Err(PyValueError::new_err(format!("expected a 1-D array of floats, got an array of shape {:?}", arr.shape())));
+        }
+        let a = arr.readonly();
+        let a1 = a
+            .as_array()
+            .into_dimensionality::<numpy::ndarray::Ix1>()
+            .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?
+            .to_owned();
+        Ok(Vector(PyArray1::from_owned_array(py, a1).readonly()))
+    }
+}
+
+pub(crate) fn to_py(e: Error) -> PyErr {
+    let msg = e.to_string();
+    match e {
+        Error::Description(_) | Error::InvalidProperty { .. } | Error::UnknownBody { .. } => InvalidSceneError::new_err(msg),
+        Error::Shape { .. } | Error::Argument { .. } => PyValueError::new_err(msg),
+        Error::NonFinite { .. } => NonFiniteError::new_err(msg),
+        Error::SingularMass { .. } => SingularMassError::new_err(msg),
+        Error::Solver(_) => SolverError::new_err(msg),
+    }
+}
+
+/// Copy a (possibly strided) NumPy vector into `dst`, checking length and finiteness.
+pub(crate) fn read_into(what: &str, src: &ArrayView1<f64>, dst: &mut [f64]) -> Result<(), Error> {
+    if src.len() != dst.len() {
+        return Err(Error::Shape { what: what.to_string(), expected: dst.len(), got: src.len() });
+    }
+    // contiguous fast path (the common case): plain copy, one finiteness pass
+    if let Some(sl) = src.as_slice() {
+        dst.copy_from_slice(sl);
+        if dst.iter().all(|x| x.is_finite()) {
+            return Ok(());
+        }
+    }
+    for (i, (d, s)) in dst.iter_mut().zip(src.iter()).enumerate() {
+        if !s.is_finite() {
+            return Err(Error::NonFinite { what: what.to_string(), index: i });
+        }
+        *d = *s;
+    }
+    Ok(())
+}
+
+pub(crate) fn check_time(t: f64) -> Result<(), Error> {
+    if t.is_finite() { Ok(()) } else { Err(Error::NonFinite { what: "t".into(), index: 0 }) }
+}
+
+pub(crate) fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    PyArray1::from_vec(py, v).reshape([rows, cols])
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add_class::<PySystem>()?;
+    m.add_class::<PySceneChecker>()?;
+    m.add_function(wrap_pyfunction!(item_name, m)?)?;
+    m.add_function(wrap_pyfunction!(beam_elastic_dofs, m)?)?;
+    m.add("UkflexError", py.get_type::<UkflexError>())?;
+    m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
+    m.add("SingularMassError", py.get_type::<SingularMassError>())?;
+    m.add("NonFiniteError", py.get_type::<NonFiniteError>())?;
+    m.add("SolverError", py.get_type::<SolverError>())?;
+    Ok(())
+}
+

@@ -1,0 +1,75 @@
+//! Drivers (rheonomic constraints, 1 row each): a relative angle `phi_a - phi_b - f(t) = 0`
+//! (`b` defaults to the ground frame) or a world coordinate of a point `r[axis] - f(t) = 0`.
+
+use super::{rows, BuildContext, ConstraintOut, Motion};
+use crate::body::{Body, Marker};
+use crate::description::{Axis, MarkerDesc, MotionDesc};
+use crate::error::{Error, Result};
+
+#[derive(Debug, Clone)]
+pub struct AngleDriver {
+    pub a: Marker,
+    pub b: Marker,
+    pub motion: Motion,
+}
+
+impl AngleDriver {
+    pub const ROWS: &'static [&'static str] = &[""];
+
+    pub fn from_desc(ctx: &BuildContext, item: &str, a: &MarkerDesc, b: Option<&MarkerDesc>, motion: &MotionDesc) -> Result<Self> {
+        let (a, b) = match b {
+            Some(b) => ctx.oriented_pair(item, a, b)?,
+            None => {
+                let a = ctx.oriented_marker(item, a)?;
+                if a.body.is_none() {
+                    return Err(Error::invalid(item, "marker a is on the ground (the driver would constrain nothing)"));
+                }
+                (a, Marker::ground([0.0, 0.0], 0.0))
+            }
+        };
+        Ok(AngleDriver { a, b, motion: Motion::from_desc(item, motion)? })
+    }
+
+    #[inline]
+    pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
+        let (sa, sb) = (self.a.state(bodies, q, qd), self.b.state(bodies, q, qd));
+        rows::angle(bodies, &self.a, &self.b, &sa, &sb, self.motion.eval(t), n, out, 0);
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct CoordinateDriver {
+    pub point: Marker,
+    pub axis: Axis,
+    pub motion: Motion,
+}
+
+impl CoordinateDriver {
+    pub const ROWS: &'static [&'static str] = &[""];
+
+    pub fn from_desc(ctx: &BuildContext, item: &str, point: &MarkerDesc, axis: Axis, motion: &MotionDesc) -> Result<Self> {
+        let point = ctx.marker(item, point)?;
+        if point.body.is_none() {
+            return Err(Error::invalid(item, "the point is on the ground (the driver would constrain nothing)"));
+        }
+        Ok(CoordinateDriver { point, axis, motion: Motion::from_desc(item, motion)? })
+    }
+
+    #[inline]
+    pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
+        let sp = self.point.state(bodies, q, qd);
+        let k = match self.axis {
+            Axis::X => 0,
+            Axis::Y => 1,
+        };
+        let f = self.motion.eval(t);
+        if let Some(phi) = out.phi.as_deref_mut() {
+            phi[0] = sp.r[k] - f.0;
+        }
+        let mut w = [0.0; 2];
+        w[k] = 1.0;
+        self.point.add_point_jacobian(bodies, &sp, w, &mut out.jac[0..n]);
+        out.phi_t[0] = -f.1;
+        out.gamma[0] = -sp.h[k] + f.2;
+    }
+}

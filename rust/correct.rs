@@ -1,0 +1,343 @@
+//! Moving a state onto the constraint manifold (between steps and at build; allocates, not
+//! the acceleration hot path):
+//!
+//! * `project`: Newton steps `dq = -M^-1 A^T (A M^-1 A^T)^+ Phi` until `max |Phi| <= tol`, then
+//!   `dqd = -M^-1 A^T (A M^-1 A^T)^+ (A qd + Phi_t)`: the closest consistent state in the
+//!   kinetic-energy norm (Gauss's principle applied to the correction). Each step is the UK
+//!   kernel with `Q = 0` and `b = -residual`.
+//! * `correct`: the same, with some coordinates held at their values (the initial-state
+//!   correction: by default every elastic coordinate, so an undeformed guess stays undeformed),
+//!   damped Newton steps, and a report of what changed.
+
+use faer::Mat;
+
+use crate::dynamics::{constraints, mass_and_forces};
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::uk::{evaluate, solve};
+
+/// Outcome of a projection onto the constraint manifold.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Projection {
+    /// Newton iterations used for the positions.
+    pub iterations: usize,
+    /// max |Phi| after the position correction.
+    pub position_residual: f64,
+    /// max |A qd + Phi_t| after the velocity correction.
+    pub velocity_residual: f64,
+    /// Mass-norm of the position and velocity corrections, `sqrt(dq^T M dq)`.
+    pub position_correction: f64,
+    pub velocity_correction: f64,
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// `sqrt(v^T M v)` from the body blocks in `data` (reporting only).
+fn mass_norm(model: &Model, data: &Data, v: &[f64]) -> f64 {
+    let e: f64 = model.bodies.iter().zip(&data.bodies).map(|(b, bd)| b.kinetic_energy(bd, v)).sum();
+    (2.0 * e).max(0.0).sqrt()
+}
+
+/// `A qd + Phi_t` from the terms in `data`.
+fn velocity_residual(model: &Model, data: &Data, qd: &[f64], out: &mut [f64]) {
+    let n = model.n;
+    for (i, o) in out.iter_mut().enumerate() {
+        let row = &data.jac[i * n..(i + 1) * n];
+        *o = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i];
+    }
+}
+
+/// Project `(q, qd)` onto `Phi(q, t) = 0` and `A qd + Phi_t = 0` along the mass metric.
+pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], qd: &mut [f64], tol: f64, max_iter: usize) -> Result<Projection> {
+    let n = model.n;
+    let zeros = vec![0.0; n];
+    let mut dq_total = vec![0.0; n];
+    let mut iterations = 0;
+    let mut pos_res;
+    loop {
+        evaluate(model, data, t, q, &zeros, true)?;
+        pos_res = max_abs(&data.phi);
+        if pos_res <= tol || iterations >= max_iter {
+            break;
+        }
+        data.force.fill(0.0);
+        for i in 0..model.m {
+            data.gamma[i] = -data.phi[i];
+        }
+        solve(model, data)?;
+        for i in 0..n {
+            q[i] += data.qdd[i];
+            dq_total[i] += data.qdd[i];
+        }
+        iterations += 1;
+    }
+    let position_correction = mass_norm(model, data, &dq_total);
+    // velocities at the corrected positions
+    evaluate(model, data, t, q, qd, false)?;
+    data.force.fill(0.0);
+    let mut vres = vec![0.0; model.m];
+    velocity_residual(model, data, qd, &mut vres);
+    for i in 0..model.m {
+        data.gamma[i] = -vres[i];
+    }
+    solve(model, data)?;
+    let dqd = data.qdd.clone();
+    for i in 0..n {
+        qd[i] += dqd[i];
+    }
+    let velocity_correction = mass_norm(model, data, &dqd);
+    velocity_residual(model, data, qd, &mut vres);
+    Ok(Projection { iterations, position_residual: pos_res, velocity_residual: max_abs(&vres), position_correction, velocity_correction })
+}
+
+/// Settings of `correct`.
+#[derive(Debug, Clone)]
+pub struct CorrectOptions {
+    /// `hold[i]`: coordinate `i` keeps its value (length n).
+    pub hold: Vec<bool>,
+    /// Newton stops when `max |Phi| <= position_tol` (absolute, m and rad).
+    pub position_tol: f64,
+    /// Accepted `max |A qd + Phi_t| <= velocity_tol * max(1, max |qd|)`.
+    pub velocity_tol: f64,
+    pub max_iterations: usize,
+}
+
+/// What `correct` did. `q`, `qd` are the corrected state (as far as it got).
+#[derive(Debug, Clone)]
+pub struct Correction {
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub iterations: usize,
+    pub position_residual_before: f64,
+    pub position_residual_after: f64,
+    pub velocity_residual_before: f64,
+    pub velocity_residual_after: f64,
+    /// `Phi` at the end of the position correction (m).
+    pub phi: Vec<f64>,
+    /// `A qd + Phi_t` at the end (m; zeros when the positions failed).
+    pub velocity: Vec<f64>,
+    pub positions_ok: bool,
+    pub velocities_ok: bool,
+}
+
+/// Minimum-norm solution of `A[:, free] dx = r` in the metric `M[free, free]` (the UK/Gauss
+/// projection restricted to the free coordinates): `dx_free = F^-T (A_f F^-T)^+ r` with
+/// `M_ff = F F^T`. Needs the mass blocks and `A` at the current `q` in `data`.
+fn metric_step(model: &Model, data: &Data, free: &[bool], r: &[f64]) -> Result<Vec<f64>> {
+    let (n, m) = (model.n, model.m);
+    let mut dx = vec![0.0; n];
+    let idx: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
+    let k = idx.len();
+    if k == 0 || m == 0 {
+        return Ok(dx);
+    }
+    // M restricted to the free coordinates (block diagonal by body): only the free entries of
+    // each body block are visited, so holding the elastic coordinates of a long beam costs a
+    // 3 x 3 block, not its whole mass matrix.
+    let mut pos = vec![usize::MAX; n];
+    for (p, &i) in idx.iter().enumerate() {
+        pos[i] = p;
+    }
+    let mut blocks: Vec<(usize, usize)> = Vec::new(); // (first compact index, size) per body
+    let mut mf = vec![0.0; 0];
+    let mut offsets = Vec::new();
+    for (body, bd) in model.bodies.iter().zip(&data.bodies) {
+        let local: Vec<usize> = (body.offset..body.offset + body.n_coords).filter(|&i| free[i]).collect();
+        let kb = local.len();
+        if kb == 0 {
+            continue;
+        }
+        let first = pos[local[0]];
+        let mut blk = vec![0.0; kb * kb];
+        body.dense_block(bd, &mut |i, j, v| {
+            let (gi, gj) = (body.offset + i, body.offset + j);
+            if free[gi] && free[gj] {
+                blk[(pos[gi] - first) * kb + pos[gj] - first] = v;
+            }
+        });
+        if !cholesky(&mut blk, kb) {
+            return Err(Error::SingularMass { item: format!("body '{}': mass block of the corrected coordinates", body.name) });
+        }
+        blocks.push((first, kb));
+        offsets.push(mf.len());
+        mf.extend_from_slice(&blk);
+    }
+    // B^T = F^-1 A_f^T (k x m)
+    let mut bt = Mat::<f64>::zeros(k, m);
+    let mut col = vec![0.0; k];
+    for i in 0..m {
+        for (p, &g) in idx.iter().enumerate() {
+            col[p] = data.jac[i * n + g];
+        }
+        for (&(first, kb), &off) in blocks.iter().zip(&offsets) {
+            lower_solve(&mf[off..off + kb * kb], kb, &mut col[first..first + kb]);
+        }
+        for p in 0..k {
+            bt[(p, i)] = col[p];
+        }
+    }
+    // y = (B)^+ r = U S^+ V^T r with B^T = U S V^T
+    let svd = bt.thin_svd().map_err(|e| Error::Solver(format!("SVD in the state correction did not converge: {e:?}")))?;
+    let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
+    let smax = if s.nrows() > 0 { s[0] } else { 0.0 };
+    let tol = (k.max(m) as f64) * f64::EPSILON * smax;
+    let mut y = vec![0.0; k];
+    for j in 0..s.nrows() {
+        if s[j] > tol && s[j] > 0.0 {
+            let mut c = 0.0;
+            for i in 0..m {
+                c += v[(i, j)] * r[i];
+            }
+            c /= s[j];
+            for p in 0..k {
+                y[p] += u[(p, j)] * c;
+            }
+        }
+    }
+    for (&(first, kb), &off) in blocks.iter().zip(&offsets) {
+        upper_solve(&mf[off..off + kb * kb], kb, &mut y[first..first + kb]);
+    }
+    for (p, &g) in idx.iter().enumerate() {
+        dx[g] = y[p];
+    }
+    Ok(dx)
+}
+
+/// In-place lower Cholesky of a k x k row-major matrix; `false` if not positive definite.
+fn cholesky(a: &mut [f64], k: usize) -> bool {
+    for j in 0..k {
+        let mut d = a[j * k + j];
+        for p in 0..j {
+            d -= a[j * k + p] * a[j * k + p];
+        }
+        if !(d > 0.0) || !d.is_finite() {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * k + j] = d;
+        for i in j + 1..k {
+            let mut s = a[i * k + j];
+            for p in 0..j {
+                s -= a[i * k + p] * a[j * k + p];
+            }
+            a[i * k + j] = s / d;
+        }
+        for i in 0..j {
+            a[i * k + j] = 0.0;
+        }
+    }
+    true
+}
+
+fn lower_solve(l: &[f64], k: usize, x: &mut [f64]) {
+    for i in 0..k {
+        let mut s = x[i];
+        for p in 0..i {
+            s -= l[i * k + p] * x[p];
+        }
+        x[i] = s / l[i * k + i];
+    }
+}
+
+fn upper_solve(l: &[f64], k: usize, x: &mut [f64]) {
+    for i in (0..k).rev() {
+        let mut s = x[i];
+        for p in i + 1..k {
+            s -= l[p * k + i] * x[p];
+        }
+        x[i] = s / l[i * k + i];
+    }
+}
+
+/// Correct `(q, qd)` onto the constraints at time `t`, holding the coordinates marked in
+/// `opts.hold`: damped Newton on the positions (the step halved while `max |Phi|` grows, stop
+/// after 5 iterations without halving the best residual), then one velocity projection.
+pub fn correct(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], opts: &CorrectOptions) -> Result<Correction> {
+    let (n, m) = (model.n, model.m);
+    if opts.hold.len() != n {
+        return Err(Error::Shape { what: "hold".into(), expected: n, got: opts.hold.len() });
+    }
+    let free: Vec<bool> = opts.hold.iter().map(|h| !h).collect();
+    let zeros = vec![0.0; n];
+    let mut q = q.to_vec();
+    constraints(model, data, t, &q, &zeros, true);
+    let mut phi = data.phi.clone();
+    let r0 = max_abs(&phi);
+    let (mut res, mut best, mut it, mut stall) = (r0, r0, 0usize, 0usize);
+    let mut r = vec![0.0; m];
+    while res > opts.position_tol && it < opts.max_iterations {
+        it += 1;
+        mass_and_forces(model, data, &q, &zeros);
+        constraints(model, data, t, &q, &zeros, false);
+        for i in 0..m {
+            r[i] = -phi[i];
+        }
+        let dq = metric_step(model, data, &free, &r)?;
+        let mut step = 1.0;
+        let mut q_try = q.clone();
+        loop {
+            for i in 0..n {
+                q_try[i] = q[i] + step * dq[i];
+            }
+            constraints(model, data, t, &q_try, &zeros, true);
+            if max_abs(&data.phi) < res || step < 1e-6 {
+                break;
+            }
+            step *= 0.5;
+        }
+        q.copy_from_slice(&q_try);
+        phi.copy_from_slice(&data.phi);
+        res = max_abs(&phi);
+        if res < 0.5 * best {
+            best = res;
+            stall = 0;
+        } else {
+            stall += 1;
+            if stall >= 5 {
+                break;
+            }
+        }
+        if !res.is_finite() {
+            break;
+        }
+    }
+    let positions_ok = res <= opts.position_tol;
+    let mut out = Correction {
+        q,
+        qd: qd.to_vec(),
+        iterations: it,
+        position_residual_before: r0,
+        position_residual_after: res,
+        velocity_residual_before: f64::NAN,
+        velocity_residual_after: f64::NAN,
+        phi,
+        velocity: vec![0.0; m],
+        positions_ok,
+        velocities_ok: false,
+    };
+    if !positions_ok {
+        return Ok(out);
+    }
+    mass_and_forces(model, data, &out.q, &zeros);
+    constraints(model, data, t, &out.q, &zeros, false);
+    let mut vres = vec![0.0; m];
+    velocity_residual(model, data, &out.qd, &mut vres);
+    out.velocity_residual_before = max_abs(&vres);
+    for i in 0..m {
+        r[i] = -vres[i];
+    }
+    let dqd = metric_step(model, data, &free, &r)?;
+    for i in 0..n {
+        out.qd[i] += dqd[i];
+    }
+    velocity_residual(model, data, &out.qd, &mut vres);
+    out.velocity_residual_after = max_abs(&vres);
+    out.velocity = vres;
+    let scale = max_abs(&out.qd).max(1.0);
+    out.velocities_ok = out.velocity_residual_after <= opts.velocity_tol * scale;
+    Ok(out)
+}
+

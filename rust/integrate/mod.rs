@@ -1,0 +1,389 @@
+//! Native integrators for the second-order system `qdd = g(t, q, qd)` written as
+//! `y' = f(t, y)`, `y = [q, qd]`, `f = [qd, g]`:
+//!
+//! * `Dopri5`: Dormand-Prince 5(4) with Hairer's step-size control (PI, beta = 0.04) and his
+//!   4th-order dense output (`DOPRI5`, Hairer, Norsett & Wanner, Solving ODEs I, II.5).
+//! * `Radau5`: 3-stage Radau IIA (order 5), Hairer & Wanner's `RADAU5` (Solving ODEs II, IV.8):
+//!   simplified Newton with the transformed real + complex iteration matrices, LU reused over
+//!   steps while the Newton contraction stays small, Gustafsson's predictive step control,
+//!   collocation dense output. The second-order structure `J = [[0, I], [Jq, Jv]]` reduces
+//!   both iteration matrices from 2n x 2n to n x n (Hairer's `M1` trick):
+//!   `(g I - J) [x1; x2] = [r1; r2]` <=> `(g^2 I - g Jv - Jq) x2 = g r2 + Jq r1`,
+//!   `x1 = (r1 + x2) / g`.
+//!
+//! Both run on a `SecondOrderSystem` (the UK system: `UkSystem`), allocate their workspaces
+//! once in `new`, and do not allocate per step (checked by a counting allocator in
+//! `tests/integrators.rs`). `integrate` drives a stepper to `t_end`, writes outputs at the
+//! accepted steps or at requested times (dense output), and calls the system's `post_step` hook
+//! after every accepted step -- the place for a projection onto the constraint manifold; when
+//! the hook changes `y` the stepper re-evaluates `f` there (`Stepper::restart_at`).
+
+// Hairer's constants are kept with all their printed digits; index loops mirror the papers.
+#![allow(clippy::excessive_precision, clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
+
+mod dopri5;
+mod lu;
+mod radau5;
+
+pub use dopri5::Dopri5;
+pub use radau5::Radau5;
+
+use crate::correct;
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::jacobian::{uk_jacobian, JacobianWorkspace};
+use crate::model::Model;
+use crate::uk;
+
+/// `qdd = g(t, q, qd)` with its Jacobians.
+pub trait SecondOrderSystem {
+    /// Number of coordinates n (the state has 2n entries).
+    fn n(&self) -> usize;
+    /// `qdd = g(t, q, qd)`.
+    fn acc(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &mut [f64]) -> Result<()>;
+    /// `jq = dg/dq`, `jv = dg/dqd` (n x n, row-major).
+    fn jac(&mut self, t: f64, q: &[f64], qd: &[f64], jq: &mut [f64], jv: &mut [f64]) -> Result<()>;
+    /// Called after every accepted step with the new state; may change it (projection).
+    /// Return `true` if `y` was changed.
+    fn post_step(&mut self, _t: f64, _y: &mut [f64]) -> Result<bool> {
+        Ok(false)
+    }
+}
+
+/// `dy = f(t, y) = [qd, g(t, q, qd)]`.
+#[inline]
+fn rhs<S: SecondOrderSystem + ?Sized>(sys: &mut S, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()> {
+    let n = sys.n();
+    let (dq, dqd) = dy.split_at_mut(n);
+    dq.copy_from_slice(&y[n..]);
+    sys.acc(t, &y[..n], &y[n..], dqd)
+}
+
+/// The UK equations of motion of a model as a `SecondOrderSystem`.
+pub struct UkSystem<'a> {
+    pub model: &'a Model,
+    pub data: Data,
+    pub jws: JacobianWorkspace,
+    /// Optional projection onto `Phi = 0`, `A qd + Phi_t = 0` after each accepted step:
+    /// `(tol, max_iter)` for `correct::project` (which allocates its report buffers).
+    pub projection: Option<(f64, usize)>,
+    /// UK evaluations spent inside finite-difference Jacobians (full, factorization-reusing).
+    pub jac_full_evals: usize,
+    pub jac_cheap_evals: usize,
+}
+
+impl<'a> UkSystem<'a> {
+    pub fn new(model: &'a Model, data: Data) -> Self {
+        let jws = JacobianWorkspace::new(model);
+        UkSystem { model, data, jws, projection: None, jac_full_evals: 0, jac_cheap_evals: 0 }
+    }
+}
+
+impl SecondOrderSystem for UkSystem<'_> {
+    fn n(&self) -> usize {
+        self.model.n
+    }
+    #[inline]
+    fn acc(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &mut [f64]) -> Result<()> {
+        uk::acceleration(self.model, &mut self.data, t, q, qd)?;
+        qdd.copy_from_slice(&self.data.qdd);
+        Ok(())
+    }
+    fn jac(&mut self, t: f64, q: &[f64], qd: &[f64], jq: &mut [f64], jv: &mut [f64]) -> Result<()> {
+        uk_jacobian(self.model, &mut self.data, &mut self.jws, t, q, qd, jq, jv)?;
+        self.jac_full_evals += self.jws.full_evals;
+        self.jac_cheap_evals += self.jws.cheap_evals;
+        Ok(())
+    }
+    fn post_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool> {
+        let Some((tol, max_iter)) = self.projection else { return Ok(false) };
+        let n = self.model.n;
+        let (q, qd) = y.split_at_mut(n);
+        correct::project(self.model, &mut self.data, t, q, qd, tol, max_iter)?;
+        Ok(true)
+    }
+}
+
+/// Tolerances and limits shared by the integrators.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub rtol: f64,
+    /// Absolute tolerance: one value, or one per state entry (2n).
+    pub atol: Vec<f64>,
+    /// Initial step (default: Hairer's estimate).
+    pub first_step: Option<f64>,
+    pub max_step: f64,
+    /// Maximum number of step attempts.
+    pub max_steps: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options { rtol: 1e-6, atol: vec![1e-9], first_step: None, max_step: f64::INFINITY, max_steps: 1_000_000 }
+    }
+}
+
+impl Options {
+    /// Check every setting once (the bindings and the steppers rely on it); returns the
+    /// absolute tolerance expanded to `dim` entries.
+    pub fn validate(&self, dim: usize) -> Result<Vec<f64>> {
+        let bad = |m: String| Err(Error::argument("integrator", m));
+        let v = match self.atol.len() {
+            1 => vec![self.atol[0]; dim],
+            k if k == dim => self.atol.clone(),
+            k => return Err(Error::Shape { what: "atol".into(), expected: dim, got: k }),
+        };
+        if !(self.rtol > 0.0) || !self.rtol.is_finite() || v.iter().any(|a| !(*a >= 0.0) || !a.is_finite()) {
+            return bad("rtol must be positive and finite, atol >= 0 and finite".into());
+        }
+        if let Some(h) = self.first_step {
+            if !(h > 0.0) || !h.is_finite() {
+                return bad(format!("first_step must be positive and finite, got {h}"));
+            }
+        }
+        if !(self.max_step > 0.0) {
+            return bad(format!("max_step must be positive, got {}", self.max_step));
+        }
+        Ok(v)
+    }
+}
+
+/// Counters of one run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Right-hand-side evaluations by the integrator (Jacobian evaluations excluded).
+    pub nfev: usize,
+    pub njev: usize,
+    /// LU decompositions (Radau: real and complex counted separately, as scipy does).
+    pub nlu: usize,
+    pub naccept: usize,
+    pub nreject: usize,
+}
+
+/// The state every stepper keeps: the current and previous time, the next step size, the
+/// state vector and the counters.
+#[derive(Debug, Clone, Default)]
+pub struct StepState {
+    pub t: f64,
+    pub t_old: f64,
+    /// Next step size to try.
+    pub h: f64,
+    pub y: Vec<f64>,
+    pub stats: Stats,
+    /// Step attempts so far (bounded by `Options::max_steps`).
+    pub steps: usize,
+}
+
+impl StepState {
+    fn new(dim: usize) -> Self {
+        StepState { y: vec![0.0; dim], ..Default::default() }
+    }
+
+    fn start(&mut self, t0: f64, y0: &[f64]) {
+        self.t = t0;
+        self.t_old = t0;
+        self.y.copy_from_slice(y0);
+        self.stats = Stats::default();
+        self.steps = 0;
+    }
+
+    /// The checks every method makes before a step attempt.
+    fn check_attempt(&mut self, method: &str, max_steps: usize) -> Result<()> {
+        self.steps += 1;
+        if self.steps > max_steps {
+            return Err(Error::Solver(format!("{method}: more than {max_steps} steps at t = {}", self.t)));
+        }
+        if 0.1 * self.h.abs() <= self.t.abs() * f64::EPSILON || !self.h.is_finite() {
+            return Err(Error::Solver(format!("{method}: step size too small (h = {:e}) at t = {}", self.h, self.t)));
+        }
+        Ok(())
+    }
+}
+
+/// One-step integrator with dense output.
+pub trait Stepper {
+    /// Start at `(t0, y0)`; `t_end` bounds the first step.
+    fn init<S: SecondOrderSystem>(&mut self, sys: &mut S, t0: f64, y0: &[f64], t_end: f64) -> Result<()>;
+    /// One accepted step (rejected attempts are retried inside), never beyond `t_end`.
+    fn step<S: SecondOrderSystem>(&mut self, sys: &mut S, t_end: f64) -> Result<()>;
+    /// State at `t` in `[t_old, t]` from the dense output of the last step.
+    fn dense(&self, t: f64, out: &mut [f64]);
+    /// `y` was changed (post-step hook): re-evaluate what depends on it.
+    fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()>;
+    fn state(&self) -> &StepState;
+    fn state_mut(&mut self) -> &mut StepState;
+
+    fn t(&self) -> f64 {
+        self.state().t
+    }
+    fn t_old(&self) -> f64 {
+        self.state().t_old
+    }
+    fn y(&self) -> &[f64] {
+        &self.state().y
+    }
+    fn y_mut(&mut self) -> &mut [f64] {
+        &mut self.state_mut().y
+    }
+    fn stats(&self) -> Stats {
+        self.state().stats
+    }
+}
+
+fn rms_norm(v: &[f64], scale: &[f64]) -> f64 {
+    (v.iter().zip(scale).map(|(x, s)| (x / s) * (x / s)).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+/// Hairer's initial step guess (HINIT) for a method whose error estimate has order `iord`.
+#[allow(clippy::too_many_arguments)]
+fn initial_step<S: SecondOrderSystem>(sys: &mut S, t0: f64, y0: &[f64], f0: &[f64], rtol: f64, atol: &[f64], iord: i32, hmax: f64, y1: &mut [f64], f1: &mut [f64], nfev: &mut usize) -> Result<f64> {
+    let (mut dnf, mut dny) = (0.0, 0.0);
+    for i in 0..y0.len() {
+        let sk = atol[i] + rtol * y0[i].abs();
+        dnf += (f0[i] / sk).powi(2);
+        dny += (y0[i] / sk).powi(2);
+    }
+    let mut h = if dnf <= 1e-10 || dny <= 1e-10 { 1e-6 } else { (dny / dnf).sqrt() * 0.01 };
+    h = h.min(hmax);
+    for i in 0..y0.len() {
+        y1[i] = y0[i] + h * f0[i];
+    }
+    rhs(sys, t0 + h, y1, f1)?;
+    *nfev += 1;
+    let mut der2 = 0.0;
+    for i in 0..y0.len() {
+        let sk = atol[i] + rtol * y0[i].abs();
+        der2 += ((f1[i] - f0[i]) / sk).powi(2);
+    }
+    let der2 = der2.sqrt() / h;
+    let der12 = der2.abs().max(dnf.sqrt());
+    let h1 = if der12 <= 1e-15 { (h * 1e-3).max(1e-6) } else { (0.01 / der12).powf(1.0 / iord as f64) };
+    Ok((100.0 * h).min(h1).min(hmax))
+}
+
+
+/// Trajectory of a run: `t` (nt) and `y` (nt x dim, row-major).
+#[derive(Debug, Clone, Default)]
+pub struct Solution {
+    pub t: Vec<f64>,
+    pub y: Vec<f64>,
+    pub dim: usize,
+    pub stats: Stats,
+    /// 0: reached `t_end`; -1: failed (see `message`).
+    pub status: i32,
+    pub message: String,
+}
+
+/// Integrate from `(t0, y0)` to `t_end`. Outputs at `t_eval` (strictly increasing, within
+/// `[t0, t_end]`) from the dense output, or at every accepted step when `t_eval` is `None`.
+/// A failure inside the run ends it with `status = -1` and the trajectory up to there; only
+/// invalid arguments are returned as `Err`.
+pub fn integrate<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut S, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>) -> Result<Solution> {
+    let dim = y0.len();
+    if dim != 2 * sys.n() {
+        return Err(Error::Shape { what: "y0".into(), expected: 2 * sys.n(), got: dim });
+    }
+    if !(t_end > t0) || !t_end.is_finite() || !t0.is_finite() {
+        return Err(Error::argument("t_end", format!("must be finite and greater than t0 = {t0}, got {t_end}")));
+    }
+    if let Some(te) = t_eval {
+        if te.windows(2).any(|w| !(w[1] > w[0])) || te.iter().any(|x| !(*x >= t0 && *x <= t_end)) {
+            return Err(Error::argument("t_eval", format!("must be strictly increasing within [t0, t_end] = [{t0}, {t_end}]")));
+        }
+    }
+    let mut sol = Solution { dim, ..Default::default() };
+    let cap = t_eval.map(|te| te.len()).unwrap_or(1024);
+    sol.t.reserve(cap);
+    sol.y.reserve(cap * dim);
+    let mut next = 0usize;
+    let mut buf = vec![0.0; dim];
+    // the run; a failure ends it with the trajectory up to there
+    let mut run = |sol: &mut Solution| -> Result<()> {
+        stepper.init(sys, t0, y0, t_end)?;
+        match t_eval {
+            None => {
+                sol.t.push(t0);
+                sol.y.extend_from_slice(y0);
+            }
+            Some(te) => {
+                while next < te.len() && te[next] == t0 {
+                    sol.t.push(t0);
+                    sol.y.extend_from_slice(y0);
+                    next += 1;
+                }
+            }
+        }
+        while stepper.t() < t_end {
+            let step = stepper.step(sys, t_end);
+            sol.stats = stepper.stats();
+            step?;
+            let t = stepper.t();
+            if sys.post_step(t, stepper.y_mut())? {
+                stepper.restart_at(sys)?;
+            }
+            match t_eval {
+                None => {
+                    sol.t.push(t);
+                    sol.y.extend_from_slice(stepper.y());
+                }
+                Some(te) => {
+                    while next < te.len() && te[next] <= t {
+                        if te[next] == t {
+                            sol.y.extend_from_slice(stepper.y());
+                        } else {
+                            stepper.dense(te[next], &mut buf);
+                            sol.y.extend_from_slice(&buf);
+                        }
+                        sol.t.push(te[next]);
+                        next += 1;
+                    }
+                }
+            }
+        }
+        Ok(())
+    };
+    match run(&mut sol) {
+        Ok(()) => sol.message = "The solver successfully reached the end of the integration interval.".into(),
+        Err(e) => {
+            sol.status = -1;
+            sol.message = e.to_string();
+        }
+    }
+    sol.stats = stepper.stats();
+    Ok(sol)
+}
+
+/// The native methods by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    Dopri5,
+    Radau5,
+}
+
+impl Method {
+    pub fn from_name(name: &str) -> Option<Method> {
+        match name.to_ascii_uppercase().as_str() {
+            "DOPRI5" => Some(Method::Dopri5),
+            "RADAU5" => Some(Method::Radau5),
+            _ => None,
+        }
+    }
+}
+
+/// Convenience: run `method` on the UK system of `model` with a workspace `data`.
+pub fn integrate_uk(model: &Model, data: Data, method: Method, opts: Options, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, projection: Option<(f64, usize)>) -> Result<(Solution, usize, usize)> {
+    let mut sys = UkSystem::new(model, data);
+    sys.projection = projection;
+    let sol = match method {
+        Method::Dopri5 => {
+            let mut st = Dopri5::new(2 * model.n, opts)?;
+            integrate(&mut st, &mut sys, t0, y0, t_end, t_eval)?
+        }
+        Method::Radau5 => {
+            let mut st = Radau5::new(model.n, opts)?;
+            integrate(&mut st, &mut sys, t0, y0, t_end, t_eval)?
+        }
+    };
+    Ok((sol, sys.jac_full_evals, sys.jac_cheap_evals))
+}
+
