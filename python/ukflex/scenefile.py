@@ -303,36 +303,20 @@ def _scene(path: str, text: str, description: Dict[str, Any]) -> Scene:
         scene.validate()
         return scene
     except InvalidSceneError as exc:
-        where = _locate(description, text)
-        raise SceneFileError(f"{path}: {where}{exc}") from None
+        raise SceneFileError(f"{path}: {_where(getattr(exc, 'entry', None), description, text)}{exc}") from None
 
 
-def _locate(description: Dict[str, Any], text: str) -> str:
-    """The first array entry whose addition makes the description invalid, as ``[[key]] #k (line L): ``.
-
-    Entries are added in the order the scene is built (bodies, joints, drivers, forces), so a
-    joint that names an unknown body is reported at the joint.
-    """
-    trial: Dict[str, Any] = {k: description[k] for k in ("gravity",) if k in description}
-    try:
-        Scene.from_dict(dict(trial, bodies=[]))
-    except InvalidSceneError:
-        return ""  # gravity or the top level itself; the message says which
-    for key in ITEM_ARRAYS:
-        items = description.get(key)
-        if items is None:
-            continue
-        if not isinstance(items, list):
-            return ""
-        for i in range(len(items)):
-            try:
-                Scene.from_dict(dict(trial, **{key: items[: i + 1]}))
-            except InvalidSceneError:
-                lines = _array_lines(text, key)
-                line = f" (line {lines[i]})" if i < len(lines) and len(lines) == len(items) else ""
-                return f"[[{key}]] #{i + 1}{line}: "
-        trial[key] = items
-    return ""
+def _where(entry: Any, description: Dict[str, Any], text: str) -> str:
+    """``[[key]] #k (line L): `` for the array entry ``entry = (key, index)`` the core refused
+    (the scene is built in the order bodies, joints, drivers, forces, so a joint that names an
+    unknown body is reported at the joint); empty for the top level."""
+    if not entry:
+        return ""
+    key, i = entry
+    lines = _array_lines(text, key)
+    items = description.get(key) or []
+    line = f" (line {lines[i]})" if i < len(lines) and len(lines) == len(items) else ""
+    return f"[[{key}]] #{i + 1}{line}: "
 
 
 # ------------------------------------------------------------------------------------- writing

@@ -15,8 +15,8 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from .errors import InconsistentInitialStateError, InvalidSceneError, SingularMassError
-from .scene import Scene
+from .description import normalize
+from .errors import InconsistentInitialStateError, core as _core
 
 __all__ = ["System", "InitialCorrection"]
 
@@ -90,24 +90,13 @@ class InitialCorrection:
         )
 
 
-def _core_module():
-    try:
-        from . import _core  # type: ignore[attr-defined]
-    except ImportError as exc:  # pragma: no cover - depends on the build
-        raise ImportError(
-            "ukflex._core (the compiled Rust extension) is not available; build it with "
-            "`bash scripts/dev-build.sh`"
-        ) from exc
-    return _core
-
-
 class System:
     """A compiled multibody system (Rust core) with a consistent initial state.
 
     Parameters
     ----------
     description : Scene or dict
-        The scene (a :class:`ukflex.Scene` or its description dict, validated in Python first).
+        The scene (a :class:`ukflex.Scene` or its description dict, validated by the core).
     correct : bool
         Correct the initial guess onto the constraints (default True).  With ``False``, ``q0`` and
         ``qd0`` are the guess itself.
@@ -157,7 +146,7 @@ class System:
 
     def __init__(
         self,
-        description: Union[Scene, Dict[str, Any]],
+        description: Any,
         *,
         correct: bool = True,
         hold: Union[str, None, Sequence[str]] = "elastic",
@@ -166,15 +155,14 @@ class System:
         max_iterations: int = 50,
         t0: float = 0.0,
     ):
-        if isinstance(description, Scene):
-            scene = description
-        elif isinstance(description, dict):
-            scene = Scene.from_dict(description)
+        if isinstance(description, dict):
+            _, self.description = normalize(description)
+        elif hasattr(description, "to_dict") and hasattr(description, "validate"):
+            description.validate()
+            self.description = description.to_dict()
         else:
             raise TypeError(f"System needs a Scene or a description dict, got {type(description).__name__}")
-        scene.validate()
-        self.description: Dict[str, Any] = scene.to_dict()
-        core = _core_module().System(json.dumps(self.description))
+        core = _core.System(json.dumps(self.description))
         self.core = core
 
         # hot per-step methods: the compiled object's bound methods, no Python layer
@@ -208,7 +196,8 @@ class System:
         self.body_slices: Dict[str, Tuple[int, int]] = {k: (int(v[0]), int(v[1])) for k, v in dict(core.body_slices).items()}
         self.coordinate_names: List[str] = list(core.coordinate_names)
         self.constraint_names: List[str] = list(core.constraint_names)
-        self._kinds = {b["name"]: b["kind"] for b in self.description["bodies"]}
+        self.body_kind = core.body_kind
+        self.body_info = core.body_info
 
         self.t0 = float(t0)
         q_guess, qd_guess = core.initial_guess()
@@ -246,22 +235,6 @@ class System:
     def __repr__(self) -> str:
         return f"System(bodies={self.body_names}, n_coords={self.n_coords}, n_constraints={self.n_constraints})"
 
-    def body_kind(self, body: str) -> str:
-        """Kind of body ``body`` (``"rigid"``, ``"beam"``, ...)."""
-        if body not in self._kinds:
-            raise KeyError(f"unknown body {body!r}; bodies are {self.body_names}")
-        return self._kinds[body]
-
-    def body_info(self, body: str) -> Dict[str, Any]:
-        """Properties of body ``body`` as the core derived them (kind, mass, and for beams
-        length, elements, n_f, section area, second moment, material)."""
-        kind = self.body_kind(body)
-        d = next(b for b in self.description["bodies"] if b["name"] == body)
-        info: Dict[str, Any] = {"kind": kind}
-        if kind == "beam":
-            info.update({k: d[k] for k in ("length", "elements", "theory", "density", "youngs_modulus", "frame")})
-        return info
-
     def coordinate_index(self, name: str) -> int:
         """Index in ``q`` of coordinate ``name`` (e.g. ``"crank.theta"``, ``"coupler.qf0"``)."""
         try:
@@ -277,18 +250,20 @@ class System:
         return slice(start, stop)
 
     def elastic_slice(self, body: str) -> slice:
-        """Slice of ``q`` holding beam ``body``'s elastic coordinates ``q_f``."""
-        s = self.body_slice(body)
-        if self._kinds[body] != "beam":
-            raise KeyError(f"body {body!r} is rigid: it has no elastic coordinates")
-        return slice(s.start + 3, s.stop)
+        """Slice of ``q`` holding body ``body``'s elastic coordinates ``q_f``."""
+        if body not in self.body_slices:
+            raise KeyError(f"unknown body {body!r}; bodies are {self.body_names}")
+        start, stop = self.core.elastic_range(body)
+        if start == stop:
+            raise KeyError(f"body {body!r} is {self.body_kind(body)}: it has no elastic coordinates")
+        return slice(start, stop)
 
     def elastic_mask(self) -> np.ndarray:
-        """Boolean mask (n,) of the elastic coordinates of every beam."""
+        """Boolean mask (n,) of the elastic coordinates of every flexible body."""
         mask = np.zeros(self.n_coords, dtype=bool)
-        for name, kind in self._kinds.items():
-            if kind == "beam":
-                mask[self.elastic_slice(name)] = True
+        for name in self.body_names:
+            start, stop = self.core.elastic_range(name)
+            mask[start:stop] = True
         return mask
 
     def energy(self, q: np.ndarray, qd: np.ndarray) -> float:
@@ -349,28 +324,6 @@ class System:
                 mask[self.coordinate_index(h)] = True
         return mask
 
-    def _metric_step(self, M: np.ndarray, A: np.ndarray, r: np.ndarray, free: np.ndarray) -> np.ndarray:
-        """Minimum-norm solution of ``A[:, free] dx = r`` in the metric ``M[free, free]``.
-
-        ``dx_free = L^-T (A_f L^-T)^+ r`` with ``M_ff = L L^T`` (the UK/Gauss projection).
-        """
-        dx = np.zeros(self.n_coords)
-        if not np.any(free) or A.shape[0] == 0:
-            return dx
-        W = M[np.ix_(free, free)]
-        try:
-            L = np.linalg.cholesky(W)
-        except np.linalg.LinAlgError:
-            raise SingularMassError(
-                "mass matrix block of the corrected coordinates is not positive definite"
-            ) from None
-        Af = A[:, free]
-        # B = A_f L^-T  <=>  L B^T = A_f^T
-        B = np.linalg.solve(L, Af.T).T
-        y, *_ = np.linalg.lstsq(B, r, rcond=None)
-        dx[free] = np.linalg.solve(L.T, y)
-        return dx
-
     def _worst_rows(self, residual: np.ndarray, k: int = 3) -> List[str]:
         order = np.argsort(-np.abs(residual))[:k]
         return [self.constraint_names[i] for i in order if abs(residual[i]) > 0.0]
@@ -380,69 +333,33 @@ class System:
         return ", ".join(f"{self.constraint_names[i]} = {residual[i]:.3e}" for i in order)
 
     def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations):
-        core, t0 = self.core, self.t0
         held = self._held_mask(hold)
-        free = ~held
-        q = q_guess.copy()
-        phi = np.asarray(core.phi(t0, q))
-        r0 = self._max_abs(phi)
-        res = r0
-        it = 0
-        best = res
-        stall = 0
-        while res > position_tol and it < max_iterations:
-            it += 1
-            dq = self._metric_step(core.M(q), core.A(q), -phi, free)
-            # damped Newton: halve the step while the residual grows
-            step = 1.0
-            for _ in range(30):
-                q_try = q + step * dq
-                phi_try = np.asarray(core.phi(t0, q_try))
-                if self._max_abs(phi_try) < res or step < 1e-6:
-                    break
-                step *= 0.5
-            q, phi = q_try, phi_try
-            res = self._max_abs(phi)
-            if res < 0.5 * best:
-                best, stall = res, 0
-            else:
-                stall += 1
-                if stall >= 5:
-                    break
-        if not res <= position_tol:
-            rows = self._worst_rows(phi)
-            detail = self._detail(phi)
+        c = self.core.correct(self.t0, q_guess, qd_guess, [bool(h) for h in held], position_tol=position_tol,
+                              velocity_tol=velocity_tol, max_iterations=max_iterations)
+        if not c["positions_ok"]:
+            phi = np.asarray(c["phi"])
             raise InconsistentInitialStateError(
-                f"initial positions cannot be corrected onto the constraints Phi(q, t0) = 0: after {it} "
-                f"Newton iteration(s) max |Phi| = {res:.3e} (tolerance {position_tol:.1e}); largest residual "
-                f"rows: {detail}" + (" (held coordinates: elastic)" if np.any(held) else ""),
-                rows=rows,
+                f"initial positions cannot be corrected onto the constraints Phi(q, t0) = 0: after {c['iterations']} "
+                f"Newton iteration(s) max |Phi| = {c['position_residual_after']:.3e} (tolerance {position_tol:.1e}); "
+                f"largest residual rows: {self._detail(phi)}" + (" (held coordinates: elastic)" if np.any(held) else ""),
+                rows=self._worst_rows(phi),
                 residuals=phi,
             )
-
-        A = core.A(q)
-        vres = A @ qd_guess + core.phi_t(t0)
-        v0 = self._max_abs(vres)
-        dqd = self._metric_step(core.M(q), A, -vres, free)
-        qd = qd_guess + dqd
-        vres = A @ qd + core.phi_t(t0)
-        v1 = self._max_abs(vres)
-        scale = max(1.0, self._max_abs(qd))
-        if not v1 <= velocity_tol * scale:
-            rows = self._worst_rows(vres)
-            detail = self._detail(vres)
+        if not c["velocities_ok"]:
+            vres = np.asarray(c["velocity"])
             raise InconsistentInitialStateError(
                 f"initial velocities cannot be projected onto A qd = -Phi_t with the held coordinates fixed: "
-                f"max |A qd + Phi_t| = {v1:.3e}; largest residual rows: {detail}",
-                rows=rows,
+                f"max |A qd + Phi_t| = {c['velocity_residual_after']:.3e}; largest residual rows: {self._detail(vres)}",
+                rows=self._worst_rows(vres),
                 residuals=vres,
             )
+        q, qd = np.asarray(c["q"]), np.asarray(c["qd"])
         report = InitialCorrection(
-            iterations=it,
-            position_residual_before=r0,
-            position_residual_after=res,
-            velocity_residual_before=v0,
-            velocity_residual_after=v1,
+            iterations=int(c["iterations"]),
+            position_residual_before=float(c["position_residual_before"]),
+            position_residual_after=float(c["position_residual_after"]),
+            velocity_residual_before=float(c["velocity_residual_before"]),
+            velocity_residual_after=float(c["velocity_residual_after"]),
             dq=q - q_guess,
             dqd=qd - qd_guess,
             held=[n for n, h in zip(self.coordinate_names, held) if h],
