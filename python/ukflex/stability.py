@@ -32,7 +32,7 @@ from scipy.integrate import solve_ivp
 
 from .errors import SolverError, UkflexError
 from .results import SimulationResult
-from .simulate import _make_result, as_system
+from .simulate import as_system, simulate
 from .system import System
 
 __all__ = [
@@ -102,26 +102,32 @@ class IntegrationFailure(SolverError):  # type: ignore[misc, valid-type]
 
 
 # ------------------------------------------------------------------------------------ running
-def _configure(system: System, stabilization: Any, rank_tolerance: Any, pseudoinverse: Optional[str]) -> Tuple[str, Optional[float], float]:
-    """Apply stabilization / rank tolerance to the core; returns (kind, projection_tol, interval)."""
-    kind, proj_tol, interval = "none", None, 0.0
-    system.core.set_stabilization("none")
+def _configure(system: System, stabilization: Any, rank_tolerance: Any,
+               pseudoinverse: Optional[str]) -> Tuple[Any, Optional[float], float]:
+    """Apply stabilization, rank tolerance and pseudoinverse to the system.
+
+    Returns ``(label, projection_tol, interval)``: ``label`` is ``"none"``, ``"projection"`` or
+    ``{"kind": "baumgarte", "alpha": a, "beta": b}`` (stored in the result's ``extra``).
+    """
+    label: Any = "none"
+    proj_tol, interval = None, 0.0
+    system.set_stabilization("none")
     if stabilization is None or stabilization == "none":
         pass
     elif isinstance(stabilization, str) and stabilization == "projection":
-        kind, proj_tol = "projection", 1e-12
+        label, proj_tol = "projection", 1e-12
     elif isinstance(stabilization, dict):
         kind = stabilization.get("kind", "none")
         if kind == "baumgarte":
-            system.core.set_stabilization("baumgarte", float(stabilization["alpha"]), float(stabilization["beta"]))
+            label = _baumgarte(system, stabilization["alpha"], stabilization["beta"])
         elif kind == "projection":
+            label = "projection"
             proj_tol = float(stabilization.get("tol", 1e-12))
             interval = float(stabilization.get("interval", 0.0))
         elif kind != "none":
             raise ValueError(f"unknown stabilization kind {kind!r} (use 'none', 'baumgarte', 'projection')")
     elif isinstance(stabilization, (tuple, list)) and stabilization and stabilization[0] == "baumgarte":
-        kind = "baumgarte"
-        system.core.set_stabilization("baumgarte", float(stabilization[1]), float(stabilization[2]))
+        label = _baumgarte(system, stabilization[1], stabilization[2])
     else:
         raise ValueError(
             "stabilization must be None, 'projection', ('baumgarte', alpha, beta) or a dict with kind "
@@ -129,13 +135,18 @@ def _configure(system: System, stabilization: Any, rank_tolerance: Any, pseudoin
         )
     if rank_tolerance is not None:
         if isinstance(rank_tolerance, dict):
-            system.core.set_rank_tolerance(rank_tolerance.get("rcond"), float(rank_tolerance.get("atol", 0.0)))
+            system.set_rank_tolerance(rank_tolerance.get("rcond"), float(rank_tolerance.get("atol", 0.0)))
         else:
             rcond, atol = rank_tolerance
-            system.core.set_rank_tolerance(rcond, float(atol))
+            system.set_rank_tolerance(rcond, float(atol))
     if pseudoinverse is not None:
-        system.core.set_pseudoinverse(pseudoinverse)
-    return kind, proj_tol, interval
+        system.set_pseudoinverse(pseudoinverse)
+    return label, proj_tol, interval
+
+
+def _baumgarte(system: System, alpha: Any, beta: Any) -> Dict[str, Any]:
+    system.set_stabilization("baumgarte", float(alpha), float(beta))
+    return {"kind": "baumgarte", "alpha": alpha, "beta": beta}
 
 
 def run(
@@ -179,7 +190,7 @@ def run(
           each accepted step (native methods) -- or every ``interval`` seconds by restarting the
           scipy integrator (scipy methods; default ``interval = (t_end - t0) / 100``) -- project
           ``q`` onto ``Phi = 0`` (Newton in the mass metric) and ``qd`` onto
-          ``A qd + Phi_t = 0`` (:meth:`ukflex._core.System.project`).
+          ``A qd + Phi_t = 0`` (:meth:`ukflex.System.project`).
     rank_tolerance : (rcond, atol) or dict, optional
         Pseudoinverse tolerance: singular values of ``A F^-T`` at or below
         ``max(atol, rcond sigma_max)`` are dropped (``rcond=None``: ``max(m, n) eps``).
@@ -200,32 +211,20 @@ def run(
         ``extra`` holds ``stabilization``, ``projections`` (scipy) and the native statistics.
     """
     system = as_system(scene_or_system)
-    kind, proj_tol, interval = _configure(system, stabilization, rank_tolerance, pseudoinverse)
-    t0 = system.t0
+    label, proj_tol, interval = _configure(system, stabilization, rank_tolerance, pseudoinverse)
     atol_v = 1e-3 * rtol if atol is None else float(atol)
     te = None if t_eval is None else np.asarray(t_eval, dtype=float)
-    extra: Dict[str, Any] = {"stabilization": kind if kind != "baumgarte" else dict(kind="baumgarte", alpha=stabilization[1] if isinstance(stabilization, (tuple, list)) else stabilization["alpha"], beta=stabilization[2] if isinstance(stabilization, (tuple, list)) else stabilization["beta"])}
     if method.upper() in NATIVE_METHODS:
-        tic = time.perf_counter()
-        out = system.core.integrate(
-            t0, system.y0, float(t_end), method=method.upper(), rtol=rtol, atol=np.array([atol_v]), t_eval=te,
-            max_step=max_step, max_steps=max_steps, projection_tol=proj_tol,
-        )
-        wall = time.perf_counter() - tic
-        for k in ("naccept", "nreject", "jac_evals"):
-            extra[k] = out.get(k)
-
-        class _Sol:
-            nfev, njev, nlu = out["nfev"], out["njev"], out["nlu"]
-            status, message = out["status"], out["message"]
-
-        res = _make_result(system, out["t"], out["y"], _Sol, wall, method.upper(), "uk", rtol, atol_v, extra)
+        res = simulate(system, t_end, method.upper(), rtol=rtol, atol=atol_v, t_eval=te, max_step=max_step,
+                       max_steps=max_steps, projection_tol=proj_tol)
     else:
-        res = _run_scipy(system, float(t_end), method, rtol, atol_v, te, proj_tol, interval, max_step, extra, max_nfev)
+        res = _run_scipy(system, float(t_end), method, rtol, atol_v, te, proj_tol, interval, max_step, max_nfev)
+    res.extra["stabilization"] = label
     if res.status < 0:
         reason = res.message
-        t_fail = float(res.t[-1]) if res.t.size else t0
+        t_fail = float(res.t[-1]) if res.t.size else system.t0
         if raise_on_failure:
+            kind = label["kind"] if isinstance(label, dict) else label
             raise IntegrationFailure(
                 f"integration failed at t = {t_fail:.6g} s ({res.method}, {kind}): {reason}; "
                 f"the partial result ({res.t.size} outputs) is in .result", res, reason, t_fail
@@ -237,7 +236,7 @@ class _Budget(Exception):
     pass
 
 
-def _run_scipy(system, t_end, method, rtol, atol, t_eval, proj_tol, interval, max_step, extra, max_nfev=None):
+def _run_scipy(system, t_end, method, rtol, atol, t_eval, proj_tol, interval, max_step, max_nfev=None):
     """solve_ivp with an accepted-step recorder (partial results survive an exception) and
     optional projection at segment ends."""
     n = system.n_coords
@@ -246,7 +245,7 @@ def _run_scipy(system, t_end, method, rtol, atol, t_eval, proj_tol, interval, ma
     if max_step is not None:
         opts["max_step"] = max_step
     if method in ("Radau", "BDF"):
-        opts["jac"] = system.core.jac
+        opts["jac"] = system.jac
     fun = system.rhs
     if max_nfev is not None:
         count = [0]
@@ -297,8 +296,8 @@ def _run_scipy(system, t_end, method, rtol, atol, t_eval, proj_tol, interval, ma
                     ys.append(yy)
             break
         nfev += int(sol.nfev)
-        njev += int(getattr(sol, "njev", 0))
-        nlu += int(getattr(sol, "nlu", 0))
+        njev += int(sol.njev)
+        nlu += int(sol.nlu)
         if t_eval is None:
             first = 0 if k == 0 else 1
             ts.extend(sol.t[first:])
@@ -311,23 +310,19 @@ def _run_scipy(system, t_end, method, rtol, atol, t_eval, proj_tol, interval, ma
             break
         y = np.array(rec_y[-1])  # the segment end state (the last accepted step, t = tb)
         if proj_tol is not None and k < len(bounds) - 2:
-            qn, qdn, rep = system.core.project(tb, y[:n], y[n:], tol=proj_tol)
+            qn, qdn, rep = system.project(tb, y[:n], y[n:], tol=proj_tol)
             projections.append({"t": tb, **{kk: float(v) for kk, v in rep.items()}})
             y = np.concatenate([qn, qdn])
             if t_eval is None and ts and ts[-1] == tb:
                 ys[-1] = y.copy()
     wall = time.perf_counter() - tic
-    extra["projections"] = len(projections)
+    extra: Dict[str, Any] = {"projections": len(projections)}
     if projections:
         extra["max_projection_correction"] = max(p["position_correction"] for p in projections)
-
-    class _Sol:
-        pass
-
-    _Sol.nfev, _Sol.njev, _Sol.nlu, _Sol.status, _Sol.message = nfev, njev, nlu, status, message
-    t_arr = np.asarray(ts, dtype=float)
     y_arr = np.asarray(ys, dtype=float).T if ys else np.zeros((2 * n, 0))
-    return _make_result(system, t_arr, y_arr, _Sol, wall, method, "uk", rtol, atol, extra)
+    return SimulationResult.from_trajectory(
+        system, np.asarray(ts, dtype=float), y_arr, method=method, formulation="uk", rtol=rtol, atol=atol, nfev=nfev,
+        njev=njev, nlu=nlu, wall_time=wall, status=status, message=message, extra=extra)
 
 
 # ------------------------------------------------------------------------------------ diagnostics
@@ -353,12 +348,12 @@ def rank_history(result: SimulationResult, rcond: Optional[float] = None, atol: 
         return {"rank": rank, "ratio": ratio, "dropped": dropped, "changes": changes, "full": 0, "min_rank": 0,
                 "closeness": np.zeros(nt), "max_closeness": 0.0}
     # evaluate with the plain UK right-hand side (no Baumgarte term: the rank depends on q only)
-    s.core.set_rank_tolerance(rcond, atol)
+    s.set_rank_tolerance(rcond, atol)
     prev = None
     closeness = np.zeros(nt)
     for k in range(nt):
         s.qdd(result.t[k], result.q[k], result.qd[k])
-        info = s.core.rank_info()
+        info = s.rank_info()
         rank[k] = int(info["rank"])
         ratio[k] = info["sigma_min_kept"] / info["sigma_max"] if info["sigma_max"] > 0 else 0.0
         dropped[k] = info["sigma_max_dropped"]
@@ -530,7 +525,7 @@ def check(
             out.append(Diagnosis("fragile-rank", (
                 f"a singular value came within {rh['max_closeness']:.2g} x of the pseudoinverse tolerance: the rank "
                 "decision may flip from call to call (discontinuous accelerations, step-size collapse); set a looser "
-                "rank tolerance, e.g. System.core.set_rank_tolerance(rcond=1e-10)"), rh["max_closeness"]))
+                "rank tolerance, e.g. System.set_rank_tolerance(rcond=1e-10)"), rh["max_closeness"]))
         if not rh["changes"] and rh["min_rank"] == rh["full"]:
             worst = float(rh["ratio"].min())
             if worst < 1e-3:
@@ -655,7 +650,7 @@ def scaling_accuracy(system: System, t: Optional[float] = None, q=None, qd=None)
     t = system.t0 if t is None else float(t)
     q = system.q0 if q is None else np.asarray(q, dtype=float)
     qd = system.qd0 if qd is None else np.asarray(qd, dtype=float)
-    system.core.set_stabilization("none")
+    system.set_stabilization("none")
     M, Q, A, b = system.M(q), system.Q(t, q, qd), system.A(q), system.b(t, q, qd)
     ref = augmented_reference(M, Q, A, b)
     Ml = M.astype(np.longdouble)
@@ -842,7 +837,7 @@ def _long_run_study(quick: bool, log) -> Dict[str, Any]:
                             "max_velocity": d["max_velocity"], "wall": wall, "nfev": r.nfev,
                             "peak_v": float(np.abs(_v_mid(r)).max())})
         log(f"  long run {label}: {wall:.1f}s drift {d['max_position']:.2e}")
-    system.core.set_stabilization("none")
+    system.set_stabilization("none")
     # scipy path: projection by restarts
     tic = time.perf_counter()
     Ts = min(T, 10 * extreme.REVOLUTION)
