@@ -37,7 +37,7 @@ _PEAKS = {}
 
 @pytest.mark.parametrize("beam,gravity,n", GRID, ids=[f"{b}-{'g' if g else 'nog'}-N{n}" for b, g, n in GRID])
 def test_paper_scene_grid(beam, gravity, n, record_property):
-    system = scenes.slider_crank(beam=beam, elements=n, gravity=gravity).build()
+    system = scenes.slider_crank(theory=beam, elements=n, gravity=gravity).build()
     t_eval = np.linspace(0.0, T_END, 1001)
     start = time.perf_counter()
     res = simulate(system, T_END, method=GRID_METHOD, rtol=RTOL, t_eval=t_eval)
@@ -68,7 +68,7 @@ def test_paper_peaks_converge_with_mesh():
     for key in [(b, g, n) for b in ("timoshenko", "euler-bernoulli") for g in (True, False) for n in (1, 8, 16)]:
         if key not in _PEAKS:
             beam, gravity, n = key
-            res = simulate(scenes.slider_crank(beam=beam, elements=n, gravity=gravity), T_END, method=GRID_METHOD,
+            res = simulate(scenes.slider_crank(theory=beam, elements=n, gravity=gravity), T_END, method=GRID_METHOD,
                            rtol=RTOL, t_eval=np.linspace(0, T_END, 1001))
             _PEAKS[key] = np.abs(res.beam_displacement("coupler", 0.5)[1][res.t <= 0.07]).max() / LB
     for beam in ("timoshenko", "euler-bernoulli"):
@@ -84,7 +84,7 @@ def test_paper_scene_radau_matches_dop853(beam):
     """The paper's case (N = 1, gravity, rtol = 1e-6) with the default implicit method agrees
     with the explicit one; both obey the constraints."""
     t_eval = np.linspace(0.0, T_END, 1001)
-    scene = scenes.slider_crank(beam=beam)
+    scene = scenes.slider_crank(theory=beam)
     radau = simulate(scene, T_END, rtol=RTOL, t_eval=t_eval)
     dop = simulate(scene, T_END, method="DOP853", rtol=RTOL, t_eval=t_eval)
     assert radau.method == "Radau" and radau.njev > 0
