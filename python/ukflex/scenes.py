@@ -74,6 +74,15 @@ def gravity_vector(gravity: Any) -> Optional[Tuple[float, float]]:
     return (g[0], g[1])
 
 
+def _round_beam(s: Scene, name: str, length: float, elements: int, theory: str, diameter: float, density: float,
+                youngs_modulus: float, poisson_ratio: float, shear_factor: float, **options: Any):
+    """A pinned-pinned beam of circular section (the paper's coupler); ``poisson_ratio`` and
+    ``shear_factor`` go to Timoshenko beams only."""
+    kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor} if theory == "timoshenko" else {}
+    return s.beam(name, length=length, elements=elements, theory=theory, section=Circular(diameter), density=density,
+                  youngs_modulus=youngs_modulus, frame="pinned-pinned", **options, **kw)
+
+
 @renamed_parameters(beam="theory")
 def slider_crank(
     theory: str = "timoshenko",
@@ -134,25 +143,14 @@ def slider_crank(
         angle=0.0,
         angular_velocity=omega,
     )
-    kw = {}
-    if theory == "timoshenko":
-        kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor}
-    coupler = s.beam(
-        "coupler",
-        length=Lb,
-        elements=elements,
-        theory=theory,
-        section=Circular(d),
-        density=density,
-        youngs_modulus=youngs_modulus,
-        frame="pinned-pinned",
+    coupler = _round_beam(
+        s, "coupler", Lb, elements, theory, d, density, youngs_modulus, poisson_ratio, shear_factor,
         rotary_inertia=rotary_inertia,
         damping=damping,
         position=(L, 0.0),
         angle=0.0,
         velocity=(0.0, L * omega),
         angular_velocity=-L * omega / Lb,
-        **kw,
     )
     s.revolute(s.ground.point(0.0, 0.0), crank.point(0.0, 0.0), name="crank_pivot")
     s.revolute(crank.point(L, 0.0), coupler.at(0.0), name="crank_coupler")
@@ -352,21 +350,8 @@ def pinned_beam(
     elastic block ``M_ff``, ``K_ff`` gives the simply supported beam's natural frequencies.
     """
     s = Scene(gravity=gravity_vector(gravity))
-    kw = {}
-    if theory == "timoshenko":
-        kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor}
-    b = s.beam(
-        "beam",
-        length=length,
-        elements=elements,
-        theory=theory,
-        section=Circular(diameter),
-        density=density,
-        youngs_modulus=youngs_modulus,
-        frame="pinned-pinned",
-        rotary_inertia=rotary_inertia,
-        **kw,
-    )
+    b = _round_beam(s, "beam", length, elements, theory, diameter, density, youngs_modulus, poisson_ratio,
+                    shear_factor, rotary_inertia=rotary_inertia)
     s.revolute(s.ground.point(0, 0), b.at(0.0), name="pin")
     s.point_on_line(b.at(1.0), s.ground.line((0, 0), angle=0.0), name="roller")
     return s

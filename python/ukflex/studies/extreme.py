@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from .. import Circular, ConstantSpeed, Scene
-from ..scenes import PAPER, gravity_vector, slider_crank
+from ..scenes import PAPER, double_pendulum, gravity_vector, slider_crank
 
 __all__ = [
     "stiff",
@@ -200,18 +200,10 @@ def duplicate_joint(elements: int = 1, **kw: Any) -> Scene:
 
 # ------------------------------------------------------------------------------------ 7
 def mass_ratio(ratio: float = 1e-6, lengths: Tuple[float, float] = (1.0, 0.7), angles=(0.0, math.pi / 3)) -> Scene:
-    """Double pendulum of uniform rods with masses ``1`` and ``ratio`` kg, released from rest.
-    Conservative; ``cond(M)`` grows like ``1 / ratio`` (or ``ratio``)."""
-    s = Scene(gravity=(0.0, -PAPER["g"]))
-    (l1, l2), (m1, m2), (a1, a2) = lengths, (1.0, float(ratio)), angles
-    p1 = (0.5 * l1 * math.cos(a1), 0.5 * l1 * math.sin(a1))
-    tip = (l1 * math.cos(a1), l1 * math.sin(a1))
-    p2 = (tip[0] + 0.5 * l2 * math.cos(a2), tip[1] + 0.5 * l2 * math.sin(a2))
-    r1 = s.rigid_body("rod1", mass=m1, inertia=m1 * l1**2 / 12, position=p1, angle=a1)
-    r2 = s.rigid_body("rod2", mass=m2, inertia=m2 * l2**2 / 12, position=p2, angle=a2)
-    s.revolute(s.ground.point(0, 0), r1.point(-l1 / 2, 0), name="pivot")
-    s.revolute(r1.point(l1 / 2, 0), r2.point(-l2 / 2, 0), name="elbow")
-    return s
+    """Double pendulum of uniform rods with masses ``1`` and ``ratio`` kg, released from rest
+    (:func:`ukflex.scenes.double_pendulum`).  Conservative; ``cond(M)`` grows like
+    ``1 / ratio`` (or ``ratio``)."""
+    return double_pendulum(lengths=lengths, masses=(1.0, float(ratio)), angles=angles, gravity=True)
 
 
 def near_massless(slider_mass: float = 1e-9, slider_inertia: Optional[float] = None, elements: int = 1, **kw: Any) -> Scene:

@@ -190,56 +190,28 @@ def _plot_fig4(path: str, t: np.ndarray, curves: Dict[str, np.ndarray], elements
 
 
 # ----------------------------------------------------------------------------------- Table 1
-def _record_states(system, t_end: float, method: str, rtol: float, atol: float):
-    """One UK (Rust) run recording every right-hand-side state; returns (T, Y, run info)."""
+def _timed_uk_run(system, t_end: float, method: str, rtol: float, atol: float, record: bool = False):
+    """A UK (Rust) run as ``simulate`` does it (scipy, ``System.rhs``, ``System.jac``), timing the
+    rhs and Jacobian calls; with ``record`` every right-hand-side state is kept.
+
+    Returns ``(T, Y, info)``: the recorded times (k,) and states (k, 2n) (empty unless
+    ``record``) and ``wall_time``, ``accel_time``, ``nfev``, ``njev``, ``status``, ``steps``.
+    """
     from scipy.integrate import solve_ivp
 
     ts: List[float] = []
     ys: List[np.ndarray] = []
     acc = [0.0]
-    rhs0 = system.rhs
-    jac0 = system.jac
-    clock = time.perf_counter
-
-    def rhs(t, y):
-        ts.append(t)
-        ys.append(y.copy())
-        tic = clock()
-        f = rhs0(t, y)
-        acc[0] += clock() - tic
-        return f
-
-    def jac(t, y):
-        tic = clock()
-        J = jac0(t, y)
-        acc[0] += clock() - tic
-        return J
-
-    kw = {"jac": jac} if method in ("BDF", "Radau") else {}
-    tic = clock()
-    sol = solve_ivp(rhs, (system.t0, t_end), system.y0, method=method, rtol=rtol, atol=atol, **kw)
-    wall = clock() - tic
-    if sol.status != 0:
-        raise RuntimeError(f"recording run failed: {sol.message}")
-    info = {"wall_time": wall, "nfev": int(sol.nfev), "njev": int(sol.njev), "accel_time": acc[0],
-            "steps": int(sol.t.size - 1)}
-    return np.array(ts), np.array(ys), info
-
-
-def _uk_rust_whole_run(system, t_end: float, method: str, rtol: float, atol: float) -> Dict[str, float]:
-    """A UK (Rust) run as ``simulate`` does it, timing the rhs and Jacobian calls."""
-    from scipy.integrate import solve_ivp
-
-    acc = [0.0]
-    n = [0]
     rhs0, jac0 = system.rhs, system.jac
     clock = time.perf_counter
 
     def rhs(t, y):
+        if record:
+            ts.append(t)
+            ys.append(y.copy())
         tic = clock()
         f = rhs0(t, y)
         acc[0] += clock() - tic
-        n[0] += 1
         return f
 
     def jac(t, y):
@@ -252,7 +224,9 @@ def _uk_rust_whole_run(system, t_end: float, method: str, rtol: float, atol: flo
     tic = clock()
     sol = solve_ivp(rhs, (system.t0, t_end), system.y0, method=method, rtol=rtol, atol=atol, **kw)
     wall = clock() - tic
-    return {"wall_time": wall, "accel_time": acc[0], "nfev": n[0], "njev": int(sol.njev), "status": int(sol.status)}
+    info = {"wall_time": wall, "accel_time": acc[0], "nfev": int(sol.nfev), "njev": int(sol.njev),
+            "status": int(sol.status), "steps": int(sol.t.size - 1), "message": sol.message}
+    return np.array(ts), np.array(ys), info
 
 
 def _accel_functions(system) -> Dict[str, Callable]:
@@ -370,7 +344,9 @@ def table1(
           f"machine: {machine_line(info)}", file=stream, flush=True)
     for beam in theories:
         system = System(scenes.slider_crank(theory=beam, elements=elements))
-        T, Y, rec = _record_states(system, t_end, method, rtol, atol)
+        T, Y, rec = _timed_uk_run(system, t_end, method, rtol, atol, record=True)
+        if rec["status"] != 0:
+            raise RuntimeError(f"recording run failed: {rec['message']}")
         k = T.size
         if mode == "quick" and k > max_states:
             sel = np.unique(np.linspace(0, k - 1, max_states).round().astype(int))
@@ -397,7 +373,7 @@ def table1(
         if whole:
             runs: Dict[str, Dict[str, float]] = {}
             jobs = {
-                "uk-rust": lambda: _uk_rust_whole_run(system, t_end, method, rtol, atol),
+                "uk-rust": lambda: _timed_uk_run(system, t_end, method, rtol, atol)[2],
                 "uk-numpy": lambda: simulate(system, t_end, method=method, rtol=rtol, atol=atol, formulation="uk-numpy"),
                 "cp-once": lambda: simulate(system, t_end, method=method, rtol=rtol, atol=atol, formulation="cp"),
                 "cp-every": lambda: simulate(system, t_end, method=method, rtol=rtol, atol=atol, formulation="cp",
