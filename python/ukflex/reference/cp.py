@@ -175,8 +175,7 @@ class CPSystem:
 
 def reduced_accelerations(model, p, t, q, qd):
     """Independent accelerations from the reduced equations and the full qdd."""
-    M, Q, A, b = model.terms(t, q, qd) if hasattr(model, "terms") else (
-        model.M(q), model.Q(t, q, qd), model.A(q), model.gamma(t, q, qd))
+    M, Q, A, b = model.terms(t, q, qd)
     n = q.size
     Ar, br = A[p.rows], b[p.rows]
     AD = Ar[:, p.dep]
