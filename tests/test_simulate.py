@@ -238,3 +238,22 @@ def test_four_bar_with_flexible_coupler():
     assert res.success
     assert res.max_residual("position") < 1e-6
     assert np.allclose(res.coordinate("crank.theta"), math.pi / 2 + 10.0 * res.t, atol=1e-6)
+
+
+def test_result_from_trajectory_equals_the_simulate_result():
+    """SimulationResult.from_trajectory on a raw native run gives what simulate gives (it is
+    what simulate uses), and refuses states of the wrong shape (e.g. transposed)."""
+    system = scenes.slider_crank(elements=2).build()
+    te = np.linspace(0.0, 0.005, 11)
+    ref = simulate(system, 0.005, method="DOPRI5", rtol=1e-6, t_eval=te)
+    out = system.integrate(system.t0, system.y0, 0.005, "DOPRI5", 1e-6, np.array([1e-9]), te)
+    res = ukflex.SimulationResult.from_trajectory(system, out["t"], out["y"], method="DOPRI5", rtol=1e-6,
+                                                  nfev=out["nfev"], status=out["status"])
+    np.testing.assert_array_equal(res.t, ref.t)
+    np.testing.assert_array_equal(res.q, ref.q)
+    np.testing.assert_array_equal(res.qd, ref.qd)
+    for kind in ("position", "velocity", "acceleration"):
+        np.testing.assert_array_equal(res.residuals[kind], ref.residuals[kind])
+    assert res.nfev == ref.nfev and res.success and res.system is system
+    with pytest.raises(ValueError, match="shape"):
+        ukflex.SimulationResult.from_trajectory(system, out["t"], out["y"].T)

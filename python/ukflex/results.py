@@ -92,6 +92,11 @@ class SimulationResult:
         method, formulation, rtol, atol, nfev, njev, nlu, wall_time, status, message, extra
             Stored as given (see the class attributes).
 
+        Raises
+        ------
+        ValueError
+            ``t`` or ``y`` has the wrong shape.
+
         Examples
         --------
         >>> out = system.integrate(system.t0, system.y0, 0.1, "DOPRI5")      # doctest: +SKIP
@@ -100,7 +105,10 @@ class SimulationResult:
         """
         n = system.n_coords
         t = np.asarray(t, dtype=float)
-        y = np.asarray(y, dtype=float).reshape(2 * n, t.size)
+        y = np.asarray(y, dtype=float)
+        if t.ndim != 1 or y.shape != (2 * n, t.size):
+            raise ValueError(f"from_trajectory: expected t of shape (nt,) and y of shape (2n, nt) = "
+                             f"({2 * n}, {t.size}), got {t.shape} and {y.shape}")
         q = np.ascontiguousarray(y[:n].T)
         qd = np.ascontiguousarray(y[n:].T)
         return cls(t=t, q=q, qd=qd, residuals=_residual_norms(system, t, q, qd), nfev=int(nfev), njev=int(njev),
