@@ -40,8 +40,6 @@ import numpy as np
 
 __all__ = ["main", "Progress"]
 
-#: Span of the paper's Fig. 4 [s] (``ukflex.studies.paper.PAPER_WINDOW``).
-PAPER_WINDOW = 0.07
 RUN_DEFAULTS = {"t_end": 1.0, "method": "Radau", "rtol": 1e-6, "atol": None, "formulation": "uk", "samples": 201}
 
 
@@ -404,7 +402,7 @@ def _cmd_crosscheck(args: argparse.Namespace) -> int:
 
 # ----------------------------------------------------------------------------------- parser
 _FMT = argparse.RawDescriptionHelpFormatter
-THEORIES = ("timoshenko", "euler-bernoulli")
+_THEORIES = ("timoshenko", "euler-bernoulli")
 
 
 class _DeprecatedAlias(argparse.Action):
@@ -423,8 +421,8 @@ class _DeprecatedAlias(argparse.Action):
 def _add_theory_option(p: argparse.ArgumentParser, default: Optional[str] = "timoshenko") -> None:
     """--theory (and its deprecated alias --beam)."""
     shown = f"default {default}" if default else "default both"
-    p.add_argument("--theory", choices=THEORIES, default=default, help=f"coupler beam theory ({shown})")
-    p.add_argument("--beam", dest="theory", choices=THEORIES, action=_DeprecatedAlias, new="--theory",
+    p.add_argument("--theory", choices=_THEORIES, default=default, help=f"coupler beam theory ({shown})")
+    p.add_argument("--beam", dest="theory", choices=_THEORIES, action=_DeprecatedAlias, new="--theory",
                    help=argparse.SUPPRESS)
 
 
