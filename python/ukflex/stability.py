@@ -396,8 +396,8 @@ def beam_properties(system: System, body: str) -> Dict[str, Any]:
 
 def _section(system: System, body: str) -> Tuple[float, float]:
     """(area, second moment) of beam ``body``'s section.  ``System.body_info`` does not report
-    them yet, so they come from the description's section through the one Python copy of the
-    section formulas (the NumPy reference's)."""
+    them yet, so they come from the description's section through the NumPy reference's
+    section formulas (no copy of them here)."""
     from .reference import section_properties
 
     desc = next(b for b in system.description["bodies"] if b["name"] == body)
