@@ -4,10 +4,10 @@
 
 Reports, per call (minimum over repeats, and median), for the paper's slider-crank:
 
-* the Rust UK acceleration alone (``System.core._time_acceleration``: a loop inside Rust),
+* the Rust UK acceleration alone (``ukflex.simulate.time_acceleration``: a loop inside Rust),
 * ``System.qdd(t, q, qd)`` and ``System.rhs(t, y)`` (the binding: argument checks, copies,
   a fresh output array),
-* ``System.core.jac(t, y)`` (Rust finite-difference Jacobian, 2n x 2n),
+* ``System.jac(t, y)`` (Rust finite-difference Jacobian, 2n x 2n),
 * NumPy UK: ``ReferenceModel(description)`` terms ``M, Q, A, gamma`` + ``uk_qdd``,
 * NumPy CP: ``choose_partition(A)`` + ``reduced_accelerations`` (coordinate partitioning with
   the partition recomputed every call, as in the paper's implementation) and with a fixed
@@ -27,6 +27,7 @@ import numpy as np
 import ukflex
 from ukflex.reference import ReferenceModel, uk_qdd
 from ukflex.reference.cp import choose_partition, reduced_accelerations
+from ukflex.simulate import time_acceleration
 
 
 def per_call(fn, states, repeats=15, min_time=0.05):
@@ -57,17 +58,16 @@ def main():
     ap.add_argument("--states", type=int, default=20)
     args = ap.parse_args()
 
-    scene = ukflex.scenes.slider_crank(beam=args.theory, elements=args.elements)
+    scene = ukflex.scenes.slider_crank(theory=args.theory, elements=args.elements)
     system = ukflex.System(scene)
     n = system.n_coords
     # states along a trajectory (native run), so all methods see realistic, consistent states
     te = np.linspace(0.0, 0.07, args.states)
-    run = system.core.integrate(system.t0, system.y0, 0.07, "DOPRI5", 1e-8, None, te)
+    run = system.integrate(system.t0, system.y0, 0.07, "DOPRI5", 1e-8, None, te)
     Y = np.ascontiguousarray(run["y"].T)
     states = [(float(t), Y[k].copy(), Y[k, :n].copy(), Y[k, n:].copy()) for k, t in enumerate(run["t"])]
 
     ref = ReferenceModel(system.description)
-    core = system.core
     parts = {}
 
     def numpy_uk(s):
@@ -93,13 +93,13 @@ def main():
         scale = np.max(np.abs(a))
         worst = max(worst, np.max(np.abs(a - b)) / scale, np.max(np.abs(a - c)) / scale)
 
-    rust_only = [core._time_acceleration(s[0], s[2], s[3], reps=2000, batches=9) for s in states]
+    rust_only = [time_acceleration(system, s[0], s[2], s[3], reps=2000, batches=9) for s in states]
     rust_min = min(rust_only)
     rust_med = statistics.median(rust_only)
     rows = [("Rust UK acceleration (loop inside Rust)", (rust_min, rust_med))]
     rows.append(("System.qdd(t, q, qd)", per_call(lambda s: system.qdd(s[0], s[2], s[3]), states)))
     rows.append(("System.rhs(t, y)", per_call(lambda s: system.rhs(s[0], s[1]), states)))
-    rows.append(("System.core.jac(t, y) (2n x 2n)", per_call(lambda s: core.jac(s[0], s[1]), states, repeats=7)))
+    rows.append(("System.jac(t, y) (2n x 2n)", per_call(lambda s: system.jac(s[0], s[1]), states, repeats=7)))
     rows.append(("NumPy UK (ReferenceModel + uk_qdd)", per_call(numpy_uk, states, repeats=5)))
     rows.append(("NumPy CP, partition every call", per_call(numpy_cp_every_call, states, repeats=5)))
     rows.append(("NumPy CP, fixed partition", per_call(numpy_cp_fixed, states, repeats=5)))

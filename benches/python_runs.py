@@ -6,9 +6,9 @@ For each configuration: wall time (minimum of repeats), steps/evaluations, and t
 of the coupler midpoint deflection v(0.5)/Lb over 101 equally spaced times against a tight
 reference (native DOPRI5, rtol 1e-11, cross-checked with native RADAU5, rtol 1e-10).
 
-Paths: native DOPRI5 / RADAU5 (``System.core.integrate``, all in Rust, GIL released); scipy
+Paths: native DOPRI5 / RADAU5 (``System.integrate``, all in Rust, GIL released); scipy
 ``solve_ivp`` driven by ``System.rhs`` -- explicit RK45 / DOP853, and implicit Radau / BDF with
-the Rust Jacobian ``System.core.jac`` and (``--skip-slow`` leaves it out) with scipy's own
+the Rust Jacobian ``System.jac`` and (``--skip-slow`` leaves it out) with scipy's own
 finite-difference Jacobian. Not a test: figures depend on the machine and its load.
 """
 from __future__ import annotations
@@ -30,19 +30,19 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args()
 
-    system = ukflex.System(ukflex.scenes.slider_crank(beam=args.theory, elements=args.elements))
+    system = ukflex.System(ukflex.scenes.slider_crank(theory=args.theory, elements=args.elements))
     n = system.n_coords
     t_end = 0.1
     te = np.linspace(0.0, t_end, 101)
-    S, _ = system.core.beam_shape("coupler", 0.5)
+    S, _ = system.beam_shape("coupler", 0.5)
     sl = system.elastic_slice("coupler")
     Lb = system.description["bodies"][1]["length"]
 
     def v(Y):  # Y (2n, nt)
         return S[1] @ Y[sl.start:sl.stop, :] / Lb
 
-    ref = system.core.integrate(system.t0, system.y0, t_end, "DOPRI5", 1e-11, np.array([1e-14]), te)
-    chk = system.core.integrate(system.t0, system.y0, t_end, "RADAU5", 1e-10, np.array([1e-13]), te)
+    ref = system.integrate(system.t0, system.y0, t_end, "DOPRI5", 1e-11, np.array([1e-14]), te)
+    chk = system.integrate(system.t0, system.y0, t_end, "RADAU5", 1e-10, np.array([1e-13]), te)
     v_ref = v(ref["y"])
     print(f"paper slider-crank, {args.theory}, N = {args.elements} (n = {n}): max |v(0.5)/Lb| = {np.max(np.abs(v_ref)):.4e}")
     print(f"reference: native DOPRI5 rtol 1e-11 ({ref['wall_time'] * 1e3:.0f} ms); native RADAU5 rtol 1e-10 differs by "
@@ -61,7 +61,7 @@ def main():
         print(f"{name:44s} {rtol:7.0e} {best * 1e3:10.2f} {st} {nfev:8d} {njev:6d} {err:13.2e}", flush=True)
 
     def native(method, rtol):
-        r = system.core.integrate(system.t0, system.y0, t_end, method, rtol, None, te)
+        r = system.integrate(system.t0, system.y0, t_end, method, rtol, None, te)
         assert r["status"] == 0, r["message"]
         return r["y"], r["naccept"], r["nfev"], r["njev"]
 
@@ -81,8 +81,8 @@ def main():
     for rtol in (1e-3, 3e-4, 1e-4, 1e-6):
         row("scipy DOP853 <- System.rhs", rtol, lambda: scipy("DOP853", rtol), repeats=1)
     for rtol in (1e-3, 1e-6):
-        row("scipy Radau <- rhs + Rust jac", rtol, lambda: scipy("Radau", rtol, system.core.jac), repeats=1)
-        row("scipy BDF <- rhs + Rust jac", rtol, lambda: scipy("BDF", rtol, system.core.jac), repeats=1)
+        row("scipy Radau <- rhs + Rust jac", rtol, lambda: scipy("Radau", rtol, system.jac), repeats=1)
+        row("scipy BDF <- rhs + Rust jac", rtol, lambda: scipy("BDF", rtol, system.jac), repeats=1)
     if not args.skip_slow:
         row("scipy Radau <- rhs, scipy FD Jacobian", 1e-6, lambda: scipy("Radau", 1e-6), repeats=1)
     print("(scipy does not report its step count; nfev excludes the UK calls inside the Rust Jacobian)")

@@ -41,7 +41,7 @@ def main():
     def job(k, system=None):
         s = system if system is not None else systems[k]
         y0 = systems[k].y0
-        r = s.core.integrate(0.0, y0, 0.1, args.method, args.rtol, None, te)
+        r = s.integrate(0.0, y0, 0.1, args.method, args.rtol, None, te)
         assert r["status"] == 0, r["message"]
         return r["y"]
 
@@ -88,7 +88,7 @@ def main():
 
     def long_run():
         box["t0"] = time.perf_counter()
-        shared.core.integrate(0.0, shared.y0, 0.1, args.method, 1e-6, None, te)
+        shared.integrate(0.0, shared.y0, 0.1, args.method, 1e-6, None, te)
         box["t1"] = time.perf_counter()
 
     stamps = []
@@ -106,7 +106,7 @@ def main():
 def _proc_job(arg):
     w, method, rtol = arg
     s = ukflex.System(ukflex.scenes.slider_crank(omega=w))
-    r = s.core.integrate(0.0, s.y0, 0.1, method, rtol, None, np.linspace(0.0, 0.1, 101))
+    r = s.integrate(0.0, s.y0, 0.1, method, rtol, None, np.linspace(0.0, 0.1, 101))
     return r["status"]
 
 

@@ -270,7 +270,7 @@ def test_cli_run(tmp_path):
     assert "energy" in out.stdout and "max ||Phi||" in out.stdout
     assert (tmp_path / "pendulum.csv").exists() and (tmp_path / "pendulum.npz").exists()
     bad = subprocess.run(
-        [sys.executable, "-m", "ukflex", "run", "slider_crank", "--param", "beam=eb"],
+        [sys.executable, "-m", "ukflex", "run", "slider_crank", "--param", "theory=eb"],
         capture_output=True,
         text=True,
         env=env,

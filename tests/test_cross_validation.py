@@ -102,7 +102,7 @@ def test_builtin_api_scene_is_the_reference_scene():
     (the pivot joint is declared ground-first there, so its two rows change sign)."""
     from ukflex import scenes as api_scenes
     for beam in ("timoshenko", "euler-bernoulli"):
-        da = api_scenes.slider_crank(beam=beam, elements=2).to_dict()
+        da = api_scenes.slider_crank(theory=beam, elements=2).to_dict()
         ma, mr = ReferenceModel(da), ReferenceModel(scenes.slider_crank(beam, 2))
         ra = rust(da)
         q, qd = random_state(mr, np.random.default_rng(102))

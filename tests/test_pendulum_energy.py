@@ -23,7 +23,7 @@ def _relative_energy_drift(res, scale):
 @pytest.fixture(scope="module")
 def drifts():
     out = {}
-    scene = scenes.pendulum(length=L, mass=M, angle=-math.pi / 2 + PHI0, g=G)
+    scene = scenes.pendulum(length=L, mass=M, angle=-math.pi / 2 + PHI0, gravity=G)
     for rtol in (1e-5, 1e-7, 1e-9, 1e-11):
         res = simulate(scene, 5.0, rtol=rtol, atol=1e-3 * rtol, t_eval=np.linspace(0, 5, 501))
         assert res.success
@@ -57,7 +57,7 @@ def test_energy_is_not_trivially_constant(drifts):
 
 def test_period_matches_elliptic_integral():
     """Uniform rod pivoted at one end: T = 4 sqrt(I_p / (m g h)) K(sin^2(phi0 / 2))."""
-    scene = scenes.pendulum(length=L, mass=M, angle=-math.pi / 2 + PHI0, g=G)
+    scene = scenes.pendulum(length=L, mass=M, angle=-math.pi / 2 + PHI0, gravity=G)
     t = np.linspace(0.0, 4.0, 40001)
     res = simulate(scene, 4.0, method="DOP853", rtol=1e-11, atol=1e-13, t_eval=t)
     w = res.velocity("rod.theta")

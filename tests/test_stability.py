@@ -1,4 +1,5 @@
-"""Issue 6: safeguards of ukflex.stability (scaling accuracy, failures keep partial results)."""
+"""Issue 6: safeguards of ukflex.stability (scaling accuracy, failures keep partial results) and the
+stability report (ukflex.studies.stability)."""
 
 import numpy as np
 import pytest
@@ -8,8 +9,9 @@ from conftest import core_available
 pytestmark = pytest.mark.skipif(not core_available(), reason="ukflex._core not built")
 
 import ukflex  # noqa: E402
-from ukflex import extreme as X  # noqa: E402
+from ukflex.studies import extreme as X  # noqa: E402
 from ukflex import stability as S  # noqa: E402
+from ukflex.studies import stability as report_study  # noqa: E402
 
 
 def test_longdouble_reference_solves_to_extended_precision():
@@ -56,7 +58,7 @@ def test_drift_warning_and_baumgarte_option_validation():
 
 
 def test_report_writes_markdown_for_one_case(tmp_path):
-    data = S.report(str(tmp_path), quick=True, cases=["mass_ratio_1e6"], verbose=False)
+    data = report_study.report(str(tmp_path), quick=True, cases=["mass_ratio_1e6"], verbose=False)
     md = (tmp_path / "stability.md").read_text()
     assert "mass_ratio_1e6" in md and (tmp_path / "stability.json").exists()
     runs = data["cases"][0]["runs"]

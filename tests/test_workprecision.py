@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import ukflex
-from ukflex import workprecision as wp
+from ukflex.studies import workprecision as wp
 
 T_END = 0.004
 SAMPLES = 41
@@ -64,7 +64,7 @@ def test_error_falls_with_rtol_and_formulations_agree(study):
 def test_error_measure_matches_a_direct_computation(study):
     _, res = study
     row = next(r for r in res["rows"] if r["formulation"] == "uk" and r["rtol"] == 1e-3)
-    system = wp._paper_system("timoshenko", 1)
+    system = wp.paper_system("timoshenko", 1)
     t = np.linspace(0.0, T_END, SAMPLES)
     sim = ukflex.simulate(system, T_END, method="RK45", rtol=1e-3, atol=1e-6, t_eval=t)
     _, v = sim.beam_displacement("coupler", 0.5)

@@ -6,8 +6,11 @@ Rust core (``ukflex._core``, private) + Python API:
 * :class:`System` -- compiled Rust-backed system with a consistent initial state;
 * :func:`simulate` -- time integration with ``scipy.integrate.solve_ivp``;
 * :mod:`ukflex.scenes` -- built-in scenes (the paper's slider-crank, pendulums, ...);
-* :mod:`ukflex.extreme` -- catalogue of stiff and extreme scenes; :mod:`ukflex.stability` --
-  stabilization, diagnostics (rank loss, drift, buckling, FFRF validity) and the stability report.
+* :mod:`ukflex.stability` -- stabilization and diagnostics (rank loss, drift, buckling, FFRF
+  validity);
+* :mod:`ukflex.studies` -- studies on the public API: the paper's reproduction, work-precision,
+  the extreme catalogue and its stability report, cross-checks against :mod:`ukflex.reference`;
+* ``ukflex`` (also ``python -m ukflex``) -- the command line (:mod:`ukflex.cli`).
 """
 
 from .errors import (
@@ -35,7 +38,6 @@ from .system import InitialCorrection, System
 from .results import SimulationResult
 from .simulate import simulate
 from . import scenes
-from . import extreme
 
 __version__ = "0.1.0"
 
@@ -56,7 +58,6 @@ __all__ = [
     "SimulationResult",
     "simulate",
     "scenes",
-    "extreme",
     "UkflexError",
     "InvalidSceneError",
     "SingularMassError",

@@ -1,11 +1,17 @@
-"""Type stubs of the compiled Rust extension ``ukflex._core`` (private; use ``ukflex.System``)."""
+"""Type stubs of the compiled Rust extension ``ukflex._core`` (private; use ``ukflex.System``).
 
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+tests/test_stubs.py checks these against the compiled module: every name, parameter name,
+parameter kind and default must match.
+"""
+
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
-F64 = npt.NDArray[np.float64]
+_F64 = npt.NDArray[np.float64]
+
+__all__ = ["System", "UkflexError", "InvalidSceneError", "SingularMassError", "NonFiniteError", "SolverError"]
 
 class UkflexError(Exception): ...
 class InvalidSceneError(UkflexError): ...
@@ -13,53 +19,59 @@ class SingularMassError(UkflexError): ...
 class SolverError(UkflexError): ...
 class NonFiniteError(UkflexError): ...
 
+@final
 class System:
     """Compiled model + workspace built from a JSON scene description (docs/scene-format.md)."""
 
-    def __init__(self, description_json: str) -> None: ...
-    def M(self, q: F64) -> F64:
+    def __new__(cls, description_json: str) -> "System": ...
+    def M(self, q: _F64) -> _F64:
         """Mass matrix, shape (n, n)."""
-    def Q(self, t: float, q: F64, qd: F64) -> F64:
+    def Q(self, t: float, q: _F64, qd: _F64) -> _F64:
         """Generalized forces (applied + quadratic velocity + elastic), shape (n,)."""
-    def phi(self, t: float, q: F64) -> F64:
+    def phi(self, t: float, q: _F64) -> _F64:
         """Constraint residual Phi(q, t), shape (m,)."""
-    def A(self, q: F64) -> F64:
+    def A(self, q: _F64) -> _F64:
         """Constraint Jacobian Phi_q, shape (m, n)."""
-    def phi_t(self, t: float) -> F64:
+    def phi_t(self, t: float) -> _F64:
         """Partial time derivative of Phi, shape (m,)."""
-    def b(self, t: float, q: F64, qd: F64) -> F64:
+    def b(self, t: float, q: _F64, qd: _F64) -> _F64:
         """Right-hand side gamma of A qdd = b, shape (m,)."""
-    def qdd(self, t: float, q: F64, qd: F64) -> F64:
+    def qdd(self, t: float, q: _F64, qd: _F64) -> _F64:
         """Udwadia-Kalaba accelerations, shape (n,)."""
-    def rhs(self, t: float, y: F64) -> F64:
+    def rhs(self, t: float, y: _F64) -> _F64:
         """First-order right-hand side [qd, qdd] of y = [q, qd], shape (2n,)."""
-    def multipliers(self, t: float, q: F64, qd: F64) -> F64:
+    def _time_acceleration(self, t: float, q: _F64, qd: _F64, reps: int = 1000, batches: int = 21) -> float:
+        """Benchmark helper: seconds per call of the Rust UK acceleration alone (min over batches)."""
+    def multipliers(self, t: float, q: _F64, qd: _F64) -> _F64:
         """Lagrange multipliers with M qdd + A^T lam = Q, shape (m,)."""
-    def residuals(self, t: float, q: F64, qd: F64) -> Tuple[F64, F64, F64]:
+    def residuals(self, t: float, q: _F64, qd: _F64) -> Tuple[_F64, _F64, _F64]:
         """(Phi, A qd + Phi_t, A qdd - b), each shape (m,)."""
     def rank(self) -> Tuple[int, float]:
         """(rank, smallest kept singular value) of the last UK solve."""
-    def initial_guess(self) -> Tuple[F64, F64]:
+    def initial_guess(self) -> Tuple[_F64, _F64]:
         """(q, qd) from the description's state fields, each shape (n,)."""
-    def beam_shape(self, body_name: str, xi: float) -> Tuple[F64, F64]:
-        """(S (2, n_f), N_psi (n_f,)) at x = xi * length of a beam."""
-    def beam_matrices(self, body_name: str) -> Tuple[F64, F64]:
-        """Constant elastic blocks (M_ff, K_ff) of a beam, each (n_f, n_f)."""
+    def beam_shape(self, body: str, xi: float) -> Tuple[_F64, _F64]:
+        """(S (2, n_f), N_psi (n_f,)) at x = xi * length of beam ``body``."""
+    def beam_matrices(self, body: str) -> Tuple[_F64, _F64]:
+        """Constant elastic blocks (M_ff, K_ff) of beam ``body``, each (n_f, n_f)."""
     def rank_info(self) -> Dict[str, Any]:
         """rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the last UK solve."""
-    def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None: ...
-    def set_pseudoinverse(self, kind: str) -> None: ...
-    def set_stabilization(self, kind: str = "none", alpha: float = 0.0, beta: float = 0.0) -> None: ...
-    def jac(self, t: float, y: F64, scheme: str = "central") -> F64:
+    def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None:
+        """Drop singular values of A F^-T at or below max(atol, rcond sigma_max)."""
+    def set_pseudoinverse(self, kind: str = "auto") -> None:
+        """Pseudoinverse backend: "auto", "qr-jacobi" or "faer"."""
+    def set_stabilization(self, kind: str = "none", alpha: float = 0.0, beta: float = 0.0) -> None:
+        """Constraint stabilization: kind "none" or "baumgarte" (Phi_dd + 2 alpha Phi_d + beta^2 Phi = 0)."""
+    def jac(self, t: float, y: _F64, scheme: str = "central") -> _F64:
         """d[qd, qdd]/d[q, qd], shape (2n, 2n) (finite differences in Rust)."""
     def integrate(
         self,
         t0: float,
-        y0: F64,
+        y0: _F64,
         t_end: float,
         method: str = "RADAU5",
         rtol: float = 1e-6,
-        atol: Union[None, float, F64] = None,
+        atol: Union[None, float, _F64] = None,
         t_eval: Optional[Sequence[float]] = None,
         first_step: Optional[float] = None,
         max_step: Optional[float] = None,
@@ -68,11 +80,13 @@ class System:
     ) -> Dict[str, Any]:
         """Native integration; dict with t (nt,), y (2n, nt), status, message, statistics."""
     def project(
-        self, t: float, q: F64, qd: F64, tol: float = 1e-12, max_iter: int = 20
-    ) -> Tuple[F64, F64, Dict[str, Any]]:
+        self, t: float, q: _F64, qd: _F64, tol: float = 1e-12, max_iter: int = 20
+    ) -> Tuple[_F64, _F64, Dict[str, Any]]:
         """Project (q, qd) onto Phi = 0, A qd + Phi_t = 0 in the mass metric."""
-    def kinetic_energy(self, q: F64, qd: F64) -> float: ...
-    def potential_energy(self, q: F64) -> float: ...
+    def kinetic_energy(self, q: _F64, qd: _F64) -> float:
+        """1/2 qd^T M(q) qd."""
+    def potential_energy(self, q: _F64) -> float:
+        """Gravity + elastic strain + springs (and -F.r of constant loads)."""
     @property
     def n_coords(self) -> int: ...
     @property

@@ -57,24 +57,32 @@ class MechanismDrawer:
         self.system = system
         self.scale = float(deform_scale)
         desc = system.description
-        self.bodies = {b["name"]: b for b in desc["bodies"]}
+        #: name -> kind ("rigid", "beam", ...), in declaration order
+        self.bodies = {name: system.body_kind(name) for name in system.body_names}
         self.markers = _markers_of(desc)
         self._beam_S: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
-        for name, b in self.bodies.items():
-            if b["kind"] == "beam":
-                k = max(2, points_per_element * int(b["elements"])) + 1
+        self._length: Dict[str, float] = {}
+        for name, kind in self.bodies.items():
+            if kind == "beam":
+                info = system.body_info(name)
+                self._length[name] = float(info["length"])
+                k = max(2, points_per_element * int(info["elements"])) + 1
                 xi = np.linspace(0.0, 1.0, k)
                 S = np.array([np.asarray(system.beam_shape(name, float(x))[0]) for x in xi])  # (k, 2, n_f)
-                self._beam_S[name] = (xi * b["length"], S)
+                self._beam_S[name] = (xi * self._length[name], S)
         self._marker_S: Dict[int, np.ndarray] = {}
         for i, (_, m, _) in enumerate(self.markers):
             body = m["body"]
-            if body != GROUND and self.bodies[body]["kind"] == "beam":
+            if body != GROUND and self.bodies[body] == "beam":
                 self._marker_S[i] = np.asarray(system.beam_shape(body, float(m["xi"]))[0])
-        # rigid bodies: the attachment points in the body frame (+ the centre of mass)
+        # rigid bodies: the attachment points in the body frame (+ the centre of mass, which
+        # System.body_info does not report yet: read from the description)
         self._rigid_points: Dict[str, np.ndarray] = {}
-        for name, b in self.bodies.items():
-            if b["kind"] == "rigid":
+        self._com: Dict[str, np.ndarray] = {}
+        for b in desc["bodies"]:
+            name = b["name"]
+            if self.bodies[name] == "rigid":
+                self._com[name] = np.asarray(b.get("com", (0.0, 0.0)), dtype=float)
                 pts = [tuple(m["point"]) for _, m, _ in self.markers if m["body"] == name]
                 uniq = []
                 for p in pts:
@@ -83,21 +91,20 @@ class MechanismDrawer:
                 self._rigid_points[name] = np.array(uniq, dtype=float).reshape(-1, 2)
 
     def _frame(self, q: np.ndarray, name: str):
-        sl = self.system.body_slice(name)
-        qb = q[sl]
+        """(position (2,), rotation matrix (2, 2)) of body ``name``'s frame at ``q``."""
+        qb = q[self.system.body_slice(name)]
         c, s = math.cos(qb[2]), math.sin(qb[2])
-        return qb, np.array([[c, -s], [s, c]])
+        return qb[:2], np.array([[c, -s], [s, c]])
 
     def body_polyline(self, q: np.ndarray, name: str) -> np.ndarray:
         """World points (k, 2) drawing body ``name`` at ``q``."""
-        b = self.bodies[name]
-        qb, R = self._frame(q, name)
-        if b["kind"] == "beam":
+        r, R = self._frame(q, name)
+        if self.bodies[name] == "beam":
             x, S = self._beam_S[name]
-            disp = S @ qb[3:]  # (k, 2)
+            disp = S @ q[self.system.elastic_slice(name)]  # (k, 2)
             local = np.column_stack([x + self.scale * disp[:, 0], self.scale * disp[:, 1]])
-            return qb[:2] + local @ R.T
-        com = np.asarray(b.get("com", (0.0, 0.0)), dtype=float)
+            return r + local @ R.T
+        com = self._com[name]
         pts = self._rigid_points[name]
         if pts.shape[0] == 0:
             local = com[None, :]
@@ -108,7 +115,7 @@ class MechanismDrawer:
             for p in pts:  # a star: com -> p -> com -> next point ...
                 seq += [com, p, com]
             local = np.array(seq)
-        return qb[:2] + local @ R.T
+        return r + local @ R.T
 
     def marker_position(self, q: np.ndarray, i: int) -> np.ndarray:
         """World position (2,) of marker ``i`` (index into ``self.markers``)."""
@@ -116,13 +123,13 @@ class MechanismDrawer:
         body = m["body"]
         if body == GROUND:
             return np.asarray(m["point"], dtype=float)
-        qb, R = self._frame(q, body)
+        r, R = self._frame(q, body)
         if i in self._marker_S:
-            d = self._marker_S[i] @ qb[3:]
-            local = np.array([m["xi"] * self.bodies[body]["length"] + self.scale * d[0], self.scale * d[1]])
+            d = self._marker_S[i] @ q[self.system.elastic_slice(body)]
+            local = np.array([m["xi"] * self._length[body] + self.scale * d[0], self.scale * d[1]])
         else:
             local = np.asarray(m["point"], dtype=float)
-        return qb[:2] + R @ local
+        return r + R @ local
 
     def joint_positions(self, q: np.ndarray) -> np.ndarray:
         """World positions (k, 2) of the joints' first markers (revolute, weld) and of points on lines."""
@@ -183,10 +190,10 @@ class _Scene2D:
         if gp.size:
             ax.plot(gp[:, 0], gp[:, 1], "^", color="0.3", ms=9, zorder=1)
         self.lines = {}
-        for k, (name, b) in enumerate(drawer.bodies.items()):
-            lw = 2.5 if b["kind"] == "beam" else 4.0
+        for k, (name, kind) in enumerate(drawer.bodies.items()):
+            lw = 2.5 if kind == "beam" else 4.0
             (ln,) = ax.plot([], [], "-", lw=lw, color=self.COLORS[k % len(self.COLORS)], label=name,
-                            solid_capstyle="round", zorder=2, marker="o" if b["kind"] == "rigid" else None,
+                            solid_capstyle="round", zorder=2, marker="o" if kind == "rigid" else None,
                             ms=3)
             self.lines[name] = ln
         (self.joints,) = ax.plot([], [], "o", ms=6, mfc="white", mec="k", mew=1.2, zorder=3)
@@ -207,7 +214,7 @@ class _Scene2D:
 
 def _title(res, deform_scale: float, title: Optional[str]) -> str:
     base = title or "ukflex"
-    if any(b["kind"] == "beam" for b in res.system.description["bodies"]):
+    if any(res.system.body_kind(name) == "beam" for name in res.system.body_names):
         base += f" (elastic displacements x{deform_scale:g})" if deform_scale != 1.0 else " (true scale)"
     return base
 

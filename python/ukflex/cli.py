@@ -2,9 +2,6 @@
 
 Commands
 --------
-``ukflex paper --out DIR``
-    Reproduce the paper: Fig. 4 (``fig4.csv``, ``fig4.png``) for the Timoshenko and the
-    Euler-Bernoulli coupler, and the Table 1 analogue (``table1.md``, ``table1.csv``).
 ``ukflex run SCENE``
     Simulate a built-in scene or a TOML scene file; write CSV, NPZ, a plot of chosen outputs
     and (``--animate``) a GIF.
@@ -12,11 +9,20 @@ Commands
     List the built-in scenes.
 ``ukflex export NAME``
     Write a built-in scene as a TOML scene file (a starting point for your own).
+``ukflex paper --out DIR``
+    Reproduce the paper: Fig. 4 (``fig4.csv``, ``fig4.png``) for the Timoshenko and the
+    Euler-Bernoulli coupler, and the Table 1 analogue (``table1.md``, ``table1.csv``).
 ``ukflex bench work-precision|elements|table1 --out DIR``
     Error against run time for every integrator and formulation; the same over element
     counts; the Table 1 analogue alone.
+``ukflex stability --out DIR``
+    The stability report over the catalogue of extreme scenes.
+``ukflex crosscheck errata|sweep|timing|bdf``
+    Cross-checks against the NumPy reference (the paper's errata, Rust UK vs CP, timings).
 
-Each command is a ``_cmd_<name>(args)`` function registered in ``_build_parser``.
+``run``, ``list`` and ``export`` use the library; ``paper``, ``bench``, ``stability`` and
+``crosscheck`` run the studies of :mod:`ukflex.studies` (imported when the command runs).
+Each command is a ``_cmd_<name>(args)`` function; ``_build_parser`` registers them.
 """
 
 from __future__ import annotations
@@ -27,16 +33,12 @@ import csv
 import os
 import sys
 import time
+import warnings
 from typing import Any, Callable, Dict, List, Optional, Sequence, TextIO
 
 import numpy as np
 
-from .paper import PAPER_WINDOW, run_fig4
-
-__all__ = ["main", "run_paper"]
-
-#: Backwards-compatible name of :func:`ukflex.paper.run_fig4`.
-run_paper = run_fig4
+__all__ = ["main", "Progress"]
 
 RUN_DEFAULTS = {"t_end": 1.0, "method": "Radau", "rtol": 1e-6, "atol": None, "formulation": "uk", "samples": 201}
 
@@ -86,7 +88,7 @@ class Progress:
 
     ``callback(label, t_end)`` returns a ``progress(t)`` function for :func:`ukflex.simulate`;
     the line appears after ``delay`` seconds (short runs stay quiet) and is refreshed at most
-    every ``interval`` seconds; :meth:`done` clears it.
+    every ``interval`` seconds; it is cleared when ``t`` reaches ``t_end`` or by :meth:`done`.
     """
 
     def __init__(self, enabled: Optional[bool] = None, stream: Optional[TextIO] = None, delay: float = 0.5,
@@ -105,6 +107,9 @@ class Progress:
         last = [start]
 
         def progress(t: float) -> None:
+            if t >= t_end:  # the run is over: leave the terminal line clean for what follows
+                self.done()
+                return
             now = time.perf_counter()
             if now - start < self.delay or now - last[0] < self.interval:
                 return
@@ -141,13 +146,9 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
     With ``defaults=None`` the options default to None, so that a scene file's ``[solver]``
     values fill in what the command line does not give (then :data:`RUN_DEFAULTS`).
     """
-    from .simulate import FORMULATIONS, METHODS
+    from .simulate import FORMULATIONS, METHODS, NATIVE_METHODS
 
-    try:
-        from .simulate import NATIVE_METHODS as native
-    except ImportError:  # pragma: no cover - older simulate.py
-        native = ()
-    native = list(native)
+    native = list(NATIVE_METHODS)
 
     def hint(key: str) -> str:
         if defaults is not None:
@@ -162,8 +163,8 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
     d = defaults or {}
     p.add_argument("--t-end", type=_positive_float, default=d.get("t_end"), help="end time [s]" + hint("t_end"))
     p.add_argument("--method", default=d.get("method"), choices=list(METHODS) + native,
-                   help="integrator: a scipy solve_ivp method"
-                        + (f" or a native Rust integrator ({', '.join(native)})" if native else "") + hint("method"))
+                   help=f"integrator: a scipy solve_ivp method or a native Rust integrator ({', '.join(native)})"
+                        + hint("method"))
     p.add_argument("--rtol", type=_positive_float, default=d.get("rtol"), help="relative tolerance" + hint("rtol"))
     p.add_argument("--atol", type=_positive_float, default=d.get("atol"), help="absolute tolerance" + hint("atol"))
     p.add_argument("--formulation", default=d.get("formulation"), choices=FORMULATIONS,
@@ -173,32 +174,16 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
 
 # ----------------------------------------------------------------------------------- paper
 def _cmd_paper(args: argparse.Namespace) -> int:
-    from .paper import table1
+    from .studies.paper import run_paper
 
     prog = _progress_from(args)
-
-    def cb(label: str):
-        return prog.callback(label, args.t_end)
-
     try:
-        run_fig4(
-            args.out,
-            elements=args.elements,
-            t_end=args.t_end,
-            method=args.method,
-            rtol=args.rtol,
-            atol=args.atol,
-            samples=args.samples,
-            formulation=args.formulation,
-            gravity=not args.no_gravity,
-            plot=not args.no_plot,
-            progress=cb,
-        )
+        run_paper(args.out, table=args.table, table_t_end=args.table_t_end, repeats=args.repeats,
+                  elements=args.elements, t_end=args.t_end, method=args.method, rtol=args.rtol, atol=args.atol,
+                  samples=args.samples, formulation=args.formulation, gravity=not args.no_gravity,
+                  plot=not args.no_plot, progress=lambda label: prog.callback(label, args.t_end))
     finally:
         prog.done()
-    if args.table != "none":
-        span = args.table_t_end if args.table_t_end is not None else min(args.t_end, PAPER_WINDOW)
-        table1(args.out, mode=args.table, elements=args.elements, t_end=span, repeats=args.repeats)
     return 0
 
 
@@ -353,7 +338,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
 # ----------------------------------------------------------------------------------- bench
 def _cmd_bench_wp(args: argparse.Namespace) -> int:
-    from .workprecision import run_work_precision
+    from .studies.workprecision import run_work_precision
 
     rtols = args.rtols or ([1e-3, 1e-5, 1e-7] if args.quick else None)
     kw: Dict[str, Any] = {}
@@ -365,14 +350,14 @@ def _cmd_bench_wp(args: argparse.Namespace) -> int:
         kw["formulations"] = args.formulations
     if args.native is not None:
         kw["native"] = args.native
-    run_work_precision(args.out, beam=args.beam, elements=args.elements, t_end=args.t_end, samples=args.samples,
+    run_work_precision(args.out, theory=args.theory, elements=args.elements, t_end=args.t_end, samples=args.samples,
                        budget=args.budget, ref_rtol=args.ref_rtol, skip_after_timeout=not args.no_skip,
                        plot=not args.no_plot, **kw)
     return 0
 
 
 def _cmd_bench_elements(args: argparse.Namespace) -> int:
-    from .workprecision import run_elements
+    from .studies.workprecision import run_elements
 
     cases = []
     for c in args.cases.split(","):
@@ -383,7 +368,7 @@ def _cmd_bench_elements(args: argparse.Namespace) -> int:
     kw: Dict[str, Any] = {}
     if args.rtols:
         kw["rtols"] = args.rtols
-    run_elements(args.out, elements=args.elements, cases=cases, beam=args.beam, t_end=args.t_end,
+    run_elements(args.out, elements=args.elements, cases=cases, theory=args.theory, t_end=args.t_end,
                  samples=args.samples, budget=args.budget, ref_rtol=args.ref_rtol,
                  skip_after_timeout=not args.no_skip, plot=not args.no_plot,
                  reference_elements=args.reference_elements, **kw)
@@ -391,7 +376,7 @@ def _cmd_bench_elements(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_table1(args: argparse.Namespace) -> int:
-    from .paper import table1
+    from .studies.paper import table1
 
     table1(args.out, mode=args.mode, elements=args.elements, t_end=args.t_end, method=args.method, rtol=args.rtol,
            repeats=args.repeats, max_states=args.max_states, whole=args.whole or None,
@@ -399,32 +384,49 @@ def _cmd_bench_table1(args: argparse.Namespace) -> int:
     return 0
 
 
+# ----------------------------------------------------------------------------------- stability, crosscheck
+def _cmd_stability(args: argparse.Namespace) -> int:
+    from .studies.stability import report
+
+    report(args.out, quick=args.quick, cases=args.case)
+    print(f"wrote {os.path.join(args.out, 'stability.md')}")
+    return 0
+
+
+def _cmd_crosscheck(args: argparse.Namespace) -> int:
+    from .studies.crosscheck import run
+
+    run(args.study, t_end=args.t_end, rtol=args.rtol, theory=args.theory)
+    return 0
+
+
 # ----------------------------------------------------------------------------------- parser
 _FMT = argparse.RawDescriptionHelpFormatter
+_THEORIES = ("timoshenko", "euler-bernoulli")
 
 
-def _build_parser() -> argparse.ArgumentParser:
-    from .outputs import OUTPUT_HELP
-    from .scenes import SCENES
-    from .workprecision import DEFAULT_RTOLS, FORMULATIONS as WP_FORMS, NATIVE_METHODS, SCIPY_METHODS
+class _DeprecatedAlias(argparse.Action):
+    """An old option name that still works for one release: stores into the new option's
+    destination and says so on stderr."""
 
-    parser = argparse.ArgumentParser(
-        prog="ukflex",
-        formatter_class=_FMT,
-        description="Planar flexible multibody dynamics with the Udwadia-Kalaba formulation (Rust core), "
-                    "cross-checked against coordinate partitioning (NumPy).",
-        epilog="examples:\n"
-               "  ukflex paper --out results/paper          # Fig. 4 and the Table 1 analogue\n"
-               "  ukflex run examples/slider_crank.toml --animate\n"
-               "  ukflex run pendulum --t-end 2 --method DOP853 --plot rod.theta --plot energy\n"
-               "  ukflex export four_bar > my_scene.toml    # start a scene file from a built-in scene\n"
-               "  ukflex bench work-precision --out results/wp --quick\n"
-               "\nRun 'ukflex COMMAND --help' for the options of a command.",
-    )
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    sub.required = True
+    def __init__(self, option_strings: Sequence[str], dest: str, new: str = "", **kwargs: Any):
+        self.new = new
+        super().__init__(option_strings, dest, **kwargs)
 
-    # paper ---------------------------------------------------------------------------------
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"{parser.prog}: {option_string} is deprecated and will be removed; use {self.new}", file=sys.stderr)
+        setattr(namespace, self.dest, values)
+
+
+def _add_theory_option(p: argparse.ArgumentParser, default: Optional[str] = "timoshenko") -> None:
+    """--theory (and its deprecated alias --beam)."""
+    shown = f"default {default}" if default else "default both"
+    p.add_argument("--theory", choices=_THEORIES, default=default, help=f"coupler beam theory ({shown})")
+    p.add_argument("--beam", dest="theory", choices=_THEORIES, action=_DeprecatedAlias, new="--theory",
+                   help=argparse.SUPPRESS)
+
+
+def _add_paper_parser(sub) -> None:
     p = sub.add_parser(
         "paper", formatter_class=_FMT,
         help="reproduce the paper: Fig. 4 and the Table 1 analogue",
@@ -453,7 +455,11 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_progress_option(p)
     p.set_defaults(func=_cmd_paper)
 
-    # run -----------------------------------------------------------------------------------
+
+def _add_run_parser(sub) -> None:
+    from .outputs import OUTPUT_HELP
+    from .scenes import SCENES
+
     p = sub.add_parser(
         "run", formatter_class=_FMT,
         help="simulate a built-in scene or a TOML scene file",
@@ -486,7 +492,10 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_progress_option(p)
     p.set_defaults(func=_cmd_run)
 
-    # list / export -------------------------------------------------------------------------
+
+def _add_list_export_parsers(sub) -> None:
+    from .scenes import SCENES
+
     p = sub.add_parser("list", help="list the built-in scenes", description="List the built-in scenes.")
     p.set_defaults(func=_cmd_list)
 
@@ -502,7 +511,12 @@ def _build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rtol", type=_positive_float, default=1e-6, help="[solver] rtol to write (default 1e-6)")
     p.set_defaults(func=_cmd_export)
 
-    # bench ---------------------------------------------------------------------------------
+
+def _add_bench_parsers(sub) -> None:
+    from .simulate import FORMULATIONS, NATIVE_METHODS
+    from .studies.paper import PAPER_WINDOW
+    from .studies.workprecision import DEFAULT_RTOLS, SCIPY_METHODS
+
     p = sub.add_parser("bench", help="work-precision studies and the Table 1 analogue",
                        description="Benchmarks on the paper's slider-crank: 'work-precision', 'elements', 'table1'.")
     bsub = p.add_subparsers(dest="bench", metavar="BENCH")
@@ -511,8 +525,7 @@ def _build_parser() -> argparse.ArgumentParser:
 
     def common(q: argparse.ArgumentParser, ref_rtol: float) -> None:
         q.add_argument("--out", required=True, help="output directory")
-        q.add_argument("--beam", choices=("timoshenko", "euler-bernoulli"), default="timoshenko",
-                       help="coupler beam theory (default timoshenko)")
+        _add_theory_option(q)
         q.add_argument("--t-end", type=_positive_float, default=0.1, help="end time [s] (default 0.1)")
         q.add_argument("--samples", type=_positive_int, default=1001,
                        help="output times where the error is measured (default 1001)")
@@ -539,8 +552,8 @@ def _build_parser() -> argparse.ArgumentParser:
     q.add_argument("--elements", type=_positive_int, default=1, help="coupler elements (default 1)")
     q.add_argument("--methods", type=_str_list(SCIPY_METHODS + ("RK23",)), default=None,
                    help=f"comma-separated scipy methods (default {','.join(SCIPY_METHODS)})")
-    q.add_argument("--formulations", type=_str_list(WP_FORMS), default=None,
-                   help=f"comma-separated formulations (default {','.join(WP_FORMS)})")
+    q.add_argument("--formulations", type=_str_list(FORMULATIONS), default=None,
+                   help=f"comma-separated formulations (default {','.join(FORMULATIONS)})")
     q.add_argument("--native", type=_str_list(NATIVE_METHODS), default=None,
                    help=f"comma-separated native integrators (default {','.join(NATIVE_METHODS)}; '' for none)")
     q.add_argument("--quick", action="store_true", help="rtols 1e-3, 1e-5, 1e-7 only")
@@ -570,7 +583,8 @@ def _build_parser() -> argparse.ArgumentParser:
     q.add_argument("--out", required=True, help="output directory")
     q.add_argument("--mode", choices=("quick", "full"), default="full", help="quick or full (default full)")
     q.add_argument("--elements", type=_positive_int, default=1, help="coupler elements (default 1)")
-    q.add_argument("--t-end", type=_positive_float, default=PAPER_WINDOW, help="simulated span [s] (default 0.07)")
+    q.add_argument("--t-end", type=_positive_float, default=PAPER_WINDOW,
+                   help=f"simulated span [s] (default {PAPER_WINDOW:g})")
     q.add_argument("--method", default="BDF", help="scipy method of the recording run (default BDF, like ode15s)")
     q.add_argument("--rtol", type=_positive_float, default=1e-6, help="rtol of the runs (default 1e-6)")
     q.add_argument("--repeats", type=_positive_int, default=5, help="timing sweeps, best kept (default 5)")
@@ -579,6 +593,65 @@ def _build_parser() -> argparse.ArgumentParser:
     q.add_argument("--whole-repeats", type=_positive_int, default=None,
                    help="repeats of each whole-simulation run (default --repeats)")
     q.set_defaults(func=_cmd_bench_table1)
+
+
+def _add_stability_parser(sub) -> None:
+    p = sub.add_parser(
+        "stability", formatter_class=_FMT,
+        help="the stability report over the catalogue of extreme scenes",
+        description="Run every case of the catalogue of stiff and extreme scenes (ukflex.studies.extreme) with the\n"
+                    "native and scipy integrators and the NumPy coordinate partitioning, then the long-run drift,\n"
+                    "scaling and units studies; write DIR/stability.md and DIR/stability.json.",
+    )
+    p.add_argument("--out", required=True, help="output directory (stability.md, stability.json)")
+    p.add_argument("--quick", action="store_true", help="reduced sizes (minutes instead of hours)")
+    p.add_argument("--case", action="append", default=None, metavar="NAME",
+                   help="run only this case (repeatable; skips the long-run, scaling and units studies)")
+    p.set_defaults(func=_cmd_stability)
+
+
+def _add_crosscheck_parser(sub) -> None:
+    from .studies.crosscheck import STUDIES
+
+    p = sub.add_parser(
+        "crosscheck", formatter_class=_FMT,
+        help="cross-checks against the NumPy reference (errata, Rust UK vs CP, timings)",
+        description="Studies on the paper's slider-crank against the independent NumPy reference; each prints\n"
+                    "markdown tables (docs/errata.md):\n"
+                    "  errata  the paper's printed single-element terms, each erratum on and off (NumPy only)\n"
+                    "  sweep   Rust UK vs NumPy coordinate partitioning over rtol, with and without gravity\n"
+                    "  timing  acceleration time of NumPy UK vs CP (partition once / every call)\n"
+                    "  bdf     paper-like BDF runs (Rust UK, NumPy CP) against a tight reference; E-B vs Timoshenko",
+    )
+    p.add_argument("study", choices=STUDIES, metavar="STUDY", help=f"one of {', '.join(STUDIES)}")
+    p.add_argument("--t-end", type=_positive_float, default=None,
+                   help="simulated span [s] (default 0.07; timing 0.02)")
+    p.add_argument("--rtol", type=_positive_float, default=1e-8, help="rtol of the errata runs (default 1e-8)")
+    _add_theory_option(p, default=None)
+    p.set_defaults(func=_cmd_crosscheck)
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="ukflex",
+        formatter_class=_FMT,
+        description="Planar flexible multibody dynamics with the Udwadia-Kalaba formulation (Rust core), "
+                    "cross-checked against coordinate partitioning (NumPy).",
+        epilog="examples:\n"
+               "  ukflex run examples/slider_crank.toml --animate\n"
+               "  ukflex run pendulum --t-end 2 --method DOP853 --plot rod.theta --plot energy\n"
+               "  ukflex export four_bar > my_scene.toml    # start a scene file from a built-in scene\n"
+               "  ukflex paper --out results/paper          # Fig. 4 and the Table 1 analogue\n"
+               "  ukflex bench work-precision --out results/wp --quick\n"
+               "  ukflex stability --out results/stability --quick\n"
+               "  ukflex crosscheck errata\n"
+               "\nRun 'ukflex COMMAND --help' for the options of a command.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for add in (_add_run_parser, _add_list_export_parsers, _add_paper_parser, _add_bench_parsers,
+                _add_stability_parser, _add_crosscheck_parser):
+        add(sub)
     return parser
 
 
@@ -588,16 +661,19 @@ def main(argv: Optional[List[str]] = None) -> int:
 
     parser = _build_parser()
     args = parser.parse_args(argv)
-    try:
-        return int(args.func(args) or 0)
-    except (UkflexError, ValueError, TypeError, NotImplementedError, KeyError) as exc:
-        # user-facing problems (bad scene files or parameters, inconsistent scenes): one line, exit 2
-        msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
-        print(f"ukflex {args.command}: error: {type(exc).__name__}: {msg}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print(f"ukflex {args.command}: interrupted", file=sys.stderr)
-        return 130
+    with warnings.catch_warnings():
+        # old parameter names (--param beam=..., g=...) still work: say so on stderr
+        warnings.filterwarnings("default", category=DeprecationWarning, module=r"ukflex(\.|$)")
+        try:
+            return int(args.func(args) or 0)
+        except (UkflexError, ValueError, TypeError, NotImplementedError, KeyError) as exc:
+            # user-facing problems (bad scene files or parameters, inconsistent scenes): one line, exit 2
+            msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+            print(f"ukflex {args.command}: error: {type(exc).__name__}: {msg}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print(f"ukflex {args.command}: interrupted", file=sys.stderr)
+            return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -22,7 +22,7 @@ from typing import List, Tuple
 
 import numpy as np
 
-__all__ = ["evaluate", "validate", "default_outputs", "OUTPUT_HELP"]
+__all__ = ["evaluate", "validate", "default_outputs", "beam_names", "OUTPUT_HELP"]
 
 OUTPUT_HELP = (
     "t, a coordinate (crank.theta), d:<coordinate> (rate), residual.position|velocity|acceleration, energy, "
@@ -46,7 +46,7 @@ def _parse(system, expr: str):
     m = _BEAM_EXPR.match(e)
     if m:
         what, body, xi_text, per_length = m.groups()
-        beams = [b["name"] for b in system.description["bodies"] if b["kind"] == "beam"]
+        beams = beam_names(system)
         if body not in beams:
             raise ValueError(f"output {expr!r}: {body!r} is not a beam; beams are {beams}")
         try:
@@ -69,11 +69,13 @@ def validate(system, expr: str) -> None:
     _parse(system, expr)
 
 
+def beam_names(system) -> List[str]:
+    """Names of the system's beams, in declaration order."""
+    return [b for b in system.body_names if system.body_kind(b) == "beam"]
+
+
 def _beam_length(system, body: str) -> float:
-    for b in system.description["bodies"]:
-        if b["name"] == body:
-            return float(b["length"])
-    raise KeyError(body)  # pragma: no cover - _parse checked it
+    return float(system.body_info(body)["length"])
 
 
 def evaluate(res, expr: str) -> Tuple[str, np.ndarray]:
@@ -109,21 +111,19 @@ def evaluate(res, expr: str) -> Tuple[str, np.ndarray]:
     if what == "psi":
         return f"psi({body}, {xi:g}) [rad]", res.beam_rotation(body, xi)
     # world position of the deformed axis point
-    S, _ = system.beam_shape(body, float(xi))
-    S = np.asarray(S)
-    sl = system.body_slice(body)
-    qb = res.q[:, sl]
-    local = np.column_stack([xi * _beam_length(system, body) + qb[:, 3:] @ S[0], qb[:, 3:] @ S[1]])
-    c, s = np.cos(qb[:, 2]), np.sin(qb[:, 2])
+    u, v = res.beam_displacement(body, xi)
+    local = np.column_stack([xi * _beam_length(system, body) + u, v])
+    x, y, th = (res.coordinate(f"{body}.{c}") for c in ("x", "y", "theta"))
+    c, s = np.cos(th), np.sin(th)
     if what == "x":
-        return f"x({body}, {xi:g}) [m]", qb[:, 0] + c * local[:, 0] - s * local[:, 1]
-    return f"y({body}, {xi:g}) [m]", qb[:, 1] + s * local[:, 0] + c * local[:, 1]
+        return f"x({body}, {xi:g}) [m]", x + c * local[:, 0] - s * local[:, 1]
+    return f"y({body}, {xi:g}) [m]", y + s * local[:, 0] + c * local[:, 1]
 
 
 def default_outputs(system) -> List[str]:
     """Outputs plotted when none are chosen: each beam's midpoint deflection ``v(B, 0.5)/L``,
     or the angles of the first (up to four) bodies of a rigid scene."""
-    beams = [b["name"] for b in system.description["bodies"] if b["kind"] == "beam"]
+    beams = beam_names(system)
     if beams:
         return [f"v({b}, 0.5)/L" for b in beams]
     return [f"{b}.theta" for b in system.body_names[:4]]

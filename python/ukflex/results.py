@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import csv
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -56,6 +56,64 @@ class SimulationResult:
     rtol: float = float("nan")
     atol: Any = float("nan")
     extra: Dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def from_trajectory(
+        cls,
+        system: Any,
+        t: Sequence[float],
+        y: Any,
+        *,
+        method: str = "",
+        formulation: str = "uk",
+        rtol: float = float("nan"),
+        atol: Any = float("nan"),
+        nfev: int = 0,
+        njev: int = 0,
+        nlu: int = 0,
+        wall_time: float = float("nan"),
+        status: int = 0,
+        message: str = "",
+        extra: Optional[Dict[str, Any]] = None,
+    ) -> "SimulationResult":
+        """A result from states computed elsewhere (a native run, a custom integration loop).
+
+        The residual histories are evaluated here with the system's compiled ``residuals``.
+
+        Parameters
+        ----------
+        system : ukflex.System
+            The system the states belong to.
+        t : array of shape (nt,)
+            Output times [s].
+        y : array of shape (2n, nt)
+            States ``[q; qd]`` column by column, as ``solve_ivp`` and ``System.integrate``
+            return them.
+        method, formulation, rtol, atol, nfev, njev, nlu, wall_time, status, message, extra
+            Stored as given (see the class attributes).
+
+        Raises
+        ------
+        ValueError
+            ``t`` or ``y`` has the wrong shape.
+
+        Examples
+        --------
+        >>> out = system.integrate(system.t0, system.y0, 0.1, "DOPRI5")      # doctest: +SKIP
+        >>> res = SimulationResult.from_trajectory(system, out["t"], out["y"], method="DOPRI5",
+        ...                                        nfev=out["nfev"], status=out["status"])
+        """
+        n = system.n_coords
+        t = np.asarray(t, dtype=float)
+        y = np.asarray(y, dtype=float)
+        if t.ndim != 1 or y.shape != (2 * n, t.size):
+            raise ValueError(f"from_trajectory: expected t of shape (nt,) and y of shape (2n, nt) = "
+                             f"({2 * n}, {t.size}), got {t.shape} and {y.shape}")
+        q = np.ascontiguousarray(y[:n].T)
+        qd = np.ascontiguousarray(y[n:].T)
+        return cls(t=t, q=q, qd=qd, residuals=_residual_norms(system, t, q, qd), nfev=int(nfev), njev=int(njev),
+                   nlu=int(nlu), wall_time=float(wall_time), status=int(status), message=str(message), system=system,
+                   method=method, formulation=formulation, rtol=rtol, atol=atol, extra=dict(extra or {}))
 
     @property
     def success(self) -> bool:
@@ -173,3 +231,14 @@ class SimulationResult:
             method=self.method,
             formulation=self.formulation,
         )
+
+
+def _residual_norms(system: Any, t: np.ndarray, q: np.ndarray, qd: np.ndarray) -> Dict[str, np.ndarray]:
+    """Euclidean norms of the position, velocity and acceleration residuals, each shape (nt,)."""
+    out = {k: np.zeros(t.size) for k in ("position", "velocity", "acceleration")}
+    if system.n_constraints == 0:
+        return out
+    for i in range(t.size):
+        for key, r in zip(("position", "velocity", "acceleration"), system.residuals(t[i], q[i], qd[i])):
+            out[key][i] = np.linalg.norm(r)
+    return out

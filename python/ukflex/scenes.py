@@ -2,13 +2,21 @@
 
 Every function returns a :class:`ukflex.Scene` (call ``.build()`` or pass it to
 :func:`ukflex.simulate`).  ``SCENES`` maps the names used by ``ukflex run`` to the functions.
+
+Parameter names are the same in every scene (and in ``ukflex run NAME --param KEY=VALUE``):
+``theory`` is a beam theory (``"timoshenko"`` or ``"euler-bernoulli"``), ``elements`` a beam's
+element count, ``gravity`` is ``True`` (9.81 m/s^2 along -Y), ``False``, a magnitude along -Y or
+a vector (:func:`gravity_vector`).  The old spellings ``beam=`` (slider_crank) and ``g=``
+(pendulum, double_pendulum) still work for one release, with a ``DeprecationWarning``.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Callable, Dict, Optional, Tuple
+import numbers
+from typing import Any, Callable, Dict, Optional, Tuple
 
+from ._deprecation import renamed_parameters
 from .scene import Circular, ConstantSpeed, Harmonic, Polynomial, Rectangular, Scene
 
 __all__ = [
@@ -19,6 +27,7 @@ __all__ = [
     "cantilever",
     "pinned_beam",
     "every_joint",
+    "gravity_vector",
     "SCENES",
     "PAPER",
 ]
@@ -39,19 +48,46 @@ PAPER = {
 STEEL = {"density": 7850.0, "youngs_modulus": 2.1e11, "poisson_ratio": 0.3, "shear_factor": 5.0 / 6.0}
 
 
-def _gravity(gravity) -> Optional[Tuple[float, float]]:
+def gravity_vector(gravity: Any) -> Optional[Tuple[float, float]]:
+    """The gravity vector meant by a scene function's ``gravity=`` argument.
+
+    Parameters
+    ----------
+    gravity : bool, None, float or (2,) sequence
+        ``True``: ``(0, -9.81)``; ``False`` or ``None``: no gravity; a number ``g``:
+        ``(0, -g)`` (a magnitude along -Y); a 2-vector: itself [m/s^2].
+
+    Returns
+    -------
+    (gx, gy) or None
+        What :class:`ukflex.Scene` takes (``None``: no gravity term).
+    """
     if gravity is True:
         return (0.0, -PAPER["g"])
     if gravity is False or gravity is None:
         return None
+    if isinstance(gravity, numbers.Real):
+        return (0.0, -float(gravity))
     g = tuple(float(v) for v in gravity)
+    if len(g) != 2:
+        raise ValueError(f"gravity must be True, False, a magnitude or a 2-vector, got {gravity!r}")
     return (g[0], g[1])
 
 
+def _round_beam(s: Scene, name: str, length: float, elements: int, theory: str, diameter: float, density: float,
+                youngs_modulus: float, poisson_ratio: float, shear_factor: float, **options: Any):
+    """A pinned-pinned beam of circular section (the paper's coupler); ``poisson_ratio`` and
+    ``shear_factor`` go to Timoshenko beams only."""
+    kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor} if theory == "timoshenko" else {}
+    return s.beam(name, length=length, elements=elements, theory=theory, section=Circular(diameter), density=density,
+                  youngs_modulus=youngs_modulus, frame="pinned-pinned", **options, **kw)
+
+
+@renamed_parameters(beam="theory")
 def slider_crank(
-    beam: str = "timoshenko",
+    theory: str = "timoshenko",
     elements: int = 1,
-    gravity=True,
+    gravity: Any = True,
     omega: float = PAPER["omega"],
     crank_length: float = PAPER["crank_length"],
     coupler_length: float = PAPER["coupler_length"],
@@ -74,12 +110,13 @@ def slider_crank(
 
     Parameters
     ----------
-    beam : {"timoshenko", "euler-bernoulli"}
-        Coupler beam theory.
+    theory : {"timoshenko", "euler-bernoulli"}
+        Coupler beam theory (deprecated alias: ``beam``).
     elements : int
         Number of coupler elements (the paper: 1).
-    gravity : bool or (2,) sequence
-        ``True``: ``(0, -9.81)``; ``False``: no gravity; or an explicit vector.
+    gravity : bool, float or (2,) sequence
+        ``True``: ``(0, -9.81)``; ``False``: no gravity; a magnitude along -Y; or a vector
+        (:func:`gravity_vector`).
     omega : float
         Crank speed [rad/s].
     rotary_inertia : bool, optional
@@ -96,7 +133,7 @@ def slider_crank(
     L, Lb, d = crank_length, coupler_length, diameter
     area = math.pi * d * d / 4.0
     m_crank = density * area * L
-    s = Scene(gravity=_gravity(gravity))
+    s = Scene(gravity=gravity_vector(gravity))
     crank = s.rigid_body(
         "crank",
         mass=m_crank,
@@ -106,25 +143,14 @@ def slider_crank(
         angle=0.0,
         angular_velocity=omega,
     )
-    kw = {}
-    if beam == "timoshenko":
-        kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor}
-    coupler = s.beam(
-        "coupler",
-        length=Lb,
-        elements=elements,
-        theory=beam,
-        section=Circular(d),
-        density=density,
-        youngs_modulus=youngs_modulus,
-        frame="pinned-pinned",
+    coupler = _round_beam(
+        s, "coupler", Lb, elements, theory, d, density, youngs_modulus, poisson_ratio, shear_factor,
         rotary_inertia=rotary_inertia,
         damping=damping,
         position=(L, 0.0),
         angle=0.0,
         velocity=(0.0, L * omega),
         angular_velocity=-L * omega / Lb,
-        **kw,
     )
     s.revolute(s.ground.point(0.0, 0.0), crank.point(0.0, 0.0), name="crank_pivot")
     s.revolute(crank.point(L, 0.0), coupler.at(0.0), name="crank_coupler")
@@ -133,20 +159,22 @@ def slider_crank(
     return s
 
 
+@renamed_parameters(g="gravity")
 def pendulum(
     length: float = 1.0,
     mass: float = 1.0,
     angle: float = -math.pi / 4,
     angular_velocity: float = 0.0,
-    g: float = 9.81,
+    gravity: Any = True,
 ) -> Scene:
     """Rigid rod pendulum (uniform rod, inertia ``m L^2 / 12`` about its centre) under gravity.
 
     The body reference point is the rod's centre, so all three coordinates move; the pivot is the
     rod end ``(-L/2, 0)`` pinned to the world origin.  ``angle`` is measured from +X (``-pi/2``
-    hangs straight down).  Conservative: ``T + V`` is constant.
+    hangs straight down).  Conservative: ``T + V`` is constant.  ``gravity``: see
+    :func:`gravity_vector` (deprecated alias: ``g``, a magnitude).
     """
-    s = Scene(gravity=(0.0, -g))
+    s = Scene(gravity=gravity_vector(gravity))
     c, si = math.cos(angle), math.sin(angle)
     h = length / 2.0
     rod = s.rigid_body(
@@ -162,14 +190,16 @@ def pendulum(
     return s
 
 
+@renamed_parameters(g="gravity")
 def double_pendulum(
     lengths: Tuple[float, float] = (1.0, 0.7),
     masses: Tuple[float, float] = (1.0, 0.5),
     angles: Tuple[float, float] = (0.0, math.pi / 3),
-    g: float = 9.81,
+    gravity: Any = True,
 ) -> Scene:
-    """Two uniform rigid rods in a chain, released from rest (angles from +X)."""
-    s = Scene(gravity=(0.0, -g))
+    """Two uniform rigid rods in a chain, released from rest (angles from +X).  ``gravity``: see
+    :func:`gravity_vector` (deprecated alias: ``g``, a magnitude)."""
+    s = Scene(gravity=gravity_vector(gravity))
     (l1, l2), (m1, m2), (a1, a2) = lengths, masses, angles
     p1 = (0.5 * l1 * math.cos(a1), 0.5 * l1 * math.sin(a1))
     tip = (l1 * math.cos(a1), l1 * math.sin(a1))
@@ -188,7 +218,7 @@ def four_bar(
     ground: float = 0.3,
     crank_angle: float = math.pi / 2,
     omega: Optional[float] = 10.0,
-    gravity=True,
+    gravity: Any = True,
     flexible_coupler: Optional[str] = None,
     elements: int = 2,
 ) -> Scene:
@@ -204,7 +234,7 @@ def four_bar(
     flexible_coupler : {None, "timoshenko", "euler-bernoulli"}
         Model the coupler as a pinned-pinned steel beam (rectangular 10 x 5 mm section).
     """
-    s = Scene(gravity=_gravity(gravity))
+    s = Scene(gravity=gravity_vector(gravity))
     a, b, c, d = crank, coupler, rocker, ground
     A = (a * math.cos(crank_angle), a * math.sin(crank_angle))
     # B: |B - A| = b, |B - D| = c, D = (d, 0); take the intersection above the line A-D
@@ -265,7 +295,7 @@ def cantilever(
     elements: int = 4,
     theory: str = "euler-bernoulli",
     section=None,
-    gravity=True,
+    gravity: Any = True,
     tip_force: Tuple[float, float] = (0.0, 0.0),
     damping: float = 0.0,
     **material,
@@ -279,7 +309,7 @@ def cantilever(
     """
     mat = dict(STEEL)
     mat.update(material)
-    s = Scene(gravity=_gravity(gravity))
+    s = Scene(gravity=gravity_vector(gravity))
     kw = {}
     if theory == "timoshenko":
         kw = {"poisson_ratio": mat["poisson_ratio"], "shear_factor": mat["shear_factor"]}
@@ -311,7 +341,7 @@ def pinned_beam(
     poisson_ratio: float = PAPER["poisson_ratio"],
     shear_factor: float = PAPER["shear_factor"],
     rotary_inertia: Optional[bool] = None,
-    gravity=False,
+    gravity: Any = False,
 ) -> Scene:
     """The paper's coupler alone, simply supported: pinned at ``xi = 0`` (revolute to ground) and
     its ``xi = 1`` end on the ground X axis (point-on-line), frame pinned-pinned.
@@ -319,28 +349,15 @@ def pinned_beam(
     The supports fix the frame's ``x``, ``y`` and ``theta`` at the undeformed state, so the
     elastic block ``M_ff``, ``K_ff`` gives the simply supported beam's natural frequencies.
     """
-    s = Scene(gravity=_gravity(gravity))
-    kw = {}
-    if theory == "timoshenko":
-        kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor}
-    b = s.beam(
-        "beam",
-        length=length,
-        elements=elements,
-        theory=theory,
-        section=Circular(diameter),
-        density=density,
-        youngs_modulus=youngs_modulus,
-        frame="pinned-pinned",
-        rotary_inertia=rotary_inertia,
-        **kw,
-    )
+    s = Scene(gravity=gravity_vector(gravity))
+    b = _round_beam(s, "beam", length, elements, theory, diameter, density, youngs_modulus, poisson_ratio,
+                    shear_factor, rotary_inertia=rotary_inertia)
     s.revolute(s.ground.point(0, 0), b.at(0.0), name="pin")
     s.point_on_line(b.at(1.0), s.ground.line((0, 0), angle=0.0), name="roller")
     return s
 
 
-def every_joint(gravity=True) -> Scene:
+def every_joint(gravity: Any = True) -> Scene:
     """A scene using every joint, driver and force kind, with rigid and beam bodies.
 
     * ``crank`` (rigid): revolute to ground, angle driver with harmonic motion;
@@ -357,7 +374,7 @@ def every_joint(gravity=True) -> Scene:
     Scene
         ``n = 24`` coordinates, 14 constraint rows, 10 degrees of freedom.
     """
-    s = Scene(gravity=_gravity(gravity))
+    s = Scene(gravity=gravity_vector(gravity))
     Lc, Ll = 0.1, 0.3
     crank = s.rigid_body("crank", mass=0.2, inertia=0.2 * Lc**2 / 12, com=(Lc / 2, 0), angular_velocity=1.5)
     link = s.beam(

@@ -5,7 +5,6 @@ from __future__ import annotations
 import inspect
 import math
 import time
-from types import SimpleNamespace
 from typing import Any, Callable, Dict, Optional, Sequence, Union
 
 import numpy as np
@@ -16,10 +15,10 @@ from .results import SimulationResult
 from .scene import Scene
 from .system import System
 
-__all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "fd_jacobian"]
+__all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "time_acceleration"]
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
-#: Integrators that run entirely in Rust with the GIL released (``System.core.integrate``):
+#: Integrators that run entirely in Rust with the GIL released (``System.integrate``):
 #: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
 NATIVE_METHODS = ("DOPRI5", "RADAU5")
 _NATIVE_OPTIONS = ("first_step", "max_step", "max_steps", "projection_tol")
@@ -55,58 +54,6 @@ def _positive_scalar(name: str, value: Any) -> float:
     if not math.isfinite(x) or x <= 0.0:
         raise ValueError(f"{name} must be positive and finite, got {value!r}")
     return x
-
-
-def fd_jacobian(system: System, floor: float = 1e-3):
-    """Forward-difference Jacobian of ``system.rhs`` for the implicit integrators.
-
-    ``d[qd, qdd]/d[q, qd] = [[0, I], [dqdd/dq, dqdd/dqd]]``: only the lower blocks are
-    differenced (``2 n`` calls of the compiled ``qdd``), with steps
-    ``sqrt(eps) * max(|y_j|, floor)``.  Unlike scipy's adaptive ``num_jac`` it never grows the
-    step for a column that is exactly zero (e.g. the rhs does not depend on a pinned body's
-    absolute position), which overflows in scipy's BDF.
-
-    Returns
-    -------
-    callable
-        ``jac(t, y) -> ndarray (2n, 2n)``.
-    """
-    n = system.n_coords
-    qdd = system.qdd
-    sq = math.sqrt(np.finfo(float).eps)
-    eye = np.eye(n)
-
-    def jac(t: float, y: np.ndarray) -> np.ndarray:
-        q, qd = y[:n], y[n:]
-        f0 = qdd(t, q, qd)
-        J = np.zeros((2 * n, 2 * n))
-        J[:n, n:] = eye
-        h = sq * np.maximum(np.abs(y), floor)
-        for j in range(n):
-            qj = q.copy()
-            qj[j] += h[j]
-            J[n:, j] = (qdd(t, qj, qd) - f0) / (qj[j] - q[j])
-        for j in range(n):
-            vj = qd.copy()
-            vj[j] += h[n + j]
-            J[n:, n + j] = (qdd(t, q, vj) - f0) / (vj[j] - qd[j])
-        return J
-
-    return jac
-
-
-def _residual_history(system: System, t: np.ndarray, q: np.ndarray, qd: np.ndarray) -> Dict[str, np.ndarray]:
-    nt = t.size
-    out = {k: np.zeros(nt) for k in ("position", "velocity", "acceleration")}
-    if system.n_constraints == 0:
-        return out
-    res = system.residuals
-    for i in range(nt):
-        rp, rv, ra = res(t[i], q[i], qd[i])
-        out["position"][i] = np.linalg.norm(rp)
-        out["velocity"][i] = np.linalg.norm(rv)
-        out["acceleration"][i] = np.linalg.norm(ra)
-    return out
 
 
 def simulate(
@@ -160,8 +107,8 @@ def simulate(
     **options
         Further ``solve_ivp`` options (``max_step``, ``first_step``, ``jac``, ...).  For
         ``"Radau"`` and ``"BDF"`` the default ``jac`` is the core's finite-difference Jacobian
-        ``System.core.jac`` (or :func:`fd_jacobian` if the core lacks it); pass ``jac=None`` for
-        scipy's own ``num_jac``, which overflows on the exactly-zero columns of these systems.
+        ``System.jac``; pass ``jac=None`` for scipy's own ``num_jac``, which overflows on the
+        exactly-zero columns of these systems.
         ``nfev`` counts only the integrator's ``rhs`` calls, not those inside Jacobians.
 
     Returns
@@ -236,12 +183,14 @@ def simulate(
 
     y0 = np.concatenate([q_init, qd_init])
     if method in ("Radau", "BDF") and "jac" not in options:
-        core_jac = getattr(system.core, "jac", None)  # Rust finite differences, GIL released
-        options["jac"] = core_jac if core_jac is not None else fd_jacobian(system)
+        options["jac"] = system.jac  # Rust finite differences, GIL released
     start = time.perf_counter()
     sol = solve_ivp(system.rhs, (t0, t_end_f), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol_v, **options)
     wall = time.perf_counter() - start
-    return _make_result(system, sol.t, sol.y, sol, wall, method, "uk", rtol, atol_v)
+    return SimulationResult.from_trajectory(
+        system, sol.t, sol.y, method=method if isinstance(method, str) else method.__name__, formulation="uk",
+        rtol=rtol, atol=atol_v, nfev=sol.nfev, njev=sol.njev, nlu=sol.nlu, wall_time=wall, status=sol.status,
+        message=sol.message)
 
 
 def _with_progress_event(options: Dict[str, Any], progress: Callable[[float], None]) -> Dict[str, Any]:
@@ -257,7 +206,7 @@ def _with_progress_event(options: Dict[str, Any], progress: Callable[[float], No
 
 
 def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options) -> SimulationResult:
-    """Run a native Rust integrator (``System.core.integrate``: all steps in Rust, GIL released)."""
+    """Run a native Rust integrator (``System.integrate``: all steps in Rust, GIL released)."""
     unknown = sorted(set(options) - set(_NATIVE_OPTIONS))
     if unknown:
         raise TypeError(f"native method {method!r} does not take option(s) {unknown}; it accepts {_NATIVE_OPTIONS}")
@@ -269,67 +218,46 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options)
         kwargs["max_steps"] = int(options["max_steps"])
     atol_arr = np.atleast_1d(np.asarray(atol, dtype=float))
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
-    out = system.core.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),
-                                atol_arr, te, **kwargs)
-    info = SimpleNamespace(nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], status=out["status"],
-                           message=out["message"])
-    extra = {k: out[k] for k in ("naccept", "nreject", "jac_evals")}
-    return _make_result(system, out["t"], out["y"], info, out["wall_time"], method, "uk", rtol, atol, extra=extra)
-
-
-def _make_result(system, t, y, sol, wall, method, formulation, rtol, atol, extra=None) -> SimulationResult:
-    n = system.n_coords
-    t = np.asarray(t, dtype=float)
-    y = np.asarray(y, dtype=float)
-    q = np.ascontiguousarray(y[:n].T)
-    qd = np.ascontiguousarray(y[n : 2 * n].T)
-    return SimulationResult(
-        t=t,
-        q=q,
-        qd=qd,
-        residuals=_residual_history(system, t, q, qd),
-        nfev=int(getattr(sol, "nfev", 0)),
-        njev=int(getattr(sol, "njev", (extra or {}).get("njev", 0))),
-        nlu=int(getattr(sol, "nlu", (extra or {}).get("nlu", 0))),
-        wall_time=float(wall),
-        status=int(getattr(sol, "status", 0)),
-        message=str(getattr(sol, "message", "")),
-        system=system,
-        method=method if isinstance(method, str) else method.__name__,
-        formulation=formulation,
-        rtol=rtol,
-        atol=atol,
-        extra=extra or {},
-    )
+    out = system.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),
+                           atol_arr, te, **kwargs)
+    return SimulationResult.from_trajectory(
+        system, out["t"], out["y"], method=method, formulation="uk", rtol=rtol, atol=atol, nfev=out["nfev"],
+        njev=out["njev"], nlu=out["nlu"], wall_time=out["wall_time"], status=out["status"], message=out["message"],
+        extra={k: out[k] for k in ("naccept", "nreject", "jac_evals")})
 
 
 def _simulate_reference(system, formulation, t_end, method, rtol, atol, t_eval, q0, qd0, partition, options):
     """Run the NumPy reference (uk-numpy or coordinate partitioning) on the same description."""
-    try:
-        from . import reference  # noqa: F401
-        fn = getattr(reference, "simulate_uk_numpy" if formulation == "uk-numpy" else "simulate_cp")
-    except (ImportError, AttributeError) as exc:
-        name = "simulate_uk_numpy" if formulation == "uk-numpy" else "simulate_cp"
-        raise NotImplementedError(
-            f"formulation {formulation!r} needs ukflex.reference.{name}, which is not available yet ({exc})"
-        ) from exc
+    from . import reference
+
+    fn = reference.simulate_uk_numpy if formulation == "uk-numpy" else reference.simulate_cp
     kwargs: Dict[str, Any] = dict(method=method, rtol=rtol, atol=atol, t_eval=t_eval, q0=q0, qd0=qd0)
     if formulation == "cp" and partition is not None:
         kwargs["partition"] = partition
     kwargs.update(options)
-    start = time.perf_counter()
     out = fn(system.description, t_end, **kwargs)
-    wall = time.perf_counter() - start
-    if isinstance(out, SimulationResult):
-        if out.system is None:
-            out.system = system
-        return out
-    t = getattr(out, "t", None)
-    y = getattr(out, "y", None)
-    if t is None or y is None:
-        raise TypeError(f"ukflex.reference returned {type(out).__name__}, expected an object with t and y")
-    extra = dict(getattr(out, "extra", None) or {})
-    for key in ("accel_time", "repartitions"):
-        if hasattr(out, key):
-            extra[key] = getattr(out, key)
-    return _make_result(system, t, y, out, getattr(out, "wall_time", wall), method, formulation, rtol, atol, extra)
+    extra = dict(out.extra, accel_time=out.accel_time, repartitions=out.repartitions)
+    return SimulationResult.from_trajectory(
+        system, out.t, out.y, method=method if isinstance(method, str) else method.__name__, formulation=formulation,
+        rtol=rtol, atol=atol, nfev=out.nfev, njev=out.extra.get("njev", 0), nlu=out.extra.get("nlu", 0),
+        wall_time=out.wall_time, status=out.status, message=out.message, extra=extra)
+
+
+def time_acceleration(system: System, t: float, q: Sequence[float], qd: Sequence[float], reps: int = 1000,
+                      batches: int = 21) -> float:
+    """Seconds per call of the Rust UK acceleration alone at ``(t, q, qd)`` (benchmark helper).
+
+    The minimum over ``batches`` batches of ``reps`` calls, timed inside Rust with the GIL
+    released: the core's cost without the Python binding's argument checks and copies (compare
+    with timing ``system.qdd(t, q, qd)`` from Python).
+
+    Parameters
+    ----------
+    system : System
+    t : float
+    q, qd : array of shape (n,)
+    reps, batches : int
+        Calls per batch and batches.
+    """
+    return float(system.core._time_acceleration(float(t), np.ascontiguousarray(q, dtype=float),
+                                                np.ascontiguousarray(qd, dtype=float), int(reps), int(batches)))

@@ -42,7 +42,8 @@ from scipy.integrate import solve_ivp
 from ._blas import single_blas_thread
 from .uk import SimulationResult, _as_model, correct_initial_state, fd_jacobian
 
-__all__ = ["simulate_cp", "choose_partition", "CPPartition", "NewtonFailure", "SingularDependentBlock"]
+__all__ = ["simulate_cp", "choose_partition", "CPPartition", "CPSystem", "reduced_accelerations", "NewtonFailure",
+           "SingularDependentBlock"]
 
 
 class NewtonFailure(RuntimeError):
@@ -111,8 +112,28 @@ def choose_partition(A, rank_rtol=1e-10):
     return CPPartition(dep, ind, rows, cond)
 
 
-class _CPSystem:
-    """State recovery and reduced accelerations for a fixed partition."""
+class CPSystem:
+    """State recovery and reduced accelerations for a fixed partition (one call of the
+    ``partition="once"`` right-hand side of :func:`simulate_cp` is :meth:`recover` then
+    :meth:`accelerations`).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+    part : CPPartition
+    q_guess : array of shape (n,)
+        Start of the first Newton iteration; afterwards the last recovered ``q``.
+    newton_tol, newton_maxit
+        Newton-Raphson tolerance on ``|Phi|`` (relative to ``1 + |q_D|``) and iteration limit.
+
+    Methods
+    -------
+    recover(t, qI, qdI) -> (q, qd, A_D)
+        Full ``q`` (Newton on ``Phi = 0`` with ``q_I`` fixed) and ``qd`` (from
+        ``A qd = -Phi_t``), each shape (n,), and the dependent block of ``A``.
+    accelerations(t, q, qd) -> (qdd_I, qdd)
+        The reduced equations (:func:`reduced_accelerations`).
+    """
 
     def __init__(self, model, part, q_guess, newton_tol=1e-12, newton_maxit=25):
         self.model = model
@@ -154,8 +175,7 @@ class _CPSystem:
 
 def reduced_accelerations(model, p, t, q, qd):
     """Independent accelerations from the reduced equations and the full qdd."""
-    M, Q, A, b = model.terms(t, q, qd) if hasattr(model, "terms") else (
-        model.M(q), model.Q(t, q, qd), model.A(q), model.gamma(t, q, qd))
+    M, Q, A, b = model.terms(t, q, qd)
     n = q.size
     Ar, br = A[p.rows], b[p.rows]
     AD = Ar[:, p.dep]
@@ -226,7 +246,7 @@ def _simulate_once(model, t0, t_end, q0, qd0, method, rtol, atol, t_eval, factor
     while True:
         part = choose_partition(model.A(qcur))
         history.append((tcur, part.dep.tolist(), part.cond))
-        sysm = _CPSystem(model, part, qcur, newton_tol=newton_tol)
+        sysm = CPSystem(model, part, qcur, newton_tol=newton_tol)
         nI = part.ind.size
         limit = factor * part.cond
         # relative tolerances on the independent states only
@@ -238,7 +258,7 @@ def _simulate_once(model, t0, t_end, q0, qd0, method, rtol, atol, t_eval, factor
             nfev[0] += 1
             return np.concatenate([y[nI:], qddI])
 
-        ev_sys = _CPSystem(model, part, qcur, newton_tol=newton_tol)
+        ev_sys = CPSystem(model, part, qcur, newton_tol=newton_tol)
 
         def cond_event(t, y):
             _, _, AD = ev_sys.recover(t, y[:nI], y[nI:])
@@ -259,7 +279,7 @@ def _simulate_once(model, t0, t_end, q0, qd0, method, rtol, atol, t_eval, factor
             break
         # reconstruct the full state along the accepted steps (Newton warm-started step by
         # step: the branch of the dependent coordinates is followed continuously)
-        rec = _CPSystem(model, part, qcur, newton_tol=newton_tol)
+        rec = CPSystem(model, part, qcur, newton_tol=newton_tol)
         step_t = sol.t
         full_q, full_qd = [], []
         for k, tk in enumerate(step_t):

@@ -183,13 +183,12 @@ def _as_model(description_or_model):
 
 
 def simulate_uk_numpy(description_or_model, t_end, method="BDF", rtol=1e-6, atol=1e-9,
-                      t_eval=None, partition=None, q0=None, qd0=None, t0=0.0, accel="uk",
+                      t_eval=None, q0=None, qd0=None, t0=0.0, accel="uk",
                       **solve_ivp_kwargs):
     """Integrate ``y = [q, qd]`` with scipy's solve_ivp, accelerations from the NumPy UK
     formula (``accel="uk"``) or the augmented solve (``accel="augmented"``).
 
-    ``partition`` is accepted for signature compatibility with :func:`simulate_cp` and
-    ignored. Initial states passed in must be consistent; if None, ``initial_guess()``
+    Initial states passed in must be consistent; if None, ``initial_guess()``
     corrected by :func:`correct_initial_state` (elastic coordinates held) is used.
     """
     model = _as_model(description_or_model)
@@ -204,8 +203,7 @@ def simulate_uk_numpy(description_or_model, t_end, method="BDF", rtol=1e-6, atol
     def rhs(t, y):
         tic = time.perf_counter()
         q, qd = y[:n], y[n:]
-        M, Q, A, b = model.terms(t, q, qd) if hasattr(model, "terms") else (
-            model.M(q), model.Q(t, q, qd), model.A(q), model.gamma(t, q, qd))
+        M, Q, A, b = model.terms(t, q, qd)
         if accel == "uk":
             qdd = uk_qdd(M, Q, A, b)
         else:
@@ -226,4 +224,4 @@ def simulate_uk_numpy(description_or_model, t_end, method="BDF", rtol=1e-6, atol
                             message=sol.message, nfev=nfev[0], wall_time=wall,
                             accel_time=acc_time[0], repartitions=0, success=sol.success,
                             formulation="uk-numpy" if accel == "uk" else "augmented-numpy",
-                            extra={"njev": getattr(sol, "njev", 0), "nlu": getattr(sol, "nlu", 0)})
+                            extra={"njev": sol.njev, "nlu": sol.nlu})

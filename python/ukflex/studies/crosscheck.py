@@ -1,28 +1,35 @@
-"""Reproducible numerical studies behind docs/errata.md and the cross-validation report.
+"""Cross-checks against the NumPy reference, behind docs/errata.md and the cross-validation report.
 
-    python -m ukflex.reference.studies errata   [--t-end 0.07] [--rtol 1e-8]
-    python -m ukflex.reference.studies sweep    [--t-end 0.07]     (needs ukflex._core)
-    python -m ukflex.reference.studies timing   [--t-end 0.02]
-    python -m ukflex.reference.studies bdf                         (needs ukflex._core)
+    ukflex crosscheck errata   [--t-end 0.07] [--rtol 1e-8]   the paper's printed terms vs corrected
+    ukflex crosscheck sweep    [--t-end 0.07]                 Rust UK vs NumPy CP over rtol
+    ukflex crosscheck timing   [--t-end 0.02]                 NumPy UK vs CP acceleration time
+    ukflex crosscheck bdf      [--t-end 0.07]                 paper-like BDF runs, E-B vs Timoshenko
 
-Pure NumPy/SciPy except ``sweep``, which imports the compiled core lazily (inside the
-function) to compare Rust UK against NumPy CP.
+(:func:`run` is the same as a function.)  ``errata`` and ``timing`` use only the NumPy
+reference; ``sweep`` and ``bdf`` compare it with the Rust core through :class:`ukflex.System`.
 """
 from __future__ import annotations
 
-import argparse
-import json
+import sys
 import time
+import warnings
+from typing import Optional, TextIO
 
 import numpy as np
+from scipy.integrate import solve_ivp
 
-from .cp import simulate_cp
-from .model import ReferenceModel
-from .paper_closed_form import ALL_FIXES, PaperSliderCrank
-from .uk import correct_initial_state, simulate_uk_numpy
+from .. import System
+from ..reference import ReferenceModel, correct_initial_state, simulate_cp, simulate_uk_numpy
+from ..reference.paper_closed_form import ALL_FIXES, PaperSliderCrank
+from ..reference.uk import fd_jacobian
+
+__all__ = ["STUDIES", "paper_description", "errata_effects", "rtol_sweep", "timing", "bdf_study", "run"]
+
+#: The studies of :func:`run` (``ukflex crosscheck STUDY``).
+STUDIES = ("errata", "sweep", "timing", "bdf")
 
 
-def paper_description(beam="timoshenko", elements=1, gravity=True):
+def paper_description(theory="timoshenko", elements=1, gravity=True):
     """The paper's scene as a description dict (crank frame at the ground pivot)."""
     L, Lb, d, rho = 0.1524, 0.3048, 0.00635, 7834.56
     a = np.pi * d * d / 4
@@ -33,7 +40,7 @@ def paper_description(beam="timoshenko", elements=1, gravity=True):
              "com": [L / 2, 0.0], "position": [0.0, 0.0], "angle": 0.0,
              "angular_velocity": 124.8},
             {"name": "coupler", "kind": "beam", "length": Lb, "elements": elements,
-             "theory": beam, "density": rho, "youngs_modulus": 2.06843e11,
+             "theory": theory, "density": rho, "youngs_modulus": 2.06843e11,
              "poisson_ratio": 0.285, "shear_factor": 0.8,
              "section": {"shape": "circular", "diameter": d}, "frame": "pinned-pinned",
              "position": [L, 0.0], "angle": 0.0},
@@ -63,7 +70,7 @@ def _closed_form_deflection(model, t_end, t_eval, rtol, atol):
     return PaperSliderCrank.midpoint_deflection(res.q)
 
 
-def errata_effects(beam="timoshenko", t_end=0.07, rtol=1e-8, atol=1e-11, npts=701):
+def errata_effects(theory="timoshenko", t_end=0.07, rtol=1e-8, atol=1e-11, npts=701):
     """Coupler midpoint deflection v(Lb/2)/Lb of the closed-form model for every variant.
 
     Returns dict variant -> (t, v). Reference variant: ``"corrected"`` (all fixes, ukflex's
@@ -81,38 +88,46 @@ def errata_effects(beam="timoshenko", t_end=0.07, rtol=1e-8, atol=1e-11, npts=70
                                                   rotary="full")
     out = {}
     for name, kw in variants.items():
-        out[name] = (t, _closed_form_deflection(PaperSliderCrank(beam, **kw), t_end, t, rtol, atol))
+        out[name] = (t, _closed_form_deflection(PaperSliderCrank(theory, **kw), t_end, t, rtol, atol))
     # the general element-by-element model through coordinate partitioning, for the record
-    m = ReferenceModel(paper_description(beam))
+    m = ReferenceModel(paper_description(theory))
     cp = simulate_cp(m, t_end, method="DOP853", rtol=rtol, atol=atol, t_eval=t)
     S, _ = m.beam_shape("coupler", 0.5)
     out["general model (CP)"] = (t, (S @ cp.q[6:9])[1] / 0.3048)
     return out
 
 
-def _print_errata(beam, out):
+def _print_errata(theory, out, stream):
     t, ref = out["corrected"]
     peak = np.abs(ref).max()
-    print(f"\n### {beam}: coupler midpoint deflection v(Lb/2)/Lb, t in [0, {t[-1]:g}] s")
-    print(f"corrected model: max|v|/Lb = {peak:.5e} at t = {t[np.argmax(np.abs(ref))]:.4f} s\n")
-    print("| variant | max abs(v - v_corrected)/Lb | relative to peak | its own peak |v|/Lb |")
-    print("|---|---|---|---|")
+    print(f"\n### {theory}: coupler midpoint deflection v(Lb/2)/Lb, t in [0, {t[-1]:g}] s", file=stream)
+    print(f"corrected model: max|v|/Lb = {peak:.5e} at t = {t[np.argmax(np.abs(ref))]:.4f} s\n", file=stream)
+    print("| variant | max abs(v - v_corrected)/Lb | relative to peak | its own peak |v|/Lb |", file=stream)
+    print("|---|---|---|---|", file=stream)
     for name, (_, v) in out.items():
         if name == "corrected":
             continue
         d = np.abs(v - ref).max()
-        print(f"| {name} | {d:.3e} | {d / peak:.2e} | {np.abs(v).max():.5e} |")
+        print(f"| {name} | {d:.3e} | {d / peak:.2e} | {np.abs(v).max():.5e} |", file=stream)
 
 
-def rtol_sweep(beam="timoshenko", gravity=True, t_end=0.07, rtols=(1e-6, 1e-8, 1e-10),
+def _rust(description):
+    """The Rust core on the description, without the initial correction (the studies start
+    from the reference's corrected state)."""
+    return System(description, correct=False)
+
+
+def _v_mid(system, S, Y):
+    """v(Lb/2)/Lb of the coupler for states Y (rows: the coordinates, or [q; qd])."""
+    return (S @ Y[system.elastic_slice("coupler")])[1] / system.body_info("coupler")["length"]
+
+
+def rtol_sweep(theory="timoshenko", gravity=True, t_end=0.07, rtols=(1e-6, 1e-8, 1e-10),
                npts=71, method="DOP853"):
     """Rust UK (solve_ivp on System.rhs) vs NumPy CP: max |v_rust - v_cp| / max |v|."""
-    from scipy.integrate import solve_ivp
-    from ukflex import _core                     # lazy: only this study needs the core
-
-    d = paper_description(beam, gravity=gravity)
+    d = paper_description(theory, gravity=gravity)
     m = ReferenceModel(d)
-    r = _core.System(json.dumps(d))
+    r = _rust(d)
     q0, qd0 = correct_initial_state(m)
     t = np.linspace(0.0, t_end, npts)
     S, _ = m.beam_shape("coupler", 0.5)
@@ -124,18 +139,18 @@ def rtol_sweep(beam="timoshenko", gravity=True, t_end=0.07, rtols=(1e-6, 1e-8, 1
                        t_eval=t)
         wr = time.perf_counter() - tic
         cp = simulate_cp(m, t_end, method=method, rtol=rtol, atol=atol, t_eval=t, q0=q0, qd0=qd0)
-        vr = (S @ sr.y[6:9])[1] / 0.3048
-        vc = (S @ cp.q[6:9])[1] / 0.3048
+        vr = _v_mid(r, S, sr.y)
+        vc = _v_mid(r, S, cp.q)
         rows.append(dict(rtol=rtol, diff=np.abs(vr - vc).max(), peak=np.abs(vr).max(),
                          rust_nfev=sr.nfev, rust_wall=wr, cp_nfev=cp.nfev, cp_wall=cp.wall_time,
                          repartitions=cp.repartitions,
-                         rust_phi=np.abs([r.phi(tk, sr.y[:9, k]) for k, tk in enumerate(t)]).max()))
+                         rust_phi=np.abs([r.phi(tk, sr.y[:r.n_coords, k]) for k, tk in enumerate(t)]).max()))
     return rows
 
 
-def timing(beam="timoshenko", t_end=0.02, rtol=1e-6, method="DOP853"):
+def timing(theory="timoshenko", t_end=0.02, rtol=1e-6, method="DOP853"):
     """Acceleration-evaluation time: UK (NumPy), CP partitioned once, CP every call."""
-    m = ReferenceModel(paper_description(beam))
+    m = ReferenceModel(paper_description(theory))
     q0, qd0 = correct_initial_state(m)
     out = {}
     for name, f in [
@@ -156,34 +171,30 @@ def timing(beam="timoshenko", t_end=0.02, rtol=1e-6, method="DOP853"):
     return out
 
 
-def bdf_study(t_end=0.07):
+def bdf_study(t_end=0.07, stream=None):
     """Paper-like integrator (BDF, rtol 1e-6): Rust UK vs NumPy CP vs a DOP853 1e-10 reference;
     E-B vs Timoshenko; and scipy's num_jac overflow on raw System.rhs at rtol 1e-8."""
-    import warnings
-    from scipy.integrate import solve_ivp
-    from ukflex import _core                     # lazy: only this study needs the core
-    from .uk import fd_jacobian
-
+    stream = stream or sys.stdout
     t = np.linspace(0.0, t_end, 701)
     ref = {}
     for beam in ("euler-bernoulli", "timoshenko"):
         d = paper_description(beam)
-        r, m = _core.System(json.dumps(d)), ReferenceModel(d)
+        r, m = _rust(d), ReferenceModel(d)
         q0, qd0 = correct_initial_state(m)
         S, _ = m.beam_shape("coupler", 0.5)
         y0 = np.r_[q0, qd0]
         sr = solve_ivp(r.rhs, (0, t_end), y0, method="DOP853", rtol=1e-10, atol=1e-13, t_eval=t)
-        ref[beam] = (S @ sr.y[6:9])[1] / 0.3048
+        ref[beam] = _v_mid(r, S, sr.y)
         pk = np.abs(ref[beam]).max()
         sb = solve_ivp(r.rhs, (0, t_end), y0, method="BDF", rtol=1e-6, atol=1e-9, t_eval=t)
-        vb = (S @ sb.y[6:9])[1] / 0.3048
+        vb = _v_mid(r, S, sb.y)
         cp = simulate_cp(m, t_end, method="BDF", rtol=1e-6, atol=1e-9, t_eval=t[::10], q0=q0,
                          qd0=qd0)
-        vc = (S @ cp.q[6:9])[1] / 0.3048
+        vc = _v_mid(r, S, cp.q)
         print(f"{beam}: BDF rtol 1e-6, atol 1e-9 (max abs dv / peak): Rust UK vs reference "
               f"{np.abs(vb - ref[beam]).max() / pk:.2e}, NumPy CP vs reference "
               f"{np.abs(vc - ref[beam][::10]).max() / pk:.2e}, Rust UK vs CP "
-              f"{np.abs(vb[::10] - vc).max() / pk:.2e}; nfev Rust {sb.nfev}, CP {cp.nfev}")
+              f"{np.abs(vb[::10] - vc).max() / pk:.2e}; nfev Rust {sb.nfev}, CP {cp.nfev}", file=stream)
         for jac in ("scipy num_jac", "fd_jacobian"):
             kw = {} if jac.startswith("scipy") else {"jac": fd_jacobian(r.rhs, 1e-11)}
             with warnings.catch_warnings():
@@ -192,50 +203,47 @@ def bdf_study(t_end=0.07):
                     s2 = solve_ivp(r.rhs, (0, t_end), y0, method="BDF", rtol=1e-8, atol=1e-11,
                                    **kw)
                     print(f"  raw System.rhs, BDF rtol 1e-8, {jac}: status {s2.status}, "
-                          f"njev {s2.njev}")
+                          f"njev {s2.njev}", file=stream)
                 except Exception as exc:            # noqa: BLE001 (report what happened)
-                    print(f"  raw System.rhs, BDF rtol 1e-8, {jac}: {type(exc).__name__}: {exc}")
+                    print(f"  raw System.rhs, BDF rtol 1e-8, {jac}: {type(exc).__name__}: {exc}", file=stream)
     dv = np.abs(ref["euler-bernoulli"] - ref["timoshenko"])
     pk = np.abs(ref["timoshenko"]).max()
     print(f"E-B vs Timoshenko: max abs dv/Lb = {dv.max():.3e} ({dv.max() / pk:.2e} of the peak); "
-          f"peaks {np.abs(ref['euler-bernoulli']).max():.6e}, {pk:.6e}")
+          f"peaks {np.abs(ref['euler-bernoulli']).max():.6e}, {pk:.6e}", file=stream)
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m ukflex.reference.studies")
-    ap.add_argument("study", choices=["errata", "sweep", "timing", "bdf"])
-    ap.add_argument("--t-end", type=float, default=None)
-    ap.add_argument("--rtol", type=float, default=1e-8)
-    ap.add_argument("--beam", default=None)
-    args = ap.parse_args(argv)
-    beams = [args.beam] if args.beam else ["euler-bernoulli", "timoshenko"]
-    if args.study == "errata":
-        for beam in beams:
-            _print_errata(beam, errata_effects(beam, t_end=args.t_end or 0.07, rtol=args.rtol,
-                                               atol=1e-3 * args.rtol))
-    elif args.study == "bdf":
-        bdf_study(t_end=args.t_end or 0.07)
-    elif args.study == "sweep":
-        for beam in beams:
+def run(study: str, t_end: Optional[float] = None, rtol: float = 1e-8, theory: Optional[str] = None,
+        stream: Optional[TextIO] = None) -> None:
+    """Run one of :data:`STUDIES` for ``theory`` (default both) and print its markdown tables.
+
+    ``t_end`` defaults to 0.07 s (0.02 s for ``timing``); ``rtol`` applies to ``errata``.
+    """
+    if study not in STUDIES:
+        raise ValueError(f"unknown study {study!r}; expected one of {STUDIES}")
+    stream = stream or sys.stdout
+    theories = [theory] if theory else ["euler-bernoulli", "timoshenko"]
+    if study == "errata":
+        for th in theories:
+            _print_errata(th, errata_effects(th, t_end=t_end or 0.07, rtol=rtol, atol=1e-3 * rtol), stream)
+    elif study == "bdf":
+        bdf_study(t_end=t_end or 0.07, stream=stream)
+    elif study == "sweep":
+        for th in theories:
             for gravity in (True, False):
-                print(f"\n### {beam}, gravity={gravity}: Rust UK vs NumPy CP, "
-                      f"t in [0, {args.t_end or 0.07:g}] s (DOP853, atol = 1e-3 rtol)")
+                print(f"\n### {th}, gravity={gravity}: Rust UK vs NumPy CP, "
+                      f"t in [0, {t_end or 0.07:g}] s (DOP853, atol = 1e-3 rtol)", file=stream)
                 print("| rtol | max abs(v_rust - v_cp)/Lb | / peak | Rust nfev | Rust wall s "
-                      "| CP nfev | CP wall s | CP repartitions | Rust max abs(Phi) |")
-                print("|---|---|---|---|---|---|---|---|---|")
-                for row in rtol_sweep(beam, gravity, t_end=args.t_end or 0.07):
+                      "| CP nfev | CP wall s | CP repartitions | Rust max abs(Phi) |", file=stream)
+                print("|---|---|---|---|---|---|---|---|---|", file=stream)
+                for row in rtol_sweep(th, gravity, t_end=t_end or 0.07):
                     print(f"| {row['rtol']:.0e} | {row['diff']:.2e} | {row['diff'] / row['peak']:.2e}"
                           f" | {row['rust_nfev']} | {row['rust_wall']:.2f} | {row['cp_nfev']}"
-                          f" | {row['cp_wall']:.1f} | {row['repartitions']} | {row['rust_phi']:.1e} |")
+                          f" | {row['cp_wall']:.1f} | {row['repartitions']} | {row['rust_phi']:.1e} |", file=stream)
     else:
-        for beam in beams:
-            print(f"\n### {beam}: t in [0, {args.t_end or 0.02:g}] s, DOP853 rtol 1e-6, best of 3")
-            print("| formulation | calls | accel time s | per call ms | wall s |")
-            print("|---|---|---|---|---|")
-            for name, res in timing(beam, t_end=args.t_end or 0.02).items():
+        for th in theories:
+            print(f"\n### {th}: t in [0, {t_end or 0.02:g}] s, DOP853 rtol 1e-6, best of 3", file=stream)
+            print("| formulation | calls | accel time s | per call ms | wall s |", file=stream)
+            print("|---|---|---|---|---|", file=stream)
+            for name, res in timing(th, t_end=t_end or 0.02).items():
                 print(f"| {name} | {res.nfev} | {res.accel_time:.2f} | "
-                      f"{1e3 * res.accel_time / res.nfev:.3f} | {res.wall_time:.2f} |")
-
-
-if __name__ == "__main__":
-    main()
+                      f"{1e3 * res.accel_time / res.nfev:.3f} | {res.wall_time:.2f} |", file=stream)

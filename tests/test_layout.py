@@ -1,0 +1,240 @@
+"""The package layout (issue 10): the library stands apart from the studies, the reference never
+reaches the Rust core, studies use only public names, no import cycles, and the old names still
+work for one release with a DeprecationWarning."""
+
+import ast
+import importlib
+import json
+import os
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ukflex
+from ukflex import cli, scenes
+
+PKG = Path(__file__).resolve().parents[1] / "python" / "ukflex"
+ENV = dict(os.environ, MPLBACKEND="Agg")
+
+#: Deprecated forwarders (removed with the old names): their imports are not dependencies.
+DEPRECATED_FORWARDERS = {("ukflex.stability", "__getattr__"), ("ukflex.stability", "main")}
+#: scene.py <-> system.py (Scene.build imports System lazily): owned by the core rewrite.
+KNOWN_CYCLES = [{"ukflex.scene", "ukflex.system"}]
+
+
+def _modules():
+    """{dotted name: path} of every Python module of the package."""
+    out = {}
+    for path in PKG.rglob("*.py"):
+        parts = path.relative_to(PKG.parent).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        out[name] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _imports(name, path):
+    """[(imported module, imported names, enclosing function or None)] of every import in a file,
+    relative imports resolved."""
+    tree = ast.parse(path.read_text())
+    package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+    out = []
+
+    def visit(node, func):
+        for child in ast.iter_child_nodes(node):
+            f = child.name if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)) and func is None else func
+            if isinstance(child, ast.Import):
+                out.extend((a.name, [], func) for a in child.names)
+            elif isinstance(child, ast.ImportFrom):
+                if child.level:
+                    base = package.split(".")
+                    base = base[: len(base) - child.level + 1]
+                    mod = ".".join(base + ([child.module] if child.module else []))
+                else:
+                    mod = child.module or ""
+                out.append((mod, [a.name for a in child.names], func))
+            visit(child, f)
+
+    visit(tree, None)
+    return out
+
+
+def _edges(name, path):
+    """Modules of the package that ``name`` imports: ``from P import sub`` depends on the
+    submodule ``P.sub`` (the compiled ``_core`` counts as one), ``from P import attr`` on ``P``."""
+    for mod, names, func in _imports(name, path):
+        if (name, func) in DEPRECATED_FORWARDERS or not mod.startswith("ukflex"):
+            continue
+        subs = [n for n in names if f"{mod}.{n}" in MODULES or n == "_core"]
+        if mod in MODULES and (not names or len(subs) < len(names)) and mod != name:
+            yield mod
+        yield from (f"{mod}.{n}" for n in subs if f"{mod}.{n}" in MODULES)
+
+
+def test_reference_never_imports_the_rest_of_ukflex():
+    for name, path in MODULES.items():
+        if not name.startswith("ukflex.reference"):
+            continue
+        for mod, names, _ in _imports(name, path):
+            assert not mod.startswith("ukflex") or mod.startswith("ukflex.reference"), (name, mod)
+            assert "_core" not in mod and "_core" not in names, (name, mod, names)
+
+
+def test_library_does_not_import_the_studies():
+    for name, path in MODULES.items():
+        if name.startswith(("ukflex.studies", "ukflex.reference")) or name == "ukflex.cli":
+            continue  # the CLI is the driver of both
+        bad = [e for e in _edges(name, path) if e.startswith("ukflex.studies")]
+        assert not bad, f"{name} imports {bad}"
+
+
+def test_studies_use_only_public_names():
+    for name, path in MODULES.items():
+        if not name.startswith("ukflex.studies"):
+            continue
+        for mod, names, _ in _imports(name, path):
+            if mod.startswith("ukflex") and not mod.startswith("ukflex.studies"):
+                assert not any(p.startswith("_") for p in mod.split(".")), f"{name} imports private module {mod}"
+                assert not [n for n in names if n.startswith("_")], f"{name} imports private {names} from {mod}"
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Attribute):
+                assert node.attr != "core", f"{name}:{node.lineno} reaches into System.core"
+                private = node.attr.startswith("_") and not node.attr.startswith("__")
+                assert not private, f"{name}:{node.lineno} uses private attribute {node.attr}"
+
+
+def test_no_import_cycles():
+    graph = {name: set(_edges(name, path)) for name, path in MODULES.items()}
+    cycles = []
+    index, low, stack, on_stack, counter = {}, {}, [], set(), [0]
+
+    def strongconnect(v):  # Tarjan
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                strongconnect(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = set()
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                comp.add(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                cycles.append(comp)
+
+    for v in sorted(graph):
+        if v not in index:
+            strongconnect(v)
+    assert [c for c in cycles if c not in KNOWN_CYCLES] == []
+
+
+def test_extreme_is_not_exported_at_top_level():
+    r = subprocess.run([sys.executable, "-c", "import ukflex, sys; print('extreme' in dir(ukflex), "
+                        "any(m.startswith('ukflex.studies') for m in sys.modules))"],
+                       capture_output=True, text=True, env=ENV)
+    assert r.returncode == 0 and r.stdout.split() == ["False", "False"], r.stdout + r.stderr
+    assert "extreme" not in ukflex.__all__
+
+
+# ---------------------------------------------------------------------------- deprecated names
+def _fresh_import(name):
+    sys.modules.pop(name, None)
+    return importlib.import_module(name)
+
+
+@pytest.mark.parametrize("old,new", [("ukflex.extreme", "ukflex.studies.extreme"),
+                                     ("ukflex.paper", "ukflex.studies.paper"),
+                                     ("ukflex.workprecision", "ukflex.studies.workprecision")])
+def test_moved_modules_forward_with_a_warning(old, new):
+    with pytest.warns(DeprecationWarning, match=new.replace(".", r"\.")):
+        mod = _fresh_import(old)
+    target = importlib.import_module(new)
+    for name in target.__all__:
+        got = getattr(mod, name)
+        assert got is getattr(target, name) or got.__wrapped__ is getattr(target, name), name
+
+
+def test_old_extreme_and_workprecision_accept_beam():
+    with pytest.warns(DeprecationWarning):
+        X = _fresh_import("ukflex.extreme")
+    from ukflex.studies import extreme
+
+    with pytest.warns(DeprecationWarning, match="theory="):
+        old = X.flexible(beam="timoshenko").to_dict()
+    assert old == extreme.flexible(theory="timoshenko").to_dict()
+    with pytest.warns(DeprecationWarning):
+        wp = _fresh_import("ukflex.workprecision")
+    with pytest.raises(TypeError, match=r"run_work_precision\(\) got both beam= \(deprecated\) and theory="):
+        wp.run_work_precision("unused", beam="timoshenko", theory="timoshenko")
+
+
+def test_stability_report_alias_and_module_entry_point():
+    from ukflex import stability
+    from ukflex.studies.stability import report
+
+    with pytest.warns(DeprecationWarning, match="ukflex.studies.stability.report"):
+        assert stability.report is report
+    r = subprocess.run([sys.executable, "-m", "ukflex.stability", "--help"], capture_output=True, text=True, env=ENV)
+    assert r.returncode == 0 and "usage: ukflex stability" in r.stdout
+    assert "DeprecationWarning" in r.stderr and "ukflex stability" in r.stderr
+
+
+def test_scene_parameter_aliases():
+    with pytest.warns(DeprecationWarning, match=r"slider_crank\(beam=...\).*theory="):
+        old = scenes.slider_crank(beam="euler-bernoulli", elements=2).to_dict()
+    assert old == scenes.slider_crank(theory="euler-bernoulli", elements=2).to_dict()
+    assert old["bodies"][1]["theory"] == "euler-bernoulli"
+    with pytest.raises(TypeError, match="both"):
+        scenes.slider_crank(beam="timoshenko", theory="timoshenko")
+    for fn in (scenes.pendulum, scenes.double_pendulum):
+        with pytest.warns(DeprecationWarning, match="gravity="):
+            old = fn(g=3.7).to_dict()
+        assert old == fn(gravity=3.7).to_dict() and old["gravity"] == [0.0, -3.7]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the new names warn about nothing
+        scenes.slider_crank(theory="timoshenko", gravity=False)
+        scenes.pendulum(gravity=(1.0, -2.0))
+
+
+def test_gravity_forms():
+    g = scenes.gravity_vector
+    assert g(True) == (0.0, -9.81) and g(False) is None and g(None) is None
+    assert g(3.0) == (0.0, -3.0) and g(np.float64(2.0)) == (0.0, -2.0) and g(0) == (0.0, -0.0)
+    assert g((1, -2)) == (1.0, -2.0) and g(np.array([0.5, 0.0])) == (0.5, 0.0)
+    with pytest.raises(ValueError, match="2-vector"):
+        g((1.0, 2.0, 3.0))
+    for gravity, expected in ((True, [0.0, -9.81]), (False, None), (1.62, [0.0, -1.62]), ((0.0, -3.0), [0.0, -3.0])):
+        for fn in scenes.SCENES.values():
+            assert fn(gravity=gravity).to_dict().get("gravity") == expected, (fn.__name__, gravity)
+
+
+def test_cli_deprecated_spellings_still_work(capsys):
+    args = cli._build_parser().parse_args(["bench", "elements", "--out", "x", "--beam", "euler-bernoulli"])
+    assert args.theory == "euler-bernoulli"
+    assert "--beam is deprecated" in capsys.readouterr().err
+    r = subprocess.run([sys.executable, "-m", "ukflex", "export", "slider_crank", "--param", "beam=euler-bernoulli"],
+                       capture_output=True, text=True, env=ENV)
+    assert r.returncode == 0 and 'theory = "euler-bernoulli"' in r.stdout
+    assert "DeprecationWarning" in r.stderr and "theory=" in r.stderr
+
+
+def test_deprecated_names_are_listed():
+    """Each deprecated spelling the package keeps, and where the docs say so."""
+    doc = (PKG.parents[1] / "docs" / "scene-format.md").read_text()
+    for spelling in ("beam=", "g=", "--beam", "ukflex.extreme", "python -m ukflex.stability"):
+        assert spelling in doc, spelling
+    assert json.dumps(scenes.PAPER)  # the paper data stays plain data
