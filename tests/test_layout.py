@@ -23,7 +23,7 @@ ENV = dict(os.environ, MPLBACKEND="Agg")
 #: Deprecated forwarders (removed with the old names): their imports are not dependencies.
 DEPRECATED_FORWARDERS = {("ukflex.stability", "__getattr__"), ("ukflex.stability", "main")}
 #: scene.py <-> system.py (Scene.build imports System lazily): owned by the core rewrite.
-KNOWN_CYCLES = [{"ukflex.scene", "ukflex.system"}]
+KNOWN_CYCLES: list = []
 
 
 def _modules():

@@ -63,7 +63,7 @@ def test_slider_crank_description_matches_paper(paper_data):
 
 
 def test_slider_crank_options():
-    d = scenes.slider_crank(beam="euler-bernoulli", elements=4, gravity=False, omega=10.0).to_dict()
+    d = scenes.slider_crank(theory="euler-bernoulli", elements=4, gravity=False, omega=10.0).to_dict()
     assert "gravity" not in d
     coupler = d["bodies"][1]
     assert coupler["theory"] == "euler-bernoulli" and coupler["elements"] == 4

@@ -11,7 +11,17 @@ import numpy.typing as npt
 
 _F64 = npt.NDArray[np.float64]
 
-__all__ = ["System", "UkflexError", "InvalidSceneError", "SingularMassError", "NonFiniteError", "SolverError"]
+__all__ = [
+    "System",
+    "SceneChecker",
+    "item_name",
+    "beam_elastic_dofs",
+    "UkflexError",
+    "InvalidSceneError",
+    "SingularMassError",
+    "NonFiniteError",
+    "SolverError",
+]
 
 class UkflexError(Exception): ...
 class InvalidSceneError(UkflexError): ...
@@ -40,7 +50,7 @@ class System:
         """Udwadia-Kalaba accelerations, shape (n,)."""
     def rhs(self, t: float, y: _F64) -> _F64:
         """First-order right-hand side [qd, qdd] of y = [q, qd], shape (2n,)."""
-    def _time_acceleration(self, t: float, q: _F64, qd: _F64, reps: int = 1000, batches: int = 21) -> float:
+    def time_acceleration(self, t: float, q: _F64, qd: _F64, reps: int = 1000, batches: int = 21) -> float:
         """Benchmark helper: seconds per call of the Rust UK acceleration alone (min over batches)."""
     def multipliers(self, t: float, q: _F64, qd: _F64) -> _F64:
         """Lagrange multipliers with M qdd + A^T lam = Q, shape (m,)."""
@@ -99,3 +109,39 @@ class System:
     def coordinate_names(self) -> List[str]: ...
     @property
     def constraint_names(self) -> List[str]: ...
+    def body_kind(self, body: str) -> str:
+        """Kind of a body: "rigid", "beam" or "point_mass"."""
+    def elastic_range(self, body: str) -> Tuple[int, int]:
+        """(start, stop) of a body's elastic coordinates in q."""
+    def body_info(self, body: str) -> Dict[str, Any]:
+        """Properties of a body as the core derived them."""
+    def correct(
+        self,
+        t: float,
+        q: _F64,
+        qd: _F64,
+        hold: Sequence[bool],
+        position_tol: float = 1e-12,
+        velocity_tol: float = 1e-10,
+        max_iterations: int = 50,
+    ) -> Dict[str, Any]:
+        """Initial-state correction with held coordinates; a report dict."""
+
+@final
+class SceneChecker:
+    """Validates a scene item by item with the core's rules (used by ``ukflex.Scene``)."""
+
+    def __new__(cls, gravity_json: Optional[str] = None) -> "SceneChecker": ...
+    @staticmethod
+    def check_top_level(description_json: str) -> None: ...
+    def add_body(self, item_json: str) -> Dict[str, Any]: ...
+    def add_joint(self, item_json: str) -> Dict[str, Any]: ...
+    def add_driver(self, item_json: str) -> Dict[str, Any]: ...
+    def add_force(self, item_json: str) -> Dict[str, Any]: ...
+    def finish(self) -> None: ...
+
+def item_name(section: str, kind: str, name: Optional[str], index: int) -> str:
+    """How errors name a scene item."""
+
+def beam_elastic_dofs(elements: int, frame: str) -> int:
+    """Number of elastic coordinates of a beam."""

@@ -75,15 +75,14 @@ class MechanismDrawer:
             body = m["body"]
             if body != GROUND and self.bodies[body] == "beam":
                 self._marker_S[i] = np.asarray(system.beam_shape(body, float(m["xi"]))[0])
-        # rigid bodies: the attachment points in the body frame (+ the centre of mass, which
-        # System.body_info does not report yet: read from the description)
+        # rigid bodies: the attachment points in the body frame and the centre of mass
         self._rigid_points: Dict[str, np.ndarray] = {}
         self._com: Dict[str, np.ndarray] = {}
         for b in desc["bodies"]:
             name = b["name"]
             if self.bodies[name] == "rigid":
-                self._com[name] = np.asarray(b.get("com", (0.0, 0.0)), dtype=float)
-                pts = [tuple(m["point"]) for _, m, _ in self.markers if m["body"] == name]
+                self._com[name] = np.asarray(system.body_info(name)["com"], dtype=float)
+                pts = [tuple(m["point"]) for _, m, _ in self.markers if m["body"] == name and "point" in m]
                 uniq = []
                 for p in pts:
                     if all(math.hypot(p[0] - u[0], p[1] - u[1]) > 1e-12 for u in uniq):
@@ -93,12 +92,16 @@ class MechanismDrawer:
     def _frame(self, q: np.ndarray, name: str):
         """(position (2,), rotation matrix (2, 2)) of body ``name``'s frame at ``q``."""
         qb = q[self.system.body_slice(name)]
+        if self.bodies[name] == "point_mass":  # a particle: no orientation
+            return qb[:2], np.eye(2)
         c, s = math.cos(qb[2]), math.sin(qb[2])
         return qb[:2], np.array([[c, -s], [s, c]])
 
     def body_polyline(self, q: np.ndarray, name: str) -> np.ndarray:
         """World points (k, 2) drawing body ``name`` at ``q``."""
         r, R = self._frame(q, name)
+        if self.bodies[name] == "point_mass":
+            return r[None, :]
         if self.bodies[name] == "beam":
             x, S = self._beam_S[name]
             disp = S @ q[self.system.elastic_slice(name)]  # (k, 2)
@@ -128,7 +131,7 @@ class MechanismDrawer:
             d = self._marker_S[i] @ q[self.system.elastic_slice(body)]
             local = np.array([m["xi"] * self._length[body] + self.scale * d[0], self.scale * d[1]])
         else:
-            local = np.asarray(m["point"], dtype=float)
+            local = np.asarray(m.get("point", (0.0, 0.0)), dtype=float)
         return r + R @ local
 
     def joint_positions(self, q: np.ndarray) -> np.ndarray:
@@ -193,8 +196,8 @@ class _Scene2D:
         for k, (name, kind) in enumerate(drawer.bodies.items()):
             lw = 2.5 if kind == "beam" else 4.0
             (ln,) = ax.plot([], [], "-", lw=lw, color=self.COLORS[k % len(self.COLORS)], label=name,
-                            solid_capstyle="round", zorder=2, marker="o" if kind == "rigid" else None,
-                            ms=3)
+                            solid_capstyle="round", zorder=2, marker="o" if kind in ("rigid", "point_mass") else None,
+                            ms=8 if kind == "point_mass" else 3)
             self.lines[name] = ln
         (self.joints,) = ax.plot([], [], "o", ms=6, mfc="white", mec="k", mew=1.2, zorder=3)
         self.text = ax.text(0.02, 0.96, "", transform=ax.transAxes, va="top", fontsize=9)
@@ -304,7 +307,8 @@ def snapshots(
         for c, name in enumerate(drawer.bodies):
             p = drawer.body_polyline(res.q[i], name)
             ax.plot(p[:, 0], p[:, 1], "-", color=_Scene2D.COLORS[c % len(_Scene2D.COLORS)], alpha=alpha,
-                    lw=2.0, label=name if k == len(idx) - 1 else None)
+                    lw=2.0, label=name if k == len(idx) - 1 else None,
+                    marker="o" if drawer.bodies[name] == "point_mass" else None, ms=7)
     sc.text.set_text("t = " + ", ".join(f"{res.t[i]:.3g}" for i in idx) + " s")
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()

@@ -241,12 +241,8 @@ def _initial(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
 
 
 def _solver(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
-    from .simulate import FORMULATIONS, METHODS
+    from .simulate import FORMULATIONS, METHODS, NATIVE_METHODS
 
-    try:
-        from .simulate import NATIVE_METHODS
-    except ImportError:  # pragma: no cover - older simulate.py
-        NATIVE_METHODS = ()
     METHODS = tuple(METHODS) + tuple(NATIVE_METHODS)
     _check_keys(path, "[solver]", d, SOLVER_KEYS)
     out: Dict[str, Any] = {}

@@ -259,5 +259,5 @@ def time_acceleration(system: System, t: float, q: Sequence[float], qd: Sequence
     reps, batches : int
         Calls per batch and batches.
     """
-    return float(system.core._time_acceleration(float(t), np.ascontiguousarray(q, dtype=float),
+    return float(system.time_acceleration(float(t), np.ascontiguousarray(q, dtype=float),
                                                 np.ascontiguousarray(qd, dtype=float), int(reps), int(batches)))

@@ -395,14 +395,9 @@ def beam_properties(system: System, body: str) -> Dict[str, Any]:
 
 
 def _section(system: System, body: str) -> Tuple[float, float]:
-    """(area, second moment) of beam ``body``'s section.  ``System.body_info`` does not report
-    them yet, so they come from the description's section through the NumPy reference's
-    section formulas (no copy of them here)."""
-    from .reference import section_properties
-
-    desc = next(b for b in system.description["bodies"] if b["name"] == body)
-    area, second_moment = section_properties(desc["section"])
-    return float(area), float(second_moment)
+    """(area, second moment) of beam ``body``'s section, as the core derived them."""
+    info = system.body_info(body)
+    return float(info["area"]), float(info["second_moment"])
 
 
 def buckling_load(system: System, body: str) -> float:

@@ -189,6 +189,8 @@ class System:
         self.rank_info = core.rank_info
         self.project = core.project
         self.integrate = core.integrate
+        # benchmark helper: seconds per Rust UK call (minimum over batches, GIL released)
+        self.time_acceleration = core.time_acceleration
 
         self.n_coords: int = int(core.n_coords)
         self.n_constraints: int = int(core.n_constraints)

@@ -238,11 +238,11 @@ impl PySystem {
         Ok(out)
     }
 
-    /// Benchmark helper (not API): seconds per call of the Rust UK acceleration alone at
+    /// Benchmark helper: seconds per call of the Rust UK acceleration alone at
     /// (t, q, qd), the minimum over `batches` batches of `reps` calls, GIL released. Lets a
     /// Python benchmark separate the core's time from the binding's overhead in one run.
     #[pyo3(signature = (t, q, qd, reps=1000, batches=21))]
-    fn _time_acceleration(&self, py: Python<'_>, t: f64, q: Vector<'_>, qd: Vector<'_>, reps: usize, batches: usize) -> PyResult<f64> {
+    fn time_acceleration(&self, py: Python<'_>, t: f64, q: Vector<'_>, qd: Vector<'_>, reps: usize, batches: usize) -> PyResult<f64> {
         let n = self.model.n;
         let (mut qv, mut qdv) = (vec![0.0; n], vec![0.0; n]);
         read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
