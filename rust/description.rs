@@ -152,6 +152,18 @@ pub enum BeamTheory {
     EulerBernoulli,
 }
 
+/// Strain measure of a beam's elastic forces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Strain {
+    /// Linear strain (the paper): no coupling of axial force and bending.
+    Linear,
+    /// Second-order axial strain `u' + v'^2 / 2` averaged over each element (a constant axial
+    /// force per element): geometric stiffening/softening and foreshortening.
+    #[default]
+    Nonlinear,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReferenceConditions {
@@ -178,6 +190,9 @@ pub struct BeamDesc {
     #[serde(default = "one")]
     pub elements: usize,
     pub theory: BeamTheory,
+    /// Default: nonlinear (the physically right answer at speed).
+    #[serde(default)]
+    pub strain: Strain,
     pub density: f64,
     pub youngs_modulus: f64,
     #[serde(default, skip_serializing_if = "Option::is_none")]

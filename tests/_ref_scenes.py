@@ -19,11 +19,12 @@ M_CRANK = RHO * AREA * L_CRANK
 
 
 def slider_crank(theory="timoshenko", elements=1, gravity=True, frame="pinned-pinned",
-                 rotary_inertia=None, damping=0.0, omega=OMEGA):
-    """The paper's flexible slider-crank (crank frame at the ground pivot)."""
+                 rotary_inertia=None, damping=0.0, omega=OMEGA, strain="linear"):
+    """The paper's flexible slider-crank (crank frame at the ground pivot; the paper's linear
+    strain unless ``strain`` says otherwise)."""
     coupler = {
         "name": "coupler", "kind": "beam", "length": L_COUPLER, "elements": elements,
-        "theory": theory, "density": RHO, "youngs_modulus": E_MOD, "poisson_ratio": NU,
+        "theory": theory, "strain": strain, "density": RHO, "youngs_modulus": E_MOD, "poisson_ratio": NU,
         "shear_factor": K_SHEAR, "section": {"shape": "circular", "diameter": DIAMETER},
         "frame": frame, "position": [L_CRANK, 0.0], "angle": 0.0,
         "velocity": [0.0, 0.0], "angular_velocity": 0.0,

@@ -197,7 +197,7 @@ def test_cantilever_static_deflection():
     w = -rho * b * h * 9.81
     # first mode ~ 52 rad/s; beta = 2 / 52 gives it critical damping, and every higher
     # (overdamped) mode decays at about 1 / beta = 26 1/s: settled to ~1e-7 by t = 0.6 s
-    scene = scenes.cantilever(length=L, elements=4, tip_force=(0.0, P), damping=2.0 / 52.0)
+    scene = scenes.cantilever(length=L, elements=4, tip_force=(0.0, P), damping=2.0 / 52.0, strain="linear")
     res = simulate(scene, 0.8, rtol=1e-6, atol=1e-10, t_eval=[0.6, 0.8])
     _, v = res.beam_displacement("beam", 1.0)
     expected = P * L**3 / (3 * EI) + w * L**4 / (8 * EI)

@@ -109,6 +109,10 @@ class System:
     def coordinate_names(self) -> List[str]: ...
     @property
     def constraint_names(self) -> List[str]: ...
+    def axial_forces(self, body: str, q: _F64) -> _F64:
+        """Axial force of each element of a beam at q, shape (elements,)."""
+    def elastic_stiffness(self, body: str, q: _F64) -> _F64:
+        """Tangent stiffness of a beam's elastic forces at q, shape (n_f, n_f)."""
     def body_kind(self, body: str) -> str:
         """Kind of a body: "rigid", "beam" or "point_mass"."""
     def elastic_range(self, body: str) -> Tuple[int, int]:

@@ -383,6 +383,7 @@ class Scene:
         youngs_modulus: float,
         elements: int = 1,
         theory: str = "timoshenko",
+        strain: Optional[str] = None,
         poisson_ratio: Optional[float] = None,
         shear_modulus: Optional[float] = None,
         shear_factor: Optional[float] = None,
@@ -411,6 +412,12 @@ class Scene:
         elements : int
             Number of finite elements ``N >= 1``; the beam has ``n_f = 3 N`` elastic coordinates.
         theory : {"timoshenko", "euler-bernoulli"}
+        strain : {"nonlinear", "linear"}, optional
+            Strain measure of the elastic forces.  Default (the core's): ``"nonlinear"``, the
+            second-order axial strain ``u' + v'^2 / 2`` averaged over each element (a constant
+            axial force per element, free of membrane locking): the axial force couples with
+            bending (geometric stiffening), which matters as soon as it is a noticeable
+            fraction of the Euler load.  ``"linear"`` is the paper's linear FFRF model.
         poisson_ratio, shear_modulus : float, optional
             Exactly one is needed for Timoshenko (``G = E / (2 (1 + nu))``); optional otherwise.
         shear_factor : float, optional
@@ -433,7 +440,7 @@ class Scene:
         d = dict(name=name, kind="beam", length=length, elements=elements, theory=theory, density=density,
                  youngs_modulus=youngs_modulus, section=section, frame=frame, damping=damping, position=position,
                  angle=angle, velocity=velocity, angular_velocity=angular_velocity)
-        d.update(_given(poisson_ratio=poisson_ratio, shear_modulus=shear_modulus, shear_factor=shear_factor,
+        d.update(_given(strain=strain, poisson_ratio=poisson_ratio, shear_modulus=shear_modulus, shear_factor=shear_factor,
                         rotary_inertia=rotary_inertia, elastic=elastic, elastic_rates=elastic_rates))
         return self._add_body(d)
 

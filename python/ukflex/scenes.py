@@ -98,6 +98,7 @@ def slider_crank(
     shear_factor: float = PAPER["shear_factor"],
     rotary_inertia: Optional[bool] = None,
     damping: float = 0.0,
+    strain: str = "linear",
 ) -> Scene:
     """The paper's flexible slider-crank (section 5, Fig. 3; data in DESIGN.md section 3).
 
@@ -123,6 +124,12 @@ def slider_crank(
         Coupler rotary inertia (default: the core's default for the theory).
     damping : float
         Coupler stiffness-proportional damping [s] (the paper: none).
+    strain : {"linear", "nonlinear"}
+        The coupler's strain measure.  Default ``"linear"``: this scene reproduces the paper,
+        whose linear FFRF model has no geometric stiffening.  At the paper's crank speed the
+        coupler's axial force couples with bending and ``strain="nonlinear"`` (the default of
+        :meth:`ukflex.Scene.beam`) is the physically right model; see
+        ``docs/geometric-nonlinearity.md``.
 
     Returns
     -------
@@ -147,6 +154,7 @@ def slider_crank(
         s, "coupler", Lb, elements, theory, d, density, youngs_modulus, poisson_ratio, shear_factor,
         rotary_inertia=rotary_inertia,
         damping=damping,
+        strain=strain,
         position=(L, 0.0),
         angle=0.0,
         velocity=(0.0, L * omega),
@@ -298,6 +306,7 @@ def cantilever(
     gravity: Any = True,
     tip_force: Tuple[float, float] = (0.0, 0.0),
     damping: float = 0.0,
+    strain: Optional[str] = None,
     **material,
 ) -> Scene:
     """Horizontal cantilever: a beam along +X, clamped frame, welded to the ground at ``xi = 0``.
@@ -305,7 +314,8 @@ def cantilever(
     Loaded by its weight (``gravity``) and a constant ``tip_force`` [N] at ``xi = 1``.  Default
     section: rectangular 20 x 10 mm steel (``material`` overrides ``density``,
     ``youngs_modulus``, ``poisson_ratio``, ``shear_factor``).  Static tip deflection under a tip
-    load ``P``: ``P L^3 / (3 E I)``.
+    load ``P``: ``P L^3 / (3 E I)`` (linear theory; ``strain`` defaults to the core's
+    ``"nonlinear"``, which settles at the same deflection to second order).
     """
     mat = dict(STEEL)
     mat.update(material)
@@ -323,6 +333,7 @@ def cantilever(
         youngs_modulus=mat["youngs_modulus"],
         frame="clamped",
         damping=damping,
+        strain=strain,
         **kw,
     )
     s.weld(s.ground.frame(), b.at(0.0), name="clamp")

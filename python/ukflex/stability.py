@@ -409,16 +409,12 @@ def buckling_load(system: System, body: str) -> float:
 def axial_force(result: SimulationResult, body: str) -> np.ndarray:
     """Axial force of each element of beam ``body`` from its elastic strain, shape (nt, N).
 
-    ``N_k = E a (u(x_{k+1}) - u(x_k)) / l`` (the axial displacement is linear in each element),
-    tension positive.  This is the elastic force the model carries; it excludes any geometric
-    (axial load - bending) coupling, which the linear FFRF model does not have.
+    ``N_k = E a eps_k`` with the element's axial strain as the model defines it (the core's
+    ``System.axial_forces``): ``(u(x_{k+1}) - u(x_k)) / l`` for linear strain, plus the averaged
+    ``v'^2 / 2`` for nonlinear strain; tension positive.
     """
     s: System = result.system
-    p = beam_properties(s, body)
-    N = p["elements"]
-    rows = np.array([np.asarray(s.beam_shape(body, k / N)[0])[0] for k in range(N + 1)])  # (N+1, n_f)
-    u = result.q[:, s.elastic_slice(body)] @ rows.T  # (nt, N+1)
-    return p["E"] * p["area"] * np.diff(u, axis=1) / (p["length"] / N)
+    return np.array([np.asarray(s.axial_forces(body, q)) for q in result.q])
 
 
 def joint_end_force(result: SimulationResult, joint: str, body: str) -> np.ndarray:

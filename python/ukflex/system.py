@@ -200,6 +200,8 @@ class System:
         self.constraint_names: List[str] = list(core.constraint_names)
         self.body_kind = core.body_kind
         self.body_info = core.body_info
+        self.axial_forces = core.axial_forces
+        self.elastic_stiffness = core.elastic_stiffness
 
         self.t0 = float(t0)
         q_guess, qd_guess = core.initial_guess()

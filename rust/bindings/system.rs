@@ -540,6 +540,38 @@ impl PySystem {
         Ok((mat(py, beam.m_ff.to_dense(), nf, nf)?, mat(py, beam.k_ff.to_dense(), nf, nf)?))
     }
 
+    /// Axial force of each element of a beam at q (E a times the element's averaged axial strain,
+    /// second-order with nonlinear strain; tension positive), shape (elements,).
+    fn axial_forces<'py>(&self, py: Python<'py>, body: &str, q: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let bi = self.body(body)?;
+        if !matches!(self.model.bodies[bi].kind, BodyKind::Beam(_)) {
+            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+        }
+        let v = self.with_ws(|model, ws| {
+            Self::load(ws, &q, None)?;
+            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            let crate::body::BodyData::Beam(bd) = &ws.data.bodies[bi] else { unreachable!("beam data") };
+            Ok(bd.axial_force.clone())
+        })?;
+        Ok(PyArray1::from_vec(py, v))
+    }
+
+    /// Tangent stiffness of a beam's elastic forces at q, K_t = -dQ_el/dq_f, shape (n_f, n_f)
+    /// (K_ff for linear strain; plus the geometric stiffness for nonlinear strain).
+    fn elastic_stiffness<'py>(&self, py: Python<'py>, body: &str, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let bi = self.body(body)?;
+        let b = &self.model.bodies[bi];
+        let BodyKind::Beam(beam) = &b.kind else {
+            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+        };
+        let nf = beam.n_f;
+        let mut qv = vec![0.0; self.model.n];
+        read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
+        let mut k = vec![0.0; nf * nf];
+        beam.elastic_tangent(&qv[b.elastic_range()], &mut |i, j, v| k[i * nf + j] += v);
+        mat(py, k, nf, nf)
+    }
+
     /// Kinetic energy 1/2 qd^T M(q) qd (from the body blocks).
     fn kinetic_energy(&self, q: Vector<'_>, qd: Vector<'_>) -> PyResult<f64> {
         self.with_ws(|model, ws| {
@@ -603,6 +635,10 @@ impl PySystem {
                 d.set_item("rotary_inertia", sec.rotary_inertia)?;
                 d.set_item("damping", beam.damping)?;
                 d.set_item("shear_parameter", beam.phi)?;
+                d.set_item("strain", match beam.strain {
+                    crate::description::Strain::Linear => "linear",
+                    crate::description::Strain::Nonlinear => "nonlinear",
+                })?;
             }
             BodyKind::PointMass(_) => {}
         }

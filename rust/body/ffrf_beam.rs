@@ -4,7 +4,7 @@
 //! Gauss quadrature of the element shape functions (paper eqs. 6-9, 23, 26-33).
 
 use super::{add_frame_gravity, add_frame_point_jacobian, finite_vec2, frame_mass_block, frame_mass_moment, frame_point_state, InitialState, MarkerState};
-use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions, SectionDesc};
+use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions, SectionDesc, Strain};
 use crate::error::{check_finite_item, non_negative, positive, Error, Result};
 use crate::linalg::{cholesky3, solve_lower3, solve_upper3, Banded, BandedCholesky, GAUSS4};
 
@@ -165,7 +165,17 @@ pub struct Beam {
     pub k_ff: Banded,
     /// Cholesky factor of `M_ff` (constant: the elastic block of the body factor).
     pub l_ff: BandedCholesky,
+    pub strain: Strain,
+    /// `E a l`: the axial stiffness of one element times its length.
+    pub eal: f64,
+    /// Element geometric matrix `G = int_0^l N_v'^T N_v' dx` on the transverse element dofs
+    /// `(v_j, psi_j, v_j+1, psi_j+1)` (the same for every element): the element's averaged
+    /// axial strain is `(u_j+1 - u_j)/l + d^T G d / (2 l)`.
+    pub g_el: [[f64; 4]; 4],
 }
+
+/// Element dofs `(v_j, psi_j, v_j+1, psi_j+1)` within `(u_j, v_j, psi_j, u_j+1, v_j+1, psi_j+1)`.
+const TRANSVERSE: [usize; 4] = [1, 2, 4, 5];
 
 /// Sparse shape of one axis point: `(q_f index, S_u, S_v, N_psi)` for each nonzero column.
 #[derive(Debug, Clone, Default)]
@@ -314,6 +324,15 @@ impl Beam {
         }
         let l_ff = BandedCholesky::factor(&m_ff)
             .map_err(|i| Error::SingularMass { item: format!("{item}: elastic mass block, pivot {i}") })?;
+        let mut g_el = [[0.0; 4]; 4];
+        for &(s, w) in GAUSS4.iter() {
+            let sh = element_shape(s, l, phi);
+            for (a, &ia) in TRANSVERSE.iter().enumerate() {
+                for (b, &ib) in TRANSVERSE.iter().enumerate() {
+                    g_el[a][b] += w * l * sh.dnv[ia] * sh.dnv[ib];
+                }
+            }
+        }
         Ok(Beam {
             length,
             elements: n_el,
@@ -336,6 +355,9 @@ impl Beam {
             m_ff,
             k_ff,
             l_ff,
+            strain: d.strain,
+            eal: e * area * l,
+            g_el,
         })
     }
 
@@ -385,6 +407,9 @@ pub struct BeamData {
     pub ls: [[f64; 3]; 3],
     /// Scratch of length n_f: `i_rf + M_ff^tr q_f`.
     pub w: Vec<f64>,
+    /// Axial force of each element at the last `mass_and_forces` (`E a` times the element's
+    /// averaged axial strain; tension positive).
+    pub axial_force: Vec<f64>,
 }
 
 #[inline]
@@ -431,6 +456,135 @@ impl Beam {
             x2: vec![0.0; nf],
             ls: [[0.0; 3]; 3],
             w: vec![0.0; nf],
+            axial_force: vec![0.0; self.elements],
+        }
+    }
+
+    /// Nodal dofs `(u_j, v_j, psi_j, u_j+1, v_j+1, psi_j+1)` of element `el` from `q_f`
+    /// (zero where the reference conditions removed them).
+    #[inline]
+    fn element_dofs(&self, el: usize, qf: &[f64]) -> [f64; 6] {
+        let mut d = [0.0; 6];
+        for (a, v) in d.iter_mut().enumerate() {
+            if let Some(i) = self.dof_map[3 * el + a] {
+                *v = qf[i];
+            }
+        }
+        d
+    }
+
+    /// Element axial strain parts: `(eps_lin, gamma, G d)` with `eps_lin = (u_j+1 - u_j)/l`,
+    /// `gamma = d^T G d / (2 l)` (the averaged `v'^2 / 2`).
+    #[inline]
+    fn element_strain(&self, d: &[f64; 6]) -> (f64, f64, [f64; 4]) {
+        let l = self.element_length;
+        let mut gd = [0.0; 4];
+        let mut gamma = 0.0;
+        for a in 0..4 {
+            for b in 0..4 {
+                gd[a] += self.g_el[a][b] * d[TRANSVERSE[b]];
+            }
+            gamma += d[TRANSVERSE[a]] * gd[a];
+        }
+        ((d[3] - d[0]) / l, gamma / (2.0 * l), gd)
+    }
+
+    /// Axial forces of the elements into `bd.axial_force` and, with nonlinear strain, the
+    /// forces of the second-order axial strain into `ff` (the elastic part of `Q_f`): with the
+    /// element's averaged strain `eps = eps_lin + gamma`, `U = E a l eps^2 / 2` adds to the
+    /// linear `E a l eps_lin^2 / 2` (in `K_ff`) the force
+    /// `-E a l [gamma B + eps G d / l]`, `B = (e_u,j+1 - e_u,j) / l`.
+    ///
+    /// Damping acts on the strain rates the model defines: with nonlinear strain the axial
+    /// part of `-beta K_ff qd_f` (the rate of `eps_lin`) becomes the rate of `eps`, i.e. it
+    /// adds `-beta E a l [(b . d_dot) b - (B . d_dot) B]` with `b = B + G d / l` (otherwise the
+    /// foreshortening that keeps `eps` at zero while the beam bends would be damped as if it
+    /// strained the beam).
+    #[inline]
+    fn axial_forces(&self, bd: &mut BeamData, qf: &[f64], qfd: &[f64], ff: &mut [f64]) {
+        let l = self.element_length;
+        let ea = self.eal / l;
+        let nonlinear = self.strain == Strain::Nonlinear;
+        for el in 0..self.elements {
+            let d = self.element_dofs(el, qf);
+            let (eps_lin, gamma, gd) = self.element_strain(&d);
+            if !nonlinear {
+                bd.axial_force[el] = ea * eps_lin;
+                continue;
+            }
+            let n = ea * (eps_lin + gamma);
+            bd.axial_force[el] = n;
+            // the damping's axial force: beta E a (b . d_dot - B . d_dot) on b, plus
+            // beta E a (b . d_dot) (b - B) (see the doc above), as coefficients of B and G d / l
+            let (mut nd_b, mut nd_g) = (0.0, 0.0);
+            if self.damping > 0.0 {
+                let dd = self.element_dofs(el, qfd);
+                let bdot = (dd[3] - dd[0]) / l;
+                let gdot: f64 = (0..4).map(|a| gd[a] * dd[TRANSVERSE[a]]).sum::<f64>() / l;
+                // (b.dd) b - (B.dd) B = gdot B + (bdot + gdot) G d / l
+                nd_b = self.damping * ea * gdot;
+                nd_g = self.damping * ea * (bdot + gdot);
+            }
+            let map = |a: usize| self.dof_map[3 * el + a];
+            if let Some(i) = map(0) {
+                ff[i] += ea * gamma + nd_b;
+            }
+            if let Some(i) = map(3) {
+                ff[i] -= ea * gamma + nd_b;
+            }
+            for (a, &ia) in TRANSVERSE.iter().enumerate() {
+                if let Some(i) = map(ia) {
+                    ff[i] -= (n + nd_g) * gd[a];
+                }
+            }
+        }
+    }
+
+    /// Tangent stiffness of the elastic forces, `K_t = -dQ_el/dq_f` (n_f x n_f): `K_ff` plus,
+    /// with nonlinear strain, `E a l (b b^T - B B^T) + N G` per element (`b = B + G d / l`).
+    /// `put(i, j, v)` receives entries in elastic-coordinate indices (repeated indices add up).
+    pub fn elastic_tangent(&self, qf: &[f64], put: &mut impl FnMut(usize, usize, f64)) {
+        let nf = self.n_f;
+        for i in 0..nf {
+            for j in i.saturating_sub(self.k_ff.hb)..(i + self.k_ff.hb + 1).min(nf) {
+                put(i, j, self.k_ff.get(i, j));
+            }
+        }
+        if self.strain != Strain::Nonlinear {
+            return;
+        }
+        let l = self.element_length;
+        for el in 0..self.elements {
+            let d = self.element_dofs(el, qf);
+            let (eps_lin, gamma, gd) = self.element_strain(&d);
+            let n = self.eal / l * (eps_lin + gamma);
+            let mut bl = [0.0; 6]; // B
+            bl[0] = -1.0 / l;
+            bl[3] = 1.0 / l;
+            let mut b = bl; // B + G d / l
+            for (a, &ia) in TRANSVERSE.iter().enumerate() {
+                b[ia] += gd[a] / l;
+            }
+            let mut k = [[0.0; 6]; 6];
+            for p in 0..6 {
+                for r in 0..6 {
+                    k[p][r] = self.eal * (b[p] * b[r] - bl[p] * bl[r]);
+                }
+            }
+            for (a, &ia) in TRANSVERSE.iter().enumerate() {
+                for (c, &ic) in TRANSVERSE.iter().enumerate() {
+                    k[ia][ic] += n * self.g_el[a][c];
+                }
+            }
+            for p in 0..6 {
+                let Some(i) = self.dof_map[3 * el + p] else { continue };
+                for r in 0..6 {
+                    let Some(j) = self.dof_map[3 * el + r] else { continue };
+                    if k[p][r] != 0.0 {
+                        put(i, j, k[p][r]);
+                    }
+                }
+            }
         }
     }
 
@@ -485,6 +639,7 @@ impl Beam {
         }
         self.s_tilde.mul_add(2.0 * thd, qfd, ff);
         self.k_ff.mul_add(-1.0, qf, ff);
+        self.axial_forces(bd, qf, qfd, ff);
         if self.damping > 0.0 {
             self.k_ff.mul_add(-self.damping, qfd, ff);
         }
@@ -604,10 +759,19 @@ impl Beam {
         0.5 * e
     }
 
-    /// `1/2 q_f^T K_ff q_f`.
+    /// `1/2 q_f^T K_ff q_f`, plus `E a l (eps^2 - eps_lin^2) / 2` per element with nonlinear
+    /// strain.
     pub fn strain_energy(&self, q: &[f64]) -> f64 {
         let qf = &q[3..];
-        0.5 * self.k_ff.bilinear(qf, qf)
+        let mut u = 0.5 * self.k_ff.bilinear(qf, qf);
+        if self.strain == Strain::Nonlinear {
+            for el in 0..self.elements {
+                let (eps_lin, gamma, _) = self.element_strain(&self.element_dofs(el, qf));
+                let eps = eps_lin + gamma;
+                u += 0.5 * self.eal * (eps * eps - eps_lin * eps_lin);
+            }
+        }
+        u
     }
 
     /// `int rho r dV = m R + A Sigma`.

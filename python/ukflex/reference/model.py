@@ -185,6 +185,7 @@ class _Beam:
     damping: float
     q0: np.ndarray
     qd0: np.ndarray
+    strain: str = "nonlinear"
     kind: str = "beam"
     # derived
     l: float = 0.0
@@ -201,6 +202,10 @@ class _Beam:
     rw: np.ndarray = field(default=None)          # rho I * weight * l
     Sg: np.ndarray = field(default=None)
     Pg: np.ndarray = field(default=None)
+    # second-order axial strain: per element, u' (N, n_f) and v' at the Gauss points (N, G, n_f)
+    dug: np.ndarray = field(default=None)
+    dvg: np.ndarray = field(default=None)
+    wg: np.ndarray = field(default=None)
 
     def setup(self):
         N = self.elements
@@ -250,6 +255,47 @@ class _Beam:
         self.rw = np.concatenate(rws) if self.rotary else np.zeros_like(self.mw)
         self.Sg = np.concatenate(Ss)
         self.Pg = np.concatenate(Ps)
+        if self.strain not in ("linear", "nonlinear"):
+            raise ModelError(f"beam {self.name!r}: unknown strain {self.strain!r}")
+        du, dv, _ = element_shape_derivatives(s, self.l, self.phi)
+        self.wg = w
+        self.dug = np.array([du[0] @ self.B[3 * k:3 * k + 6, :] for k in range(N)])
+        self.dvg = np.array([dv @ self.B[3 * k:3 * k + 6, :] for k in range(N)])
+
+    def axial(self, qf):
+        """Element axial strains averaged over each element, ``eps = u' + 1/2 mean(v'^2)``
+        (``u'`` alone for linear strain), and their gradients on ``q_f``: (eps (N,), eps_lin (N,),
+        grad (N, n_f))."""
+        eps_lin = self.dug @ qf
+        if self.strain == "linear":
+            return eps_lin, eps_lin, self.dug
+        vp = self.dvg @ qf                                   # (N, G)
+        eps = eps_lin + 0.5 * (vp * vp) @ self.wg
+        grad = self.dug + np.einsum("g,kg,kgf->kf", self.wg, vp, self.dvg)
+        return eps, eps_lin, grad
+
+    def axial_force(self, qf):
+        """Axial force of each element ``E a eps`` (N,)."""
+        return self.E * self.area * self.axial(qf)[0]
+
+    def nonlinear_elastic(self, qf):
+        """What the second-order axial strain adds to the linear elastic model: (strain energy,
+        generalized force on ``q_f``), from ``U = E a l eps^2 / 2`` per element less the linear
+        ``E a l eps_lin^2 / 2`` already in ``K_ff``."""
+        eps, eps_lin, grad = self.axial(qf)
+        eal = self.E * self.area * self.l
+        energy = 0.5 * eal * float(np.sum(eps * eps - eps_lin * eps_lin))
+        force = -eal * (eps @ grad - eps_lin @ self.dug)
+        return energy, force
+
+    def nonlinear_damping(self, qf, qfd):
+        """What strain-rate damping adds with the second-order strain: ``-beta E a l`` times
+        ``(grad . qfd) grad - (u' . qfd) u'`` per element (the linear part is ``-beta K_ff qfd``)."""
+        if self.strain == "linear" or not self.damping:
+            return np.zeros_like(qf)
+        _, _, grad = self.axial(qf)
+        eal = self.E * self.area * self.l
+        return -self.damping * eal * ((grad @ qfd) @ grad - (self.dug @ qfd) @ self.dug)
 
     def shape(self, xi):
         """S (2, n_f) and N_psi (n_f,) at ``x = xi * length``."""
@@ -412,6 +458,7 @@ class ReferenceModel:
                           kshear=float(ks) if ks is not None else 1.0,
                           area=a, I=I, frame=bd.get("frame", "pinned-pinned"), rotary=bool(rot),
                           damping=float(bd.get("damping", 0.0) or 0.0),
+                          strain=bd.get("strain", "nonlinear"),
                           q0=np.r_[_vec2(bd.get("position")), float(bd.get("angle", 0.0))],
                           qd0=np.r_[_vec2(bd.get("velocity")),
                                     float(bd.get("angular_velocity", 0.0))])
@@ -594,8 +641,10 @@ class ReferenceModel:
                 if g is not None:
                     Qb += np.einsum("g,gia,i->a", b.mw, L, g)
                 Qb[3:] -= b.K_ff @ qf
+                Qb[3:] += b.nonlinear_elastic(qf)[1]
                 if b.damping:
                     Qb[3:] -= b.damping * (b.K_ff @ qfd)
+                    Qb[3:] += b.nonlinear_damping(qf, qfd)
                 Q[sl] += Qb
         for f in self.forces:
             kind = f[0]
@@ -725,7 +774,7 @@ class ReferenceModel:
                     V -= b.mass * g @ (q[o:o + 2] + Arot @ b.com)
             else:
                 qf = q[o + 3:o + b.n]
-                V += 0.5 * qf @ b.K_ff @ qf
+                V += 0.5 * qf @ b.K_ff @ qf + b.nonlinear_elastic(qf)[0]
                 if g is not None:
                     u, L, Arot, _ = self._body_L(b, q)
                     r = q[o:o + 2] + u @ Arot.T
