@@ -93,6 +93,117 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], qd: &mut [
     Ok(Projection { iterations, position_residual: pos_res, velocity_residual: max_abs(&vres), position_correction, velocity_correction })
 }
 
+/// Buffers of `project_in_place`, sized once per model.
+#[derive(Debug, Clone)]
+pub struct ProjectWorkspace {
+    zeros: Vec<f64>,
+    vres: Vec<f64>,
+    /// A velocity scratch (n) for callers that perturb velocities.
+    pub v: Vec<f64>,
+    lambda: Vec<f64>,
+    rhs: Vec<f64>,
+}
+
+impl ProjectWorkspace {
+    pub fn new(model: &Model) -> Self {
+        let (n, m) = (model.n, model.m);
+        ProjectWorkspace { zeros: vec![0.0; n], vres: vec![0.0; m], v: vec![0.0; n], lambda: vec![0.0; m], rhs: vec![0.0; m] }
+    }
+}
+
+/// After `uk::acceleration_with_phi` at `(t, q, qd)`: project `q` onto `Phi = 0` (one Newton
+/// step) and `qd` onto `A qd + Phi_t = 0` where the residuals exceed the tolerances, with the
+/// factorization that call made (both corrections are minimum-mass-norm steps through the same
+/// `F^-T B^+`). `data.lambda` is kept; `data.qdd` is not. Returns whether `(q, qd)` changed.
+/// One Newton step suffices for the per-step drift it is meant for (quadratic convergence from
+/// a residual of that size); the next step's call corrects whatever is left.
+pub fn project_with_factorization(model: &Model, data: &mut Data, ws: &mut ProjectWorkspace, q: &mut [f64], qd: &mut [f64], tol: ProjectionTolerance) -> Result<bool> {
+    let n = model.n;
+    if model.m == 0 {
+        return Ok(false);
+    }
+    velocity_residual(model, data, qd, &mut ws.vres);
+    let (pos, vel) = (max_abs(&data.phi) > tol.position_tol, max_abs(&ws.vres) > tol.velocity_tol);
+    if !(pos || vel) {
+        return Ok(false);
+    }
+    ws.lambda.copy_from_slice(&data.lambda);
+    if pos {
+        for (v, p) in ws.rhs.iter_mut().zip(&data.phi) {
+            *v = -p;
+        }
+        crate::uk::min_norm_correction(model, data, &ws.rhs);
+        for i in 0..n {
+            q[i] += data.qdd[i];
+        }
+    }
+    if vel {
+        for v in ws.vres.iter_mut() {
+            *v = -*v;
+        }
+        crate::uk::min_norm_correction(model, data, &ws.vres);
+        for i in 0..n {
+            qd[i] += data.qdd[i];
+        }
+    }
+    data.lambda.copy_from_slice(&ws.lambda);
+    Ok(true)
+}
+
+/// When `project_in_place` projects.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProjectionTolerance {
+    /// Project the positions while `max |Phi| > position_tol` (absolute).
+    pub position_tol: f64,
+    /// Project the velocities when `max |A qd + Phi_t| > velocity_tol` (absolute).
+    pub velocity_tol: f64,
+    /// Newton iterations for the positions.
+    pub max_iter: usize,
+}
+
+/// The projection of `project` without allocation or report, for use after integration steps:
+/// Newton steps on the positions while `max |Phi| > position_tol` (at most `max_iter`), then
+/// the velocity projection if `max |A qd + Phi_t| > velocity_tol`. Returns whether `(q, qd)`
+/// changed.
+pub fn project_in_place(model: &Model, data: &mut Data, ws: &mut ProjectWorkspace, t: f64, q: &mut [f64], qd: &mut [f64], p: ProjectionTolerance) -> Result<bool> {
+    let ProjectionTolerance { position_tol: tol, velocity_tol, max_iter } = p;
+    let n = model.n;
+    let mut changed = false;
+    constraints(model, data, t, q, &ws.zeros, true);
+    let mut iterations = 0;
+    while max_abs(&data.phi) > tol && iterations < max_iter {
+        mass_and_forces(model, data, q, &ws.zeros);
+        crate::dynamics::factor_mass(model, data)?;
+        data.force.fill(0.0);
+        for i in 0..model.m {
+            data.gamma[i] = -data.phi[i];
+        }
+        solve(model, data)?;
+        for i in 0..n {
+            q[i] += data.qdd[i];
+        }
+        changed = true;
+        iterations += 1;
+        constraints(model, data, t, q, &ws.zeros, true);
+    }
+    // velocities (A and Phi_t at the current q; A does not depend on qd)
+    velocity_residual(model, data, qd, &mut ws.vres);
+    if max_abs(&ws.vres) > velocity_tol {
+        mass_and_forces(model, data, q, &ws.zeros);
+        crate::dynamics::factor_mass(model, data)?;
+        data.force.fill(0.0);
+        for i in 0..model.m {
+            data.gamma[i] = -ws.vres[i];
+        }
+        solve(model, data)?;
+        for i in 0..n {
+            qd[i] += data.qdd[i];
+        }
+        changed = true;
+    }
+    Ok(changed)
+}
+
 /// Settings of `correct`.
 #[derive(Debug, Clone)]
 pub struct CorrectOptions {

@@ -76,13 +76,52 @@ pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]
 /// Dense mass matrix (n x n, row-major) from the body blocks of the last `mass_and_forces`
 /// (inspection and the initial-state correction, not the hot path).
 pub fn dense_mass(model: &Model, data: &Data) -> Vec<f64> {
+    let mut m = vec![0.0; model.n * model.n];
+    dense_mass_into(model, data, &mut m);
+    m
+}
+
+/// `out = M x` from the body blocks of the last `mass_and_forces` (allocation free).
+pub fn mass_times(model: &Model, data: &Data, x: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for (body, bd) in model.bodies.iter().zip(&data.bodies) {
+        let o = body.offset;
+        body.dense_block(bd, &mut |i, j, v| out[o + i] += v * x[o + j]);
+    }
+}
+
+/// `dense_mass` into a buffer of length n^2 (overwritten).
+pub fn dense_mass_into(model: &Model, data: &Data, m: &mut [f64]) {
     let n = model.n;
-    let mut m = vec![0.0; n * n];
+    m.fill(0.0);
     for (body, bd) in model.bodies.iter().zip(&data.bodies) {
         let o = body.offset;
         body.dense_block(bd, &mut |i, j, v| m[(o + i) * n + o + j] = v);
     }
-    m
+}
+
+/// The stiffness part of `tangent_into` alone (n x n, overwritten).
+pub fn stiffness_into(model: &Model, data: &Data, q: &[f64], qd: &[f64], k: &mut [f64]) {
+    let n = model.n;
+    k.fill(0.0);
+    for (body, bd) in model.bodies.iter().zip(&data.bodies) {
+        let o = body.offset;
+        body.tangent(bd, q, qd, &mut |i, j, v| k[(o + i) * n + o + j] += v, &mut |_, _, _| {});
+    }
+}
+
+/// The stiffness `k = -dQ/dq` and damping `c = -dQ/dqd` that the bodies know analytically
+/// (elastic tangent stiffness and strain-rate damping; not the inertial velocity terms, the
+/// gravity or the force elements), n x n row-major, overwritten. For implicit methods'
+/// iteration matrices.
+pub fn tangent_into(model: &Model, data: &Data, q: &[f64], qd: &[f64], k: &mut [f64], c: &mut [f64]) {
+    let n = model.n;
+    k.fill(0.0);
+    c.fill(0.0);
+    for (body, bd) in model.bodies.iter().zip(&data.bodies) {
+        let o = body.offset;
+        body.tangent(bd, q, qd, &mut |i, j, v| k[(o + i) * n + o + j] += v, &mut |i, j, v| c[(o + i) * n + o + j] += v);
+    }
 }
 
 /// Kinetic energy `1/2 qd^T M qd` from the body blocks (calls `mass_and_forces` at `(q, qd)`).

@@ -252,6 +252,29 @@ pub fn acceleration(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64
     solve(model, data)
 }
 
+/// `acceleration` that also leaves `Phi` in `data.phi` (for a projection that reuses the
+/// factorization).
+pub fn acceleration_with_phi(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) -> Result<()> {
+    evaluate(model, data, t, q, qd, true)?;
+    stabilize_rhs(model, data, qd);
+    solve(model, data)
+}
+
+/// `data.qdd = F^-T B^+ r`: the minimum-mass-norm `dx` with `A dx = r`, from the
+/// factorization of `B^T = F^-1 A^T` already in `data` (left by `solve`). Overwrites `y`,
+/// `qdd_free`, `gamma`, `residual`, `coeff`, `lambda` and `qdd` of `data`.
+pub fn min_norm_correction(model: &Model, data: &mut Data, r: &[f64]) {
+    if model.m == 0 {
+        data.qdd.fill(0.0);
+        return;
+    }
+    // correct(): y += B^+ (gamma - A qdd_free), qdd = F^-T y; with y = qdd_free = 0, gamma = r
+    data.qdd_free.fill(0.0);
+    data.y.fill(0.0);
+    data.gamma.copy_from_slice(r);
+    correct(model, data);
+}
+
 /// `qdd` at `(t, q, qd)` reusing the mass factor and the SVD of `B^T` already in `data`, which
 /// must come from a full `acceleration` at the same `q` (and `t` for rheonomic rows): `M`, `A`
 /// and `B` depend on `q` only, so a change of `qd` changes just `Q` and `b`. Used for the

@@ -87,6 +87,8 @@ class System:
         max_step: Optional[float] = None,
         max_steps: int = 1_000_000,
         projection_tol: Optional[float] = None,
+        rho_inf: float = 0.9,
+        step: Optional[float] = None,
     ) -> Dict[str, Any]:
         """Native integration; dict with t (nt,), y (2n, nt), status, message, statistics."""
     def project(

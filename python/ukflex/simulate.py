@@ -20,8 +20,8 @@ __all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system",
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 #: Integrators that run entirely in Rust with the GIL released (``System.integrate``):
 #: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
-NATIVE_METHODS = ("DOPRI5", "RADAU5")
-_NATIVE_OPTIONS = ("first_step", "max_step", "max_steps", "projection_tol")
+NATIVE_METHODS = ("DOPRI5", "RADAU5", "GENALPHA")
+_NATIVE_OPTIONS = ("first_step", "max_step", "max_steps", "projection_tol", "rho_inf", "step")
 FORMULATIONS = ("uk", "uk-numpy", "cp")
 
 
@@ -83,9 +83,13 @@ def simulate(
         Any ``solve_ivp`` method: ``"Radau"`` (default, implicit, for the stiff elastic modes),
         ``"BDF"``, ``"LSODA"``, ``"RK45"``, ``"RK23"``, ``"DOP853"``; or a native Rust integrator
         (all steps in Rust, GIL released, same result object): ``"DOPRI5"`` (Dormand-Prince 5(4),
-        dense output) or ``"RADAU5"`` (Radau IIA order 5, Rust Jacobian). Native methods take the
-        options ``first_step``, ``max_step``, ``max_steps`` and ``projection_tol`` (project onto
-        the constraints after every accepted step); see docs/performance.md.
+        dense output), ``"RADAU5"`` (Radau IIA order 5, Rust Jacobian) or ``"GENALPHA"``
+        (generalized-alpha for stiff flexible systems: numerical dissipation ``rho_inf``
+        (default 0.9), a structured Newton matrix, fixed ``step`` or error-controlled steps,
+        projection onto the constraints by default). Native methods take the options
+        ``first_step``, ``max_step``, ``max_steps`` and ``projection_tol`` (project onto the
+        constraints after every accepted step whose residuals exceed it; 0: off), GENALPHA also
+        ``rho_inf`` and ``step``; see docs/integrators.md.
     rtol : float
         Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s).
     atol : float or array of shape (2n,), optional
@@ -211,9 +215,12 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options)
     if unknown:
         raise TypeError(f"native method {method!r} does not take option(s) {unknown}; it accepts {_NATIVE_OPTIONS}")
     kwargs: Dict[str, Any] = {}
-    for key in ("first_step", "max_step", "projection_tol"):
+    for key in ("first_step", "max_step", "step"):
         if options.get(key) is not None:
             kwargs[key] = _positive_scalar(key, options[key])
+    for key in ("projection_tol", "rho_inf"):  # 0 is meaningful (projection off, full dissipation)
+        if options.get(key) is not None:
+            kwargs[key] = float(options[key])
     if options.get("max_steps") is not None:
         kwargs["max_steps"] = int(options["max_steps"])
     atol_arr = np.atleast_1d(np.asarray(atol, dtype=float))

@@ -375,16 +375,19 @@ impl PySystem {
 
     /// Integrate natively (Rust, GIL released) from (t0, y0) to t_end.
     ///
-    /// method: "DOPRI5" (Dormand-Prince 5(4), dense output) or "RADAU5" (Radau IIA order 5,
-    /// Rust finite-difference Jacobian). atol: float or (2n,) array. t_eval: output times
-    /// (dense output) or None for every accepted step. projection_tol: if given, project onto
-    /// the constraint manifold after every accepted step (uk::project). The run uses its own
-    /// workspace (copying this System's pseudoinverse tolerance, stabilization and backend), so
-    /// several threads can integrate the same System concurrently.
+    /// method: "DOPRI5" (Dormand-Prince 5(4), dense output), "RADAU5" (Radau IIA order 5,
+    /// Rust finite-difference Jacobian) or "GENALPHA" (generalized-alpha with numerical
+    /// dissipation `rho_inf`, structured Newton matrix; fixed `step` or error-controlled).
+    /// atol: float or (2n,) array. t_eval: output times (dense output) or None for every
+    /// accepted step. projection_tol: project onto the constraint manifold after every accepted
+    /// step whose residuals exceed it (None: the method's default, 1e-11 for GENALPHA, off for
+    /// the others; 0: off). The run uses its own workspace (copying this System's pseudoinverse
+    /// tolerance, stabilization and backend), so several threads can integrate the same System
+    /// concurrently.
     ///
     /// Returns a dict: t (nt,), y (2n, nt), status (0 ok, -1 failed), message, nfev, njev, nlu,
     /// naccept, nreject, jac_evals (UK calls inside Jacobians), wall_time [s].
-    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None))]
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=0.9, step=None))]
     #[allow(clippy::too_many_arguments)]
     fn integrate<'py>(
         &self,
@@ -400,10 +403,18 @@ impl PySystem {
         max_step: Option<f64>,
         max_steps: usize,
         projection_tol: Option<f64>,
+        rho_inf: f64,
+        step: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let n = self.model.n;
-        let method = Method::from_name(method)
-            .ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5' or 'RADAU5')")))?;
+        let mut method = Method::from_name(method)
+            .ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5' or 'GENALPHA')")))?;
+        if let Method::GenAlpha(go) = &mut method {
+            go.rho_inf = rho_inf;
+            go.step = step;
+        } else if step.is_some() {
+            return Err(PyValueError::new_err("step (a fixed step size) applies to GENALPHA only"));
+        }
         let mut y = vec![0.0; 2 * n];
         read_into("y0", &y0.as_array(), &mut y).map_err(to_py)?;
         check_time(t0).map_err(to_py)?;
@@ -414,11 +425,12 @@ impl PySystem {
         };
         let t_eval: Option<Vec<f64>> = t_eval.map(|a| a.as_array().iter().copied().collect());
         let max_step = max_step.unwrap_or(f64::INFINITY);
-        if let Some(p) = projection_tol {
-            if !(p > 0.0) || !p.is_finite() {
-                return Err(PyValueError::new_err(format!("projection_tol must be positive and finite, got {p}")));
-            }
-        }
+        let projection = match projection_tol {
+            None => method.default_projection(),
+            Some(p) if p == 0.0 => None,
+            Some(p) if p > 0.0 && p.is_finite() => Some(crate::correct::ProjectionTolerance { position_tol: p, velocity_tol: p, max_iter: 20 }),
+            Some(p) => return Err(PyValueError::new_err(format!("projection_tol must be >= 0 and finite, got {p}"))),
+        };
         let opts = Options { rtol, atol, first_step, max_step, max_steps };
         opts.validate(2 * n).map_err(to_py)?;
         // a fresh workspace with this System's settings: the run does not hold the lock
@@ -431,7 +443,7 @@ impl PySystem {
                 data.stabilization = stabilization;
                 data.svd_backend = backend;
                 let tic = std::time::Instant::now();
-                let r = integrate_uk(model, data, method, opts, t0, &y, t_end, t_eval.as_deref(), projection_tol.map(|p| (p, 20)));
+                let r = integrate_uk(model, data, method, opts, t0, &y, t_end, t_eval.as_deref(), projection);
                 r.map(|(sol, full, cheap)| (sol, full + cheap, tic.elapsed().as_secs_f64()))
             }))
         });

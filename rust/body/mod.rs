@@ -191,6 +191,21 @@ impl Body {
         }
     }
 
+    /// Stiffness `-dQ_b/dq_b` and damping `-dQ_b/dqd_b` of the body's own forces that it knows
+    /// analytically (elastic tangent, strain-rate damping), in body coordinates.
+    pub fn tangent(&self, _bd: &BodyData, q: &[f64], _qd: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
+        match &self.kind {
+            BodyKind::Beam(b) => {
+                let qf = &self.seg(q)[3..];
+                b.elastic_tangent(qf, &mut |i, j, v| k(3 + i, 3 + j, v));
+                if b.damping > 0.0 {
+                    b.elastic_tangent(qf, &mut |i, j, v| c(3 + i, 3 + j, b.damping * v));
+                }
+            }
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) => {}
+        }
+    }
+
     /// `1/2 qd_b^T M_b qd_b` (after `mass_and_forces` at the same `q`).
     pub fn kinetic_energy(&self, bd: &BodyData, qd: &[f64]) -> f64 {
         let qdb = self.seg(qd);

@@ -1,0 +1,528 @@
+//! Generalized-alpha (Chung & Hulbert 1993, in the form of Arnold & Bruls 2007) for
+//! `qdd = g(t, q, qd)`, the UK acceleration: numerical dissipation of the high frequencies set
+//! by `rho_inf` (1: none, the trapezoidal rule; 0: asymptotic annihilation), second order.
+//!
+//! Step `n -> n+1` with the acceleration-like variable `a`:
+//! * `(1 - alpha_m) a_{n+1} + alpha_m a_n = (1 - alpha_f) qdd_{n+1} + alpha_f qdd_n`,
+//! * `q_{n+1} = q_n + h qd_n + h^2 (1/2 - beta) a_n + h^2 beta a_{n+1}`,
+//! * `qd_{n+1} = qd_n + h (1 - gamma) a_n + h gamma a_{n+1}`,
+//! * `qdd_{n+1} = g(t_{n+1}, q_{n+1}, qd_{n+1})`: the UK acceleration (the constraint forces come
+//!   from the UK solve; there are no multiplier unknowns).
+//!
+//! The unknown is `qdd_{n+1}`; Newton on `R = qdd - g(q(qdd), qd(qdd))` with the structured
+//! iteration matrix of the constrained linearization: with `beta' = h^2 beta (1 - alpha_f) /
+//! (1 - alpha_m)` (`dq/dqdd`), `gamma' = h gamma (1 - alpha_f) / (1 - alpha_m)` (`dqd/dqdd`),
+//! the stiffness `K = -dQ/dq` and damping `C = -dQ/dqd` the system knows analytically, the
+//! correction solves
+//!
+//! `[M + gamma' C + beta' K, A^T; A, 0] [dx; mu] = [-M R; -A R]`,
+//!
+//! which is exactly the Newton step `(I + P M^-1 (beta' K + gamma' C)) dx = -R` with the
+//! `M`-orthogonal projector `P` onto the constraint null space (`P M^-1 A^T = 0`): the
+//! linearization of `g` for constant `M`, `A`. Terms that vary with `q` (`M(q)`, `A(q)`,
+//! centrifugal stiffness) only slow the contraction: the matrix is factored once (dense LU) and
+//! reused over steps while Newton contracts fast, refreshed when it does not.
+//!
+//! Constraint drift: the UK acceleration satisfies `A qdd = b` exactly, so positions and
+//! velocities drift only by the discretization error; the system's `post_step` hook projects
+//! them back (`UkSystem` with a projection tolerance) -- cheap, because the drift per step is
+//! tiny and the hook returns at once while it is below the tolerance.
+//!
+//! Step size: fixed (`GenAlphaOptions::step`), or controlled by the local error estimate of
+//! the positions `h^2 |beta - 1/6| |a_{n+1} - a_n|` (Zienkiewicz & Xie 1991) against
+//! `atol + rtol |q|`. Dense output: the cubic Hermite interpolant of `(q, qd)` at both ends.
+
+use super::lu::{lu_real, lu_real_solve};
+use super::{initial_step, Options, SecondOrderSystem, StepState, Stepper};
+use crate::correct::ProjectionTolerance;
+use crate::error::{Error, Result};
+
+/// Settings of the generalized-alpha method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GenAlphaOptions {
+    /// Spectral radius at infinite frequency, in [0, 1].
+    pub rho_inf: f64,
+    /// Fixed step size; `None`: error-controlled steps (`rtol`, `atol`, `first_step`,
+    /// `max_step` of `Options`).
+    pub step: Option<f64>,
+    /// Newton iterations per attempt.
+    pub max_newton: usize,
+    /// Projection onto the constraints after each step (with the factorization of the step's
+    /// final kernel call).
+    pub projection: Option<ProjectionTolerance>,
+}
+
+impl Default for GenAlphaOptions {
+    fn default() -> Self {
+        GenAlphaOptions { rho_inf: 0.9, step: None, max_newton: 8, projection: None }
+    }
+}
+
+/// Re-read the slowly varying velocity terms (`C`, `db/dqd`) of the iteration matrix after this
+/// many steps, or at once when Newton contracts worse than `REFRESH_CONTRACTION`.
+const VELOCITY_TERMS_AGE: usize = 64;
+const REFRESH_CONTRACTION: f64 = 0.3;
+/// Newton stops when the estimated remaining position error, in the error-test units of
+/// `rtol`/`atol`, falls below this.
+const NEWTON_KAPPA: f64 = 0.1;
+
+pub struct GenAlpha {
+    opts: Options,
+    go: GenAlphaOptions,
+    atol: Vec<f64>,
+    n: usize,
+    m: usize,
+    st: StepState,
+    /// Method coefficients.
+    alpha_m: f64,
+    alpha_f: f64,
+    beta: f64,
+    gamma: f64,
+    /// `qdd` and `a` at `t`, and their values at the start of the step.
+    qdd: Vec<f64>,
+    a: Vec<f64>,
+    /// The step's start: `q_n`, `qd_n` (for the dense output and retries).
+    q0: Vec<f64>,
+    qd0: Vec<f64>,
+    qdd_prev: Vec<f64>,
+    a_prev: Vec<f64>,
+    /// Newton unknown and trial state.
+    x: Vec<f64>,
+    a_new: Vec<f64>,
+    q_new: Vec<f64>,
+    qd_new: Vec<f64>,
+    g: Vec<f64>,
+    /// `[-M R; -A R]` and the correction.
+    rhs: Vec<f64>,
+    /// Multipliers: the Newton unknown beside `qdd` (augmented iteration), and their value at
+    /// the start of the step.
+    lam: Vec<f64>,
+    lam_prev: Vec<f64>,
+    r2: Vec<f64>,
+    /// Structure at the last refresh: `M` (n x n), `K`, `C`, `A` (m x n), `db/dqd` (m x n).
+    mm: Vec<f64>,
+    kk: Vec<f64>,
+    cc: Vec<f64>,
+    aa: Vec<f64>,
+    bv: Vec<f64>,
+    /// Factored iteration matrix ((n+m) x (n+m)) and its pivots; the `h` it was built for.
+    lu: Vec<f64>,
+    piv: Vec<usize>,
+    lu_h: f64,
+    have_structure: bool,
+    /// Re-read the velocity terms before the next attempt; steps since they were read.
+    refresh: bool,
+    age: usize,
+    /// Newton iterations of the last step, total.
+    pub newton_iterations: usize,
+    /// Refreshes of the structure (`njev`) and factorizations (`nlu`) are in `stats`.
+    reject: bool,
+    /// Local error estimate of the last accepted step (error-test units).
+    err_prev: f64,
+}
+
+impl GenAlpha {
+    /// `n` coordinates, `m` constraint rows of the system to be integrated.
+    pub fn new(n: usize, m: usize, opts: Options, go: GenAlphaOptions) -> Result<Self> {
+        let atol = opts.validate(2 * n)?;
+        if !(0.0..=1.0).contains(&go.rho_inf) {
+            return Err(Error::argument("rho_inf", format!("must lie in [0, 1], got {}", go.rho_inf)));
+        }
+        if let Some(h) = go.step {
+            if !(h > 0.0) || !h.is_finite() {
+                return Err(Error::argument("step", format!("must be positive and finite, got {h}")));
+            }
+        }
+        if go.max_newton == 0 {
+            return Err(Error::argument("max_newton", "must be at least 1"));
+        }
+        let r = go.rho_inf;
+        let alpha_m = (2.0 * r - 1.0) / (r + 1.0);
+        let alpha_f = r / (r + 1.0);
+        let gamma = 0.5 - alpha_m + alpha_f;
+        let beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+        let z = |k: usize| vec![0.0; k];
+        let nm = n + m;
+        Ok(GenAlpha {
+            opts,
+            go,
+            atol,
+            n,
+            m,
+            st: StepState::new(2 * n),
+            alpha_m,
+            alpha_f,
+            beta,
+            gamma,
+            qdd: z(n),
+            a: z(n),
+            q0: z(n),
+            qd0: z(n),
+            qdd_prev: z(n),
+            a_prev: z(n),
+            x: z(n),
+            a_new: z(n),
+            q_new: z(n),
+            qd_new: z(n),
+            g: z(n),
+            rhs: z(nm),
+            lam: z(m),
+            lam_prev: z(m),
+            r2: z(m),
+            mm: z(n * n),
+            kk: z(n * n),
+            cc: z(n * n),
+            aa: z(m * n),
+            bv: z(m * n),
+            lu: z(nm * nm),
+            piv: vec![0; nm],
+            lu_h: 0.0,
+            have_structure: false,
+            refresh: true,
+            age: 0,
+            newton_iterations: 0,
+            reject: false,
+            err_prev: 0.0,
+        })
+    }
+
+    /// `(beta', gamma')` for step `h`.
+    fn primes(&self, h: f64) -> (f64, f64) {
+        let c = (1.0 - self.alpha_f) / (1.0 - self.alpha_m);
+        (h * h * self.beta * c, h * self.gamma * c)
+    }
+
+    /// Re-read `M`, `K`, `C`, `A`, `db/dqd` at `(t, q, qd)`.
+    fn read_structure<S: SecondOrderSystem>(&mut self, sys: &mut S, t: f64, at_iterate: bool) -> Result<()> {
+        let n = self.n;
+        let (q, qd) = if at_iterate { (&self.q_new[..], &self.qd_new[..]) } else { (&self.st.y[..n], &self.st.y[n..]) };
+        if !sys.structure(t, q, qd, &mut self.mm, &mut self.kk, &mut self.cc, &mut self.aa, &mut self.bv)? {
+            return Err(Error::argument("method", "GENALPHA needs a system with a structured Jacobian (mass, stiffness, constraints)"));
+        }
+        self.have_structure = true;
+        self.st.stats.njev += 1;
+        Ok(())
+    }
+
+    /// Assemble and factor `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]` for step `h`.
+    fn factor(&mut self, h: f64) -> Result<()> {
+        let (n, m) = (self.n, self.m);
+        let nm = n + m;
+        let (bp, gp) = self.primes(h);
+        for i in 0..n {
+            for j in 0..n {
+                self.lu[i * nm + j] = self.mm[i * n + j] + gp * self.cc[i * n + j] + bp * self.kk[i * n + j];
+            }
+            for r in 0..m {
+                self.lu[i * nm + n + r] = self.aa[r * n + i];
+            }
+        }
+        for r in 0..m {
+            for j in 0..n {
+                self.lu[(n + r) * nm + j] = self.aa[r * n + j] - gp * self.bv[r * n + j];
+            }
+            for s in 0..m {
+                self.lu[(n + r) * nm + n + s] = 0.0;
+            }
+        }
+        self.st.stats.nlu += 1;
+        self.lu_h = h;
+        if !lu_real(&mut self.lu, &mut self.piv, nm) {
+            // redundant constraint rows make the saddle-point matrix singular: regularize the
+            // multiplier block (the correction dx is unaffected where A has full row rank)
+            for r in 0..m {
+                for j in 0..n {
+                    self.lu[(n + r) * nm + j] = self.aa[r * n + j] - gp * self.bv[r * n + j];
+                    self.lu[j * nm + n + r] = self.aa[r * n + j];
+                }
+            }
+            for i in 0..n {
+                for j in 0..n {
+                    self.lu[i * nm + j] = self.mm[i * n + j] + gp * self.cc[i * n + j] + bp * self.kk[i * n + j];
+                }
+            }
+            let scale = self.mm.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300);
+            for r in 0..m {
+                for s in 0..m {
+                    self.lu[(n + r) * nm + n + s] = if r == s { -1e-12 * scale } else { 0.0 };
+                }
+            }
+            self.st.stats.nlu += 1;
+            if !lu_real(&mut self.lu, &mut self.piv, nm) {
+                return Err(Error::Solver(format!("GENALPHA: iteration matrix singular at t = {}", self.st.t)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Positions and velocities of the step for the unknown `x = qdd_{n+1}`.
+    fn trial(&mut self, h: f64) {
+        let (am, af, b, g) = (self.alpha_m, self.alpha_f, self.beta, self.gamma);
+        for i in 0..self.n {
+            let a1 = ((1.0 - af) * self.x[i] + af * self.qdd_prev[i] - am * self.a_prev[i]) / (1.0 - am);
+            self.a_new[i] = a1;
+            self.q_new[i] = self.q0[i] + h * self.qd0[i] + h * h * ((0.5 - b) * self.a_prev[i] + b * a1);
+            self.qd_new[i] = self.qd0[i] + h * ((1.0 - g) * self.a_prev[i] + g * a1);
+        }
+    }
+
+    /// Weighted RMS of `v` with the position weights `atol + rtol |q|`.
+    fn position_norm(&self, v: &[f64]) -> f64 {
+        let n = self.n;
+        let mut s = 0.0;
+        for i in 0..n {
+            let w = self.atol[i] + self.opts.rtol * self.q0[i].abs().max(self.q_new[i].abs());
+            s += (v[i] / w) * (v[i] / w);
+        }
+        (s / n as f64).sqrt()
+    }
+
+    /// One attempt of step `h` from the saved start: Newton on `qdd_{n+1}` (and the
+    /// multipliers), starting from `qdd_n`, `lambda_n`.
+    ///
+    /// The iterations run on the acceleration-level equations `M qdd + A^T lambda = Q`,
+    /// `A qdd = b` at the trial state (assembly only); their root is the UK acceleration. The
+    /// converged iterate is then replaced by the UK acceleration itself, `qdd = g(q, qd)` (one UK
+    /// evaluation per step: the accepted accelerations and multipliers are the UK solution, and
+    /// the difference is the Newton error). The fast-varying part of the iteration matrix (`M`,
+    /// `K`, `A`: the stiff directions turn with the bodies and the constraints) is read at the
+    /// predicted state and factored once per attempt; `C` and `db/dqd` come from the last full
+    /// refresh. `Ok(Some((k, theta)))`: converged after `k` iterations, last contraction
+    /// `theta`; `Ok(None)`: no convergence.
+    fn attempt<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64, tol: f64) -> Result<Option<(usize, f64)>> {
+        let (n, m) = (self.n, self.m);
+        let nm = n + m;
+        let (bp, _) = self.primes(h);
+        self.x.copy_from_slice(&self.qdd_prev);
+        self.lam.copy_from_slice(&self.lam_prev);
+        let t1 = self.st.t + h;
+        let mut prev = f64::INFINITY;
+        let mut theta = 0.0;
+        for k in 1..=self.go.max_newton {
+            self.trial(h);
+            let (r1, r2) = (&mut self.g, &mut self.r2);
+            if !sys.augmented_residual(t1, &self.q_new, &self.qd_new, &self.x, &self.lam, r1, r2)? {
+                return Err(Error::argument("method", "GENALPHA needs a system with the acceleration-level residual"));
+            }
+            self.st.stats.nfev += 1;
+            if k == 1 {
+                if !sys.stiff_structure(&self.q_new, &self.qd_new, &mut self.mm, &mut self.kk, &mut self.aa)? {
+                    return Err(Error::argument("method", "GENALPHA needs a system with a structured Jacobian (mass, stiffness, constraints)"));
+                }
+                self.factor(h)?;
+            }
+            for i in 0..n {
+                self.rhs[i] = -self.g[i];
+            }
+            for r in 0..m {
+                self.rhs[n + r] = -self.r2[r];
+            }
+            lu_real_solve(&self.lu, &self.piv, nm, &mut self.rhs);
+            for i in 0..n {
+                self.x[i] += self.rhs[i];
+            }
+            for r in 0..m {
+                self.lam[r] += self.rhs[n + r];
+            }
+            // convergence on the position correction beta' dx
+            for i in 0..n {
+                self.g[i] = bp * self.rhs[i];
+            }
+            let d = self.position_norm(&self.g);
+            if std::env::var("GA_DEBUG").is_ok() {
+                eprintln!("t={:.6} k={k} d={d:.2e} tol={tol:.1e} age={}", self.st.t, self.age);
+            }
+            if !d.is_finite() {
+                return Ok(None);
+            }
+            let converged = if d <= 1e-3 * tol {
+                true
+            } else if k > 1 {
+                theta = d / prev;
+                if theta >= 1.0 {
+                    return Ok(None);
+                }
+                theta / (1.0 - theta) * d <= tol
+            } else {
+                false
+            };
+            if converged {
+                // the UK acceleration at the converged state (the accepted solution; the
+                // difference is the Newton error), and the projection with its factorization
+                self.trial(h);
+                sys.acc_projected(t1, &mut self.q_new, &mut self.qd_new, &mut self.g, self.go.projection)?;
+                self.st.stats.nfev += 1;
+                sys.multipliers(&mut self.lam);
+                let (am, af) = (self.alpha_m, self.alpha_f);
+                for i in 0..n {
+                    self.x[i] = self.g[i];
+                    self.a_new[i] = ((1.0 - af) * self.g[i] + af * self.qdd_prev[i] - am * self.a_prev[i]) / (1.0 - am);
+                }
+                return Ok(Some((k, theta)));
+            }
+            prev = d.max(f64::MIN_POSITIVE);
+        }
+        Ok(None)
+    }
+}
+
+impl Stepper for GenAlpha {
+    fn init<S: SecondOrderSystem>(&mut self, sys: &mut S, t0: f64, y0: &[f64], t_end: f64) -> Result<()> {
+        let n = self.n;
+        self.st.start(t0, y0);
+        self.reject = false;
+        self.newton_iterations = 0;
+        let (q, qd) = y0.split_at(n);
+        sys.acc(t0, q, qd, &mut self.qdd)?;
+        self.st.stats.nfev += 1;
+        sys.multipliers(&mut self.lam);
+        self.a.copy_from_slice(&self.qdd);
+        self.q0.copy_from_slice(q);
+        self.qd0.copy_from_slice(qd);
+        self.read_structure(sys, t0, false)?;
+        self.refresh = false;
+        self.age = 0;
+        let hmax = self.opts.max_step.min((t_end - t0).abs());
+        self.st.h = match (self.go.step, self.opts.first_step) {
+            (Some(h), _) => h,
+            (None, Some(h)) => h.min(hmax),
+            (None, None) => {
+                // Hairer's estimate for an order-2 error estimate, on the first-order system
+                let mut f0 = vec![0.0; 2 * n];
+                f0[..n].copy_from_slice(qd);
+                f0[n..].copy_from_slice(&self.qdd);
+                let (mut y1, mut f1) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
+                initial_step(sys, t0, y0, &f0, self.opts.rtol, &self.atol, 2, hmax, &mut y1, &mut f1, &mut self.st.stats.nfev)?
+            }
+        };
+        self.factor(self.st.h)?;
+        Ok(())
+    }
+
+    fn step<S: SecondOrderSystem>(&mut self, sys: &mut S, t_end: f64) -> Result<()> {
+        let n = self.n;
+        let fixed = self.go.step.is_some();
+        // the step's start
+        self.q0.copy_from_slice(&self.st.y[..n]);
+        self.qd0.copy_from_slice(&self.st.y[n..]);
+        self.qdd_prev.copy_from_slice(&self.qdd);
+        self.a_prev.copy_from_slice(&self.a);
+        self.lam_prev.copy_from_slice(&self.lam);
+        let mut fresh = false;
+        loop {
+            self.st.check_attempt("GENALPHA", self.opts.max_steps)?;
+            let mut h = self.st.h;
+            let last = self.st.t + 1.01 * h >= t_end;
+            if last {
+                h = t_end - self.st.t;
+            }
+            if self.refresh || self.age >= VELOCITY_TERMS_AGE {
+                let t = self.st.t;
+                self.read_structure(sys, t, false)?;
+                self.refresh = false;
+                self.age = 0;
+                fresh = true;
+            }
+            let tol = NEWTON_KAPPA;
+            let result = self.attempt(sys, h, tol)?;
+            let Some((iters, theta)) = result else {
+                // Newton failed: fresh velocity terms first, then a smaller step
+                if !fresh {
+                    self.refresh = true;
+                    continue;
+                }
+                if fixed && h < 1e-3 * self.go.step.expect("fixed") {
+                    return Err(Error::Solver(format!("GENALPHA: Newton did not converge at t = {} even with h = {h:e} (1/1000 of the fixed step)", self.st.t)));
+                }
+                // a shorter step (with a fixed step size, the next step returns to it)
+                self.st.h = 0.5 * h;
+                self.reject = true;
+                if self.st.stats.naccept >= 1 {
+                    self.st.stats.nreject += 1;
+                }
+                continue;
+            };
+            self.newton_iterations += iters;
+            // local error estimate of the positions
+            let c = h * h * (self.beta - 1.0 / 6.0).abs();
+            for i in 0..n {
+                self.g[i] = c * (self.a_new[i] - self.a_prev[i]);
+            }
+            let err = self.position_norm(&self.g).max(1e-10);
+            let mut hnew = h;
+            if !fixed {
+                let fac = (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 2.0);
+                hnew = (h * fac).min(self.opts.max_step);
+                if err > 1.0 {
+                    self.st.h = hnew;
+                    self.reject = true;
+                    if self.st.stats.naccept >= 1 {
+                        self.st.stats.nreject += 1;
+                    }
+                    continue;
+                }
+                if self.reject {
+                    hnew = hnew.min(h);
+                }
+            }
+            // accept
+            self.err_prev = err;
+            self.reject = false;
+            self.st.stats.naccept += 1;
+            self.st.t_old = self.st.t;
+            self.st.t = if last { t_end } else { self.st.t + h };
+            self.st.y[..n].copy_from_slice(&self.q_new);
+            self.st.y[n..].copy_from_slice(&self.qd_new);
+            self.qdd.copy_from_slice(&self.x);
+            self.a.copy_from_slice(&self.a_new);
+            if fixed {
+                // keep the fixed step (the last one may have been shortened to hit t_end)
+                self.st.h = self.go.step.expect("fixed");
+            } else {
+                self.st.h = hnew;
+            }
+            self.age += 1;
+            if iters > 2 && theta > REFRESH_CONTRACTION {
+                self.refresh = true;
+            }
+            return Ok(());
+        }
+    }
+
+    fn dense(&self, t: f64, out: &mut [f64]) {
+        let n = self.n;
+        let (t0, t1) = (self.st.t_old, self.st.t);
+        let h = t1 - t0;
+        if h == 0.0 {
+            out.copy_from_slice(&self.st.y);
+            return;
+        }
+        let s = (t - t0) / h;
+        // cubic Hermite of q with slopes qd; qd from its derivative
+        let (h00, h10, h01, h11) = (2.0 * s * s * s - 3.0 * s * s + 1.0, s * s * s - 2.0 * s * s + s, -2.0 * s * s * s + 3.0 * s * s, s * s * s - s * s);
+        let (d00, d10, d01, d11) = (6.0 * s * s - 6.0 * s, 3.0 * s * s - 4.0 * s + 1.0, -6.0 * s * s + 6.0 * s, 3.0 * s * s - 2.0 * s);
+        let (q1, qd1) = self.st.y.split_at(n);
+        for i in 0..n {
+            let (p0, v0, p1, v1) = (self.q0[i], self.qd0[i], q1[i], qd1[i]);
+            out[i] = h00 * p0 + h10 * h * v0 + h01 * p1 + h11 * h * v1;
+            out[n + i] = (d00 * p0 + d01 * p1) / h + d10 * v0 + d11 * v1;
+        }
+    }
+
+    fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
+        // the hook moved (q, qd) onto the constraints: the acceleration there
+        let n = self.n;
+        let (q, qd) = self.st.y.split_at(n);
+        sys.acc(self.st.t, q, qd, &mut self.qdd)?;
+        self.st.stats.nfev += 1;
+        sys.multipliers(&mut self.lam);
+        Ok(())
+    }
+
+    fn state(&self) -> &StepState {
+        &self.st
+    }
+    fn state_mut(&mut self) -> &mut StepState {
+        &mut self.st
+    }
+}
