@@ -152,6 +152,22 @@ pub enum BeamTheory {
     EulerBernoulli,
 }
 
+/// How a beam is described: floating frame of reference (small elastic coordinates on a moving
+/// frame, the paper's model) or absolute nodal coordinates (the geometrically exact ANCF cable).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BeamFormulation {
+    #[default]
+    Ffrf,
+    Ancf,
+}
+
+impl BeamFormulation {
+    pub fn is_ffrf(&self) -> bool {
+        *self == BeamFormulation::Ffrf
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReferenceConditions {
@@ -177,6 +193,9 @@ pub struct BeamDesc {
     pub length: f64,
     #[serde(default = "one")]
     pub elements: usize,
+    /// Default `ffrf` (not written out then, so FFRF descriptions stay as they were).
+    #[serde(default, skip_serializing_if = "BeamFormulation::is_ffrf")]
+    pub formulation: BeamFormulation,
     pub theory: BeamTheory,
     pub density: f64,
     pub youngs_modulus: f64,
