@@ -415,12 +415,14 @@ impl AncfCable {
         true
     }
 
-    /// `v <- (L_s (x) I_2)^-1 v`: forward substitution on the x and y components together.
+    /// `v <- (L_s (x) I_2)^-1 v`: forward substitution on the x and y components together,
+    /// from the first non-zero entry on (a constraint column touches one element).
     #[inline]
     pub fn finv(&self, _bd: &AncfCableData, v: &mut [f64]) {
         let (n, hb) = (self.l_s.n, self.l_s.hb);
         let w = hb + 1;
-        for i in 0..n {
+        let start = v.chunks_exact(2).position(|p| p[0] != 0.0 || p[1] != 0.0).unwrap_or(n);
+        for i in start..n {
             let lo = i.saturating_sub(hb);
             let row = &self.l_s.data[i * w + (lo + hb - i)..i * w + hb];
             let (mut s0, mut s1) = (0.0, 0.0);

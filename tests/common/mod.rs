@@ -37,6 +37,11 @@ pub fn paper_scene(theory: &str, elements: usize, gravity: bool) -> String {
     )
 }
 
+/// The paper's slider-crank with the coupler as an ANCF cable of `elements` elements.
+pub fn ancf_paper_scene(elements: usize, gravity: bool) -> String {
+    paper_scene("euler-bernoulli", elements, gravity).replace(r#""kind": "beam","#, r#""kind": "beam", "formulation": "ancf","#)
+}
+
 /// A scene that uses every joint, driver and force kind on rigid bodies and beams (not
 /// consistent: for term-by-term checks at random states).
 pub fn every_kind_scene() -> String {
