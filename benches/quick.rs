@@ -78,6 +78,21 @@ fn main() {
         let tail: Vec<_> = fit.iter().copied().filter(|(x, _)| *x >= 8.0).collect();
         println!("growth exponent (min times): N=1..64 {:.2}, N=8..64 {:.2}", slope(&fit), slope(&tail));
     }
+    for n_el in [1usize, 2, 4, 8, 16, 32, 64] {
+        let name = format!("coupler N={n_el}");
+        if !want(&name) {
+            continue;
+        }
+        let mut per = Vec::new();
+        for (kind, json) in [("ffrf-eb", paper_scene("euler-bernoulli", n_el, true)), ("ancf", ancf_paper_scene(n_el, true))] {
+            let (model, mut data) = build(&json);
+            let (q, qd) = bench_state(&model);
+            let r = time(|| uk::acceleration(&model, &mut data, black_box(0.01), black_box(&q), black_box(&qd)).unwrap());
+            row(&format!("{name} {kind} (n={})", model.n), r);
+            per.push(r.0);
+        }
+        println!("{:<40} ancf / ffrf-eb (min) {:.2}", "", per[1] / per[0]);
+    }
     let mut fit = Vec::new();
     for k in [2usize, 4, 8, 16, 32, 64] {
         let name = format!("chain K={k}");
@@ -98,12 +113,12 @@ fn main() {
         let den: f64 = fit.iter().map(|(x, _)| (x.ln() - mx).powi(2)).sum();
         println!("chain growth exponent (min times): {:.2}", num / den);
     }
-    for n_el in [1usize, 64] {
-        let name = format!("stages N={n_el}");
+    for (n_el, kind, json) in [(1usize, "", paper_scene("timoshenko", 1, true)), (64, "", paper_scene("timoshenko", 64, true)), (64, " ancf", ancf_paper_scene(64, true))] {
+        let name = format!("stages N={n_el}{kind}");
         if !want(&name) {
             continue;
         }
-        let (model, mut data) = build(&paper_scene("timoshenko", n_el, true));
+        let (model, mut data) = build(&json);
         let (q, qd) = bench_state(&model);
         let t = 0.01;
         uk::acceleration(&model, &mut data, t, &q, &qd).unwrap();

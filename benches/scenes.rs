@@ -4,7 +4,7 @@
 
 #[path = "../tests/common/mod.rs"]
 mod common;
-pub use common::{paper_scene, Lcg};
+pub use common::{ancf_paper_scene, paper_scene, Lcg};
 
 use ukflex::{Data, Model};
 

@@ -1,5 +1,6 @@
 //! Criterion benches of the UK acceleration: the paper's scene (N = 1, both beam theories),
-//! the same scene with N = 2..64 coupler elements, a chain of K = 2..64 rigid links, and the
+//! the same scene with N = 2..64 coupler elements, the Euler-Bernoulli coupler as an FFRF beam
+//! and as an ANCF cable at N = 1..64 (`coupler`), a chain of K = 2..64 rigid links, and the
 //! stages separately. Run: `cargo bench --bench uk`.
 
 use std::hint::black_box;
@@ -43,6 +44,20 @@ fn elements(c: &mut Criterion) {
     g.finish();
 }
 
+fn coupler(c: &mut Criterion) {
+    let mut g = c.benchmark_group("coupler");
+    for n_el in [1usize, 2, 4, 8, 16, 32, 64] {
+        for (kind, json) in [("ffrf-eb", paper_scene("euler-bernoulli", n_el, true)), ("ancf", ancf_paper_scene(n_el, true))] {
+            let (model, mut data) = build(&json);
+            let (q, qd) = bench_state(&model);
+            g.bench_with_input(BenchmarkId::new(kind, n_el), &n_el, |b, _| {
+                b.iter(|| uk::acceleration(&model, &mut data, black_box(0.01), black_box(&q), black_box(&qd)).unwrap())
+            });
+        }
+    }
+    g.finish();
+}
+
 fn chain(c: &mut Criterion) {
     let mut g = c.benchmark_group("chain");
     for k in [2usize, 4, 8, 16, 32, 64] {
@@ -76,5 +91,5 @@ fn stages(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group! { name = benches; config = config(); targets = paper, elements, chain, stages }
+criterion_group! { name = benches; config = config(); targets = paper, elements, coupler, chain, stages }
 criterion_main!(benches);

@@ -164,6 +164,22 @@ pub enum Strain {
     Nonlinear,
 }
 
+/// How a beam is described: floating frame of reference (small elastic coordinates on a moving
+/// frame, the paper's model) or absolute nodal coordinates (the geometrically exact ANCF cable).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BeamFormulation {
+    #[default]
+    Ffrf,
+    Ancf,
+}
+
+impl BeamFormulation {
+    pub fn is_ffrf(&self) -> bool {
+        *self == BeamFormulation::Ffrf
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReferenceConditions {
@@ -189,6 +205,9 @@ pub struct BeamDesc {
     pub length: f64,
     #[serde(default = "one")]
     pub elements: usize,
+    /// Default `ffrf` (not written out then, so FFRF descriptions stay as they were).
+    #[serde(default, skip_serializing_if = "BeamFormulation::is_ffrf")]
+    pub formulation: BeamFormulation,
     pub theory: BeamTheory,
     /// Default: nonlinear (the physically right answer at speed).
     #[serde(default)]

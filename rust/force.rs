@@ -64,7 +64,10 @@ impl Force {
                 let s = point.state(bodies, q, qd);
                 point.add_point_jacobian(bodies, &s, *force, qvec);
             }
-            ForceKind::Torque { frame, torque } => frame.add_angle_jacobian(bodies, *torque, qvec),
+            ForceKind::Torque { frame, torque } => {
+                let s = frame.state(bodies, q, qd);
+                frame.add_angle_jacobian(bodies, &s, *torque, qvec);
+            }
             ForceKind::SpringDamper { a, b, stiffness, damping, rest_length } => {
                 let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
                 let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];

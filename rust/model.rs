@@ -81,7 +81,11 @@ impl Model {
 
     /// Any body with stiffness-proportional damping (the scene is then truly stiff).
     pub fn has_damping(&self) -> bool {
-        self.bodies.iter().any(|b| matches!(&b.kind, BodyKind::Beam(beam) if beam.damping > 0.0))
+        self.bodies.iter().any(|b| match &b.kind {
+            BodyKind::Beam(beam) => beam.damping > 0.0,
+            BodyKind::AncfBeam(cable) => cable.damping > 0.0,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) => false,
+        })
     }
 }
 

@@ -15,6 +15,7 @@ fn scenes() -> Vec<(String, String)> {
         ("paper timoshenko N=8".into(), paper_scene("timoshenko", 8, true)),
         ("every kind".into(), every_kind_scene()),
         ("point masses and distances".into(), point_mass_scene()),
+        ("ANCF cables with every kind".into(), ancf_scene()),
     ]
 }
 

@@ -61,9 +61,17 @@ class System:
     def initial_guess(self) -> Tuple[_F64, _F64]:
         """(q, qd) from the description's state fields, each shape (n,)."""
     def beam_shape(self, body: str, xi: float) -> Tuple[_F64, _F64]:
-        """(S (2, n_f), N_psi (n_f,)) at x = xi * length of beam ``body``."""
+        """At x = xi * length of beam ``body``: FFRF (S (2, n_f), N_psi (n_f,)), elastic
+        displacement S q_f in the beam frame; ANCF (S (2, n_b), S' (2, n_b)), world position
+        S e and slope S' e of the body's coordinates e."""
     def beam_matrices(self, body: str) -> Tuple[_F64, _F64]:
-        """Constant elastic blocks (M_ff, K_ff) of beam ``body``, each (n_f, n_f)."""
+        """Constant elastic blocks (M_ff, K_ff) of beam ``body``, each (n_f, n_f); ANCF: the
+        constant mass matrix and the stiffness at the undeformed guess, each (n_b, n_b)."""
+    def tangent_stiffness(self, body: str, q: _F64) -> _F64:
+        """-dQ_el/dq_b of beam ``body``'s elastic forces at q (n,), shape (n_b, n_b)."""
+    def beam_point(self, body: str, xi: float, q: _F64) -> _F64:
+        """Columns x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
+        the ends), psi of the axis point at xi; shape (5,) for q (n,), (nt, 5) for q (nt, n)."""
     def rank_info(self) -> Dict[str, Any]:
         """rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the last UK solve."""
     def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None:
@@ -113,10 +121,8 @@ class System:
     def constraint_names(self) -> List[str]: ...
     def axial_forces(self, body: str, q: _F64) -> _F64:
         """Axial force of each element of a beam at q, shape (elements,)."""
-    def elastic_stiffness(self, body: str, q: _F64) -> _F64:
-        """Tangent stiffness of a beam's elastic forces at q, shape (n_f, n_f)."""
     def body_kind(self, body: str) -> str:
-        """Kind of a body: "rigid", "beam" or "point_mass"."""
+        """Kind of a body: "rigid", "beam" (FFRF), "ancf_beam" or "point_mass"."""
     def elastic_range(self, body: str) -> Tuple[int, int]:
         """(start, stop) of a body's elastic coordinates in q."""
     def body_info(self, body: str) -> Dict[str, Any]:

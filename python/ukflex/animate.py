@@ -2,7 +2,8 @@
 
 Beams are drawn as their deformed axis, ``r(x) = R + A(theta) (x e_1 + s S(x) q_f)`` sampled
 along the beam from the element shape functions (``System.beam_shape``), with an optional
-magnification ``s`` of the elastic displacement (``deform_scale``).  Rigid bodies are drawn as
+magnification ``s`` of the elastic displacement (``deform_scale``); an ANCF beam as its axis points
+(``System.beam_point``), their displacement from the chord of the ends magnified by ``s``.  Rigid bodies are drawn as
 lines from their centre of mass to every point where a joint, driver or force attaches to them
 (a crank becomes a bar from its pivot to its tip); joints are circles, ground attachments
 triangles, and ground lines of point-on-line and prismatic joints dashed lines.
@@ -17,6 +18,8 @@ import math
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
+
+from .outputs import BEAM_KINDS
 
 __all__ = ["MechanismDrawer", "animate", "snapshots"]
 
@@ -61,6 +64,7 @@ class MechanismDrawer:
         self.bodies = {name: system.body_kind(name) for name in system.body_names}
         self.markers = _markers_of(desc)
         self._beam_S: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
+        self._cable_xi: Dict[str, np.ndarray] = {}
         self._length: Dict[str, float] = {}
         for name, kind in self.bodies.items():
             if kind == "beam":
@@ -70,6 +74,10 @@ class MechanismDrawer:
                 xi = np.linspace(0.0, 1.0, k)
                 S = np.array([np.asarray(system.beam_shape(name, float(x))[0]) for x in xi])  # (k, 2, n_f)
                 self._beam_S[name] = (xi * self._length[name], S)
+            elif kind == "ancf_beam":
+                info = system.body_info(name)
+                self._length[name] = float(info["length"])
+                self._cable_xi[name] = np.linspace(0.0, 1.0, max(2, points_per_element * int(info["elements"])) + 1)
         self._marker_S: Dict[int, np.ndarray] = {}
         for i, (_, m, _) in enumerate(self.markers):
             body = m["body"]
@@ -97,8 +105,20 @@ class MechanismDrawer:
         c, s = math.cos(qb[2]), math.sin(qb[2])
         return qb[:2], np.array([[c, -s], [s, c]])
 
+    def _cable_points(self, q: np.ndarray, name: str, xi: Sequence[float]) -> np.ndarray:
+        """World points (k, 2) of an ANCF beam's axis at ``xi``: the chord frame of its ends plus
+        the magnified displacement from the chord."""
+        p = np.array([self.system.beam_point(name, float(x), q) for x in (0.0, 1.0, *xi)])
+        e = p[1, :2] - p[0, :2]
+        e /= np.linalg.norm(e)
+        R = np.array([[e[0], -e[1]], [e[1], e[0]]])
+        local = np.column_stack([np.asarray(xi) * self._length[name] + self.scale * p[2:, 2], self.scale * p[2:, 3]])
+        return p[0, :2] + local @ R.T
+
     def body_polyline(self, q: np.ndarray, name: str) -> np.ndarray:
         """World points (k, 2) drawing body ``name`` at ``q``."""
+        if self.bodies[name] == "ancf_beam":
+            return self._cable_points(q, name, self._cable_xi[name])
         r, R = self._frame(q, name)
         if self.bodies[name] == "point_mass":
             return r[None, :]
@@ -126,6 +146,8 @@ class MechanismDrawer:
         body = m["body"]
         if body == GROUND:
             return np.asarray(m["point"], dtype=float)
+        if self.bodies[body] == "ancf_beam":
+            return self._cable_points(q, body, [float(m["xi"])])[0]
         r, R = self._frame(q, body)
         if i in self._marker_S:
             d = self._marker_S[i] @ q[self.system.elastic_slice(body)]
@@ -194,7 +216,7 @@ class _Scene2D:
             ax.plot(gp[:, 0], gp[:, 1], "^", color="0.3", ms=9, zorder=1)
         self.lines = {}
         for k, (name, kind) in enumerate(drawer.bodies.items()):
-            lw = 2.5 if kind == "beam" else 4.0
+            lw = 2.5 if kind in BEAM_KINDS else 4.0
             (ln,) = ax.plot([], [], "-", lw=lw, color=self.COLORS[k % len(self.COLORS)], label=name,
                             solid_capstyle="round", zorder=2, marker="o" if kind in ("rigid", "point_mass") else None,
                             ms=8 if kind == "point_mass" else 3)
@@ -217,7 +239,7 @@ class _Scene2D:
 
 def _title(res, deform_scale: float, title: Optional[str]) -> str:
     base = title or "ukflex"
-    if any(res.system.body_kind(name) == "beam" for name in res.system.body_names):
+    if any(res.system.body_kind(name) in BEAM_KINDS for name in res.system.body_names):
         base += f" (elastic displacements x{deform_scale:g})" if deform_scale != 1.0 else " (true scale)"
     return base
 

@@ -9,9 +9,10 @@ An *output expression* is one of
   residual norms;
 * ``energy``: total mechanical energy ``T + V``;
 * ``u(BEAM, XI)``, ``v(BEAM, XI)``: axial / transverse elastic displacement of beam ``BEAM`` at
-  ``x = XI * length`` in the beam frame (``v(coupler, 0.5)`` is the paper's midpoint deflection);
-  append ``/L`` to divide by the beam length (``v(coupler, 0.5)/L``, the paper's Fig. 4);
-* ``psi(BEAM, XI)``: elastic cross-section rotation;
+  ``x = XI * length`` in the beam frame (an ANCF beam's: the chord frame of its ends;
+  ``v(coupler, 0.5)`` is the paper's midpoint deflection); append ``/L`` to divide by the beam
+  length (``v(coupler, 0.5)/L``, the paper's Fig. 4);
+* ``psi(BEAM, XI)``: cross-section rotation relative to the beam frame;
 * ``x(BEAM, XI)``, ``y(BEAM, XI)``: world position of the deformed beam axis point.
 """
 
@@ -22,7 +23,10 @@ from typing import List, Tuple
 
 import numpy as np
 
-__all__ = ["evaluate", "validate", "default_outputs", "beam_names", "OUTPUT_HELP"]
+__all__ = ["evaluate", "validate", "default_outputs", "beam_names", "OUTPUT_HELP", "BEAM_KINDS"]
+
+#: Body kinds that are beams (``System.body_kind``): FFRF and ANCF.
+BEAM_KINDS = ("beam", "ancf_beam")
 
 OUTPUT_HELP = (
     "t, a coordinate (crank.theta), d:<coordinate> (rate), residual.position|velocity|acceleration, energy, "
@@ -71,7 +75,7 @@ def validate(system, expr: str) -> None:
 
 def beam_names(system) -> List[str]:
     """Names of the system's beams, in declaration order."""
-    return [b for b in system.body_names if system.body_kind(b) == "beam"]
+    return [b for b in system.body_names if system.body_kind(b) in BEAM_KINDS]
 
 
 def _beam_length(system, body: str) -> float:
@@ -111,13 +115,8 @@ def evaluate(res, expr: str) -> Tuple[str, np.ndarray]:
     if what == "psi":
         return f"psi({body}, {xi:g}) [rad]", res.beam_rotation(body, xi)
     # world position of the deformed axis point
-    u, v = res.beam_displacement(body, xi)
-    local = np.column_stack([xi * _beam_length(system, body) + u, v])
-    x, y, th = (res.coordinate(f"{body}.{c}") for c in ("x", "y", "theta"))
-    c, s = np.cos(th), np.sin(th)
-    if what == "x":
-        return f"x({body}, {xi:g}) [m]", x + c * local[:, 0] - s * local[:, 1]
-    return f"y({body}, {xi:g}) [m]", y + s * local[:, 0] + c * local[:, 1]
+    x, y = res.beam_position(body, xi)
+    return (f"x({body}, {xi:g}) [m]", x) if what == "x" else (f"y({body}, {xi:g}) [m]", y)
 
 
 def default_outputs(system) -> List[str]:

@@ -141,25 +141,36 @@ class SimulationResult:
         """History of the rate of coordinate ``name``, shape (nt,)."""
         return self.qd[:, self.system.coordinate_index(name)]
 
+    def _beam_point(self, body: str, xi: float) -> np.ndarray:
+        """The core's ``beam_point`` over the run: columns x, y, u, v, psi, shape (nt, 5)."""
+        return np.asarray(self.system.beam_point(body, float(xi), self.q)).reshape(-1, 5)
+
     def beam_displacement(self, body: str, xi: float) -> Tuple[np.ndarray, np.ndarray]:
-        """Elastic displacement of beam ``body`` at ``x = xi * length``, in the beam frame.
+        """Displacement of the axis point of beam ``body`` at ``x = xi * length``, in the beam frame.
+
+        The beam frame is an FFRF beam's floating frame (``u_f = S(x) q_f``; for the
+        pinned-pinned frame the chord of the two ends) and an ANCF beam's chord frame (origin at
+        the ``xi = 0`` end, X axis towards the ``xi = 1`` end), so that the two formulations
+        compare one to one.
 
         Returns
         -------
         u, v : ndarray, shape (nt,)
-            Axial and transverse elastic displacement [m] (``u_f = S(x) q_f``).  The paper's Fig. 4
-            plots ``v(xi = 0.5) / length``.
+            Axial and transverse displacement [m] from the undeformed ``(xi * length, 0)``.  The
+            paper's Fig. 4 plots ``v(xi = 0.5) / length``.
         """
-        S, _ = self.system.beam_shape(body, float(xi))
-        S = np.asarray(S)
-        qf = self.q[:, self.system.elastic_slice(body)]
-        uv = qf @ S.T
-        return uv[:, 0], uv[:, 1]
+        p = self._beam_point(body, xi)
+        return p[:, 2], p[:, 3]
 
     def beam_rotation(self, body: str, xi: float) -> np.ndarray:
-        """Elastic cross-section rotation ``psi`` of beam ``body`` at ``xi``, shape (nt,)."""
-        _, n_psi = self.system.beam_shape(body, float(xi))
-        return self.q[:, self.system.elastic_slice(body)] @ np.asarray(n_psi)
+        """Cross-section rotation ``psi`` of beam ``body`` at ``xi`` relative to its beam frame
+        (FFRF: the elastic rotation; ANCF: the tangent's angle to the chord), shape (nt,)."""
+        return self._beam_point(body, xi)[:, 4]
+
+    def beam_position(self, body: str, xi: float) -> Tuple[np.ndarray, np.ndarray]:
+        """World position ``(x, y)`` of the (deformed) axis point of beam ``body`` at ``xi``, each (nt,)."""
+        p = self._beam_point(body, xi)
+        return p[:, 0], p[:, 1]
 
     def energy(self) -> np.ndarray:
         """Total mechanical energy ``T + V`` at each output time, shape (nt,)."""

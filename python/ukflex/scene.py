@@ -249,14 +249,16 @@ class PointMassRef(BodyRef):
 
 
 class BeamRef(BodyRef):
-    """Handle to an FFRF beam: ``at(xi)`` makes a marker on the beam axis."""
+    """Handle to a beam (FFRF or ANCF): ``at(xi)`` makes a marker on the beam axis."""
 
     kind = "beam"
 
     def at(self, xi: float, angle: float = 0.0) -> Marker:
         """Marker at the axis point ``x = xi * length``, ``xi`` in ``[0, 1]``.
 
-        Its world angle is ``theta + angle + psi(x)`` (the cross-section rotation).
+        Its world angle is ``theta + angle + psi(x)`` (the cross-section rotation); on an ANCF
+        beam ``angle`` plus the direction of the tangent ``r'(x)``, measured continuously from the
+        beam's initial ``angle`` (valid while the tangent stays within +-pi of it).
         """
         return Marker(self.name, xi=float(xi), angle=float(angle))
 
@@ -271,7 +273,7 @@ class BeamRef(BodyRef):
 
 
 MarkerLike = Union[Marker, Dict[str, Any]]
-_REFS = {"rigid": RigidBodyRef, "beam": BeamRef, "point_mass": PointMassRef}
+_REFS = {"rigid": RigidBodyRef, "beam": BeamRef, "ancf_beam": BeamRef, "point_mass": PointMassRef}
 
 
 # --------------------------------------------------------------------------------------------
@@ -382,7 +384,7 @@ class Scene:
         density: float,
         youngs_modulus: float,
         elements: int = 1,
-        theory: str = "timoshenko",
+        theory: Optional[str] = None,
         strain: Optional[str] = None,
         poisson_ratio: Optional[float] = None,
         shear_modulus: Optional[float] = None,
@@ -396,8 +398,10 @@ class Scene:
         angular_velocity: float = 0.0,
         elastic: Optional[Sequence[float]] = None,
         elastic_rates: Optional[Sequence[float]] = None,
+        formulation: str = "ffrf",
     ) -> BeamRef:
-        """Add a flexible beam (floating frame of reference, ``elements`` finite elements).
+        """Add a flexible beam of ``elements`` finite elements: floating frame of reference (FFRF,
+        default) or the geometrically exact ANCF cable (``formulation="ancf"``).
 
         Parameters
         ----------
@@ -410,38 +414,53 @@ class Scene:
         density, youngs_modulus : float
             Material density [kg/m^3] and Young's modulus [N/m^2].
         elements : int
-            Number of finite elements ``N >= 1``; the beam has ``n_f = 3 N`` elastic coordinates.
-        theory : {"timoshenko", "euler-bernoulli"}
+            Number of finite elements ``N >= 1``; an FFRF beam has ``n_f = 3 N`` elastic
+            coordinates, an ANCF beam ``4 (N + 1)`` nodal coordinates (positions and slopes).
+        theory : {"timoshenko", "euler-bernoulli"}, optional
+            Default: ``"timoshenko"`` for FFRF; the ANCF cable is Euler-Bernoulli (its default;
+            ``"timoshenko"`` is an error).
         strain : {"nonlinear", "linear"}, optional
-            Strain measure of the elastic forces.  Default (the core's): ``"nonlinear"``, the
-            second-order axial strain ``u' + v'^2 / 2`` averaged over each element (a constant
-            axial force per element, free of membrane locking): the axial force couples with
-            bending (geometric stiffening), which matters as soon as it is a noticeable
-            fraction of the Euler load.  ``"linear"`` is the paper's linear FFRF model.
+            Strain measure of an FFRF beam's elastic forces.  Default (the core's):
+            ``"nonlinear"``, the second-order axial strain ``u' + v'^2 / 2`` averaged over each
+            element (a constant axial force per element, free of membrane locking): the axial
+            force couples with bending (geometric stiffening), which matters as soon as it is a
+            noticeable fraction of the Euler load.  ``"linear"`` is the paper's linear FFRF
+            model.  (The ANCF cable is geometrically exact: no option.)
         poisson_ratio, shear_modulus : float, optional
             Exactly one is needed for Timoshenko (``G = E / (2 (1 + nu))``); optional otherwise.
         shear_factor : float, optional
             Shear correction factor ``k``, required for Timoshenko.
         frame : {"pinned-pinned", "clamped"}
-            Reference conditions of the floating frame.
+            Reference conditions of the floating frame (FFRF).  An ANCF beam has no floating
+            frame: keep the default (``"clamped"`` is an error; clamp it with a weld).
         rotary_inertia : bool, optional
             Default: true for Timoshenko, false for Euler-Bernoulli (decided by the core).
         damping : float
             Stiffness-proportional damping coefficient ``beta`` [s].
         position, angle, velocity, angular_velocity
-            Initial guess of the floating frame (origin = undeformed node 1, ``xi = 0``).
+            Initial guess of the floating frame (origin = undeformed node 1, ``xi = 0``); for an
+            ANCF beam the straight undeformed beam from ``position`` along ``angle``, in the rigid
+            motion of ``velocity`` (of the ``xi = 0`` end) and ``angular_velocity``.
         elastic, elastic_rates : (n_f,) sequence, optional
-            Initial elastic coordinates and rates (default zeros).
+            Initial elastic coordinates and rates (default zeros; FFRF only).
+        formulation : {"ffrf", "ancf"}
+            ``"ffrf"``: the floating frame of reference with linear elastic coordinates (the
+            paper's model).  ``"ancf"``: the planar ANCF cable (absolute nodal positions and
+            slopes, axial strain ``|r'| - 1`` and curvature ``r' x r'' / |r'|^2``: geometrically
+            exact, constant mass matrix; docs/scene-format.md).
 
         Returns
         -------
         BeamRef
         """
+        if theory is None:
+            theory = "euler-bernoulli" if formulation == "ancf" else "timoshenko"
         d = dict(name=name, kind="beam", length=length, elements=elements, theory=theory, density=density,
                  youngs_modulus=youngs_modulus, section=section, frame=frame, damping=damping, position=position,
                  angle=angle, velocity=velocity, angular_velocity=angular_velocity)
         d.update(_given(strain=strain, poisson_ratio=poisson_ratio, shear_modulus=shear_modulus, shear_factor=shear_factor,
                         rotary_inertia=rotary_inertia, elastic=elastic, elastic_rates=elastic_rates))
+        d["formulation"] = formulation  # the core records it only when it is not the default
         return self._add_body(d)
 
     # ----------------------------------------------------------------------------- joints

@@ -76,8 +76,8 @@ def gravity_vector(gravity: Any) -> Optional[Tuple[float, float]]:
 
 def _round_beam(s: Scene, name: str, length: float, elements: int, theory: str, diameter: float, density: float,
                 youngs_modulus: float, poisson_ratio: float, shear_factor: float, **options: Any):
-    """A pinned-pinned beam of circular section (the paper's coupler); ``poisson_ratio`` and
-    ``shear_factor`` go to Timoshenko beams only."""
+    """A beam of circular section (the paper's coupler; FFRF: pinned-pinned frame);
+    ``poisson_ratio`` and ``shear_factor`` go to Timoshenko beams only."""
     kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor} if theory == "timoshenko" else {}
     return s.beam(name, length=length, elements=elements, theory=theory, section=Circular(diameter), density=density,
                   youngs_modulus=youngs_modulus, frame="pinned-pinned", **options, **kw)
@@ -85,7 +85,7 @@ def _round_beam(s: Scene, name: str, length: float, elements: int, theory: str, 
 
 @renamed_parameters(beam="theory")
 def slider_crank(
-    theory: str = "timoshenko",
+    theory: Optional[str] = None,
     elements: int = 1,
     gravity: Any = True,
     omega: float = PAPER["omega"],
@@ -99,6 +99,7 @@ def slider_crank(
     rotary_inertia: Optional[bool] = None,
     damping: float = 0.0,
     strain: str = "linear",
+    formulation: str = "ffrf",
 ) -> Scene:
     """The paper's flexible slider-crank (section 5, Fig. 3; data in DESIGN.md section 3).
 
@@ -111,8 +112,9 @@ def slider_crank(
 
     Parameters
     ----------
-    theory : {"timoshenko", "euler-bernoulli"}
-        Coupler beam theory (deprecated alias: ``beam``).
+    theory : {"timoshenko", "euler-bernoulli"}, optional
+        Coupler beam theory (deprecated alias: ``beam``); default ``"timoshenko"`` (the paper's)
+        for the FFRF coupler, ``"euler-bernoulli"`` (the only one) for the ANCF coupler.
     elements : int
         Number of coupler elements (the paper: 1).
     gravity : bool, float or (2,) sequence
@@ -124,19 +126,25 @@ def slider_crank(
         Coupler rotary inertia (default: the core's default for the theory).
     damping : float
         Coupler stiffness-proportional damping [s] (the paper: none).
+    formulation : {"ffrf", "ancf"}
+        ``"ffrf"`` (default): the paper's linear floating-frame coupler, which this scene
+        reproduces.  ``"ancf"``: the geometrically exact ANCF cable coupler (Euler-Bernoulli):
+        the physically right answer at speed, where the axial force couples with bending.
     strain : {"linear", "nonlinear"}
-        The coupler's strain measure.  Default ``"linear"``: this scene reproduces the paper,
-        whose linear FFRF model has no geometric stiffening.  At the paper's crank speed the
-        coupler's axial force couples with bending and ``strain="nonlinear"`` (the default of
-        :meth:`ukflex.Scene.beam`) is the physically right model; see
+        The FFRF coupler's strain measure.  Default ``"linear"``: this scene reproduces the
+        paper, whose linear FFRF model has no geometric stiffening.  At the paper's crank speed
+        the coupler's axial force couples with bending and ``strain="nonlinear"`` (the default
+        of :meth:`ukflex.Scene.beam`) is the physically right FFRF model; see
         ``docs/geometric-nonlinearity.md``.
 
     Returns
     -------
     Scene
-        Bodies ``crank`` (rigid) and ``coupler`` (beam); ``n = 6 + 3 * elements`` coordinates,
-        6 constraint rows.
+        Bodies ``crank`` (rigid) and ``coupler`` (beam); ``n = 6 + 3 * elements`` coordinates
+        (ANCF: ``3 + 4 (elements + 1)``), 6 constraint rows.
     """
+    if theory is None:
+        theory = "euler-bernoulli" if formulation == "ancf" else "timoshenko"
     L, Lb, d = crank_length, coupler_length, diameter
     area = math.pi * d * d / 4.0
     m_crank = density * area * L
@@ -154,7 +162,8 @@ def slider_crank(
         s, "coupler", Lb, elements, theory, d, density, youngs_modulus, poisson_ratio, shear_factor,
         rotary_inertia=rotary_inertia,
         damping=damping,
-        strain=strain,
+        formulation=formulation,
+        **({"strain": strain} if formulation == "ffrf" else {}),
         position=(L, 0.0),
         angle=0.0,
         velocity=(0.0, L * omega),

@@ -132,7 +132,10 @@ class System:
     ``phi_t(t)`` (m,); ``b(t, q, qd)`` (m,); ``qdd(t, q, qd)`` (n,); ``rhs(t, y)`` (2n,);
     ``multipliers(t, q, qd)`` (m,) with ``M qdd + A^T lam = Q``; ``residuals(t, q, qd)`` ->
     (position, velocity, acceleration), each (m,); ``rank()``; ``beam_shape(body, xi)``;
-    ``kinetic_energy(q, qd)``; ``potential_energy(q)``.
+    ``beam_point(body, xi, q)`` -> columns x, y (world), u, v (displacement in the beam frame:
+    an FFRF beam's floating frame, an ANCF beam's chord frame of the ends), psi, for q (n,) or
+    (nt, n); ``tangent_stiffness(body, q)`` (n_b, n_b); ``kinetic_energy(q, qd)``;
+    ``potential_energy(q)``.
 
     Raises
     ------
@@ -178,6 +181,8 @@ class System:
         self.residuals = core.residuals
         self.rank = core.rank
         self.beam_shape = core.beam_shape
+        self.beam_point = core.beam_point
+        self.tangent_stiffness = core.tangent_stiffness
         self.kinetic_energy = core.kinetic_energy
         self.potential_energy = core.potential_energy
         # Jacobian of rhs, d[qd, qdd]/d[q, qd], shape (2n, 2n): finite differences in Rust (GIL released)
@@ -201,7 +206,6 @@ class System:
         self.body_kind = core.body_kind
         self.body_info = core.body_info
         self.axial_forces = core.axial_forces
-        self.elastic_stiffness = core.elastic_stiffness
 
         self.t0 = float(t0)
         q_guess, qd_guess = core.initial_guess()

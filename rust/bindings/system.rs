@@ -9,7 +9,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use super::{check_time, mat, read_into, to_py, SolverError, Vector};
-use crate::body::BodyKind;
+use crate::body::{ancf_cable, BodyKind};
+use crate::linalg::Banded;
 use crate::correct::{self, CorrectOptions};
 use crate::data::{Data, RankTolerance, Stabilization, SvdBackend};
 use crate::dynamics;
@@ -519,17 +520,32 @@ impl PySystem {
         Ok((PyArray1::from_vec(py, qn), PyArray1::from_vec(py, qdn), d))
     }
 
-    /// Elastic shape of a beam at xi in [0, 1]: (S (2, n_f), N_psi (n_f,)) with
-    /// u_f = S q_f in the beam frame and psi = N_psi q_f.
+    /// Shape of a beam at xi in [0, 1]. FFRF beam: (S (2, n_f), N_psi (n_f,)) with the elastic
+    /// displacement u_f = S q_f in the beam frame and psi = N_psi q_f. ANCF beam:
+    /// (S (2, n_b), S' (2, n_b)) over the body's n_b = 4 (N + 1) coordinates e, with the world
+    /// position r = S e and the slope r' = S' e (d/dx) of the axis point.
     #[allow(clippy::type_complexity)]
-    fn beam_shape<'py>(&self, py: Python<'py>, body: &str, xi: f64) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn beam_shape<'py>(&self, py: Python<'py>, body: &str, xi: f64) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyAny>)> {
         let bi = self.body(body)?;
-        let BodyKind::Beam(beam) = &self.model.bodies[bi].kind else {
-            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
-        };
         if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
             return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {xi}")));
         }
+        let beam = match &self.model.bodies[bi].kind {
+            BodyKind::Beam(beam) => beam,
+            BodyKind::AncfBeam(cable) => {
+                let nb = cable.n_coords();
+                let p = cable.point(xi);
+                let (mut s, mut d) = (vec![0.0; 2 * nb], vec![0.0; 2 * nb]);
+                for a in 0..4 {
+                    for c in 0..2 {
+                        s[c * nb + p.first + 2 * a + c] = p.s[a];
+                        d[c * nb + p.first + 2 * a + c] = p.d[a];
+                    }
+                }
+                return Ok((mat(py, s, 2, nb)?, mat(py, d, 2, nb)?.into_any()));
+            }
+            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam"))),
+        };
         let nf = beam.n_f;
         let ps = beam.point_shape(xi);
         let (mut s, mut npsi) = (vec![0.0; 2 * nf], vec![0.0; nf]);
@@ -538,15 +554,27 @@ impl PySystem {
             s[nf + i] = sv;
             npsi[i] = sp;
         }
-        Ok((mat(py, s, 2, nf)?, PyArray1::from_vec(py, npsi)))
+        Ok((mat(py, s, 2, nf)?, PyArray1::from_vec(py, npsi).into_any()))
     }
 
-    /// Constant elastic blocks of a beam: (M_ff, K_ff), each (n_f, n_f).
+    /// Constant elastic blocks of a beam: (M_ff, K_ff), each (n_f, n_f). ANCF beam: the
+    /// constant mass matrix M and the tangent stiffness at the undeformed initial guess (the
+    /// linear stiffness), each (n_b, n_b) over its n_b = 4 (N + 1) coordinates.
     #[allow(clippy::type_complexity)]
     fn beam_matrices<'py>(&self, py: Python<'py>, body: &str) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
         let bi = self.body(body)?;
-        let BodyKind::Beam(beam) = &self.model.bodies[bi].kind else {
-            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+        let b = &self.model.bodies[bi];
+        let beam = match &b.kind {
+            BodyKind::Beam(beam) => beam,
+            BodyKind::AncfBeam(cable) => {
+                let nb = b.n_coords;
+                let mut m = vec![0.0; nb * nb];
+                cable.dense_block(&Default::default(), &mut |i, j, v| m[i * nb + j] = v);
+                let mut k = Banded::zeros(nb, ancf_cable::HB);
+                cable.add_tangent_stiffness(&self.model.q0[b.offset..b.offset + nb], &mut k);
+                return Ok((mat(py, m, nb, nb)?, mat(py, k.to_dense(), nb, nb)?));
+            }
+            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam"))),
         };
         let nf = beam.n_f;
         Ok((mat(py, beam.m_ff.to_dense(), nf, nf)?, mat(py, beam.k_ff.to_dense(), nf, nf)?))
@@ -568,20 +596,67 @@ impl PySystem {
         Ok(PyArray1::from_vec(py, v))
     }
 
-    /// Tangent stiffness of a beam's elastic forces at q, K_t = -dQ_el/dq_f, shape (n_f, n_f)
-    /// (K_ff for linear strain; plus the geometric stiffness for nonlinear strain).
-    fn elastic_stiffness<'py>(&self, py: Python<'py>, body: &str, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    /// Tangent stiffness -dQ_el/dq_b of a beam's elastic forces at q (n,), shape (n_b, n_b) over
+    /// the body's coordinates: ANCF beam: the analytic K_t = d2U/dq_b2 (undamped); FFRF beam:
+    /// the elastic block, K_ff plus, with nonlinear strain, the geometric and second-order axial
+    /// stiffness of its averaged axial strain.
+    fn tangent_stiffness<'py>(&self, py: Python<'py>, body: &str, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let bi = self.body(body)?;
         let b = &self.model.bodies[bi];
-        let BodyKind::Beam(beam) = &b.kind else {
-            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
-        };
-        let nf = beam.n_f;
+        let nb = b.n_coords;
         let mut qv = vec![0.0; self.model.n];
         read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
-        let mut k = vec![0.0; nf * nf];
-        beam.elastic_tangent(&qv[b.elastic_range()], &mut |i, j, v| k[i * nf + j] += v);
-        mat(py, k, nf, nf)
+        let k = match &b.kind {
+            BodyKind::AncfBeam(cable) => {
+                let mut k = Banded::zeros(nb, ancf_cable::HB);
+                cable.add_tangent_stiffness(&qv[b.offset..b.offset + nb], &mut k);
+                k.to_dense()
+            }
+            BodyKind::Beam(beam) => {
+                let mut k = vec![0.0; nb * nb];
+                beam.elastic_tangent(&qv[b.elastic_range()], &mut |i, j, v| k[(3 + i) * nb + 3 + j] += v);
+                k
+            }
+            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam"))),
+        };
+        mat(py, k, nb, nb)
+    }
+
+    /// Axis point `xi` of beam `body` at the states `q`: an array (5,) for q of shape (n,), or
+    /// (nt, 5) for q of shape (nt, n), with columns x, y (world position), u, v (displacement
+    /// in the beam frame from the undeformed (xi L, 0)) and psi (section rotation relative to
+    /// that frame). The beam frame is an FFRF beam's floating frame (pinned-pinned: the chord
+    /// of the ends) and an ANCF beam's chord frame of the ends, so the two compare one to one.
+    fn beam_point<'py>(&self, py: Python<'py>, body: &str, xi: f64, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let bi = self.body(body)?;
+        if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
+            return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {xi}")));
+        }
+        let b = &self.model.bodies[bi];
+        if b.beam_point(xi, &self.model.q0).is_none() {
+            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+        }
+        let n = self.model.n;
+        let arr = py.import("numpy")?.call_method1("asarray", (q, "float64"))?.cast_into::<numpy::PyArrayDyn<f64>>()
+            .map_err(|_| PyValueError::new_err("q must be an array of floats"))?;
+        let view = arr.readonly();
+        let a = view.as_array();
+        let (rows, one) = match a.shape() {
+            [m] if *m == n => (1, true),
+            [nt, m] if *m == n => (*nt, false),
+            other => return Err(PyValueError::new_err(format!("q must have shape (n,) or (nt, n) with n = {n}, got {other:?}"))),
+        };
+        let flat: Vec<f64> = a.iter().copied().collect();
+        crate::error::check_finite("q", &flat).map_err(to_py)?;
+        let mut out = Vec::with_capacity(5 * rows);
+        for k in 0..rows {
+            out.extend_from_slice(&b.beam_point(xi, &flat[k * n..(k + 1) * n]).expect("checked: a beam"));
+        }
+        if one {
+            Ok(PyArray1::from_vec(py, out).into_any())
+        } else {
+            Ok(mat(py, out, rows, 5)?.into_any())
+        }
     }
 
     /// Kinetic energy 1/2 qd^T M(q) qd (from the body blocks).
@@ -600,7 +675,7 @@ impl PySystem {
         })
     }
 
-    /// Kind of a body: "rigid", "beam" or "point_mass".
+    /// Kind of a body: "rigid", "beam" (FFRF), "ancf_beam" or "point_mass".
     fn body_kind(&self, body: &str) -> PyResult<&'static str> {
         Ok(self.model.bodies[self.body(body)?].kind_name())
     }
@@ -612,8 +687,10 @@ impl PySystem {
     }
 
     /// Properties of a body as the core derived them: kind, mass, n_coords, n_f, and for
-    /// beams length, elements, element_length, theory, frame, area, second_moment, density,
-    /// youngs_modulus, shear_stiffness (k G), rotary_inertia, damping, shear_parameter (phi).
+    /// beams formulation ("ffrf", "ancf"), length, elements, element_length, theory, area,
+    /// second_moment, density, youngs_modulus, rotary_inertia, damping; FFRF beams also frame,
+    /// shear_stiffness (k G), shear_parameter (phi); ANCF beams axial_quadrature and
+    /// bending_quadrature (the element's integration rules).
     fn body_info<'py>(&self, py: Python<'py>, body: &str) -> PyResult<Bound<'py, PyDict>> {
         let b = &self.model.bodies[self.body(body)?];
         let d = PyDict::new(py);
@@ -628,6 +705,7 @@ impl PySystem {
             }
             BodyKind::Beam(beam) => {
                 let sec = &beam.section;
+                d.set_item("formulation", "ffrf")?;
                 d.set_item("length", beam.length)?;
                 d.set_item("elements", beam.elements)?;
                 d.set_item("element_length", beam.element_length)?;
@@ -651,6 +729,22 @@ impl PySystem {
                     crate::description::Strain::Linear => "linear",
                     crate::description::Strain::Nonlinear => "nonlinear",
                 })?;
+            }
+            BodyKind::AncfBeam(cable) => {
+                let sec = &cable.section;
+                d.set_item("formulation", "ancf")?;
+                d.set_item("length", cable.length)?;
+                d.set_item("elements", cable.elements)?;
+                d.set_item("element_length", cable.element_length)?;
+                d.set_item("theory", "euler-bernoulli")?;
+                d.set_item("area", sec.area)?;
+                d.set_item("second_moment", sec.second_moment)?;
+                d.set_item("density", sec.density)?;
+                d.set_item("youngs_modulus", sec.youngs_modulus)?;
+                d.set_item("rotary_inertia", false)?;
+                d.set_item("damping", cable.damping)?;
+                d.set_item("axial_quadrature", "lobatto-3")?;
+                d.set_item("bending_quadrature", "gauss-2")?;
             }
             BodyKind::PointMass(_) => {}
         }

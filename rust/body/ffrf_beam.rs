@@ -3,7 +3,7 @@
 //! `S_tilde`, `M_ff`, `K_ff` and the Cholesky factor of `M_ff` -- is integrated here once, by
 //! Gauss quadrature of the element shape functions (paper eqs. 6-9, 23, 26-33).
 
-use super::{add_frame_gravity, add_frame_point_jacobian, finite_vec2, frame_mass_block, frame_mass_moment, frame_point_state, InitialState, MarkerState};
+use super::{add_frame_gravity, add_frame_point_jacobian, axis_marker_xi, finite_vec2, frame_mass_block, frame_mass_moment, frame_point_state, InitialState, MarkerState};
 use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions, SectionDesc, Strain};
 use crate::error::{check_finite_item, non_negative, positive, Error, Result};
 use crate::linalg::{cholesky3, solve_lower3, solve_upper3, Banded, BandedCholesky, GAUSS4};
@@ -224,47 +224,56 @@ pub fn elastic_dofs(elements: usize, frame: ReferenceConditions) -> usize {
 /// Largest number of elements of one beam.
 pub const MAX_ELEMENTS: usize = 4096;
 
+/// Validate what every beam formulation reads from its description -- length, element count,
+/// material, section, shear data (checked whenever given, required for Timoshenko) and damping
+/// -- and derive its section. Returns `(length, section)`.
+pub fn beam_section(d: &BeamDesc, item: &str) -> Result<(f64, BeamSection)> {
+    let length = positive(item, "length", d.length)?;
+    if d.elements == 0 || d.elements > MAX_ELEMENTS {
+        return Err(Error::invalid(item, format!("elements must be in 1..={MAX_ELEMENTS}, got {}", d.elements)));
+    }
+    let density = positive(item, "density", d.density)?;
+    let e = positive(item, "youngs_modulus", d.youngs_modulus)?;
+    let (area, second_moment) = section_properties(item, &d.section)?;
+    // shear data: validated whenever given, required by Timoshenko
+    let g = match (d.shear_modulus, d.poisson_ratio) {
+        (Some(_), Some(_)) => return Err(Error::invalid(item, "give either poisson_ratio or shear_modulus, not both")),
+        (Some(g), None) => Some(positive(item, "shear_modulus", g)?),
+        (None, Some(nu)) => {
+            if !nu.is_finite() || nu <= -1.0 || nu >= 0.5 {
+                return Err(Error::invalid(item, format!("poisson_ratio must be in (-1, 0.5), got {nu}")));
+            }
+            Some(e / (2.0 * (1.0 + nu)))
+        }
+        (None, None) => None,
+    };
+    let k = d.shear_factor.map(|k| positive(item, "shear_factor", k)).transpose()?;
+    let shear_stiffness = match d.theory {
+        BeamTheory::EulerBernoulli => 0.0,
+        BeamTheory::Timoshenko => {
+            let g = g.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs poisson_ratio or shear_modulus"))?;
+            let k = k.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs shear_factor"))?;
+            k * g
+        }
+    };
+    non_negative(item, "damping", d.damping)?;
+    let rotary_inertia = d.rotary_inertia.unwrap_or(d.theory == BeamTheory::Timoshenko);
+    let section = BeamSection {
+        area,
+        second_moment,
+        density,
+        youngs_modulus: e,
+        shear_stiffness,
+        rotary_inertia,
+        theory: d.theory,
+    };
+    Ok((length, section))
+}
+
 impl Beam {
     pub fn from_desc(d: &BeamDesc, item: &str) -> Result<Beam> {
-        let length = positive(item, "length", d.length)?;
-        if d.elements == 0 || d.elements > MAX_ELEMENTS {
-            return Err(Error::invalid(item, format!("elements must be in 1..={MAX_ELEMENTS}, got {}", d.elements)));
-        }
-        let density = positive(item, "density", d.density)?;
-        let e = positive(item, "youngs_modulus", d.youngs_modulus)?;
-        let (area, second_moment) = section_properties(item, &d.section)?;
-        // shear data: validated whenever given, required by Timoshenko
-        let g = match (d.shear_modulus, d.poisson_ratio) {
-            (Some(_), Some(_)) => return Err(Error::invalid(item, "give either poisson_ratio or shear_modulus, not both")),
-            (Some(g), None) => Some(positive(item, "shear_modulus", g)?),
-            (None, Some(nu)) => {
-                if !nu.is_finite() || nu <= -1.0 || nu >= 0.5 {
-                    return Err(Error::invalid(item, format!("poisson_ratio must be in (-1, 0.5), got {nu}")));
-                }
-                Some(e / (2.0 * (1.0 + nu)))
-            }
-            (None, None) => None,
-        };
-        let k = d.shear_factor.map(|k| positive(item, "shear_factor", k)).transpose()?;
-        let shear_stiffness = match d.theory {
-            BeamTheory::EulerBernoulli => 0.0,
-            BeamTheory::Timoshenko => {
-                let g = g.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs poisson_ratio or shear_modulus"))?;
-                let k = k.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs shear_factor"))?;
-                k * g
-            }
-        };
-        non_negative(item, "damping", d.damping)?;
-        let rotary_inertia = d.rotary_inertia.unwrap_or(d.theory == BeamTheory::Timoshenko);
-        let section = BeamSection {
-            area,
-            second_moment,
-            density,
-            youngs_modulus: e,
-            shear_stiffness,
-            rotary_inertia,
-            theory: d.theory,
-        };
+        let (length, section) = beam_section(d, item)?;
+        let (density, area, second_moment, rotary_inertia) = (section.density, section.area, section.second_moment, section.rotary_inertia);
         let n_el = d.elements;
         let l = length / n_el as f64;
         let n_nodal = 3 * (n_el + 1);
@@ -356,7 +365,7 @@ impl Beam {
             k_ff,
             l_ff,
             strain: d.strain,
-            eal: e * area * l,
+            eal: section.youngs_modulus * section.area * l,
             g_el,
         })
     }
@@ -781,16 +790,7 @@ impl Beam {
 
     /// A marker on a beam is an axis point `xi` in [0, 1].
     pub fn marker_shape(&self, md: &MarkerDesc, body: &str, item: &str) -> Result<PointShape> {
-        if md.point.is_some() {
-            return Err(Error::invalid(item, format!("a marker on beam '{body}' is given by xi in [0, 1], not by a point")));
-        }
-        let Some(xi) = md.xi else {
-            return Err(Error::invalid(item, format!("a marker on beam '{body}' needs xi in [0, 1]")));
-        };
-        if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
-            return Err(Error::invalid(item, format!("marker xi on beam '{body}' must lie in [0, 1], got {xi}")));
-        }
-        Ok(self.point_shape(xi))
+        Ok(self.point_shape(axis_marker_xi(md, body, item)?))
     }
 }
 

@@ -8,15 +8,17 @@
 //! only dispatches; `dynamics.rs` only loops over bodies. Adding a kind = one file here plus
 //! one arm per `match` below (the compiler lists them).
 
+pub mod ancf_cable;
 pub mod ffrf_beam;
 pub mod point_mass;
 pub mod rigid;
 
+pub use ancf_cable::{AncfCable, AncfCableData, CablePoint};
 pub use ffrf_beam::{Beam, BeamData, PointShape};
 pub use point_mass::{PointMass, PointMassData};
 pub use rigid::{Rigid, RigidData};
 
-use crate::description::{BodyDesc, MarkerDesc};
+use crate::description::{BeamFormulation, BodyDesc, MarkerDesc};
 use crate::error::{check_finite_item, Error, Result};
 
 /// The closed set of body kinds (a scene has few bodies; the variants stay unboxed so that a
@@ -27,6 +29,7 @@ pub enum BodyKind {
     Rigid(Rigid),
     Beam(Beam),
     PointMass(PointMass),
+    AncfBeam(AncfCable),
 }
 
 /// Per-body workspace, one variant per kind (sized once in `Data::new`).
@@ -36,6 +39,7 @@ pub enum BodyData {
     Rigid(RigidData),
     Beam(BeamData),
     PointMass(PointMassData),
+    AncfBeam(AncfCableData),
 }
 
 #[derive(Debug, Clone)]
@@ -68,6 +72,11 @@ impl Body {
                 let init = k.initial_state(r, &item)?;
                 (BodyKind::Rigid(k), init)
             }
+            BodyDesc::Beam(b) if b.formulation == BeamFormulation::Ancf => {
+                let k = AncfCable::from_desc(b, &item)?;
+                let init = k.initial_state(b, &item)?;
+                (BodyKind::AncfBeam(k), init)
+            }
             BodyDesc::Beam(b) => {
                 let k = Beam::from_desc(b, &item)?;
                 let init = k.initial_state(b, &item)?;
@@ -85,20 +94,23 @@ impl Body {
         Ok((Body { name, offset, n_coords: init.q.len(), kind }, init))
     }
 
-    /// The kind's name as in the description (`"rigid"`, `"beam"`, `"point_mass"`).
+    /// The kind's name: as in the description (`"rigid"`, `"beam"`, `"point_mass"`), and
+    /// `"ancf_beam"` for a beam with formulation `ancf`.
     pub fn kind_name(&self) -> &'static str {
         match &self.kind {
             BodyKind::Rigid(_) => "rigid",
             BodyKind::Beam(_) => "beam",
             BodyKind::PointMass(_) => "point_mass",
+            BodyKind::AncfBeam(_) => "ancf_beam",
         }
     }
 
-    /// Coordinates `q[elastic_range]` that describe deformation (empty for rigid kinds).
+    /// Coordinates `q[elastic_range]` that describe deformation alone (empty for rigid kinds,
+    /// and for an ANCF cable, whose nodal coordinates carry its motion and deformation together).
     pub fn elastic_range(&self) -> std::ops::Range<usize> {
         match &self.kind {
             BodyKind::Beam(_) => self.offset + 3..self.offset + self.n_coords,
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) => self.offset..self.offset,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::AncfBeam(_) => self.offset..self.offset,
         }
     }
 
@@ -112,6 +124,7 @@ impl Body {
             BodyKind::Rigid(k) => k.mass,
             BodyKind::Beam(k) => k.mass,
             BodyKind::PointMass(k) => k.mass,
+            BodyKind::AncfBeam(k) => k.mass,
         }
     }
 
@@ -120,6 +133,7 @@ impl Body {
             BodyKind::Rigid(k) => BodyData::Rigid(k.new_data()),
             BodyKind::Beam(k) => BodyData::Beam(k.new_data()),
             BodyKind::PointMass(k) => BodyData::PointMass(k.new_data()),
+            BodyKind::AncfBeam(k) => BodyData::AncfBeam(k.new_data()),
         }
     }
 
@@ -138,6 +152,7 @@ impl Body {
             (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
+            (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -149,6 +164,7 @@ impl Body {
             (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.factor(d),
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.factor(d),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.factor(d),
+            (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.factor(d),
             _ => unreachable!("body data of another kind"),
         };
         if ok {
@@ -165,6 +181,7 @@ impl Body {
             (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.finv(d, v),
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.finv(d, v),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.finv(d, v),
+            (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.finv(d, v),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -176,6 +193,7 @@ impl Body {
             (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.finvt(d, v),
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.finvt(d, v),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.finvt(d, v),
+            (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.finvt(d, v),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -187,6 +205,7 @@ impl Body {
             (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.dense_block(d, put),
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.dense_block(d, put),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.dense_block(d, put),
+            (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.dense_block(d, put),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -202,6 +221,13 @@ impl Body {
                     b.elastic_tangent(qf, &mut |i, j, v| c(3 + i, 3 + j, b.damping * v));
                 }
             }
+            BodyKind::AncfBeam(b) => {
+                let qb = self.seg(q);
+                b.visit_element_matrices(qb, false, k);
+                if b.damping > 0.0 {
+                    b.visit_element_matrices(qb, true, c);
+                }
+            }
             BodyKind::Rigid(_) | BodyKind::PointMass(_) => {}
         }
     }
@@ -213,6 +239,7 @@ impl Body {
             (BodyKind::Rigid(k), BodyData::Rigid(d)) => k.kinetic_energy(d, qdb),
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.kinetic_energy(d, qdb),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.kinetic_energy(d, qdb),
+            (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.kinetic_energy(d, qdb),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -221,6 +248,7 @@ impl Body {
     pub fn strain_energy(&self, q: &[f64]) -> f64 {
         match &self.kind {
             BodyKind::Beam(k) => k.strain_energy(self.seg(q)),
+            BodyKind::AncfBeam(k) => k.strain_energy(self.seg(q)),
             BodyKind::Rigid(_) | BodyKind::PointMass(_) => 0.0,
         }
     }
@@ -232,6 +260,7 @@ impl Body {
             BodyKind::Rigid(k) => k.mass_moment(qb),
             BodyKind::Beam(k) => k.mass_moment(qb),
             BodyKind::PointMass(k) => k.mass_moment(qb),
+            BodyKind::AncfBeam(k) => k.mass_moment(qb),
         };
         -(g[0] * r[0] + g[1] * r[1])
     }
@@ -241,12 +270,36 @@ impl Body {
         let shape = match &self.kind {
             BodyKind::Rigid(_) => MarkerShape::Rigid(rigid::marker_point(md, &self.name, item)?),
             BodyKind::Beam(k) => MarkerShape::Beam(k.marker_shape(md, &self.name, item)?),
+            BodyKind::AncfBeam(k) => MarkerShape::Cable(k.marker_shape(md, &self.name, item)?),
             BodyKind::PointMass(_) => {
                 point_mass::check_marker(md, &self.name, item)?;
                 MarkerShape::Particle
             }
         };
         Ok(Marker { body: Some(index), angle: md.angle, shape })
+    }
+
+    /// `[x, y, u, v, psi]` of the axis point `xi` of a beam at `q` (inspection, allocates):
+    /// world position, displacement in the beam frame from the undeformed `(xi L, 0)` and the
+    /// section rotation relative to that frame. The frame is the floating frame of an FFRF
+    /// beam (for the pinned-pinned frame: the chord of the ends) and the chord frame of the
+    /// ends of an ANCF cable, so that both compare one to one. `None` for other kinds.
+    pub fn beam_point(&self, xi: f64, q: &[f64]) -> Option<[f64; 5]> {
+        let qb = self.seg(q);
+        match &self.kind {
+            BodyKind::Beam(k) => {
+                let ps = k.point_shape(xi);
+                let ms = ffrf_beam::marker_state(&ps, 0.0, qb, qb);
+                let (mut u, mut v) = (0.0, 0.0);
+                for &(i, su, sv, _) in &ps.entries {
+                    u += su * qb[3 + i];
+                    v += sv * qb[3 + i];
+                }
+                Some([ms.r[0], ms.r[1], u, v, ms.phi - qb[2]])
+            }
+            BodyKind::AncfBeam(k) => Some(k.chord_displacement(xi, qb)),
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) => None,
+        }
     }
 }
 
@@ -261,6 +314,8 @@ pub enum MarkerShape {
     Beam(PointShape),
     /// The particle itself (a point mass has no orientation).
     Particle,
+    /// An axis point of an ANCF cable.
+    Cable(CablePoint),
 }
 
 /// A point and a frame attached to a body (`body == None` for the ground).
@@ -291,6 +346,9 @@ pub struct MarkerState {
     pub r_theta: [f64; 2],
     /// cos and sin of the body angle.
     pub cs: [f64; 2],
+    /// `d phi / d r'` for a marker whose angle follows a slope `r'` (ANCF cable:
+    /// `(-r'_y, r'_x) / |r'|^2`); zero for the other kinds.
+    pub dphi_dslope: [f64; 2],
 }
 
 impl Marker {
@@ -318,6 +376,7 @@ impl Marker {
             MarkerShape::Rigid(p) => rigid::marker_state(p, self.angle, qb, qdb),
             MarkerShape::Beam(ps) => ffrf_beam::marker_state(ps, self.angle, qb, qdb),
             MarkerShape::Particle => point_mass::marker_state(self.angle, qb, qdb),
+            MarkerShape::Cable(p) => ancf_cable::marker_state(p, self.angle, qb, qdb),
             MarkerShape::Ground(_) => unreachable!("ground marker on a body"),
         }
     }
@@ -332,19 +391,21 @@ impl Marker {
             MarkerShape::Rigid(_) => rigid::add_point_jacobian(ms, w, rb),
             MarkerShape::Beam(ps) => ffrf_beam::add_point_jacobian(ps, ms, w, rb),
             MarkerShape::Particle => point_mass::add_point_jacobian(w, rb),
+            MarkerShape::Cable(p) => ancf_cable::add_point_jacobian(p, w, rb),
             MarkerShape::Ground(_) => {}
         }
     }
 
-    /// `row += w . d phi / d q`.
+    /// `row += w . d phi / d q` (`ms`: this marker's state at the same `q`).
     #[inline]
-    pub fn add_angle_jacobian(&self, bodies: &[Body], w: f64, row: &mut [f64]) {
+    pub fn add_angle_jacobian(&self, bodies: &[Body], ms: &MarkerState, w: f64, row: &mut [f64]) {
         let Some(bi) = self.body else { return };
         let body = &bodies[bi];
         let rb = &mut row[body.offset..body.offset + body.n_coords];
         match &self.shape {
             MarkerShape::Rigid(_) => rigid::add_angle_jacobian(w, rb),
             MarkerShape::Beam(ps) => ffrf_beam::add_angle_jacobian(ps, w, rb),
+            MarkerShape::Cable(p) => ancf_cable::add_angle_jacobian(p, ms, w, rb),
             MarkerShape::Particle | MarkerShape::Ground(_) => {}
         }
     }
@@ -370,6 +431,7 @@ pub(crate) fn frame_point_state(pl: [f64; 2], vl: [f64; 2], phi_local: f64, omeg
         h_phi: 0.0,
         r_theta,
         cs: [c, s],
+        dphi_dslope: [0.0; 2],
     }
 }
 
@@ -403,6 +465,20 @@ pub(crate) fn add_frame_gravity(mass: f64, m_rr: &[[f64; 3]; 3], g: [f64; 2], f:
 pub(crate) fn frame_mass_moment(mass: f64, sig: [f64; 2], q: &[f64]) -> [f64; 2] {
     let (s, c) = q[2].sin_cos();
     [mass * q[0] + c * sig[0] - s * sig[1], mass * q[1] + s * sig[0] + c * sig[1]]
+}
+
+/// The abscissa `xi` in [0, 1] of a marker on a beam axis (both beam formulations).
+pub(crate) fn axis_marker_xi(md: &MarkerDesc, body: &str, item: &str) -> Result<f64> {
+    if md.point.is_some() {
+        return Err(Error::invalid(item, format!("a marker on beam '{body}' is given by xi in [0, 1], not by a point")));
+    }
+    let Some(xi) = md.xi else {
+        return Err(Error::invalid(item, format!("a marker on beam '{body}' needs xi in [0, 1]")));
+    };
+    if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
+        return Err(Error::invalid(item, format!("marker xi on beam '{body}' must lie in [0, 1], got {xi}")));
+    }
+    Ok(xi)
 }
 
 pub(crate) fn finite_vec2(item: &str, what: &str, v: [f64; 2]) -> Result<[f64; 2]> {

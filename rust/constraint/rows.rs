@@ -37,7 +37,7 @@ pub fn point_on_line(bodies: &[Body], p: &Marker, l: &Marker, sp: &MarkerState, 
     let row = &mut out.jac[k * n_cols..(k + 1) * n_cols];
     p.add_point_jacobian(bodies, sp, nv, row);
     l.add_point_jacobian(bodies, sl, [-nv[0], -nv[1]], row);
-    l.add_angle_jacobian(bodies, jnd, row);
+    l.add_angle_jacobian(bodies, sl, jnd, row);
     out.phi_t[k] = 0.0;
     let hd = [sp.h[0] - sl.h[0], sp.h[1] - sl.h[1]];
     out.gamma[k] = -(nv[0] * hd[0] + nv[1] * hd[1] + 2.0 * sl.omega * (jn[0] * dd[0] + jn[1] * dd[1]) + sl.h_phi * jnd
@@ -51,8 +51,8 @@ pub fn angle(bodies: &[Body], a: &Marker, b: &Marker, sa: &MarkerState, sb: &Mar
         phi[k] = sa.phi - sb.phi - f.0;
     }
     let row = &mut out.jac[k * n_cols..(k + 1) * n_cols];
-    a.add_angle_jacobian(bodies, 1.0, row);
-    b.add_angle_jacobian(bodies, -1.0, row);
+    a.add_angle_jacobian(bodies, sa, 1.0, row);
+    b.add_angle_jacobian(bodies, sb, -1.0, row);
     out.phi_t[k] = -f.1;
     out.gamma[k] = -(sa.h_phi - sb.h_phi) + f.2; // -Phi_tt = f''
 }

@@ -37,6 +37,11 @@ pub fn paper_scene(theory: &str, elements: usize, gravity: bool) -> String {
     )
 }
 
+/// The paper's slider-crank with the coupler as an ANCF cable of `elements` elements.
+pub fn ancf_paper_scene(elements: usize, gravity: bool) -> String {
+    paper_scene("euler-bernoulli", elements, gravity).replace(r#""kind": "beam","#, r#""kind": "beam", "formulation": "ancf","#)
+}
+
 /// A scene that uses every joint, driver and force kind on rigid bodies and beams (not
 /// consistent: for term-by-term checks at random states).
 pub fn every_kind_scene() -> String {
@@ -89,6 +94,17 @@ pub fn random_state(model: &Model, rng: &mut Lcg) -> (Vec<f64>, Vec<f64>) {
     let (mut q, mut qd) = (vec![0.0; model.n], vec![0.0; model.n]);
     for b in &model.bodies {
         let o = b.offset;
+        if let ukflex::body::BodyKind::AncfBeam(_) = b.kind {
+            // nodal positions and slopes: the straight initial guess, moved and deformed a
+            // little (slopes stay near their direction: marker angles are measured from it)
+            for j in 0..b.n_coords {
+                let i = o + j;
+                let slope = j % 4 >= 2;
+                q[i] = model.q0[i] + if slope { 0.05 } else { 0.02 } * rng.next();
+                qd[i] = if slope { 5.0 } else { 2.0 } * rng.next();
+            }
+            continue;
+        }
         let elastic = b.elastic_range();
         for j in 0..b.n_coords {
             let i = o + j;
@@ -132,6 +148,41 @@ pub fn point_mass_scene() -> String {
       "forces": [
         {"kind": "point_force", "point": {"body": "bob"}, "force": [1.0, 0.5]},
         {"kind": "spring_damper", "a": {"body": "bead"}, "b": {"body": "ground", "point": [1.0, 0.0]}, "stiffness": 50.0, "damping": 0.5}]
+    }"#
+    .to_string()
+}
+
+/// ANCF cables with every joint, driver and force kind attached to cable markers (as point, as
+/// line, as oriented frame), gravity and strain-rate damping (not consistent: for term-by-term
+/// checks at random states).
+pub fn ancf_scene() -> String {
+    r#"{"gravity": [0.4, -9.81],
+      "bodies": [
+        {"name": "crank", "kind": "rigid", "mass": 0.3, "inertia": 0.002, "com": [0.05, 0.01]},
+        {"name": "cable", "kind": "beam", "formulation": "ancf", "length": 0.4, "elements": 3, "theory": "euler-bernoulli",
+         "density": 7800, "youngs_modulus": 2e11, "section": {"shape": "circular", "diameter": 0.01}, "frame": "pinned-pinned",
+         "damping": 1e-4, "position": [0.1, 0.0], "angle": 0.2, "velocity": [0.1, 0.3], "angular_velocity": 1.5},
+        {"name": "slider", "kind": "rigid", "mass": 0.5, "inertia": 0.001, "position": [0.3, 0.1]},
+        {"name": "rope", "kind": "beam", "formulation": "ancf", "length": 0.3, "elements": 2, "theory": "euler-bernoulli",
+         "density": 2700, "youngs_modulus": 7e10, "section": {"shape": "rectangular", "width": 0.01, "height": 0.004},
+         "frame": "pinned-pinned", "position": [0.3, 0.3], "angle": 2.5},
+        {"name": "bob", "kind": "point_mass", "mass": 0.2, "position": [0.1, 0.5]}],
+      "joints": [
+        {"kind": "revolute", "a": {"body": "ground", "point": [0.0, 0.0]}, "b": {"body": "crank", "point": [0.0, 0.0]}},
+        {"kind": "revolute", "a": {"body": "crank", "point": [0.1, 0.0]}, "b": {"body": "cable", "xi": 0.0}},
+        {"kind": "point_on_line", "point": {"body": "cable", "xi": 1.0}, "line": {"body": "ground", "point": [0.0, 0.02], "angle": 0.3}},
+        {"kind": "prismatic", "a": {"body": "slider", "point": [0.0, 0.0]}, "b": {"body": "cable", "xi": 0.5, "angle": 0.1}},
+        {"kind": "weld", "a": {"body": "rope", "xi": 0.0, "angle": 0.2}, "b": {"body": "slider", "point": [0.01, 0.0]}},
+        {"kind": "point_on_line", "point": {"body": "bob"}, "line": {"body": "rope", "xi": 0.7, "angle": -0.4}},
+        {"kind": "distance", "a": {"body": "rope", "xi": 1.0}, "b": {"body": "bob"}, "length": 0.1},
+        {"kind": "weld", "a": {"body": "cable", "xi": 0.25}, "b": {"body": "rope", "xi": 0.4}}],
+      "drivers": [
+        {"kind": "angle", "a": {"body": "cable", "xi": 0.6}, "b": {"body": "crank", "angle": 0.1}, "motion": {"kind": "harmonic", "offset": 0.1, "amplitude": 0.5, "frequency": 7.0}},
+        {"kind": "coordinate", "point": {"body": "rope", "xi": 0.5}, "axis": "y", "motion": {"kind": "polynomial", "coefficients": [0.1, 0.2, -0.3]}}],
+      "forces": [
+        {"kind": "point_force", "point": {"body": "cable", "xi": 0.3}, "force": [1.0, -2.0]},
+        {"kind": "torque", "frame": {"body": "rope", "xi": 1.0}, "torque": 0.4},
+        {"kind": "spring_damper", "a": {"body": "cable", "xi": 0.8}, "b": {"body": "ground", "point": [0.5, 0.2]}, "stiffness": 300.0, "damping": 2.0}]
     }"#
     .to_string()
 }

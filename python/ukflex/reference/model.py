@@ -18,6 +18,10 @@ core (which precomputes body-level inertia shape integrals):
 * ``K_ff`` is assembled element by element from the strain energy (paper eq. 8) by quadrature
   of the derivatives of the shape functions (6)-(7).
 
+ANCF cables (beams with ``"formulation": "ancf"``) come from :mod:`.ancf` (element by element at
+every call; constant mass matrix, no velocity terms); their marker angles follow the tangent, so
+the angle rows of the constraints carry its velocity term ``h_phi``.
+
 Pure NumPy; it never imports ``ukflex._core``.
 """
 from __future__ import annotations
@@ -27,6 +31,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from . import ancf as _ancf
 
 __all__ = [
     "ReferenceModel",
@@ -309,6 +315,51 @@ class _Beam:
         return Nv[0] @ P, Np[0] @ P
 
 
+@dataclass
+class _Cable:
+    """Planar ANCF cable: node ``j`` carries ``[x_j, y_j, x'_j, y'_j]`` (see :mod:`.ancf`)."""
+    name: str
+    offset: int
+    length: float
+    elements: int
+    rho_a: float
+    EA: float
+    EI: float
+    damping: float
+    angle0: float
+    q0: np.ndarray
+    qd0: np.ndarray
+    kind: str = "ancf"
+    n_f: int = 0
+    n: int = 0
+    l: float = 0.0
+    M_body: np.ndarray = field(default=None)
+
+    def setup(self):
+        N = self.elements
+        self.l = self.length / N
+        self.n = 4 * (N + 1)
+        me = _ancf.element_mass(self.rho_a, self.l)
+        self.M_body = np.zeros((self.n, self.n))
+        for k in range(N):
+            self.M_body[4 * k:4 * k + 8, 4 * k:4 * k + 8] += me
+
+    def element(self, xi):
+        """(element k, local s) of the axis point ``x = xi * length``."""
+        if not (0.0 <= xi <= 1.0):
+            raise ModelError(f"beam {self.name!r}: xi={xi} outside [0, 1]")
+        k = min(int(xi * self.elements), self.elements - 1)
+        return k, xi * self.elements - k
+
+    def gravity_force(self, g):
+        """Constant generalized gravity force (n,)."""
+        Q = np.zeros(self.n)
+        fe = _ancf.element_gravity(self.rho_a, self.l, g)
+        for k in range(self.elements):
+            Q[4 * k:4 * k + 8] += fe
+        return Q
+
+
 # ----------------------------------------------------------------------------------------
 # Markers, motions
 # ----------------------------------------------------------------------------------------
@@ -352,6 +403,42 @@ class _Marker:
         J[:, o + 2] = Ath @ u
         r = R + Arot @ u
         return r, J, phi, Jp, J @ qd, Jp @ qd, av
+
+
+class _CableMarker:
+    """A marker on an ANCF cable: ``r = S e`` (``a_v = 0``), angle ``angle + angle0 +
+    atan2(t0 x r', t0 . r')`` measured from the cable's initial direction ``t0``."""
+
+    def __init__(self, body, xi, angle):
+        self.body, self.angle = body, float(angle)
+        k, s = body.element(float(xi))
+        self.cols = slice(body.offset + 4 * k, body.offset + 4 * k + 8)
+        self.S, self.Sx = _ancf.hermite(s, body.l), _ancf.hermite(s, body.l, 1)
+        self.t0 = np.array([math.cos(body.angle0), math.sin(body.angle0)])
+
+    def _slope(self, q, qd):
+        t, td = self.Sx @ q[self.cols], self.Sx @ qd[self.cols]
+        return t, td, t @ t
+
+    def kin(self, q, qd, n):
+        """Same tuple as :meth:`_Marker.kin`."""
+        J = np.zeros((2, n))
+        J[:, self.cols] = self.S
+        t, td, g = self._slope(q, qd)
+        phi = self.angle + self.body.angle0 + math.atan2(self.t0[0] * t[1] - self.t0[1] * t[0], self.t0 @ t)
+        Jp = np.zeros(n)
+        Jp[self.cols] = (t[0] * self.Sx[1] - t[1] * self.Sx[0]) / g
+        return J[:, self.cols] @ q[self.cols], J, phi, Jp, J @ qd, Jp @ qd, np.zeros(2)
+
+    def phi_velocity_term(self, q, qd):
+        """``h_phi`` with ``phi_dd = J_phi qdd + h_phi``: ``d/dt (t x t_dot / |t|^2)`` without ``t_dd``."""
+        t, td, g = self._slope(q, qd)
+        return -2.0 * (t @ td) * (t[0] * td[1] - t[1] * td[0]) / g**2
+
+
+def _phi_velocity_term(marker, q, qd):
+    """Velocity term of a marker's angular acceleration (non-zero only on cables)."""
+    return marker.phi_velocity_term(q, qd) if isinstance(marker, _CableMarker) else 0.0
 
 
 class _Motion:
@@ -434,6 +521,17 @@ class ReferenceModel:
                            q0=np.r_[_vec2(bd.get("position")), float(bd.get("angle", 0.0))],
                            qd0=np.r_[_vec2(bd.get("velocity")),
                                      float(bd.get("angular_velocity", 0.0))])
+            elif kind == "beam" and bd.get("formulation", "ffrf") == "ancf":
+                if bd.get("theory") != "euler-bernoulli":
+                    raise ModelError(f"beam {name!r}: the ANCF cable is Euler-Bernoulli")
+                a, I = section_properties(bd["section"])
+                E, rho = float(bd["youngs_modulus"]), float(bd["density"])
+                b = _Cable(name=name, offset=off, length=float(bd["length"]), elements=int(bd.get("elements", 1)),
+                           rho_a=rho * a, EA=E * a, EI=E * I, damping=float(bd.get("damping", 0.0) or 0.0),
+                           angle0=float(bd.get("angle", 0.0)), q0=None, qd0=None)
+                b.setup()
+                b.q0, b.qd0 = _ancf.cable_state(_vec2(bd.get("position")), b.angle0, _vec2(bd.get("velocity")),
+                                                float(bd.get("angular_velocity", 0.0)), b.length, b.elements)
             elif kind == "beam":
                 theory = bd.get("theory", "timoshenko")
                 a, I = section_properties(bd["section"])
@@ -496,6 +594,10 @@ class ReferenceModel:
         b = self._by_name[bname]
         if b.kind == "rigid":
             return _Marker(b, _vec2(d.get("point")), angle)
+        if b.kind == "ancf":
+            if "xi" not in d:
+                raise ModelError(f"marker on beam {bname!r} needs 'xi'")
+            return _CableMarker(b, d["xi"], angle)
         if "xi" not in d:
             raise ModelError(f"marker on beam {bname!r} needs 'xi'")
         xi = float(d["xi"])
@@ -599,6 +701,8 @@ class ReferenceModel:
                 Mb[0:2, 2] = Mb[2, 0:2] = b.mass * ac
                 Mb[2, 2] = b.inertia + b.mass * (b.com @ b.com)
                 M[sl, sl] = Mb
+            elif b.kind == "ancf":
+                M[sl, sl] = b.M_body
             else:
                 u, L, Arot, Ath = self._body_L(b, q)
                 Mb = np.einsum("g,gia,gib->ab", b.mw, L, L)
@@ -631,6 +735,12 @@ class ReferenceModel:
                 if g is not None:
                     Qb += b.mass * (Lc.T @ g)
                 Q[sl] += Qb
+            elif b.kind == "ancf":
+                if g is not None:
+                    Q[sl] += b.gravity_force(g)
+                for k in range(b.elements):
+                    c = slice(o + 4 * k, o + 4 * k + 8)
+                    Q[c] += _ancf.element_elastic_force(q[c], qd[c], b.l, b.EA, b.EI, b.damping)
             else:
                 u, L, Arot, Ath = self._body_L(b, q)
                 qfd = qd[o + 3:o + b.n]
@@ -681,6 +791,7 @@ class ReferenceModel:
         for kind, ma, mb, phi0 in self.joints:
             ra, Ja, pa, Jpa, rda, pda, ava = ma.kin(q, qd, n)
             rb, Jb, pb, Jpb, rdb, pdb, avb = mb.kin(q, qd, n)
+            hpa, hpb = _phi_velocity_term(ma, q, qd), _phi_velocity_term(mb, q, qd)
             if kind in ("revolute", "weld"):
                 Phi[i:i + 2] = ra - rb
                 A[i:i + 2] = Ja - Jb
@@ -689,6 +800,7 @@ class ReferenceModel:
                 if kind == "weld":
                     Phi[i] = pa - pb - phi0
                     A[i] = Jpa - Jpb
+                    gam[i] = -(hpa - hpb)
                     i += 1
             else:  # point_on_line (point=a, line=b) and prismatic (a on b's line + angle)
                 tl = np.array([math.cos(pb), math.sin(pb)])
@@ -698,12 +810,13 @@ class ReferenceModel:
                 Phi[i] = nl @ d
                 A[i] = nl @ (Ja - Jb) - (tl @ d) * Jpb
                 # Phi_ddot = n.d_ddot + 2 n_dot.d_dot + n_ddot.d,
-                # n_dot = -t phid, n_ddot = -t phi_ddot - n phid^2
-                gam[i] = -(nl @ (ava - avb) - 2.0 * pdb * (tl @ dd) - pdb * pdb * (nl @ d))
+                # n_dot = -t phid, n_ddot = -t phi_ddot - n phid^2, phi_ddot = J_phi qdd + h_phi
+                gam[i] = -(nl @ (ava - avb) - 2.0 * pdb * (tl @ dd) - pdb * pdb * (nl @ d) - (tl @ d) * hpb)
                 i += 1
                 if kind == "prismatic":
                     Phi[i] = pa - pb - phi0
                     A[i] = Jpa - Jpb
+                    gam[i] = -(hpa - hpb)
                     i += 1
         for drv in self.drivers:
             if drv[0] == "angle":
@@ -712,7 +825,7 @@ class ReferenceModel:
                 _, _, pb, Jpb, *_ = mb.kin(q, qd, n)
                 Phi[i] = pa - pb - mot(t)
                 A[i] = Jpa - Jpb
-                gam[i] = mot(t, 2)
+                gam[i] = mot(t, 2) - (_phi_velocity_term(ma, q, qd) - _phi_velocity_term(mb, q, qd))
             else:
                 _, mp, axis, mot = drv
                 r, J, _, _, _, _, av = mp.kin(q, qd, n)
@@ -772,6 +885,11 @@ class ReferenceModel:
                 Arot, _ = _rot(q[o + 2])
                 if g is not None:
                     V -= b.mass * g @ (q[o:o + 2] + Arot @ b.com)
+            elif b.kind == "ancf":
+                for k in range(b.elements):
+                    V += _ancf.element_strain_energy(q[o + 4 * k:o + 4 * k + 8], b.l, b.EA, b.EI)
+                if g is not None:
+                    V -= b.gravity_force(g) @ q[o:o + b.n]
             else:
                 qf = q[o + 3:o + b.n]
                 V += 0.5 * qf @ b.K_ff @ qf + b.nonlinear_elastic(qf)[0]

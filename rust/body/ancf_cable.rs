@@ -1,0 +1,582 @@
+//! Planar ANCF cable (geometrically exact Euler-Bernoulli beam, absolute nodal coordinates).
+//!
+//! Node `j = 0..N` carries its position `r_j` and slope `r'_j` (`' = d/dx`, `x` the arc length
+//! of the undeformed straight beam): body coordinates `[x_j, y_j, dx_j, dy_j]` per node,
+//! `4 (N + 1)` in all. In element `k` (nodes `k`, `k + 1`, length `l`, local `s = x / l - k`)
+//! `r = S_1 r_k + S_2 r'_k + S_3 r_{k+1} + S_4 r'_{k+1}`, cubic Hermite (Berzeri and Shabana's
+//! interpolation, Exudyn's `ObjectANCFCable2D`).
+//!
+//! Strain measures as Gerstmayr and Irschik (2008) and Exudyn define them: axial strain
+//! `eps = |r'| - 1`, material curvature `K = (r' x r'') / |r'|^2`; strain energy
+//! `U = int EA/2 eps^2 + EI/2 K^2 dx`, generalized elastic force `-dU/de`; strain-rate damping
+//! `N = EA (eps + beta eps_dot)`, `M = EI (K + beta K_dot)`.
+//!
+//! Membrane locking: the axial term is integrated at the three Lobatto points of each element
+//! (`0, l/2, l`, weights `1/6, 2/3, 1/6`) and the bending term at two Gauss points -- Exudyn's
+//! `useReducedOrderIntegration = 2`. With full Gauss integration of the axial term (Exudyn's
+//! default, 5 points) a cubic element cannot bend without spurious stretching and locks: its
+//! coarse-mesh error grows with the slenderness. The reduced rule keeps the element's linear
+//! stiffness at full rank (only the three rigid motions are free, see the tests) and its error
+//! independent of the thickness (docs/scene-format.md has the measured convergence).
+//!
+//! The mass matrix `rho A int S^T S dx` is constant: `M = M_s (x) I_2` with the scalar banded
+//! `M_s` (`2 (N + 1)` square, half-bandwidth 3) factored once here, so `factor` does nothing and
+//! `finv`/`finvt` are two banded triangular solves on the x and y components. No quadratic
+//! velocity terms; gravity is a constant generalized force.
+
+use super::ffrf_beam::{beam_section, BeamSection};
+use super::{axis_marker_xi, finite_vec2, InitialState, MarkerState};
+use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions};
+use crate::error::{Error, Result};
+use crate::linalg::{Banded, BandedCholesky, GAUSS4};
+
+/// Half-bandwidth of the body coordinates' element-coupled matrices (8 coordinates an element).
+pub const HB: usize = 7;
+/// Half-bandwidth of the scalar mass matrix `M_s` (4 scalar shape functions an element).
+const HB_S: usize = 3;
+
+/// Axial-strain quadrature on `[0, 1]`: Lobatto 3 (`(abscissa, weight)`).
+pub const AXIAL_RULE: [(f64, f64); 3] = [(0.0, 1.0 / 6.0), (0.5, 2.0 / 3.0), (1.0, 1.0 / 6.0)];
+/// Bending quadrature on `[0, 1]`: Gauss 2.
+pub const BENDING_RULE: [(f64, f64); 2] = {
+    const A: f64 = 0.288_675_134_594_812_9; // 1 / (2 sqrt 3)
+    [(0.5 - A, 0.5), (0.5 + A, 0.5)]
+};
+
+/// Hermite shape functions of an element of length `l` at local `s`: values, `d/dx`, `d2/dx2`.
+#[inline]
+pub fn hermite(s: f64, l: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    let (s2, s3) = (s * s, s * s * s);
+    (
+        [1.0 - 3.0 * s2 + 2.0 * s3, l * (s - 2.0 * s2 + s3), 3.0 * s2 - 2.0 * s3, l * (s3 - s2)],
+        [6.0 * (s2 - s) / l, 1.0 - 4.0 * s + 3.0 * s2, 6.0 * (s - s2) / l, 3.0 * s2 - 2.0 * s],
+        [(12.0 * s - 6.0) / (l * l), (6.0 * s - 4.0) / l, (6.0 - 12.0 * s) / (l * l), (6.0 * s - 2.0) / l],
+    )
+}
+
+/// `sum_a c[a] e_a` for the element vector `e` (8 numbers, `e_a = (e[2a], e[2a + 1])`).
+#[inline]
+fn map(c: &[f64; 4], e: &[f64]) -> [f64; 2] {
+    let mut r = [0.0; 2];
+    for a in 0..4 {
+        r[0] += c[a] * e[2 * a];
+        r[1] += c[a] * e[2 * a + 1];
+    }
+    r
+}
+
+#[inline]
+fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+#[inline]
+fn dot2(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
+}
+
+/// Strain measures at a quadrature point and their derivatives with respect to `(r', r'')`.
+struct Axial {
+    /// `r'`, `|r'|`, `eps = |r'| - 1`.
+    rx: [f64; 2],
+    norm: f64,
+    eps: f64,
+}
+
+impl Axial {
+    #[inline]
+    fn at(d: &[f64; 4], e: &[f64]) -> Axial {
+        let rx = map(d, e);
+        let norm = dot2(rx, rx).sqrt();
+        Axial { rx, norm, eps: norm - 1.0 }
+    }
+}
+
+struct Bending {
+    rx: [f64; 2],
+    rxx: [f64; 2],
+    /// `|r'|^2`, `r' x r''`, `K = (r' x r'') / |r'|^2`.
+    g: f64,
+    f: f64,
+    k: f64,
+    /// `dK/dr'`, `dK/dr''`.
+    kr: [f64; 2],
+    krr: [f64; 2],
+}
+
+impl Bending {
+    #[inline]
+    fn at(d: &[f64; 4], dd: &[f64; 4], e: &[f64]) -> Bending {
+        let (rx, rxx) = (map(d, e), map(dd, e));
+        let g = dot2(rx, rx);
+        let f = cross(rx, rxx);
+        let k = f / g;
+        // df/dr' = (r''_y, -r''_x), df/dr'' = (-r'_y, r'_x), dg/dr' = 2 r'
+        let kr = [(rxx[1] - 2.0 * k * rx[0]) / g, (-rxx[0] - 2.0 * k * rx[1]) / g];
+        let krr = [-rx[1] / g, rx[0] / g];
+        Bending { rx, rxx, g, f, k, kr, krr }
+    }
+
+    /// `d2K / dz2` in `z = (r'_x, r'_y, r''_x, r''_y)`:
+    /// `f''/g - (f' g'^T + g' f'^T)/g^2 - f g''/g^2 + 2 f g' g'^T / g^3`.
+    fn hessian(&self) -> [[f64; 4]; 4] {
+        let (rx, rxx, g, f) = (self.rx, self.rxx, self.g, self.f);
+        let df = [rxx[1], -rxx[0], -rx[1], rx[0]];
+        let dg = [2.0 * rx[0], 2.0 * rx[1], 0.0, 0.0];
+        let mut h = [[0.0; 4]; 4];
+        let (g2, g3) = (g * g, g * g * g);
+        for i in 0..4 {
+            for j in 0..4 {
+                h[i][j] = -(df[i] * dg[j] + dg[i] * df[j]) / g2 + 2.0 * f * dg[i] * dg[j] / g3;
+            }
+        }
+        // f'' (constant): d2f / dr'_x dr''_y = 1, d2f / dr'_y dr''_x = -1
+        h[0][3] += 1.0 / g;
+        h[3][0] += 1.0 / g;
+        h[1][2] -= 1.0 / g;
+        h[2][1] -= 1.0 / g;
+        // g'' = diag(2, 2, 0, 0)
+        h[0][0] -= 2.0 * f / g2;
+        h[1][1] -= 2.0 * f / g2;
+        h
+    }
+}
+
+/// Shape data of one quadrature point, the same for every element (equal element lengths).
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    /// weight times element length
+    wl: f64,
+    d: [f64; 4],
+    dd: [f64; 4],
+}
+
+/// One ANCF cable with its constant mass matrix, its factor and the quadrature tables.
+#[derive(Debug, Clone)]
+pub struct AncfCable {
+    pub length: f64,
+    pub elements: usize,
+    pub element_length: f64,
+    pub section: BeamSection,
+    /// Strain-rate damping coefficient beta [s].
+    pub damping: f64,
+    pub mass: f64,
+    /// `E A`, `E I`.
+    pub ea: f64,
+    pub ei: f64,
+    /// Scalar mass matrix `M_s = rho A int s_a s_b dx` over the scalar shape functions
+    /// (position and slope of each node): `M = M_s (x) I_2`.
+    pub m_s: Banded,
+    /// Its Cholesky factor (the body factor is `L_s (x) I_2`, constant).
+    pub l_s: BandedCholesky,
+    /// `rho A int s_a dx` per scalar shape function: gravity is `load (x) g`, the first moment
+    /// of mass `sum_a load_a e_a`.
+    pub load: Vec<f64>,
+    /// Angle of the undeformed beam in the description: marker angles are measured from it.
+    pub angle0: f64,
+    axial: [Point; 3],
+    bending: [Point; 2],
+}
+
+/// An ANCF cable needs no per-call workspace (constant mass matrix and factor).
+#[derive(Debug, Clone, Default)]
+pub struct AncfCableData;
+
+/// Shape of a marker on a cable: the element's first body coordinate (`4 k`), the Hermite
+/// values and `d/dx` at the point, and the reference direction of the frame angle.
+#[derive(Debug, Clone)]
+pub struct CablePoint {
+    pub xi: f64,
+    pub first: usize,
+    pub s: [f64; 4],
+    pub d: [f64; 4],
+    /// Reference angle (the description's beam angle) and its direction `t_ref`.
+    pub phi_ref: f64,
+    pub t_ref: [f64; 2],
+}
+
+impl AncfCable {
+    pub fn from_desc(d: &BeamDesc, item: &str) -> Result<AncfCable> {
+        if d.theory == BeamTheory::Timoshenko {
+            return Err(Error::invalid(
+                item,
+                "the ANCF cable (formulation 'ancf') is an Euler-Bernoulli beam: theory 'timoshenko' is not available (use theory 'euler-bernoulli', or formulation 'ffrf' for a Timoshenko beam)",
+            ));
+        }
+        if d.frame != ReferenceConditions::PinnedPinned {
+            return Err(Error::invalid(
+                item,
+                "frame (the reference conditions of an FFRF beam's floating frame) does not apply to an ANCF beam, which has no floating frame: leave the default 'pinned-pinned', and clamp the beam with a weld joint",
+            ));
+        }
+        if d.rotary_inertia == Some(true) {
+            return Err(Error::invalid(item, "the ANCF cable has no rotary inertia (its mass matrix is rho A int S^T S dx): rotary_inertia must be false or absent"));
+        }
+        let (length, section) = beam_section(d, item)?;
+        let n_el = d.elements;
+        let l = length / n_el as f64;
+        let rho_a = section.density * section.area;
+        let ns = 2 * (n_el + 1);
+        let mut m_s = Banded::zeros(ns, HB_S);
+        let mut load = vec![0.0; ns];
+        for el in 0..n_el {
+            for &(s, w) in GAUSS4.iter() {
+                let (h, _, _) = hermite(s, l);
+                for a in 0..4 {
+                    load[2 * el + a] += w * l * rho_a * h[a];
+                    for b in 0..4 {
+                        m_s.add(2 * el + a, 2 * el + b, w * l * rho_a * h[a] * h[b]);
+                    }
+                }
+            }
+        }
+        let l_s = BandedCholesky::factor(&m_s).map_err(|i| Error::SingularMass { item: format!("{item}: cable mass matrix, pivot {i}") })?;
+        let point = |(s, w): (f64, f64)| {
+            let (_, d, dd) = hermite(s, l);
+            Point { wl: w * l, d, dd }
+        };
+        Ok(AncfCable {
+            length,
+            elements: n_el,
+            element_length: l,
+            ea: section.youngs_modulus * section.area,
+            ei: section.youngs_modulus * section.second_moment,
+            mass: rho_a * length,
+            section,
+            damping: d.damping,
+            m_s,
+            l_s,
+            load,
+            angle0: d.angle,
+            axial: AXIAL_RULE.map(point),
+            bending: BENDING_RULE.map(point),
+        })
+    }
+
+    /// Number of body coordinates `4 (N + 1)`.
+    pub fn n_coords(&self) -> usize {
+        4 * (self.elements + 1)
+    }
+
+    /// The straight undeformed beam from `position` (of the `xi = 0` end) and `angle`, in the
+    /// rigid motion given by `velocity` (of the `xi = 0` end) and `angular_velocity`.
+    pub fn initial_state(&self, d: &BeamDesc, item: &str) -> Result<InitialState> {
+        for (what, given) in [("elastic", &d.elastic), ("elastic_rates", &d.elastic_rates)] {
+            if given.is_some() {
+                return Err(Error::invalid(item, format!("{what} does not apply to an ANCF beam (it starts straight and undeformed; its coordinates are nodal positions and slopes)")));
+            }
+        }
+        let p = finite_vec2(item, "position", d.position)?;
+        let v = finite_vec2(item, "velocity", d.velocity)?;
+        let (s, c) = d.angle.sin_cos();
+        let w = d.angular_velocity;
+        let (mut q, mut qd, mut names) = (Vec::new(), Vec::new(), Vec::new());
+        for j in 0..=self.elements {
+            let x = j as f64 * self.element_length;
+            q.extend_from_slice(&[p[0] + x * c, p[1] + x * s, c, s]);
+            qd.extend_from_slice(&[v[0] - w * x * s, v[1] + w * x * c, -w * s, w * c]);
+            names.extend([format!("x{j}"), format!("y{j}"), format!("dx{j}"), format!("dy{j}")]);
+        }
+        Ok(InitialState { q, qd, names })
+    }
+
+    pub fn new_data(&self) -> AncfCableData {
+        AncfCableData
+    }
+
+    /// Generalized forces: gravity `load (x) g` (constant), elastic and damping forces by
+    /// element quadrature. No velocity terms (the mass matrix is constant). Allocation free.
+    #[inline]
+    pub fn mass_and_forces(&self, _bd: &mut AncfCableData, q: &[f64], qd: &[f64], gravity: Option<[f64; 2]>, f: &mut [f64]) {
+        match gravity {
+            Some(g) => {
+                for (i, ld) in self.load.iter().enumerate() {
+                    f[2 * i] = ld * g[0];
+                    f[2 * i + 1] = ld * g[1];
+                }
+            }
+            None => f.fill(0.0),
+        }
+        let beta = self.damping;
+        for el in 0..self.elements {
+            let r = 4 * el..4 * el + 8;
+            let (e, ed, fe) = (&q[r.clone()], &qd[r.clone()], &mut f[r]);
+            for p in &self.axial {
+                let ax = Axial::at(&p.d, e);
+                let mut n = self.ea * ax.eps;
+                if beta > 0.0 {
+                    n += beta * self.ea * dot2(ax.rx, map(&p.d, ed)) / ax.norm;
+                }
+                // -w N d eps/de, d eps/d r' = r'/|r'|
+                let c = -p.wl * n / ax.norm;
+                for a in 0..4 {
+                    fe[2 * a] += c * p.d[a] * ax.rx[0];
+                    fe[2 * a + 1] += c * p.d[a] * ax.rx[1];
+                }
+            }
+            for p in &self.bending {
+                let b = Bending::at(&p.d, &p.dd, e);
+                let mut m = self.ei * b.k;
+                if beta > 0.0 {
+                    m += beta * self.ei * (dot2(b.kr, map(&p.d, ed)) + dot2(b.krr, map(&p.dd, ed)));
+                }
+                let c = -p.wl * m;
+                for a in 0..4 {
+                    fe[2 * a] += c * (p.d[a] * b.kr[0] + p.dd[a] * b.krr[0]);
+                    fe[2 * a + 1] += c * (p.d[a] * b.kr[1] + p.dd[a] * b.krr[1]);
+                }
+            }
+        }
+    }
+
+    /// `out += K_t = -dQ_el/dq = d2U/dq2` (the undamped elastic force's tangent stiffness,
+    /// symmetric) at `q`, element by element: axial `EA (t t^T + eps (I - t t^T)/|r'|)`,
+    /// bending `EI (grad K grad K^T + K d2K)` in `(r', r'')`, mapped through the shape
+    /// functions. `out` is `4 (N + 1)` square in body coordinates with half-bandwidth >= `HB`.
+    pub fn add_tangent_stiffness(&self, q: &[f64], out: &mut Banded) {
+        self.add_element_matrices(q, out, false);
+    }
+
+    /// `out += C = -dQ/dqd`, the damping matrix of the strain-rate damping:
+    /// `beta (EA grad eps grad eps^T + EI grad K grad K^T)` (zero without damping).
+    pub fn add_damping_matrix(&self, q: &[f64], out: &mut Banded) {
+        if self.damping > 0.0 {
+            self.add_element_matrices(q, out, true);
+        }
+    }
+
+    fn add_element_matrices(&self, q: &[f64], out: &mut Banded, damping: bool) {
+        assert!(out.n == self.n_coords() && out.hb >= HB, "tangent matrix of the wrong shape");
+        self.visit_element_matrices(q, damping, &mut |i, j, v| out.add(i, j, v));
+    }
+
+    /// The element stiffness (or damping) matrices at `q`, entry by entry: `put(i, j, v)` in body
+    /// coordinates (repeated indices add up). Allocation free.
+    pub fn visit_element_matrices(&self, q: &[f64], damping: bool, put: &mut impl FnMut(usize, usize, f64)) {
+        let scale = if damping { self.damping } else { 1.0 };
+        for el in 0..self.elements {
+            let e = &q[4 * el..4 * el + 8];
+            let mut ke = [[0.0; 8]; 8];
+            for p in &self.axial {
+                let ax = Axial::at(&p.d, e);
+                let t = [ax.rx[0] / ax.norm, ax.rx[1] / ax.norm];
+                let mut hz = [[0.0; 2]; 2];
+                for i in 0..2 {
+                    for j in 0..2 {
+                        let tt = t[i] * t[j];
+                        let geo = if damping { 0.0 } else { ax.eps * ((i == j) as u8 as f64 - tt) / ax.norm };
+                        hz[i][j] = scale * p.wl * self.ea * (tt + geo);
+                    }
+                }
+                for a in 0..4 {
+                    for b in 0..4 {
+                        let dab = p.d[a] * p.d[b];
+                        for i in 0..2 {
+                            for j in 0..2 {
+                                ke[2 * a + i][2 * b + j] += dab * hz[i][j];
+                            }
+                        }
+                    }
+                }
+            }
+            for p in &self.bending {
+                let b = Bending::at(&p.d, &p.dd, e);
+                let grad = [b.kr[0], b.kr[1], b.krr[0], b.krr[1]];
+                let mut hz = if damping { [[0.0; 4]; 4] } else { b.hessian() };
+                for i in 0..4 {
+                    for j in 0..4 {
+                        hz[i][j] = scale * p.wl * self.ei * (grad[i] * grad[j] + b.k * hz[i][j]);
+                    }
+                }
+                // z = (r', r'') = sum_a (d_a, dd_a) e_a
+                for a in 0..4 {
+                    let za = [p.d[a], p.dd[a]];
+                    for bb in 0..4 {
+                        let zb = [p.d[bb], p.dd[bb]];
+                        for i in 0..2 {
+                            for j in 0..2 {
+                                let mut v = 0.0;
+                                for (u, wu) in za.iter().enumerate() {
+                                    for (w, ww) in zb.iter().enumerate() {
+                                        v += wu * ww * hz[2 * u + i][2 * w + j];
+                                    }
+                                }
+                                ke[2 * a + i][2 * bb + j] += v;
+                            }
+                        }
+                    }
+                }
+            }
+            for i in 0..8 {
+                for j in 0..8 {
+                    put(4 * el + i, 4 * el + j, ke[i][j]);
+                }
+            }
+        }
+    }
+
+    /// The mass matrix is constant: its factor was computed at build.
+    #[inline]
+    pub fn factor(&self, _bd: &mut AncfCableData) -> bool {
+        true
+    }
+
+    /// `v <- (L_s (x) I_2)^-1 v`: forward substitution on the x and y components together,
+    /// from the first non-zero entry on (a constraint column touches one element).
+    #[inline]
+    pub fn finv(&self, _bd: &AncfCableData, v: &mut [f64]) {
+        let (n, hb) = (self.l_s.n, self.l_s.hb);
+        let w = hb + 1;
+        let start = v.chunks_exact(2).position(|p| p[0] != 0.0 || p[1] != 0.0).unwrap_or(n);
+        for i in start..n {
+            let lo = i.saturating_sub(hb);
+            let row = &self.l_s.data[i * w + (lo + hb - i)..i * w + hb];
+            let (mut s0, mut s1) = (0.0, 0.0);
+            for (lk, k) in row.iter().zip(lo..i) {
+                s0 += lk * v[2 * k];
+                s1 += lk * v[2 * k + 1];
+            }
+            let inv = self.l_s.inv_diag[i];
+            v[2 * i] = (v[2 * i] - s0) * inv;
+            v[2 * i + 1] = (v[2 * i + 1] - s1) * inv;
+        }
+    }
+
+    /// `v <- (L_s^T (x) I_2)^-1 v`: back substitution (column sweep) on both components.
+    #[inline]
+    pub fn finvt(&self, _bd: &AncfCableData, v: &mut [f64]) {
+        let (n, hb) = (self.l_s.n, self.l_s.hb);
+        let w = hb + 1;
+        for i in (0..n).rev() {
+            let inv = self.l_s.inv_diag[i];
+            let (x0, x1) = (v[2 * i] * inv, v[2 * i + 1] * inv);
+            v[2 * i] = x0;
+            v[2 * i + 1] = x1;
+            let lo = i.saturating_sub(hb);
+            let row = &self.l_s.data[i * w + (lo + hb - i)..i * w + hb];
+            for (lk, k) in row.iter().zip(lo..i) {
+                v[2 * k] -= lk * x0;
+                v[2 * k + 1] -= lk * x1;
+            }
+        }
+    }
+
+    pub fn dense_block(&self, _bd: &AncfCableData, put: &mut impl FnMut(usize, usize, f64)) {
+        let n = self.m_s.n;
+        for i in 0..n {
+            for j in i.saturating_sub(HB_S)..(i + HB_S + 1).min(n) {
+                let m = self.m_s.get(i, j);
+                put(2 * i, 2 * j, m);
+                put(2 * i + 1, 2 * j + 1, m);
+            }
+        }
+    }
+
+    /// `1/2 qd^T M qd = 1/2 sum_c qd_c^T M_s qd_c`.
+    pub fn kinetic_energy(&self, _bd: &AncfCableData, qd: &[f64]) -> f64 {
+        let n = self.m_s.n;
+        let mut e = 0.0;
+        for i in 0..n {
+            for j in i.saturating_sub(HB_S)..(i + HB_S + 1).min(n) {
+                e += self.m_s.get(i, j) * (qd[2 * i] * qd[2 * j] + qd[2 * i + 1] * qd[2 * j + 1]);
+            }
+        }
+        0.5 * e
+    }
+
+    /// `U = sum_el [ sum_axial w l EA/2 eps^2 + sum_bending w l EI/2 K^2 ]` (the energy whose
+    /// gradient is the elastic force, same quadrature).
+    pub fn strain_energy(&self, q: &[f64]) -> f64 {
+        let mut u = 0.0;
+        for el in 0..self.elements {
+            let e = &q[4 * el..4 * el + 8];
+            for p in &self.axial {
+                u += 0.5 * p.wl * self.ea * Axial::at(&p.d, e).eps.powi(2);
+            }
+            for p in &self.bending {
+                u += 0.5 * p.wl * self.ei * Bending::at(&p.d, &p.dd, e).k.powi(2);
+            }
+        }
+        u
+    }
+
+    /// `int rho A r dx = sum_a load_a e_a`.
+    pub fn mass_moment(&self, q: &[f64]) -> [f64; 2] {
+        let mut r = [0.0; 2];
+        for (i, ld) in self.load.iter().enumerate() {
+            r[0] += ld * q[2 * i];
+            r[1] += ld * q[2 * i + 1];
+        }
+        r
+    }
+
+    /// Shape of the axis point at `xi` in [0, 1].
+    pub fn point(&self, xi: f64) -> CablePoint {
+        let t = xi * self.elements as f64;
+        let el = (t.floor() as usize).min(self.elements - 1);
+        let (s, d, _) = hermite(t - el as f64, self.element_length);
+        let (sn, cs) = self.angle0.sin_cos();
+        CablePoint { xi, first: 4 * el, s, d, phi_ref: self.angle0, t_ref: [cs, sn] }
+    }
+
+    /// A marker on a cable is an axis point `xi` in [0, 1] (the same rule as on an FFRF beam).
+    pub fn marker_shape(&self, md: &MarkerDesc, body: &str, item: &str) -> Result<CablePoint> {
+        Ok(self.point(axis_marker_xi(md, body, item)?))
+    }
+
+    /// `[x, y, u, v, psi]` of the axis point at `xi`: world position, displacement in the chord
+    /// frame of the beam ends (origin `r(0)`, X axis towards `r(L)`) from the undeformed
+    /// `(xi L, 0)`, and the angle of the tangent `r'` relative to the chord.
+    pub fn chord_displacement(&self, xi: f64, q: &[f64]) -> [f64; 5] {
+        let p = self.point(xi);
+        let e = &q[p.first..p.first + 8];
+        let (r, t) = (map(&p.s, e), map(&p.d, e));
+        let n = 4 * self.elements;
+        let r0 = [q[0], q[1]];
+        let ch = [q[n] - r0[0], q[n + 1] - r0[1]];
+        let len = dot2(ch, ch).sqrt();
+        let c = [ch[0] / len, ch[1] / len];
+        let d = [r[0] - r0[0], r[1] - r0[1]];
+        [r[0], r[1], dot2(c, d) - xi * self.length, cross(c, d), cross(c, t).atan2(dot2(c, t))]
+    }
+}
+
+/// Axis point of a cable: `r = S e`, `v = S e_dot`, `h = 0` (linear in `e`); frame angle
+/// `angle + phi_ref + atan2(t_ref x r', t_ref . r')` -- continuous, and valid while the tangent
+/// stays within +-pi of the beam's direction in the description; `omega = (r' x r'_dot)/|r'|^2`,
+/// `h_phi = -2 (r' . r'_dot)(r' x r'_dot)/|r'|^4`.
+#[inline]
+pub fn marker_state(p: &CablePoint, angle: f64, q: &[f64], qd: &[f64]) -> MarkerState {
+    let (e, ed) = (&q[p.first..p.first + 8], &qd[p.first..p.first + 8]);
+    let (r, v, t, td) = (map(&p.s, e), map(&p.s, ed), map(&p.d, e), map(&p.d, ed));
+    let g = dot2(t, t);
+    let (tw, ttd) = (cross(t, td), dot2(t, td));
+    MarkerState {
+        r,
+        phi: angle + p.phi_ref + cross(p.t_ref, t).atan2(dot2(p.t_ref, t)),
+        v,
+        omega: tw / g,
+        h: [0.0; 2],
+        h_phi: -2.0 * ttd * tw / (g * g),
+        r_theta: [0.0; 2],
+        cs: [1.0, 0.0],
+        dphi_dslope: [-t[1] / g, t[0] / g],
+    }
+}
+
+#[inline]
+pub fn add_point_jacobian(p: &CablePoint, w: [f64; 2], row: &mut [f64]) {
+    for a in 0..4 {
+        row[p.first + 2 * a] += w[0] * p.s[a];
+        row[p.first + 2 * a + 1] += w[1] * p.s[a];
+    }
+}
+
+/// `d phi / d e_a = d_a (-r'_y, r'_x) / |r'|^2`.
+#[inline]
+pub fn add_angle_jacobian(p: &CablePoint, ms: &MarkerState, w: f64, row: &mut [f64]) {
+    for a in 0..4 {
+        row[p.first + 2 * a] += w * p.d[a] * ms.dphi_dslope[0];
+        row[p.first + 2 * a + 1] += w * p.d[a] * ms.dphi_dslope[1];
+    }
+}
