@@ -144,3 +144,34 @@ pub fn potential_energy(model: &Model, q: &[f64]) -> f64 {
     }
     v
 }
+
+/// `c = -dQ/dqd` (n x n) and `bv = d gamma/dqd` (m x n) at `(t, q, qd)` by central differences
+/// in `qd`: both are quadratic in `qd` (inertial velocity terms, constraint velocity terms) plus
+/// linear damping, so the differences are exact up to rounding for any step. `v` is an n-long
+/// scratch. Leaves `data` at a perturbed state.
+pub fn velocity_jacobians_into(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], v: &mut [f64], c: &mut [f64], bv: &mut [f64]) {
+    let (n, rows) = (model.n, model.m);
+    v.copy_from_slice(qd);
+    for j in 0..n {
+        let s = 1e-3 * qd[j].abs().max(1.0);
+        v[j] = qd[j] + s;
+        mass_and_forces(model, data, q, v);
+        constraints(model, data, t, q, v, false);
+        for i in 0..n {
+            c[i * n + j] = -data.force[i];
+        }
+        for r in 0..rows {
+            bv[r * n + j] = data.gamma[r];
+        }
+        v[j] = qd[j] - s;
+        mass_and_forces(model, data, q, v);
+        constraints(model, data, t, q, v, false);
+        for i in 0..n {
+            c[i * n + j] = (c[i * n + j] + data.force[i]) / (2.0 * s);
+        }
+        for r in 0..rows {
+            bv[r * n + j] = (bv[r * n + j] - data.gamma[r]) / (2.0 * s);
+        }
+        v[j] = qd[j];
+    }
+}

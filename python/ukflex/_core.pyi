@@ -97,6 +97,7 @@ class System:
         projection_tol: Optional[float] = None,
         rho_inf: float = 0.9,
         step: Optional[float] = None,
+        jacobian: str = "structured",
     ) -> Dict[str, Any]:
         """Native integration; dict with t (nt,), y (2n, nt), status, message, statistics."""
     def project(

@@ -21,7 +21,7 @@ METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 #: Integrators that run entirely in Rust with the GIL released (``System.integrate``):
 #: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
 NATIVE_METHODS = ("DOPRI5", "RADAU5", "GENALPHA")
-_NATIVE_OPTIONS = ("first_step", "max_step", "max_steps", "projection_tol", "rho_inf", "step")
+_NATIVE_OPTIONS = ("first_step", "max_step", "max_steps", "projection_tol", "rho_inf", "step", "jacobian")
 FORMULATIONS = ("uk", "uk-numpy", "cp")
 
 
@@ -223,6 +223,8 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options)
             kwargs[key] = float(options[key])
     if options.get("max_steps") is not None:
         kwargs["max_steps"] = int(options["max_steps"])
+    if options.get("jacobian") is not None:
+        kwargs["jacobian"] = str(options["jacobian"])
     atol_arr = np.atleast_1d(np.asarray(atol, dtype=float))
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
     out = system.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),

@@ -356,7 +356,8 @@ impl PySystem {
         let scheme = match scheme {
             "central" => Differences::Central,
             "forward" => Differences::Forward,
-            other => return Err(PyValueError::new_err(format!("unknown scheme '{other}' (use 'central' or 'forward')"))),
+            "structured" => Differences::Structured,
+            other => return Err(PyValueError::new_err(format!("unknown scheme '{other}' (use 'central', 'forward' or 'structured')"))),
         };
         let mut yv = vec![0.0; 2 * n];
         read_into("y", &y.as_array(), &mut yv).map_err(to_py)?;
@@ -388,7 +389,7 @@ impl PySystem {
     ///
     /// Returns a dict: t (nt,), y (2n, nt), status (0 ok, -1 failed), message, nfev, njev, nlu,
     /// naccept, nreject, jac_evals (UK calls inside Jacobians), wall_time [s].
-    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=0.9, step=None))]
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=0.9, step=None, jacobian="structured"))]
     #[allow(clippy::too_many_arguments)]
     fn integrate<'py>(
         &self,
@@ -406,7 +407,14 @@ impl PySystem {
         projection_tol: Option<f64>,
         rho_inf: f64,
         step: Option<f64>,
+        jacobian: &str,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let jacobian = match jacobian {
+            "central" => Differences::Central,
+            "forward" => Differences::Forward,
+            "structured" => Differences::Structured,
+            other => return Err(PyValueError::new_err(format!("unknown jacobian '{other}' (use 'structured', 'central' or 'forward')"))),
+        };
         let n = self.model.n;
         let mut method = Method::from_name(method)
             .ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5' or 'GENALPHA')")))?;
@@ -444,7 +452,7 @@ impl PySystem {
                 data.stabilization = stabilization;
                 data.svd_backend = backend;
                 let tic = std::time::Instant::now();
-                let r = integrate_uk(model, data, method, opts, t0, &y, t_end, t_eval.as_deref(), projection);
+                let r = integrate_uk(model, data, method, opts, t0, &y, t_end, t_eval.as_deref(), projection, jacobian);
                 r.map(|(sol, full, cheap)| (sol, full + cheap, tic.elapsed().as_secs_f64()))
             }))
         });

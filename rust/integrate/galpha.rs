@@ -266,6 +266,20 @@ impl GenAlpha {
         }
     }
 
+    /// Weighted RMS of a Newton correction `v` with the weights `atol + rtol |q_{n+1} - q_n|`:
+    /// relative to how far the step moves each coordinate (absolute coordinates, like an ANCF
+    /// beam's, move little per step against their size, and their deformation is a tiny part
+    /// of them: `rtol |q|` would accept Newton errors larger than the deformation).
+    fn newton_norm(&self, v: &[f64]) -> f64 {
+        let n = self.n;
+        let mut s = 0.0;
+        for i in 0..n {
+            let w = self.atol[i] + self.opts.rtol * (self.q_new[i] - self.q0[i]).abs();
+            s += (v[i] / w) * (v[i] / w);
+        }
+        (s / n as f64).sqrt()
+    }
+
     /// Weighted RMS of `v` with the position weights `atol + rtol |q|`.
     fn position_norm(&self, v: &[f64]) -> f64 {
         let n = self.n;
@@ -293,7 +307,18 @@ impl GenAlpha {
         let (n, m) = (self.n, self.m);
         let nm = n + m;
         let (bp, _) = self.primes(h);
-        self.x.copy_from_slice(&self.qdd_prev);
+        let pred = std::env::var("GA_PRED").ok().and_then(|v| v.parse::<u32>().ok()).unwrap_or(0);
+        match pred {
+            1 => {
+                // a_{n+1} = a_n
+                let af = self.alpha_f;
+                for i in 0..n {
+                    self.x[i] = (self.a_prev[i] - af * self.qdd_prev[i]) / (1.0 - af);
+                }
+            }
+            2 => self.x.fill(0.0),
+            _ => self.x.copy_from_slice(&self.qdd_prev),
+        }
         self.lam.copy_from_slice(&self.lam_prev);
         let t1 = self.st.t + h;
         let mut prev = f64::INFINITY;
@@ -328,7 +353,7 @@ impl GenAlpha {
             for i in 0..n {
                 self.g[i] = bp * self.rhs[i];
             }
-            let d = self.position_norm(&self.g);
+            let d = self.newton_norm(&self.g);
             if std::env::var("GA_DEBUG").is_ok() {
                 eprintln!("t={:.6} k={k} d={d:.2e} tol={tol:.1e} age={}", self.st.t, self.age);
             }

@@ -1,7 +1,7 @@
 //! Dense LU (real and complex), allocation free after construction.
 
 /// In-place LU with partial pivoting of an n x n row-major matrix. `false` if singular.
-pub(super) fn lu_real(a: &mut [f64], piv: &mut [usize], n: usize) -> bool {
+pub(crate) fn lu_real(a: &mut [f64], piv: &mut [usize], n: usize) -> bool {
     for k in 0..n {
         let mut p = k;
         let mut best = a[k * n + k].abs();
@@ -38,7 +38,7 @@ pub(super) fn lu_real(a: &mut [f64], piv: &mut [usize], n: usize) -> bool {
     true
 }
 
-pub(super) fn lu_real_solve(a: &[f64], piv: &[usize], n: usize, x: &mut [f64]) {
+pub(crate) fn lu_real_solve(a: &[f64], piv: &[usize], n: usize, x: &mut [f64]) {
     for k in 0..n {
         x.swap(k, piv[k]);
     }
@@ -53,7 +53,7 @@ pub(super) fn lu_real_solve(a: &[f64], piv: &[usize], n: usize, x: &mut [f64]) {
 }
 
 /// Complex LU (separate real and imaginary parts), partial pivoting by modulus.
-pub(super) fn lu_cplx(ar: &mut [f64], ai: &mut [f64], piv: &mut [usize], n: usize) -> bool {
+pub(crate) fn lu_cplx(ar: &mut [f64], ai: &mut [f64], piv: &mut [usize], n: usize) -> bool {
     for k in 0..n {
         let mut p = k;
         let mut best = ar[k * n + k].hypot(ai[k * n + k]);
@@ -94,7 +94,7 @@ pub(super) fn lu_cplx(ar: &mut [f64], ai: &mut [f64], piv: &mut [usize], n: usiz
     true
 }
 
-pub(super) fn lu_cplx_solve(ar: &[f64], ai: &[f64], piv: &[usize], n: usize, xr: &mut [f64], xi: &mut [f64]) {
+pub(crate) fn lu_cplx_solve(ar: &[f64], ai: &[f64], piv: &[usize], n: usize, xr: &mut [f64], xi: &mut [f64]) {
     for k in 0..n {
         xr.swap(k, piv[k]);
         xi.swap(k, piv[k]);

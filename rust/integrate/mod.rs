@@ -23,7 +23,7 @@
 
 mod dopri5;
 mod galpha;
-mod lu;
+pub(crate) mod lu;
 mod radau5;
 
 pub use dopri5::Dopri5;
@@ -34,7 +34,7 @@ use crate::correct::{self, ProjectWorkspace, ProjectionTolerance};
 use crate::data::Data;
 use crate::dynamics;
 use crate::error::{Error, Result};
-use crate::jacobian::{uk_jacobian, JacobianWorkspace};
+use crate::jacobian::{uk_jacobian, Differences, JacobianWorkspace};
 use crate::model::Model;
 use crate::uk;
 
@@ -184,39 +184,12 @@ impl SecondOrderSystem for UkSystem<'_> {
     }
     fn structure(&mut self, t: f64, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], c: &mut [f64], a: &mut [f64], bv: &mut [f64]) -> Result<bool> {
         let (model, data) = (self.model, &mut self.data);
-        let (n, rows) = (model.n, model.m);
         dynamics::mass_and_forces(model, data, q, qd);
         dynamics::dense_mass_into(model, data, m);
         dynamics::tangent_into(model, data, q, qd, k, c);
         dynamics::constraints(model, data, t, q, qd, false);
         a.copy_from_slice(&data.jac);
-        // -dQ/dqd and db/dqd by central differences: both are quadratic in qd (velocity terms,
-        // linear damping), so the differences are exact up to rounding for any step (the
-        // bodies' analytic damping in `c` is part of Q, so `c` is replaced, not added to)
-        let v = &mut self.pws.v;
-        v.copy_from_slice(qd);
-        for j in 0..n {
-            let s = 1e-3 * qd[j].abs().max(1.0);
-            v[j] = qd[j] + s;
-            dynamics::mass_and_forces(model, data, q, v);
-            dynamics::constraints(model, data, t, q, v, false);
-            for i in 0..n {
-                c[i * n + j] = -data.force[i];
-            }
-            for r in 0..rows {
-                bv[r * n + j] = data.gamma[r];
-            }
-            v[j] = qd[j] - s;
-            dynamics::mass_and_forces(model, data, q, v);
-            dynamics::constraints(model, data, t, q, v, false);
-            for i in 0..n {
-                c[i * n + j] = (c[i * n + j] + data.force[i]) / (2.0 * s);
-            }
-            for r in 0..rows {
-                bv[r * n + j] = (bv[r * n + j] - data.gamma[r]) / (2.0 * s);
-            }
-            v[j] = qd[j];
-        }
+        dynamics::velocity_jacobians_into(model, data, t, q, qd, &mut self.pws.v, c, bv);
         Ok(true)
     }
 }
@@ -503,9 +476,10 @@ impl Method {
 }
 
 /// Convenience: run `method` on the UK system of `model` with a workspace `data`.
-pub fn integrate_uk(model: &Model, data: Data, method: Method, opts: Options, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, projection: Option<ProjectionTolerance>) -> Result<(Solution, usize, usize)> {
+pub fn integrate_uk(model: &Model, data: Data, method: Method, opts: Options, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, projection: Option<ProjectionTolerance>, jacobian: Differences) -> Result<(Solution, usize, usize)> {
     let mut sys = UkSystem::new(model, data);
     sys.projection = projection;
+    sys.jws.scheme = jacobian;
     let sol = match method {
         Method::Dopri5 => {
             let mut st = Dopri5::new(2 * model.n, opts)?;
