@@ -23,7 +23,13 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+if "--fast" in sys.argv:  # Exudyn's exudynCPPfast module (no range checks, AVX2); must be chosen before import
+    sys.exudynFast = True
 import exudyn_slider_crank as es  # noqa: E402
+
+
+def exudyn_module() -> str:
+    return "exudynCPPfast" if "exudyn.exudynCPPfast" in sys.modules else "exudynCPP"
 
 DATA = os.path.normpath(os.path.join(HERE, "..", "data"))
 REF_FILES = {"ancf": "exudyn_ref_ancf.csv", "ge": "exudyn_ref_ge.csv"}
@@ -221,7 +227,7 @@ CASES = [("omega x0.1", 0.1, 1.0), ("omega x0.5", 0.5, 1.0), ("omega x1", 1.0, 1
 
 def speeds(args) -> None:
     ns = [8, 16, 32] if not args.quick else [4, 8]
-    hs = [2.5e-5, 1.25e-5] if not args.quick else [5e-5, 2.5e-5]
+    hs = [2.5e-5, 1.25e-5, 6.25e-6] if not args.quick else [5e-5, 2.5e-5]
     cases = CASES if not args.quick else CASES[2:3]
     rows = []
     t_start = time.perf_counter()
@@ -322,10 +328,7 @@ def timing(args) -> None:
     refs = {"ancf": reference("ancf"), "ge": reference("ge")}
     configs = [(v, n, h) for v in variants for n in ns for h in hs]
     # accuracy (deterministic) from one run each
-    acc = {}
-    for key in configs:
-        r = run(*key, t_end=0.1)
-        acc[key] = r
+    solver_options = {"newton_rtol": args.newton_rtol}  # 1e-8: Exudyn's default
     load_start = wait_for_quiet(args.max_load, args.max_wait)
     walls = {key: [] for key in configs}
     loads = [load_start]
@@ -334,35 +337,42 @@ def timing(args) -> None:
         order = configs if rep % 2 == 0 else configs[::-1]  # interleaved, alternating direction
         for key in order:
             model, opts = variant_options(key[0])
-            r = es.build_and_solve(model, key[1], key[2], t_end=0.1, **opts)  # Exudyn's default Newton settings
+            r = es.build_and_solve(model, key[1], key[2], t_end=0.1, solver_options=solver_options, **opts)
             walls[key].append(r["wall"] if r["ok"] else float("nan"))
         loads.append(load1())
         print(f"repetition {rep + 1}/{args.repeat} done, load {loads[-1]:.2f}", flush=True)
     elapsed = time.perf_counter() - t0
+    acc = {}  # accuracy (deterministic), after the timed repetitions
+    for key in configs:
+        model, opts = variant_options(key[0])
+        acc[key] = es.build_and_solve(model, key[1], key[2], t_end=0.1, solver_options=solver_options, **opts)
     rows = []
     for key in configs:
         r = acc[key]
         own = refs[REF_OF[key[0]]]
         anc = refs["ancf"]
-        row = {"variant": key[0], "N": key[1], "h": key[2], "ok": int(r["ok"]), "steps": r["steps"],
+        row = {"variant": key[0], "N": key[1], "h": key[2], "module": exudyn_module(), "ok": int(r["ok"]), "steps": r["steps"],
                "median_ms": float(np.median(walls[key])) * 1e3, "min_ms": float(np.min(walls[key])) * 1e3,
                "max_ms": float(np.max(walls[key])) * 1e3, "repeats": args.repeat,
                "newton_it_per_step": r["newton"].get("newtonStepsCount", 0) / r["steps"],
                "jacobians": r["newton"].get("newtonJacobiCount", -1), "newton_rtol": r["newton_rtol"],
-               "peak": r["peak"],
+               "peak": r["peak"], "t_peak": r["t_peak"],
                "peak_err_own": abs(r["peak"] - own["peak"]) / own["peak"] if r["ok"] else float("nan"),
                "hist_err_own": es.history_error(r["t"], r["v"], own["t"], own["v"], own["peak"], 0.1) if r["ok"] else float("nan"),
                "peak_err_ancf": abs(r["peak"] - anc["peak"]) / anc["peak"] if r["ok"] else float("nan"),
                "hist_err_ancf": es.history_error(r["t"], r["v"], anc["t"], anc["v"], anc["peak"], 0.1) if r["ok"] else float("nan")}
         rows.append(row)
     header = [f"Exudyn {es.EXUDYN_VERSION} slider-crank timing: solve-only wall time (SolveDynamic call, model build "
-              "excluded), 0..0.1 s, generalized-alpha rho_inf = 0.9, Exudyn default Newton settings",
+              "excluded), 0..0.1 s, generalized-alpha rho_inf = 0.9, fixed step, modified Newton (Exudyn default) with "
+              f"relative tolerance {args.newton_rtol:g}",
               f"median/min/max of {args.repeat} interleaved repetitions; 1-min load: start {load_start:.2f}, "
               f"max {max(loads):.2f}, end {loads[-1]:.2f}; {os.cpu_count()} CPUs; {machine_load()}",
               "errors relative to the reference peak: *_own vs the converged reference of the same model "
               "(ancf -> exudyn_ref_ancf.csv, ge -> exudyn_ref_ge.csv), *_ancf vs the ANCF (Euler-Bernoulli) reference",
               f"written by: python benches/peers/exudyn_study.py timing --variants {args.variants} "
-              f"--elements {args.elements} --steps {args.steps} --repeat {args.repeat}"]
+              f"--elements {args.elements} --steps {args.steps} --repeat {args.repeat}"
+              f"{' --fast' if args.fast else ''} --newton-rtol {args.newton_rtol:g} --out {args.out}; "
+              f"Exudyn module {exudyn_module()}"]
     write_csv(os.path.join(DATA, args.out), rows, header)
     print(f"\ntiming: {elapsed:.0f} s; load start {load_start:.2f}, max {max(loads):.2f}")
     print(f"{'variant':9s} {'N':>3s} {'h':>8s} {'median ms':>10s} {'it/step':>7s} {'peak err':>9s} {'hist err':>9s} "
@@ -370,14 +380,32 @@ def timing(args) -> None:
     for r in rows:
         print(f"{r['variant']:9s} {r['N']:3d} {r['h']:8.3g} {r['median_ms']:10.1f} {r['newton_it_per_step']:7.2f} "
               f"{r['peak_err_own']:9.2e} {r['hist_err_own']:9.2e} {r['peak_err_ancf']:10.2e} {r['hist_err_ancf']:10.2e}")
+    # a peak can agree by chance: a coarse run may peak on another lobe (t_peak off) or with a history
+    # error many times the peak error; such points are listed but marked
     for which in ("own", "ancf"):
+        t_ref = refs[REF_OF[variants[0]] if which == "own" else "ancf"]["t_peak"]
         for tol in (5e-3, 1e-3):
-            for metric in ("peak", "hist"):
+            for metric in ("peak", "hist", "both"):
                 for v in variants:
-                    ok = [r for r in rows if r["variant"] == v and r[f"{metric}_err_{which}"] <= tol]
+                    if which == "own":
+                        t_ref = refs[REF_OF[v]]["t_peak"]
+
+                    def good(r):
+                        if metric == "both":
+                            return r[f"peak_err_{which}"] <= tol and r[f"hist_err_{which}"] <= tol
+                        return r[f"{metric}_err_{which}"] <= tol
+                    ok = [r for r in rows if r["variant"] == v and good(r)]
                     best = min(ok, key=lambda r: r["median_ms"]) if ok else None
+                    note = ""
+                    if best is not None and metric == "peak":
+                        lucky = [x for x in ok if abs(x["t_peak"] - t_ref) > 2e-3 or x[f"hist_err_{which}"] > 10 * tol]
+                        if best in lucky:
+                            honest = [x for x in ok if x not in lucky]
+                            b2 = min(honest, key=lambda r: r["median_ms"]) if honest else None
+                            note = (" (by chance: other lobe or history error > 10x; next: " +
+                                    (f"N={b2['N']} h={b2['h']:g} {b2['median_ms']:.1f} ms)" if b2 else "none)"))
                     print(f"fastest {v:5s} within {tol:.1%} on {metric:4s} (vs {which:4s} ref): " +
-                          (f"N={best['N']} h={best['h']:g} {best['median_ms']:.1f} ms" if best else "none in the grid"))
+                          (f"N={best['N']} h={best['h']:g} {best['median_ms']:.1f} ms" if best else "none in the grid") + note)
 
 
 # ------------------------------------------------------------------------------------------- main
@@ -399,6 +427,8 @@ def main(argv=None) -> int:
     tp.add_argument("--max-load", type=float, default=1.5, help="wait until the 1-min load is below this")
     tp.add_argument("--max-wait", type=float, default=900.0)
     tp.add_argument("--out", default="exudyn_timing.csv")
+    tp.add_argument("--fast", action="store_true", help="load exudynCPPfast (no range checks)")
+    tp.add_argument("--newton-rtol", type=float, default=1e-8, help="Newton relative tolerance (Exudyn default 1e-8)")
     tp.set_defaults(func=timing)
     a = p.parse_args(argv)
     if not es.HAVE_EXUDYN:
