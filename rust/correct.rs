@@ -117,14 +117,14 @@ impl ProjectWorkspace {
 /// `F^-T B^+`). `data.lambda` is kept; `data.qdd` is not. Returns whether `(q, qd)` changed.
 /// One Newton step suffices for the per-step drift it is meant for (quadratic convergence from
 /// a residual of that size); the next step's call corrects whatever is left.
-pub fn project_with_factorization(model: &Model, data: &mut Data, ws: &mut ProjectWorkspace, q: &mut [f64], qd: &mut [f64], tol: ProjectionTolerance) -> Result<bool> {
+pub fn project_with_factorization(model: &Model, data: &mut Data, ws: &mut ProjectWorkspace, t: f64, q: &mut [f64], qd: &mut [f64], tol: ProjectionTolerance) -> Result<bool> {
     let n = model.n;
     if model.m == 0 {
         return Ok(false);
     }
     velocity_residual(model, data, qd, &mut ws.vres);
-    let (pos, vel) = (max_abs(&data.phi) > tol.position_tol, max_abs(&ws.vres) > tol.velocity_tol);
-    if !(pos || vel) {
+    let pos = max_abs(&data.phi) > tol.position_tol;
+    if !pos && max_abs(&ws.vres) <= tol.velocity_tol {
         return Ok(false);
     }
     ws.lambda.copy_from_slice(&data.lambda);
@@ -136,8 +136,13 @@ pub fn project_with_factorization(model: &Model, data: &mut Data, ws: &mut Proje
         for i in 0..n {
             q[i] += data.qdd[i];
         }
+        // the velocity residual at the corrected positions (A turns with q: against the old A
+        // the correction would leave `dA qd` behind); the factorization of B stays (it sets only
+        // the direction of the correction, and does not read `data.jac`)
+        constraints(model, data, t, q, qd, false);
+        velocity_residual(model, data, qd, &mut ws.vres);
     }
-    if vel {
+    if max_abs(&ws.vres) > tol.velocity_tol {
         for v in ws.vres.iter_mut() {
             *v = -*v;
         }

@@ -47,12 +47,27 @@ impl Banded {
     pub fn mul_add(&self, alpha: f64, x: &[f64], y: &mut [f64]) {
         let (n, hb) = (self.n, self.hb);
         let w = 2 * hb + 1;
-        let x = &x[..n];
-        for (i, (yi, row)) in y[..n].iter_mut().zip(self.data.chunks_exact(w)).enumerate() {
+        assert!(x.len() >= n && y.len() >= n && self.data.len() >= n * w);
+        for i in 0..n {
             let lo = i.saturating_sub(hb);
             let hi = (i + hb + 1).min(n);
-            let s: f64 = row[lo + hb - i..hi + hb - i].iter().zip(&x[lo..hi]).map(|(a, b)| a * b).sum();
-            *yi += alpha * s;
+            let base = i * w + hb - i; // data index of column 0 in row i (may be "negative")
+            // two accumulators; indices are in range: lo..hi within 0..n, base + j within row i
+            let (mut s0, mut s1) = (0.0, 0.0);
+            let mut j = lo;
+            // SAFETY: lo <= j < hi <= n <= x.len(); base + j = i w + hb + (j - i) with
+            // |j - i| <= hb lies in row i's w entries, within data (checked above)
+            unsafe {
+                while j + 1 < hi {
+                    s0 += self.data.get_unchecked(base.wrapping_add(j)) * x.get_unchecked(j);
+                    s1 += self.data.get_unchecked(base.wrapping_add(j + 1)) * x.get_unchecked(j + 1);
+                    j += 2;
+                }
+                if j < hi {
+                    s0 += self.data.get_unchecked(base.wrapping_add(j)) * x.get_unchecked(j);
+                }
+                *y.get_unchecked_mut(i) += alpha * (s0 + s1);
+            }
         }
     }
 

@@ -9,7 +9,8 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use common::*;
-use ukflex::integrate::{integrate, Dopri5, Options, Radau5, SecondOrderSystem, Stepper, UkSystem};
+use ukflex::integrate::{integrate, Dopri5, GenAlpha, GenAlphaOptions, Method, Options, Radau5, SecondOrderSystem, Stepper, UkSystem};
+use ukflex::jacobian::Differences;
 use ukflex::jacobian::{uk_jacobian, JacobianWorkspace};
 use ukflex::{uk, Data, Model};
 
@@ -99,8 +100,13 @@ fn uk_acceleration_and_jacobian_do_not_allocate() {
 }
 
 fn steps_allocate<St: Stepper>(stepper: &mut St, model: &Model, steps: usize) -> usize {
+    steps_allocate_with(stepper, model, steps, |_| {})
+}
+
+fn steps_allocate_with<St: Stepper>(stepper: &mut St, model: &Model, steps: usize, setup: impl FnOnce(&mut UkSystem)) -> usize {
     let data = Data::new(model);
     let mut sys = UkSystem::new(model, data);
+    setup(&mut sys);
     let y0: Vec<f64> = model.q0.iter().chain(&model.qd0).copied().collect();
     stepper.init(&mut sys, 0.0, &y0, 1.0).unwrap();
     stepper.step(&mut sys, 1.0).unwrap();
@@ -123,11 +129,24 @@ fn native_steps_do_not_allocate() {
     let mut dp = Dopri5::new(2 * model.n, opts.clone()).unwrap();
     let n = steps_allocate(&mut dp, &model, 300);
     assert_eq!(n, 0, "DOPRI5 allocated {n} times in 300 steps");
-    let mut rd = Radau5::new(model.n, opts).unwrap();
+    let mut rd = Radau5::new(model.n, opts.clone()).unwrap();
     let n = steps_allocate(&mut rd, &model, 100);
     let st = rd.stats();
     assert!(st.njev >= 1 && st.nlu >= 2, "{st:?}");
     assert_eq!(n, 0, "RADAU5 allocated {n} times in 100 steps (stats {st:?})");
+    // the structured Jacobian (its workspace is made at the first Jacobian, before counting)
+    let mut rd = Radau5::new(model.n, opts.clone()).unwrap();
+    let n = steps_allocate_with(&mut rd, &model, 100, |sys| sys.jws.scheme = Differences::Structured);
+    assert_eq!(n, 0, "RADAU5 (structured Jacobian) allocated {n} times in 100 steps");
+    // generalized-alpha, fixed and controlled steps, with its projection
+    for step in [Some(2e-4), None] {
+        let go = GenAlphaOptions { step, projection: Method::GenAlpha(GenAlphaOptions::default()).default_projection(), ..Default::default() };
+        let mut ga = GenAlpha::new(model.n, model.m, opts.clone(), go).unwrap();
+        let n = steps_allocate(&mut ga, &model, 200);
+        let st = ga.stats();
+        assert!(st.nlu >= 1 && st.njev >= 1, "{st:?}");
+        assert_eq!(n, 0, "GENALPHA (step {step:?}) allocated {n} times in 200 steps (stats {st:?})");
+    }
 }
 
 // ---------------------------------------------------------------- accuracy on exact solutions

@@ -1,35 +1,43 @@
 //! Generalized-alpha (Chung & Hulbert 1993, in the form of Arnold & Bruls 2007) for
-//! `qdd = g(t, q, qd)`, the UK acceleration: numerical dissipation of the high frequencies set
-//! by `rho_inf` (1: none, the trapezoidal rule; 0: asymptotic annihilation), second order.
+//! `qdd = g(t, q, qd)`, the UK acceleration: second order, numerical dissipation of the high
+//! frequencies set by `rho_inf` (1: none; 0: annihilation in one step). Made for stiff flexible
+//! multibody systems, whose fast elastic modes (axial, short-element bending) are excited by a
+//! sudden start and carry nothing the user asked for: they are damped instead of resolved.
 //!
 //! Step `n -> n+1` with the acceleration-like variable `a`:
 //! * `(1 - alpha_m) a_{n+1} + alpha_m a_n = (1 - alpha_f) qdd_{n+1} + alpha_f qdd_n`,
 //! * `q_{n+1} = q_n + h qd_n + h^2 (1/2 - beta) a_n + h^2 beta a_{n+1}`,
 //! * `qd_{n+1} = qd_n + h (1 - gamma) a_n + h gamma a_{n+1}`,
-//! * `qdd_{n+1} = g(t_{n+1}, q_{n+1}, qd_{n+1})`: the UK acceleration (the constraint forces come
-//!   from the UK solve; there are no multiplier unknowns).
+//! * `qdd_{n+1} = g(t_{n+1}, q_{n+1}, qd_{n+1})`: the UK acceleration.
 //!
-//! The unknown is `qdd_{n+1}`; Newton on `R = qdd - g(q(qdd), qd(qdd))` with the structured
-//! iteration matrix of the constrained linearization: with `beta' = h^2 beta (1 - alpha_f) /
-//! (1 - alpha_m)` (`dq/dqdd`), `gamma' = h gamma (1 - alpha_f) / (1 - alpha_m)` (`dqd/dqdd`),
-//! the stiffness `K = -dQ/dq` and damping `C = -dQ/dqd` the system knows analytically, the
-//! correction solves
+//! **Newton.** The unknowns are `qdd_{n+1}` and the multipliers; the iterations run on the
+//! acceleration-level equations `M qdd + A^T lambda = Q`, `A qdd = b` at the trial state
+//! (`SecondOrderSystem::augmented_residual`: assembly only), whose root is the UK acceleration,
+//! with the iteration matrix of the constrained linearization
 //!
-//! `[M + gamma' C + beta' K, A^T; A, 0] [dx; mu] = [-M R; -A R]`,
+//! `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]`,
 //!
-//! which is exactly the Newton step `(I + P M^-1 (beta' K + gamma' C)) dx = -R` with the
-//! `M`-orthogonal projector `P` onto the constraint null space (`P M^-1 A^T = 0`): the
-//! linearization of `g` for constant `M`, `A`. Terms that vary with `q` (`M(q)`, `A(q)`,
-//! centrifugal stiffness) only slow the contraction: the matrix is factored once (dense LU) and
-//! reused over steps while Newton contracts fast, refreshed when it does not.
+//! `beta' = h^2 beta (1 - alpha_f) / (1 - alpha_m)` (`dq/dqdd`), `gamma' = h gamma
+//! (1 - alpha_f) / (1 - alpha_m)` (`dqd/dqdd`), `K = -dQ/dq` the bodies' analytic stiffness,
+//! `C = -dQ/dqd` and `db/dqd` exact differences of functions quadratic in the velocities. For
+//! constant `M`, `A` it is exactly the Newton matrix `I + P M^-1 (beta' K + gamma' C) + ...` of
+//! `qdd - g(q(qdd), qd(qdd))` (`P` the `M`-orthogonal projector onto the constraint null
+//! space). The stiff directions turn with the bodies and the constraints (a rotating beam's
+//! axial stiffness against a slider's fixed direction), so `M`, `K`, `A` are read at the
+//! predicted state, where the first residual evaluation leaves them, and the factored matrix is
+//! kept for the next steps only while Newton contracts fast with it; `C`, `db/dqd` vary slowly
+//! and are re-read every 64 steps or when Newton slows. The converged iterate is finished by
+//! one UK evaluation, `qdd_{n+1} = g(q_{n+1}, qd_{n+1})`: the accepted accelerations and
+//! multipliers are the UK solution (the difference is the Newton error, below the tolerance).
 //!
-//! Constraint drift: the UK acceleration satisfies `A qdd = b` exactly, so positions and
-//! velocities drift only by the discretization error; the system's `post_step` hook projects
-//! them back (`UkSystem` with a projection tolerance) -- cheap, because the drift per step is
-//! tiny and the hook returns at once while it is below the tolerance.
+//! **Constraint drift.** The UK acceleration satisfies `A qdd = b` exactly, so positions and
+//! velocities drift only by the discretization error. With a projection tolerance the final UK
+//! evaluation's factorization also projects `q` and `qd` back (minimum mass-norm corrections,
+//! `correct::project_with_factorization`) whenever the drift exceeds it: no extra kernel call.
 //!
-//! Step size: fixed (`GenAlphaOptions::step`), or controlled by the local error estimate of
-//! the positions `h^2 |beta - 1/6| |a_{n+1} - a_n|` (Zienkiewicz & Xie 1991) against
+//! **Step size.** Fixed (`GenAlphaOptions::step`; a step whose Newton iteration fails is
+//! halved, then the fixed step resumes), or controlled by the local error estimate of the
+//! positions `h^2 |beta - 1/6| |a_{n+1} - a_n|` (Zienkiewicz & Xie 1991) against
 //! `atol + rtol |q|`. Dense output: the cubic Hermite interpolant of `(q, qd)` at both ends.
 
 use super::lu::{lu_real, lu_real_solve};
@@ -58,6 +66,9 @@ impl Default for GenAlphaOptions {
     }
 }
 
+/// Keep the factored iteration matrix for the next step while Newton contracts at least this
+/// well with it (the stiff directions turn with the bodies, so it ages within a few steps).
+const REUSE_CONTRACTION: f64 = 0.2;
 /// Re-read the slowly varying velocity terms (`C`, `db/dqd`) of the iteration matrix after this
 /// many steps, or at once when Newton contracts worse than `REFRESH_CONTRACTION`.
 const VELOCITY_TERMS_AGE: usize = 64;
@@ -113,6 +124,8 @@ pub struct GenAlpha {
     /// Re-read the velocity terms before the next attempt; steps since they were read.
     refresh: bool,
     age: usize,
+    /// The factored matrix may serve the next step.
+    reuse: bool,
     /// Newton iterations of the last step, total.
     pub newton_iterations: usize,
     /// Refreshes of the structure (`njev`) and factorizations (`nlu`) are in `stats`.
@@ -180,6 +193,7 @@ impl GenAlpha {
             have_structure: false,
             refresh: true,
             age: 0,
+            reuse: false,
             newton_iterations: 0,
             reject: false,
             err_prev: 0.0,
@@ -202,6 +216,15 @@ impl GenAlpha {
         self.have_structure = true;
         self.st.stats.njev += 1;
         Ok(())
+    }
+
+    /// Read `M`, `K`, `A` where the system's last residual evaluation left them and factor the
+    /// iteration matrix for step `h`.
+    fn refresh_matrix<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64) -> Result<()> {
+        if !sys.stiff_structure(&self.q_new, &self.qd_new, &mut self.mm, &mut self.kk, &mut self.aa)? {
+            return Err(Error::argument("method", "GENALPHA needs a system with a structured Jacobian (mass, stiffness, constraints)"));
+        }
+        self.factor(h)
     }
 
     /// Assemble and factor `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]` for step `h`.
@@ -307,22 +330,12 @@ impl GenAlpha {
         let (n, m) = (self.n, self.m);
         let nm = n + m;
         let (bp, _) = self.primes(h);
-        let pred = std::env::var("GA_PRED").ok().and_then(|v| v.parse::<u32>().ok()).unwrap_or(0);
-        match pred {
-            1 => {
-                // a_{n+1} = a_n
-                let af = self.alpha_f;
-                for i in 0..n {
-                    self.x[i] = (self.a_prev[i] - af * self.qdd_prev[i]) / (1.0 - af);
-                }
-            }
-            2 => self.x.fill(0.0),
-            _ => self.x.copy_from_slice(&self.qdd_prev),
-        }
+        self.x.copy_from_slice(&self.qdd_prev);
         self.lam.copy_from_slice(&self.lam_prev);
         let t1 = self.st.t + h;
         let mut prev = f64::INFINITY;
         let mut theta = 0.0;
+        let mut refreshed = false;
         for k in 1..=self.go.max_newton {
             self.trial(h);
             let (r1, r2) = (&mut self.g, &mut self.r2);
@@ -330,11 +343,9 @@ impl GenAlpha {
                 return Err(Error::argument("method", "GENALPHA needs a system with the acceleration-level residual"));
             }
             self.st.stats.nfev += 1;
-            if k == 1 {
-                if !sys.stiff_structure(&self.q_new, &self.qd_new, &mut self.mm, &mut self.kk, &mut self.aa)? {
-                    return Err(Error::argument("method", "GENALPHA needs a system with a structured Jacobian (mass, stiffness, constraints)"));
-                }
-                self.factor(h)?;
+            if k == 1 && !(self.reuse && h == self.lu_h) {
+                self.refresh_matrix(sys, h)?;
+                refreshed = true;
             }
             for i in 0..n {
                 self.rhs[i] = -self.g[i];
@@ -354,16 +365,20 @@ impl GenAlpha {
                 self.g[i] = bp * self.rhs[i];
             }
             let d = self.newton_norm(&self.g);
-            if std::env::var("GA_DEBUG").is_ok() {
-                eprintln!("t={:.6} k={k} d={d:.2e} tol={tol:.1e} age={}", self.st.t, self.age);
-            }
             if !d.is_finite() {
                 return Ok(None);
             }
             let converged = if d <= 1e-3 * tol {
                 true
-            } else if k > 1 {
+            } else if prev.is_finite() {
                 theta = d / prev;
+                if theta > REUSE_CONTRACTION && !refreshed {
+                    // the reused matrix is too old for this step: read it at the current iterate
+                    self.refresh_matrix(sys, h)?;
+                    refreshed = true;
+                    prev = f64::INFINITY;
+                    continue;
+                }
                 if theta >= 1.0 {
                     return Ok(None);
                 }
@@ -383,6 +398,7 @@ impl GenAlpha {
                     self.x[i] = self.g[i];
                     self.a_new[i] = ((1.0 - af) * self.g[i] + af * self.qdd_prev[i] - am * self.a_prev[i]) / (1.0 - am);
                 }
+                self.reuse = theta <= REUSE_CONTRACTION;
                 return Ok(Some((k, theta)));
             }
             prev = d.max(f64::MIN_POSITIVE);

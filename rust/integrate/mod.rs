@@ -172,7 +172,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         };
         uk::acceleration_with_phi(self.model, &mut self.data, t, q, qd)?;
         qdd.copy_from_slice(&self.data.qdd);
-        correct::project_with_factorization(self.model, &mut self.data, &mut self.pws, q, qd, tol)
+        correct::project_with_factorization(self.model, &mut self.data, &mut self.pws, t, q, qd, tol)
     }
     fn stiff_structure(&mut self, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], a: &mut [f64]) -> Result<bool> {
         // `uk::acceleration` / `augmented_residual` left the body blocks and A of (q, qd) in `data`

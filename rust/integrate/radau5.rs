@@ -103,9 +103,7 @@ const NIT: usize = 7;
 /// RADAU5's default is 0.001 (cheap Jacobians); Hairer recommends 0.1 when the Jacobian is
 /// costly, as here (a finite-difference Jacobian is ~4n UK calls). Measured on the paper scene:
 /// 20x fewer Jacobians, 3x faster with beam damping (docs/performance.md).
-const THET_DEFAULT: f64 = 0.1;
-#[allow(non_snake_case)]
-fn THET() -> f64 { std::env::var("RADAU_THET").ok().and_then(|v| v.parse().ok()).unwrap_or(THET_DEFAULT) }
+const THET: f64 = 0.1;
 const SAFE: f64 = 0.9;
 const FACL: f64 = 5.0;
 const FACR: f64 = 0.125;
@@ -153,7 +151,7 @@ impl Radau5 {
             betan: 0.0,
             fnewt,
             faccon: 1.0,
-            theta: THET_DEFAULT,
+            theta: THET,
             hacc: 0.0,
             erracc: 0.0,
             first: true,
@@ -289,7 +287,7 @@ impl Stepper for Radau5 {
         self.need_jac = true;
         self.need_dec = true;
         self.faccon = 1.0;
-        self.theta = THET();
+        self.theta = THET;
         self.nsing = 0;
         rhs(sys, t0, &self.st.y, &mut self.f0)?;
         self.st.stats.nfev += 1;
@@ -373,7 +371,7 @@ impl Stepper for Radau5 {
             }
             // simplified Newton
             self.faccon = self.faccon.max(f64::EPSILON).powf(0.8);
-            self.theta = THET().abs();
+            self.theta = THET.abs();
             let mut newt = 0usize;
             let mut dynold = 0.0f64;
             let mut thqold = 0.0f64;
@@ -514,7 +512,7 @@ impl Stepper for Radau5 {
                     false
                 } else {
                     let qt = hnew / h;
-                    if self.theta <= THET() && (QUOT1..=QUOT2).contains(&qt) {
+                    if self.theta <= THET && (QUOT1..=QUOT2).contains(&qt) {
                         true
                     } else {
                         self.st.h = hnew;
@@ -522,7 +520,7 @@ impl Stepper for Radau5 {
                     }
                 };
                 if !keep {
-                    if self.theta <= THET() {
+                    if self.theta <= THET {
                         self.need_dec = true;
                     } else {
                         self.need_jac = true;
