@@ -85,8 +85,8 @@ pub fn dense_mass(model: &Model, data: &Data) -> Vec<f64> {
 pub fn mass_times(model: &Model, data: &Data, x: &[f64], out: &mut [f64]) {
     out.fill(0.0);
     for (body, bd) in model.bodies.iter().zip(&data.bodies) {
-        let o = body.offset;
-        body.dense_block(bd, &mut |i, j, v| out[o + i] += v * x[o + j]);
+        let r = body.offset..body.offset + body.n_coords;
+        body.mass_times(bd, &x[r.clone()], &mut out[r]);
     }
 }
 

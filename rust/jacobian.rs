@@ -197,7 +197,7 @@ impl StructuredJacobian {
     /// `jq`, `jv` (n x n row-major) at `(t, q, qd)`.
     pub fn evaluate(&mut self, model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], jq: &mut [f64], jv: &mut [f64]) -> Result<()> {
         use crate::dynamics;
-        use crate::integrate::lu::{lu_real, lu_real_solve};
+        use crate::integrate::lu::{lu_cm, lu_cm_solve}; // the saddle-point matrix is symmetric: row- and column-major alike
         let (n, m) = (model.n, model.m);
         let nm = n + m;
         dynamics::mass_and_forces(model, data, q, qd);
@@ -214,7 +214,7 @@ impl StructuredJacobian {
             self.saddle[(n + r) * nm..(n + r) * nm + n].copy_from_slice(&data.jac[r * n..(r + 1) * n]);
             self.saddle[(n + r) * nm + n..(n + r + 1) * nm].fill(0.0);
         }
-        if !lu_real(&mut self.saddle, &mut self.piv, nm) {
+        if !lu_cm(&mut self.saddle, &mut self.piv, nm) {
             // redundant constraint rows: the multiplier block, slightly regularized
             dynamics::constraints(model, data, t, q, qd, false);
             let scale = self.m_dense.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(f64::MIN_POSITIVE);
@@ -230,7 +230,7 @@ impl StructuredJacobian {
                     self.saddle[(n + r) * nm + n + s] = if r == s { -1e-12 * scale } else { 0.0 };
                 }
             }
-            if !lu_real(&mut self.saddle, &mut self.piv, nm) {
+            if !lu_cm(&mut self.saddle, &mut self.piv, nm) {
                 return Err(crate::error::Error::Solver("structured Jacobian: the saddle-point matrix is singular".into()));
             }
         }
@@ -240,7 +240,7 @@ impl StructuredJacobian {
                 self.rhs[i] = -self.k[i * n + j];
             }
             self.rhs[n..].fill(0.0);
-            lu_real_solve(&self.saddle, &self.piv, nm, &mut self.rhs);
+            lu_cm_solve(&self.saddle, &self.piv, nm, &mut self.rhs);
             for i in 0..n {
                 jq[i * n + j] = self.rhs[i];
             }
@@ -250,7 +250,7 @@ impl StructuredJacobian {
             for r in 0..m {
                 self.rhs[n + r] = self.bv[r * n + j];
             }
-            lu_real_solve(&self.saddle, &self.piv, nm, &mut self.rhs);
+            lu_cm_solve(&self.saddle, &self.piv, nm, &mut self.rhs);
             for i in 0..n {
                 jv[i * n + j] = self.rhs[i];
             }

@@ -50,6 +50,25 @@ fn mass_matrix_is_symmetric_positive_definite() {
     }
 }
 
+/// The block product `M x` (Newton residuals of the implicit methods) equals the dense mass
+/// matrix times `x` for every body kind.
+#[test]
+fn mass_times_equals_the_dense_mass_product() {
+    for (name, json) in scenes() {
+        let (model, mut data) = build(&json);
+        let mut rng = Lcg(11);
+        for _ in 0..3 {
+            let (q, x) = random_state(&model, &mut rng);
+            let m = mass(&model, &mut data, &q);
+            let want = &m * DVector::from_column_slice(&x);
+            let mut got = vec![f64::NAN; model.n];
+            dynamics::mass_times(&model, &data, &x, &mut got);
+            let err = (DVector::from_column_slice(&got) - &want).abs().max();
+            assert!(err <= 1e-13 * want.abs().max().max(1e-300), "{name}: |M x - dense| = {err:e}");
+        }
+    }
+}
+
 /// `Q_v = -Mdot qd + 1/2 d/dq (qd^T M qd)`: the velocity-quadratic part of Q is
 /// `Q(q, qd) - Q(q, 0)` when no damping acts (damping is linear in qd; removed by symmetry).
 #[test]

@@ -461,6 +461,21 @@ impl AncfCable {
         }
     }
 
+    /// `out += (M_s (x) I_2) x` (`x`, `out`: the body's segments).
+    pub fn mass_times(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.m_s.n;
+        for i in 0..n {
+            let (mut a, mut b) = (0.0, 0.0);
+            for j in i.saturating_sub(HB_S)..(i + HB_S + 1).min(n) {
+                let m = self.m_s.get(i, j);
+                a += m * x[2 * j];
+                b += m * x[2 * j + 1];
+            }
+            out[2 * i] += a;
+            out[2 * i + 1] += b;
+        }
+    }
+
     pub fn dense_block(&self, _bd: &AncfCableData, put: &mut impl FnMut(usize, usize, f64)) {
         let n = self.m_s.n;
         for i in 0..n {

@@ -603,6 +603,41 @@ impl Beam {
         [self.s_t[0] + dot(&self.s_bar[0], qf), self.s_t[1] + dot(&self.s_bar[1], qf)]
     }
 
+    /// The banded products of `mass_and_forces` in one pass over the rows (the three constant
+    /// matrices share one band layout): `w = i_rf + M_ff^tr q_f`, `m_thf = i_thf - S_tilde q_f`,
+    /// `ff = thd^2 w + 2 thd S_tilde qd_f - K_ff q_f`.
+    #[inline]
+    fn banded_terms(&self, qf: &[f64], qfd: &[f64], thd: f64, w: &mut [f64], m_thf: &mut [f64], ff: &mut [f64]) {
+        let (n, hb) = (self.n_f, self.k_ff.hb);
+        let width = 2 * hb + 1;
+        let (mt, st, kf) = (&self.m_ff_tr.data, &self.s_tilde.data, &self.k_ff.data);
+        assert!(self.m_ff_tr.hb == hb && self.s_tilde.hb == hb && mt.len() >= n * width && st.len() >= n * width && kf.len() >= n * width);
+        assert!(qf.len() >= n && qfd.len() >= n && w.len() >= n && m_thf.len() >= n && ff.len() >= n);
+        for i in 0..n {
+            let lo = i.saturating_sub(hb);
+            let hi = (i + hb + 1).min(n);
+            let base = i * width + hb - i;
+            let (mut a_w, mut a_s, mut a_sd, mut a_k) = (0.0, 0.0, 0.0, 0.0);
+            for j in lo..hi {
+                // SAFETY: lo <= j < hi <= n (vector lengths checked above); base + j =
+                // i width + hb + (j - i) with |j - i| <= hb lies in row i of each band
+                unsafe {
+                    let idx = base.wrapping_add(j);
+                    let (x, xd) = (*qf.get_unchecked(j), *qfd.get_unchecked(j));
+                    a_w += mt.get_unchecked(idx) * x;
+                    let sv = *st.get_unchecked(idx);
+                    a_s += sv * x;
+                    a_sd += sv * xd;
+                    a_k += kf.get_unchecked(idx) * x;
+                }
+            }
+            let wi = self.i_rf[i] + a_w;
+            w[i] = wi;
+            m_thf[i] = self.i_thf[i] - a_s;
+            ff[i] = thd * thd * wi + 2.0 * thd * a_sd - a_k;
+        }
+    }
+
     /// Mass blocks and generalized forces (paper eqs. 20-40), with `Sigma = s_t + S_bar q_f`,
     /// `J` = +90 deg turn:
     /// * `m_RR = m I`, `m_Rtheta = A J Sigma`, `m_Rf = A S_bar`                    (eqs. 21-25)
@@ -623,9 +658,11 @@ impl Beam {
         let sigd = [dot(&self.s_bar[0], qfd), dot(&self.s_bar[1], qfd)]; // S_bar qd_f
         let asig = [c * sig[0] - s * sig[1], s * sig[0] + c * sig[1]];
         let asigd = [c * sigd[0] - s * sigd[1], s * sigd[0] + c * sigd[1]];
-        // w = i_rf + M_ff^tr q_f
-        bd.w.copy_from_slice(&self.i_rf);
-        self.m_ff_tr.mul_add(1.0, qf, &mut bd.w);
+        // one pass over the bands: w = i_rf + M_ff^tr q_f, m_thetaf = i_thf + S_tilde^T q_f =
+        // i_thf - S_tilde q_f (M_Rf = A S_bar is not formed: the factor uses the rotated
+        // constants, `dense_block` rebuilds it), Q_f = thd^2 w + 2 thd S_tilde qd_f - K_ff q_f
+        let ff = &mut f[3..];
+        self.banded_terms(qf, qfd, thd, &mut bd.w, &mut bd.m_thf, ff);
         let mut m_thth = self.j0;
         let mut qd_w = 0.0;
         for j in 0..nf {
@@ -634,20 +671,10 @@ impl Beam {
         }
         bd.m_rr = frame_mass_block(self.mass, sig, m_thth, c, s);
         bd.cs = [c, s];
-        // m_thetaf = i_thf + S_tilde^T q_f = i_thf - S_tilde q_f  (M_Rf = A S_bar is not
-        // formed: the factor uses the rotated constants, `dense_block` rebuilds it)
-        bd.m_thf.copy_from_slice(&self.i_thf);
-        self.s_tilde.mul_add(-1.0, qf, &mut bd.m_thf);
-
         f[0] = thd * thd * asig[0] + 2.0 * thd * asigd[1];
         f[1] = thd * thd * asig[1] - 2.0 * thd * asigd[0];
         f[2] = -2.0 * thd * qd_w;
         let ff = &mut f[3..];
-        for j in 0..nf {
-            ff[j] = thd * thd * bd.w[j];
-        }
-        self.s_tilde.mul_add(2.0 * thd, qfd, ff);
-        self.k_ff.mul_add(-1.0, qf, ff);
         self.axial_forces(bd, qf, qfd, ff);
         if self.damping > 0.0 {
             self.k_ff.mul_add(-self.damping, qfd, ff);
@@ -729,6 +756,25 @@ impl Beam {
             1 => s * self.s_bar[0][j] + c * self.s_bar[1][j],
             _ => bd.m_thf[j],
         }
+    }
+
+    /// `out += M_b x` from the blocks (`x`, `out`: the body's segments).
+    pub fn mass_times(&self, bd: &BeamData, x: &[f64], out: &mut [f64]) {
+        let (xr, xf) = x.split_at(3);
+        let (or, of) = out.split_at_mut(3);
+        let [c, s] = bd.cs;
+        let (s0, s1, t) = (dot(&self.s_bar[0], xf), dot(&self.s_bar[1], xf), dot(&bd.m_thf, xf));
+        for i in 0..3 {
+            or[i] += bd.m_rr[i][0] * xr[0] + bd.m_rr[i][1] * xr[1] + bd.m_rr[i][2] * xr[2];
+        }
+        or[0] += c * s0 - s * s1;
+        or[1] += s * s0 + c * s1;
+        or[2] += t;
+        let (ka, kb) = (c * xr[0] + s * xr[1], -s * xr[0] + c * xr[1]);
+        for (((o, a), b), m) in of.iter_mut().zip(&self.s_bar[0]).zip(&self.s_bar[1]).zip(&bd.m_thf) {
+            *o += ka * a + kb * b + xr[2] * m;
+        }
+        self.m_ff.mul_add(1.0, xf, of);
     }
 
     pub fn dense_block(&self, bd: &BeamData, put: &mut impl FnMut(usize, usize, f64)) {

@@ -198,6 +198,25 @@ impl Body {
         }
     }
 
+    /// `out += M_b x` on this body's segments (after `mass_and_forces`; allocation free).
+    #[inline]
+    pub fn mass_times(&self, bd: &BodyData, x: &[f64], out: &mut [f64]) {
+        match (&self.kind, bd) {
+            (BodyKind::Rigid(_), BodyData::Rigid(d)) => {
+                for i in 0..3 {
+                    out[i] += d.m_rr[i][0] * x[0] + d.m_rr[i][1] * x[1] + d.m_rr[i][2] * x[2];
+                }
+            }
+            (BodyKind::Beam(k), BodyData::Beam(d)) => k.mass_times(d, x, out),
+            (BodyKind::PointMass(k), BodyData::PointMass(_)) => {
+                out[0] += k.mass * x[0];
+                out[1] += k.mass * x[1];
+            }
+            (BodyKind::AncfBeam(k), BodyData::AncfBeam(_)) => k.mass_times(x, out),
+            _ => unreachable!("body data of another kind"),
+        }
+    }
+
     /// Visit the nonzero entries of the body block `M_b` (after `mass_and_forces`) in body
     /// coordinates: `put(i, j, M_b[i, j])`.
     pub fn dense_block(&self, bd: &BodyData, put: &mut impl FnMut(usize, usize, f64)) {

@@ -40,7 +40,7 @@
 //! positions `h^2 |beta - 1/6| |a_{n+1} - a_n|` (Zienkiewicz & Xie 1991) against
 //! `atol + rtol |q|`. Dense output: the cubic Hermite interpolant of `(q, qd)` at both ends.
 
-use super::lu::{lu_real, lu_real_solve};
+use super::lu::{lu_cm, lu_cm_solve};
 use super::{initial_step, Options, SecondOrderSystem, StepState, Stepper};
 use crate::correct::ProjectionTolerance;
 use crate::error::{Error, Result};
@@ -227,55 +227,48 @@ impl GenAlpha {
         self.factor(h)
     }
 
-    /// Assemble and factor `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]` for step `h`.
+    /// Assemble and factor `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]` for step `h`
+    /// (column-major: the solves run down contiguous columns).
     fn factor(&mut self, h: f64) -> Result<()> {
+        self.st.stats.nlu += 1;
+        self.lu_h = h;
+        self.assemble(h, 0.0);
+        if lu_cm(&mut self.lu, &mut self.piv, self.n + self.m) {
+            return Ok(());
+        }
+        // redundant constraint rows make the saddle-point matrix singular: regularize the
+        // multiplier block (the correction dx is unaffected where A has full row rank)
+        let scale = self.mm.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300);
+        self.assemble(h, -1e-12 * scale);
+        self.st.stats.nlu += 1;
+        if !lu_cm(&mut self.lu, &mut self.piv, self.n + self.m) {
+            return Err(Error::Solver(format!("GENALPHA: iteration matrix singular at t = {}", self.st.t)));
+        }
+        Ok(())
+    }
+
+    /// The iteration matrix for step `h` into `lu` (column-major), `reg` on the diagonal of
+    /// the multiplier block.
+    fn assemble(&mut self, h: f64, reg: f64) {
         let (n, m) = (self.n, self.m);
         let nm = n + m;
         let (bp, gp) = self.primes(h);
-        for i in 0..n {
-            for j in 0..n {
-                self.lu[i * nm + j] = self.mm[i * n + j] + gp * self.cc[i * n + j] + bp * self.kk[i * n + j];
+        for j in 0..n {
+            let col = &mut self.lu[j * nm..(j + 1) * nm];
+            for i in 0..n {
+                col[i] = self.mm[i * n + j] + gp * self.cc[i * n + j] + bp * self.kk[i * n + j];
             }
             for r in 0..m {
-                self.lu[i * nm + n + r] = self.aa[r * n + i];
+                col[n + r] = self.aa[r * n + j] - gp * self.bv[r * n + j];
             }
         }
         for r in 0..m {
-            for j in 0..n {
-                self.lu[(n + r) * nm + j] = self.aa[r * n + j] - gp * self.bv[r * n + j];
-            }
+            let col = &mut self.lu[(n + r) * nm..(n + r + 1) * nm];
+            col[..n].copy_from_slice(&self.aa[r * n..(r + 1) * n]);
             for s in 0..m {
-                self.lu[(n + r) * nm + n + s] = 0.0;
+                col[n + s] = if r == s { reg } else { 0.0 };
             }
         }
-        self.st.stats.nlu += 1;
-        self.lu_h = h;
-        if !lu_real(&mut self.lu, &mut self.piv, nm) {
-            // redundant constraint rows make the saddle-point matrix singular: regularize the
-            // multiplier block (the correction dx is unaffected where A has full row rank)
-            for r in 0..m {
-                for j in 0..n {
-                    self.lu[(n + r) * nm + j] = self.aa[r * n + j] - gp * self.bv[r * n + j];
-                    self.lu[j * nm + n + r] = self.aa[r * n + j];
-                }
-            }
-            for i in 0..n {
-                for j in 0..n {
-                    self.lu[i * nm + j] = self.mm[i * n + j] + gp * self.cc[i * n + j] + bp * self.kk[i * n + j];
-                }
-            }
-            let scale = self.mm.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300);
-            for r in 0..m {
-                for s in 0..m {
-                    self.lu[(n + r) * nm + n + s] = if r == s { -1e-12 * scale } else { 0.0 };
-                }
-            }
-            self.st.stats.nlu += 1;
-            if !lu_real(&mut self.lu, &mut self.piv, nm) {
-                return Err(Error::Solver(format!("GENALPHA: iteration matrix singular at t = {}", self.st.t)));
-            }
-        }
-        Ok(())
     }
 
     /// Positions and velocities of the step for the unknown `x = qdd_{n+1}`.
@@ -353,7 +346,7 @@ impl GenAlpha {
             for r in 0..m {
                 self.rhs[n + r] = -self.r2[r];
             }
-            lu_real_solve(&self.lu, &self.piv, nm, &mut self.rhs);
+            lu_cm_solve(&self.lu, &self.piv, nm, &mut self.rhs);
             for i in 0..n {
                 self.x[i] += self.rhs[i];
             }

@@ -1,14 +1,18 @@
 //! Dense LU (real and complex), allocation free after construction.
 
-/// In-place LU with partial pivoting of an n x n row-major matrix. `false` if singular.
-pub(crate) fn lu_real(a: &mut [f64], piv: &mut [usize], n: usize) -> bool {
+/// In-place LU with partial pivoting of an n x n **column-major** matrix (`a[i + j n]` is row
+/// `i`, column `j`): every inner loop runs down a contiguous column (the trailing update and both
+/// triangular solves are `axpy`s), which suits the repeated solves with one factorization of the
+/// implicit methods. `false` if singular.
+pub(crate) fn lu_cm(a: &mut [f64], piv: &mut [usize], n: usize) -> bool {
+    assert!(a.len() >= n * n && piv.len() >= n);
     for k in 0..n {
+        let col = &a[k * n..(k + 1) * n];
         let mut p = k;
-        let mut best = a[k * n + k].abs();
-        for i in k + 1..n {
-            let v = a[i * n + k].abs();
-            if v > best {
-                best = v;
+        let mut best = col[k].abs();
+        for (i, v) in col.iter().enumerate().skip(k + 1) {
+            if v.abs() > best {
+                best = v.abs();
                 p = i;
             }
         }
@@ -18,37 +22,53 @@ pub(crate) fn lu_real(a: &mut [f64], piv: &mut [usize], n: usize) -> bool {
         }
         if p != k {
             for j in 0..n {
-                a.swap(k * n + j, p * n + j);
+                a.swap(k + j * n, p + j * n);
             }
         }
-        let inv = 1.0 / a[k * n + k];
-        let (top, bottom) = a.split_at_mut((k + 1) * n);
-        let rowk = &top[k * n..];
-        for i in 0..n - k - 1 {
-            let row = &mut bottom[i * n..(i + 1) * n];
-            let l = row[k] * inv;
-            row[k] = l;
-            if l != 0.0 {
-                for (x, r) in row[k + 1..].iter_mut().zip(&rowk[k + 1..]) {
-                    *x -= l * r;
-                }
+        let inv = 1.0 / a[k + k * n];
+        for v in &mut a[k * n + k + 1..(k + 1) * n] {
+            *v *= inv;
+        }
+        let (left, right) = a.split_at_mut((k + 1) * n);
+        let lk = &left[k * n + k + 1..(k + 1) * n];
+        for colj in right.chunks_exact_mut(n) {
+            let u = colj[k];
+            if u != 0.0 {
+                axpy(-u, lk, &mut colj[k + 1..]);
             }
         }
     }
     true
 }
 
-pub(crate) fn lu_real_solve(a: &[f64], piv: &[usize], n: usize, x: &mut [f64]) {
+/// Solve with the factors of `lu_cm`.
+pub(crate) fn lu_cm_solve(a: &[f64], piv: &[usize], n: usize, x: &mut [f64]) {
+    assert!(a.len() >= n * n && x.len() >= n && piv.len() >= n);
     for k in 0..n {
         x.swap(k, piv[k]);
     }
-    for i in 0..n {
-        let s: f64 = a[i * n..i * n + i].iter().zip(&x[..i]).map(|(l, v)| l * v).sum();
-        x[i] -= s;
+    for j in 0..n {
+        let xj = x[j];
+        if xj != 0.0 {
+            let (head, tail) = x.split_at_mut(j + 1);
+            let _ = head;
+            axpy(-xj, &a[j * n + j + 1..(j + 1) * n], &mut tail[..n - j - 1]);
+        }
     }
-    for i in (0..n).rev() {
-        let s: f64 = a[i * n + i + 1..(i + 1) * n].iter().zip(&x[i + 1..]).map(|(u, v)| u * v).sum();
-        x[i] = (x[i] - s) / a[i * n + i];
+    for j in (0..n).rev() {
+        x[j] /= a[j + j * n];
+        let xj = x[j];
+        if xj != 0.0 {
+            axpy(-xj, &a[j * n..j * n + j], &mut x[..j]);
+        }
+    }
+}
+
+/// `y += alpha x` (over the length of `y`).
+#[inline(always)]
+fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += alpha * xi;
     }
 }
 

@@ -4,7 +4,7 @@
 //! output; the iteration matrices reduced to n x n by the second-order structure (module docs
 //! of `integrate`).
 
-use super::lu::{lu_cplx, lu_cplx_solve, lu_real, lu_real_solve};
+use super::lu::{lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
 use super::{initial_step, rhs, rms_norm, Options, SecondOrderSystem, StepState, Stepper};
 use crate::error::{Error, Result};
 
@@ -181,7 +181,7 @@ impl Radau5 {
         for i in 0..n {
             for j in 0..n {
                 let (jq, jv) = (self.jq[i * n + j], self.jv[i * n + j]);
-                self.e1[i * n + j] = -f * jv - jq;
+                self.e1[i + j * n] = -f * jv - jq; // column-major for lu_cm
                 self.e2r[i * n + j] = -a * jv - jq;
                 self.e2i[i * n + j] = -b * jv;
             }
@@ -190,7 +190,7 @@ impl Radau5 {
             self.e2i[i * n + i] += g2i;
         }
         self.st.stats.nlu += 2;
-        lu_real(&mut self.e1, &mut self.piv1, n) && lu_cplx(&mut self.e2r, &mut self.e2i, &mut self.piv2, n)
+        lu_cm(&mut self.e1, &mut self.piv1, n) && lu_cplx(&mut self.e2r, &mut self.e2i, &mut self.piv2, n)
     }
 
     /// `x <- (fac1 I - J)^-1 x` for a 2n vector.
@@ -203,7 +203,7 @@ impl Radau5 {
             let s: f64 = self.jq[i * n..(i + 1) * n].iter().zip(r1.iter()).map(|(a, b)| a * b).sum();
             self.br[i] = f * r2[i] + s;
         }
-        lu_real_solve(&self.e1, &self.piv1, n, &mut self.br);
+        lu_cm_solve(&self.e1, &self.piv1, n, &mut self.br);
         for i in 0..n {
             r2[i] = self.br[i];
             r1[i] = (r1[i] + self.br[i]) / f;
