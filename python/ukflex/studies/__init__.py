@@ -8,10 +8,12 @@
 * :mod:`.stability` -- the stability report over that catalogue (``ukflex stability``);
 * :mod:`.crosscheck` -- cross-checks against the NumPy reference: the paper's errata, Rust UK
   vs CP, timings (``ukflex crosscheck``);
+* :mod:`.geometric` -- geometric nonlinearity of the coupler at speed: linear FFRF, nonlinear
+  FFRF and ANCF against Exudyn's geometrically exact references (``ukflex study-geometric``);
 * :mod:`.machine` -- the machine description in the reports' headers.
 
 The library's stability diagnostics that users call on their own runs stay in
 :mod:`ukflex.stability`.
 """
 
-__all__ = ["paper", "workprecision", "extreme", "stability", "crosscheck", "machine"]
+__all__ = ["paper", "workprecision", "extreme", "stability", "crosscheck", "geometric", "machine"]
