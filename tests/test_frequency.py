@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.linalg import eigh
 
-from ukflex import scenes
+from ukflex import NonFiniteError, scenes
 from ukflex.scenes import PAPER
 
 LB = PAPER["coupler_length"]
@@ -90,3 +90,55 @@ def test_stiffness_matrix_is_symmetric_positive_definite():
     assert K.shape == (12, 12)
     assert np.array_equal(K, K.T)
     assert np.all(np.linalg.eigvalsh(K) > 0)
+
+
+# ------------------------------------------------------------------ System.frequencies (the modal analysis)
+
+def test_constrained_frequencies_of_the_simply_supported_beam_match_the_elastic_block(frequencies):
+    """The whole constrained system (supports as joints, not as a hand-picked block) gives the
+    same lowest bending frequency as the elastic block above."""
+    for theory in ("euler-bernoulli", "timoshenko"):
+        w = scenes.pinned_beam(theory=theory, elements=8).build().frequencies()
+        assert w[0] == pytest.approx(frequencies[(theory, 8)], rel=1e-6)
+
+
+def test_pendulum_frequency_comes_from_the_constraint_force():
+    """A rigid rod on a pivot has no stiffness of its own: sqrt(m g c / I_O) comes entirely from
+    the multiplier (constraint) force's geometric stiffness.  Inverted, it is unstable: negative."""
+    L, g = 1.0, 9.81
+    exact = math.sqrt(g * (L / 2) / (L**2 / 3))
+    w = scenes.pendulum(length=L, angle=-math.pi / 2).build().frequencies()
+    assert w.shape == (1,) and w[0] == pytest.approx(exact, rel=1e-6)
+    w_up = scenes.pendulum(length=L, angle=math.pi / 2).build().frequencies()
+    assert w_up[0] == pytest.approx(-exact, rel=1e-6)
+
+
+def test_cantilever_frequencies_and_mode_shapes():
+    """Clamped-free Euler-Bernoulli beam, 8 cubic elements: beta_k^2 sqrt(EI / (rho a)) / L^2;
+    the mode shapes are mass-normalized and satisfy the clamp."""
+    b, h, E, rho = 0.02, 0.01, 2.1e11, 7850.0
+    EI, rA = E * b * h**3 / 12, rho * b * h
+    sys_ = scenes.cantilever(length=1.0, elements=8, strain="linear", gravity=False).build()
+    w, V = sys_.frequencies(modes=True)
+    assert w.shape == (sys_.n_dof,) and V.shape == (sys_.n_coords, sys_.n_dof)
+    for k, beta in enumerate((1.8751041, 4.6940911, 7.8547574)):
+        assert w[k] == pytest.approx(beta**2 * math.sqrt(EI / rA), rel=1e-3)
+    assert np.all(np.diff(w) >= 0)
+    M = sys_.M(sys_.q0)
+    assert np.allclose(V.T @ M @ V, np.eye(V.shape[1]), atol=1e-9)
+    assert np.abs(sys_.A(sys_.q0) @ V).max() < 1e-10
+
+
+def test_slider_crank_frequencies_include_the_axial_mode():
+    """The paper's slider-crank (driven crank, N = 1 coupler): three elastic frequencies, the
+    first bending near the simply supported beam's, the axial one near 29,000 rad/s (the mode
+    that makes explicit integrators slow), and bad input is a named error."""
+    sys_ = scenes.slider_crank().build()
+    w = sys_.frequencies()
+    assert w.shape == (3,)
+    assert 0.9 * omega_euler_bernoulli() < w[0] < 1.2 * omega_euler_bernoulli()
+    assert 2.5e4 < w[-1] < 3.5e4
+    with pytest.raises(ValueError, match="q: expected shape"):
+        sys_.frequencies(q=np.zeros(2))
+    with pytest.raises(NonFiniteError):
+        sys_.frequencies(qd=np.full(sys_.n_coords, np.nan))

@@ -314,6 +314,62 @@ class System:
         M = self.M(self.q0 if q is None else np.asarray(q, dtype=float))
         return M[sl, sl]
 
+    def frequencies(
+        self,
+        t: Optional[float] = None,
+        q: Optional[np.ndarray] = None,
+        qd: Optional[np.ndarray] = None,
+        modes: bool = False,
+    ):
+        """Natural frequencies [rad/s] of the constrained system linearized at a state.
+
+        The UK accelerations ``qdd(t, q, qd)`` are linearized in ``q`` by the core's central
+        differences (everything that depends on ``q``: elastic and spring stiffness, gravity and
+        the constraint forces through the multipliers, which give a pendulum its frequency;
+        the structured Jacobian of the integrators leaves the last out); the motion is restricted to the
+        tangent space ``N`` of the constraints (an orthonormal basis of the null space of
+        ``A(q)``, from an SVD) and the symmetric part of ``K_r = -N^T M (dqdd/dq) N`` is solved
+        against ``M_r = N^T M N``.  Velocity terms (damping, gyroscopic) are left out: these are
+        the undamped frequencies of the frozen state.  At an equilibrium this is the classical
+        constrained modal analysis; on a moving state (a driven crank) the centrifugal stiffening
+        at that state is included.
+
+        Parameters
+        ----------
+        t, q, qd : optional
+            The state; default the system's initial state ``t0, q0, qd0``.
+        modes : bool
+            Also return the mode shapes in ``q`` coordinates.
+
+        Returns
+        -------
+        omega : ndarray (k,)
+            ``k = n - rank(A)`` frequencies in ascending order, ``omega = sign(lam) sqrt(|lam|)``
+            for the eigenvalues ``lam`` of the reduced problem: a negative value is an unstable
+            (divergent) direction, ~0 a free rigid-body motion.
+        shapes : ndarray (n, k), only with ``modes=True``
+            Mass-normalized (``shapes.T @ M @ shapes = I``) mode shapes.
+        """
+        from scipy.linalg import eigh, null_space
+
+        t = self.t0 if t is None else float(t)
+        q = self.q0 if q is None else np.asarray(q, dtype=float)
+        qd = self.qd0 if qd is None else np.asarray(qd, dtype=float)
+        n = self.n_coords
+        for name, v in (("q", q), ("qd", qd)):
+            if v.shape != (n,):
+                raise ValueError(f"{name}: expected shape ({n},), got {v.shape}")
+        jac = np.asarray(self.core.jac(t, np.concatenate([q, qd]), "central"))
+        Jq = jac[n:, :n]
+        M = np.asarray(self.M(q))
+        N = null_space(np.asarray(self.A(q))) if self.n_constraints else np.eye(n)
+        Mr = N.T @ M @ N
+        Kr = -(N.T @ (M @ Jq) @ N)
+        Kr = 0.5 * (Kr + Kr.T)
+        lam, V = eigh(Kr, 0.5 * (Mr + Mr.T))
+        omega = np.sign(lam) * np.sqrt(np.abs(lam))
+        return (omega, N @ V) if modes else omega
+
     # ------------------------------------------------------------------------------ correction
     @staticmethod
     def _max_abs(v: np.ndarray) -> float:
