@@ -79,9 +79,13 @@ def test_drift_stays_bounded_over_100_revolutions():
 
 
 def _free_beam_energy(rho_inf):
+    """Relative energy lost by an undamped free beam (spinning at 10 rad/s, elastic velocities
+    spread over all its modes: 289 .. 35,800 rad/s) over 0.2 s with h = 2e-4 (omega h from 0.06
+    to 7)."""
     s = ukflex.Scene()
-    b = s.beam("b", length=0.5, elements=4, theory="euler-bernoulli", section=ukflex.Circular(0.01), density=1200.0,
-               youngs_modulus=2e9, angular_velocity=10.0, elastic_rates=[0.0, 0.0, 0.5, 0.0, 0.0, -0.5, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0])
+    rates = 0.5 * np.random.default_rng(0).standard_normal(12)
+    s.beam("b", length=0.5, elements=4, theory="euler-bernoulli", section=ukflex.Circular(0.01), density=1200.0,
+           youngs_modulus=2e9, angular_velocity=10.0, elastic_rates=list(rates))
     system = s.build(hold=None)
     res = ukflex.simulate(system, 0.2, method="GENALPHA", step=2e-4, rho_inf=rho_inf, t_eval=[0.0, 0.2])
     e = res.energy()
@@ -89,9 +93,13 @@ def _free_beam_energy(rho_inf):
 
 
 def test_numerical_dissipation_grows_as_rho_inf_falls():
-    d = {r: _free_beam_energy(r) for r in (1.0, 0.9, 0.6)}
-    assert abs(d[1.0]) < 1e-3  # rho_inf = 1 dissipates nothing (to second order)
-    assert 0.0 < d[0.9] < d[0.6], d
+    """rho_inf = 1 keeps the energy to second order (measured 1.3e-4); below 1 the modes with
+    omega h >> 1 are damped out (0.9: 0.42 %, 0.6: 0.48 %, 0: 0.61 % of the energy, the share
+    the fast modes held), faster the lower rho_inf."""
+    d = {r: _free_beam_energy(r) for r in (1.0, 0.9, 0.6, 0.0)}
+    assert abs(d[1.0]) < 1e-3, d
+    assert d[0.9] > 10 * abs(d[1.0]), d
+    assert d[0.9] < d[0.6] < d[0.0], d
 
 
 def test_dense_output_matches_the_steps():

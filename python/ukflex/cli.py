@@ -43,7 +43,7 @@ import numpy as np
 
 __all__ = ["main", "Progress"]
 
-RUN_DEFAULTS = {"t_end": 1.0, "method": "Radau", "rtol": 1e-6, "atol": None, "formulation": "uk", "samples": 201}
+RUN_DEFAULTS = {"t_end": 1.0, "method": "auto", "rtol": 1e-6, "atol": None, "formulation": "uk", "samples": 201}
 
 
 # ----------------------------------------------------------------------------------- helpers
@@ -165,8 +165,9 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
 
     d = defaults or {}
     p.add_argument("--t-end", type=_positive_float, default=d.get("t_end"), help="end time [s]" + hint("t_end"))
-    p.add_argument("--method", default=d.get("method"), choices=list(METHODS) + native,
-                   help=f"integrator: a scipy solve_ivp method or a native Rust integrator ({', '.join(native)})"
+    p.add_argument("--method", default=d.get("method"), choices=["auto"] + list(METHODS) + native,
+                   help=f"integrator: auto (chosen from the natural frequencies, docs/integrators.md), a scipy "
+                        f"solve_ivp method or a native Rust integrator ({', '.join(native)})"
                         + hint("method"))
     p.add_argument("--rtol", type=_positive_float, default=d.get("rtol"), help="relative tolerance" + hint("rtol"))
     p.add_argument("--atol", type=_positive_float, default=d.get("atol"), help="absolute tolerance" + hint("atol"))
@@ -283,6 +284,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     e = res.energy()
     print(f"{res.method} rtol={res.rtol:g} ({res.formulation}): status {res.status} ({res.message}); nfev {res.nfev}, "
           f"njev {res.njev}, nlu {res.nlu}; integration {res.wall_time:.3f} s")
+    if "auto" in res.extra:
+        print(f"method auto -> {res.method}: {res.extra['auto']['reason']}")
     print(f"max ||Phi|| = {res.max_residual('position'):.3e}, max ||A qd + Phi_t|| = "
           f"{res.max_residual('velocity'):.3e}, max ||A qdd - b|| = {res.max_residual('acceleration'):.3e}")
     print(f"energy T + V: {e[0]:.9g} -> {e[-1]:.9g} (change {e[-1] - e[0]:+.3e})")

@@ -243,7 +243,7 @@ def _initial(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
 def _solver(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
     from .simulate import FORMULATIONS, METHODS, NATIVE_METHODS
 
-    METHODS = tuple(METHODS) + tuple(NATIVE_METHODS)
+    METHODS = ("auto",) + tuple(METHODS) + tuple(NATIVE_METHODS)
     _check_keys(path, "[solver]", d, SOLVER_KEYS)
     out: Dict[str, Any] = {}
     for key in ("t_end", "rtol", "atol", "max_step", "first_step"):

@@ -59,7 +59,7 @@ def _positive_scalar(name: str, value: Any) -> float:
 def simulate(
     scene_or_system: Union[Scene, System, Dict[str, Any]],
     t_end: float,
-    method: Union[str, type] = "Radau",
+    method: Union[str, type] = "auto",
     rtol: float = 1e-6,
     atol: Union[None, float, Sequence[float]] = None,
     t_eval: Optional[Sequence[float]] = None,
@@ -80,7 +80,11 @@ def simulate(
     t_end : float
         End time [s], ``> t0`` (the system's initial time, normally 0).
     method : str or scipy OdeSolver subclass
-        Any ``solve_ivp`` method: ``"Radau"`` (default, implicit, for the stiff elastic modes),
+        ``"auto"`` (default): chosen from the constrained system's natural frequencies
+        (:mod:`ukflex.choice`, docs/integrators.md): native ``"GENALPHA"`` with a fixed step
+        that resolves the lowest elastic mode when the fastest modes are far beyond it (stiff
+        flexible scenes), native ``"DOPRI5"`` otherwise; the choice and its reason are in
+        ``res.method`` and ``res.extra["auto"]``.  Or any ``solve_ivp`` method: ``"Radau"``,
         ``"BDF"``, ``"LSODA"``, ``"RK45"``, ``"RK23"``, ``"DOP853"``; or a native Rust integrator
         (all steps in Rust, GIL released, same result object): ``"DOPRI5"`` (Dormand-Prince 5(4),
         dense output), ``"RADAU5"`` (Radau IIA order 5, Rust Jacobian) or ``"GENALPHA"``
@@ -131,7 +135,9 @@ def simulate(
     if formulation not in FORMULATIONS:
         raise ValueError(f"unknown formulation {formulation!r}; expected one of {FORMULATIONS}")
     if isinstance(method, str):
-        if method not in METHODS and method not in NATIVE_METHODS:
+        if method == "auto":
+            pass
+        elif method not in METHODS and method not in NATIVE_METHODS:
             raise ValueError(
                 f"unknown method {method!r}; expected one of {METHODS}, a native method {NATIVE_METHODS} "
                 "or an OdeSolver subclass"
@@ -168,6 +174,16 @@ def simulate(
             raise ValueError(f"t_eval must lie within [t0, t_end] = [{t0}, {t_end_f}]")
     q_init = system.q0 if q0 is None else _finite_array("q0", q0, (n,))
     qd_init = system.qd0 if qd0 is None else _finite_array("qd0", qd0, (n,))
+    choice = None
+    if method == "auto":
+        start = time.perf_counter()
+        method, options, choice = _resolve_auto(system, formulation, t0, t_end_f, rtol, q_init, qd_init, options)
+        choice_time = time.perf_counter() - start
+        res = simulate(system, t_end_f, method, rtol, atol, t_eval, formulation, q0=q0, qd0=qd0,
+                       partition=partition, progress=progress, **options)
+        if choice is not None:
+            res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
+        return res
     if isinstance(method, str) and method in NATIVE_METHODS:
         res = _simulate_native(system, method, t0, t_end_f, np.concatenate([q_init, qd_init]), rtol, atol_v, t_eval,
                                options)
@@ -195,6 +211,26 @@ def simulate(
         system, sol.t, sol.y, method=method if isinstance(method, str) else method.__name__, formulation="uk",
         rtol=rtol, atol=atol_v, nfev=sol.nfev, njev=sol.njev, nlu=sol.nlu, wall_time=wall, status=sol.status,
         message=sol.message)
+
+
+def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
+    """``method="auto"``: the chooser of :mod:`ukflex.choice` for the Rust UK formulation; the
+    NumPy references keep scipy's Radau.  Options that only scipy takes (``jac``, ``events``,
+    ...) map the choice to its scipy counterpart (GENALPHA -> Radau, DOPRI5 -> DOP853)."""
+    from .choice import choose_method
+
+    if formulation != "uk":
+        return "Radau", options, None
+    choice = choose_method(system, t0, t_end, rtol, q, qd)
+    scipy_only = sorted(set(options) - set(_NATIVE_OPTIONS))
+    if scipy_only:
+        choice.method = "Radau" if choice.method == "GENALPHA" else "DOP853"
+        choice.options = {}
+        choice.reason += f"; scipy {choice.method} because of the scipy option(s) {scipy_only}"
+        return choice.method, options, choice
+    merged = dict(choice.options)
+    merged.update(options)  # the user's own settings win (e.g. step=...)
+    return choice.method, merged, choice
 
 
 def _with_progress_event(options: Dict[str, Any], progress: Callable[[float], None]) -> Dict[str, Any]:

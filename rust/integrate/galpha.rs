@@ -485,9 +485,9 @@ impl Stepper for GenAlpha {
             let err = self.position_norm(&self.g).max(1e-10);
             let mut hnew = h;
             if !fixed {
-                let fac = (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 2.0);
-                hnew = (h * fac).min(self.opts.max_step);
                 if err > 1.0 {
+                    let fac = (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 1.0);
+                    hnew = (h * fac).min(self.opts.max_step);
                     self.st.h = hnew;
                     self.reject = true;
                     if self.st.stats.naccept >= 1 {
@@ -495,6 +495,15 @@ impl Stepper for GenAlpha {
                     }
                     continue;
                 }
+                // PI control (Gustafsson) of an O(h^3) estimate: smoother step sequences, fewer
+                // rejections; a dead band keeps h (and the factored matrix) for small changes
+                let fac = if self.err_prev > 0.0 {
+                    0.9 * err.powf(-0.7 / 3.0) * self.err_prev.powf(0.4 / 3.0)
+                } else {
+                    0.9 * err.powf(-1.0 / 3.0)
+                }
+                .clamp(0.2, 2.0);
+                hnew = if (1.0..=1.2).contains(&fac) { h } else { (h * fac).min(self.opts.max_step) };
                 if self.reject {
                     hnew = hnew.min(h);
                 }

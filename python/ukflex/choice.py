@@ -1,0 +1,120 @@
+"""``method="auto"``: pick the integrator from the constrained system's natural frequencies.
+
+A scene is *stiff* for a run when the time step that resolves the motions the user asked about
+is too long for its fastest mode.  The motions of interest are every flexible body's lowest
+elastic mode (a mode that stores its potential energy in elastic or spring deformation, not in
+gravity or constraint forces: a pendulum's swing is not elastic) and everything slower;
+``omega_c`` is the highest of those (without flexible bodies: the lowest spring mode).  Generalized-alpha has a relative period error of about
+``(omega h)^2 / 12``; asking for ``eps = min(1e-2, 1e3 rtol)`` (``rtol = 1e-6``: 0.1 %) on
+the lowest elastic mode ``omega_c`` gives
+
+    h = sqrt(12 eps) / omega_c   (and at most 1/20 of the run).
+
+If ``h omega_max > 1`` the fastest modes are far beyond what the run needs to resolve, and an
+explicit method would have to resolve them (its stability limit is ``h omega_max < 3.3`` for
+DOPRI5, and in practice the excited axial and short-element modes force much smaller steps):
+the chooser takes GENALPHA with that fixed step (``rho_inf = 0.9``, projection on), which damps
+them instead.  Otherwise (rigid systems, soft or slow flexible ones, tight tolerances where a
+fifth-order method wins) it takes native DOPRI5 at the user's tolerances.  See
+docs/integrators.md.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Dict, Optional
+
+import numpy as np
+
+#: the chooser's constants (one place): period-error target cap and scale, fraction of the run
+PERIOD_ERROR_CAP = 1e-2
+PERIOD_ERROR_PER_RTOL = 1e3
+MIN_STEPS = 20
+#: a mode is elastic when more than this share of omega^2 comes from the potential energy's
+#: curvature (elastic strain, springs) rather than from gravity and constraint forces
+ELASTIC_SHARE = 0.5
+#: a mode belongs to a flexible body when it carries at least this share of the mode's kinetic energy
+BODY_SHARE = 0.2
+
+
+@dataclass
+class MethodChoice:
+    """What ``method="auto"`` picked and why (also ``SimulationResult.extra["auto"]``)."""
+
+    method: str
+    options: Dict[str, Any] = field(default_factory=dict)
+    reason: str = ""
+    omega_elastic: Optional[float] = None
+    omega_max: float = 0.0
+    step: Optional[float] = None
+
+    def as_dict(self) -> Dict[str, Any]:
+        return {"method": self.method, "options": dict(self.options), "reason": self.reason,
+                "omega_elastic": self.omega_elastic, "omega_max": self.omega_max, "step": self.step}
+
+
+def elastic_shares(system, omega: np.ndarray, shapes: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Share of each mode's ``omega^2`` that is curvature of the potential energy along the
+    mode (gravity is linear in the positions and drops out; strain and spring energy stay)."""
+    shares = np.zeros(omega.size)
+    U0 = system.potential_energy(q)
+    for k in range(omega.size):
+        if omega[k] <= 0.0:
+            continue
+        v = shapes[:, k]
+        eps = 1e-5 / max(float(np.abs(v).max()), 1e-300)
+        curv = (system.potential_energy(q + eps * v) - 2.0 * U0 + system.potential_energy(q - eps * v)) / eps**2
+        # the mode is mass-normalized: its kinetic coefficient is 1, so omega^2 is its stiffness
+        shares[k] = curv / omega[k] ** 2
+    return shares
+
+
+def lowest_elastic_frequency(system, omega, shapes, shares, q) -> Optional[float]:
+    """The frequency the step must resolve: every flexible body's lowest elastic mode (the
+    lowest elastic mode with at least ``BODY_SHARE`` of its kinetic energy in that body), the
+    highest of those; without flexible bodies the lowest elastic (spring) mode; ``None`` if no
+    mode is elastic."""
+    elastic = (omega > 0.0) & (shares > ELASTIC_SHARE)
+    if not elastic.any():
+        return None
+    M = np.asarray(system.M(q))
+    per_body = []
+    for body in system.body_names:
+        if system.body_kind(body) in ("rigid", "point_mass"):
+            continue
+        sl = system.body_slice(body)
+        kinetic = np.einsum("ik,ij,jk->k", shapes[sl], M[sl, sl], shapes[sl])  # mass-normalized: sums to 1
+        mine = elastic & (kinetic > BODY_SHARE)
+        if mine.any():
+            per_body.append(float(omega[mine].min()))
+    return max(per_body) if per_body else float(omega[elastic].min())
+
+
+def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.ndarray] = None,
+                  qd: Optional[np.ndarray] = None) -> MethodChoice:
+    """The integrator ``method="auto"`` runs for ``system`` over ``[t0, t_end]`` at ``rtol``."""
+    span = float(t_end) - float(t0)
+    if system.n_dof == 0:
+        return MethodChoice("DOPRI5", reason="no degrees of freedom: the motion is prescribed")
+    omega, shapes = system.frequencies(t0, q, qd, modes=True)
+    q = system.q0 if q is None else np.asarray(q, dtype=float)
+    omega_max = float(np.abs(omega).max())
+    shares = elastic_shares(system, omega, shapes, q)
+    omega_c = lowest_elastic_frequency(system, omega, shapes, shares, q)
+    if omega_c is None:
+        return MethodChoice("DOPRI5", omega_max=omega_max,
+                            reason=f"no elastic mode (fastest mode {omega_max:.4g} rad/s): not stiff, explicit")
+    eps = min(PERIOD_ERROR_CAP, PERIOD_ERROR_PER_RTOL * rtol)
+    h = min(math.sqrt(12.0 * eps) / omega_c, span / MIN_STEPS)
+    if h * omega_max > 1.0:
+        return MethodChoice(
+            "GENALPHA", options={"step": h}, omega_elastic=omega_c, omega_max=omega_max, step=h,
+            reason=(f"stiff: the step {h:.3g} s that resolves the lowest elastic mode ({omega_c:.4g} rad/s) to a "
+                    f"period error of {eps:.2g} is {h * omega_max:.3g} times 1/omega_max ({omega_max:.4g} rad/s): "
+                    "generalized-alpha damps the fast modes instead of resolving them"))
+    return MethodChoice(
+        "DOPRI5", omega_elastic=omega_c, omega_max=omega_max,
+        reason=(f"not stiff at this tolerance: the step {h:.3g} s that resolves the lowest elastic mode "
+                f"({omega_c:.4g} rad/s) to a period error of {eps:.2g} already resolves the fastest mode "
+                f"({omega_max:.4g} rad/s): explicit, fifth order"))
