@@ -24,7 +24,10 @@ def test_the_paper_scene_is_stiff_and_gets_generalized_alpha_with_a_step_from_it
     c = choose_method(sys_, 0.0, 0.1, 1e-6)
     assert c.method == "GENALPHA"
     assert c.omega_elastic == pytest.approx(w[0]) and c.omega_max == pytest.approx(w[-1])
-    assert c.step == pytest.approx(math.sqrt(12e-3) / w[0])  # period error 1e-3 of the lowest mode
+    # a phase budget of 0.1 rad over the run for the lowest mode: period error 0.1 / (omega_1 T)
+    assert c.step == pytest.approx(math.sqrt(12 * 0.1 / (w[0] * 0.1)) / w[0])
+    longer = choose_method(sys_, 0.0, 1.0, 1e-6)  # ten times longer: the same phase budget, smaller steps
+    assert longer.step == pytest.approx(c.step / math.sqrt(10.0))
     assert c.step * c.omega_max > 1.0
     res = simulate(sys_, 0.1)
     assert res.method == "GENALPHA" and res.success
@@ -77,9 +80,11 @@ def test_user_settings_win_and_scipy_options_map_to_scipy():
 
 
 def test_auto_on_the_papers_linear_scene_against_a_tight_explicit_run():
-    """The paper's own scene (linear FFRF, N = 1): the peak within 0.1 % of DOP853 at rtol 1e-9;
-    the history within 2 % of the peak: generalized-alpha damps the 29 krad/s axial ripple that
-    the undeformed start sets off instead of tracking its phase (docs/integrators.md)."""
+    """The paper's own scene (linear FFRF, N = 1, 0..0.07 s, h = 1.36e-4): the peak within 0.1 %
+    of DOP853 at rtol 1e-9 (measured 0.07 %); the history within 3 % of the peak (measured
+    2.1 %): generalized-alpha damps the 29 krad/s axial ripple that the undeformed start sets
+    off instead of tracking its phase, and the second bending mode (4.4 krad/s, omega h = 0.6)
+    is only roughly resolved (docs/integrators.md)."""
     t = np.linspace(0.0, 0.07, 7001)
     sc = scenes.slider_crank()
     a = simulate(sc, 0.07, t_eval=t)
@@ -88,4 +93,4 @@ def test_auto_on_the_papers_linear_scene_against_a_tight_explicit_run():
     _, vd = d.beam_displacement("coupler", 0.5)
     peak = np.abs(vd).max()
     assert abs(np.abs(va).max() - peak) < 1e-3 * peak
-    assert np.abs(va - vd).max() < 2e-2 * peak
+    assert np.abs(va - vd).max() < 3e-2 * peak

@@ -4,11 +4,12 @@ A scene is *stiff* for a run when the time step that resolves the motions the us
 is too long for its fastest mode.  The motions of interest are every flexible body's lowest
 elastic mode (a mode that stores its potential energy in elastic or spring deformation, not in
 gravity or constraint forces: a pendulum's swing is not elastic) and everything slower;
-``omega_c`` is the highest of those (without flexible bodies: the lowest spring mode).  Generalized-alpha has a relative period error of about
-``(omega h)^2 / 12``; asking for ``eps = min(1e-2, 1e3 rtol)`` (``rtol = 1e-6``: 0.1 %) on
-the lowest elastic mode ``omega_c`` gives
+``omega_c`` is the highest of those (without flexible bodies: the lowest spring mode).
+Generalized-alpha has a relative period error of about ``(omega h)^2 / 12``, and over the run
+the phase of that mode drifts by ``eps omega_c T`` radians.  The chooser gives it a phase
+budget ``phi = min(1, 1e5 rtol)`` rad (``rtol = 1e-6``: 0.1 rad over the whole run), so
 
-    h = sqrt(12 eps) / omega_c   (and at most 1/20 of the run).
+    eps = min(1e-2, phi / (omega_c T)),   h = sqrt(12 eps) / omega_c   (at most T / 20).
 
 If ``h omega_max > 1`` the fastest modes are far beyond what the run needs to resolve, and an
 explicit method would have to resolve them (its stability limit is ``h omega_max < 3.3`` for
@@ -27,9 +28,11 @@ from typing import Any, Dict, Optional
 
 import numpy as np
 
-#: the chooser's constants (one place): period-error target cap and scale, fraction of the run
+#: the chooser's constants (one place): phase budget per rtol and its cap [rad], period-error
+#: cap, fewest steps per run
+PHASE_PER_RTOL = 1e5
+PHASE_CAP = 1.0
 PERIOD_ERROR_CAP = 1e-2
-PERIOD_ERROR_PER_RTOL = 1e3
 MIN_STEPS = 20
 #: a mode is elastic when more than this share of omega^2 comes from the potential energy's
 #: curvature (elastic strain, springs) rather than from gravity and constraint forces
@@ -105,7 +108,8 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
     if omega_c is None:
         return MethodChoice("DOPRI5", omega_max=omega_max,
                             reason=f"no elastic mode (fastest mode {omega_max:.4g} rad/s): not stiff, explicit")
-    eps = min(PERIOD_ERROR_CAP, PERIOD_ERROR_PER_RTOL * rtol)
+    phase = min(PHASE_CAP, PHASE_PER_RTOL * rtol)
+    eps = min(PERIOD_ERROR_CAP, phase / (omega_c * span))
     h = min(math.sqrt(12.0 * eps) / omega_c, span / MIN_STEPS)
     if h * omega_max > 1.0:
         return MethodChoice(
@@ -116,5 +120,5 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
     return MethodChoice(
         "DOPRI5", omega_elastic=omega_c, omega_max=omega_max,
         reason=(f"not stiff at this tolerance: the step {h:.3g} s that resolves the lowest elastic mode "
-                f"({omega_c:.4g} rad/s) to a period error of {eps:.2g} already resolves the fastest mode "
+                f"({omega_c:.4g} rad/s) to a period error of {eps:.2g} (phase {phase:.2g} rad over the run) already resolves the fastest mode "
                 f"({omega_max:.4g} rad/s): explicit, fifth order"))

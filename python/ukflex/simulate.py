@@ -268,7 +268,7 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options)
     return SimulationResult.from_trajectory(
         system, out["t"], out["y"], method=method, formulation="uk", rtol=rtol, atol=atol, nfev=out["nfev"],
         njev=out["njev"], nlu=out["nlu"], wall_time=out["wall_time"], status=out["status"], message=out["message"],
-        extra={k: out[k] for k in ("naccept", "nreject", "jac_evals")})
+        extra={k: out[k] for k in ("naccept", "nreject", "newton_iterations", "jac_evals")})
 
 
 def _simulate_reference(system, formulation, t_end, method, rtol, atol, t_eval, q0, qd0, partition, options):

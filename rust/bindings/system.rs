@@ -478,6 +478,7 @@ impl PySystem {
         d.set_item("nlu", sol.stats.nlu)?;
         d.set_item("naccept", sol.stats.naccept)?;
         d.set_item("nreject", sol.stats.nreject)?;
+        d.set_item("newton_iterations", sol.stats.newton)?;
         d.set_item("jac_evals", jac_evals)?;
         d.set_item("wall_time", wall)?;
         Ok(d)

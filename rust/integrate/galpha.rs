@@ -126,8 +126,6 @@ pub struct GenAlpha {
     age: usize,
     /// The factored matrix may serve the next step.
     reuse: bool,
-    /// Newton iterations of the last step, total.
-    pub newton_iterations: usize,
     /// Refreshes of the structure (`njev`) and factorizations (`nlu`) are in `stats`.
     reject: bool,
     /// Local error estimate of the last accepted step (error-test units).
@@ -194,7 +192,6 @@ impl GenAlpha {
             refresh: true,
             age: 0,
             reuse: false,
-            newton_iterations: 0,
             reject: false,
             err_prev: 0.0,
         })
@@ -405,7 +402,6 @@ impl Stepper for GenAlpha {
         let n = self.n;
         self.st.start(t0, y0);
         self.reject = false;
-        self.newton_iterations = 0;
         let (q, qd) = y0.split_at(n);
         sys.acc(t0, q, qd, &mut self.qdd)?;
         self.st.stats.nfev += 1;
@@ -476,7 +472,7 @@ impl Stepper for GenAlpha {
                 }
                 continue;
             };
-            self.newton_iterations += iters;
+            self.st.stats.newton += iters;
             // local error estimate of the positions
             let c = h * h * (self.beta - 1.0 / 6.0).abs();
             for i in 0..n {

@@ -248,6 +248,9 @@ pub struct Stats {
     pub nlu: usize,
     pub naccept: usize,
     pub nreject: usize,
+    /// Newton iterations (implicit methods: GENALPHA counts its iterations on accepted and
+    /// rejected attempts; RADAU5 its simplified-Newton iterations).
+    pub newton: usize,
 }
 
 /// The state every stepper keeps: the current and previous time, the next step size, the

@@ -414,6 +414,7 @@ impl Stepper for Radau5 {
                 self.z[1] = zb;
                 self.z[2] = zc;
                 newt += 1;
+                self.st.stats.newton += 1;
                 let mut dyno = 0.0;
                 for i in 0..dim {
                     let s = self.scal[i];
