@@ -15,7 +15,8 @@ If ``h omega_max > 1`` the fastest modes are far beyond what the run needs to re
 explicit method would have to resolve them (its stability limit is ``h omega_max < 3.3`` for
 DOPRI5, and in practice the excited axial and short-element modes force much smaller steps):
 the chooser takes GENALPHA with that fixed step (``rho_inf = 0.9``, projection on), which damps
-them instead.  Otherwise (rigid systems, soft or slow flexible ones, tight tolerances where a
+them instead; its Newton iterations stop at ``max(rtol, eps / 10)`` of each step's motion (a
+tighter Newton tolerance costs iterations and changes nothing the step size does not decide).  Otherwise (rigid systems, soft or slow flexible ones, tight tolerances where a
 fifth-order method wins) it takes native DOPRI5 at the user's tolerances.  See
 docs/integrators.md.
 """
@@ -34,6 +35,8 @@ PHASE_PER_RTOL = 1e5
 PHASE_CAP = 1.0
 PERIOD_ERROR_CAP = 1e-2
 MIN_STEPS = 20
+#: GENALPHA's Newton tolerance relative to the period-error target
+NEWTON_PER_PERIOD_ERROR = 0.1
 #: a mode is elastic when more than this share of omega^2 comes from the potential energy's
 #: curvature (elastic strain, springs) rather than from gravity and constraint forces
 ELASTIC_SHARE = 0.5
@@ -51,10 +54,13 @@ class MethodChoice:
     omega_elastic: Optional[float] = None
     omega_max: float = 0.0
     step: Optional[float] = None
+    #: the integrator's rtol when it differs from the user's (GENALPHA's Newton tolerance)
+    rtol: Optional[float] = None
 
     def as_dict(self) -> Dict[str, Any]:
         return {"method": self.method, "options": dict(self.options), "reason": self.reason,
-                "omega_elastic": self.omega_elastic, "omega_max": self.omega_max, "step": self.step}
+                "omega_elastic": self.omega_elastic, "omega_max": self.omega_max, "step": self.step,
+                "rtol": self.rtol}
 
 
 def elastic_shares(system, omega: np.ndarray, shapes: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -114,6 +120,7 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
     if h * omega_max > 1.0:
         return MethodChoice(
             "GENALPHA", options={"step": h}, omega_elastic=omega_c, omega_max=omega_max, step=h,
+            rtol=max(rtol, NEWTON_PER_PERIOD_ERROR * eps),
             reason=(f"stiff: the step {h:.3g} s that resolves the lowest elastic mode ({omega_c:.4g} rad/s) to a "
                     f"period error of {eps:.2g} is {h * omega_max:.3g} times 1/omega_max ({omega_max:.4g} rad/s): "
                     "generalized-alpha damps the fast modes instead of resolving them"))

@@ -179,7 +179,8 @@ def simulate(
         start = time.perf_counter()
         method, options, choice = _resolve_auto(system, formulation, t0, t_end_f, rtol, q_init, qd_init, options)
         choice_time = time.perf_counter() - start
-        res = simulate(system, t_end_f, method, rtol, atol, t_eval, formulation, q0=q0, qd0=qd0,
+        run_rtol = choice.rtol if choice is not None and choice.rtol is not None else rtol
+        res = simulate(system, t_end_f, method, run_rtol, atol, t_eval, formulation, q0=q0, qd0=qd0,
                        partition=partition, progress=progress, **options)
         if choice is not None:
             res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
