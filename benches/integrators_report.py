@@ -95,7 +95,8 @@ def drift():
         t0 = time.perf_counter()
         r = simulate(s, t_end)
         wall = time.perf_counter() - t0
-        print(f"   {model:16s} N={n}: {r.method} h={r.extra['auto']['step']:.3g}, {r.extra['naccept']} steps, "
+        step = r.extra["auto"]["step"]
+        print(f"   {model:16s} N={n}: {r.method}" + (f" h={step:.3g}" if step else "") + f", {r.extra['naccept']} steps, "
               f"max ||Phi|| {r.max_residual('position'):.1e}, max ||A qd + Phi_t|| {r.max_residual('velocity'):.1e}, "
               f"{wall:.2f} s")
 

@@ -28,7 +28,7 @@ def test_the_paper_scene_is_stiff_and_gets_generalized_alpha_with_a_step_from_it
     assert c.step == pytest.approx(math.sqrt(12 * 0.1 / (w[0] * 0.1)) / w[0])
     longer = choose_method(sys_, 0.0, 1.0, 1e-6)  # ten times longer: the same phase budget, smaller steps
     assert longer.step == pytest.approx(c.step / math.sqrt(10.0))
-    assert c.step * c.omega_max > 1.0
+    assert c.step * c.omega_max > 0.25
     res = simulate(sys_, 0.1)
     assert res.method == "GENALPHA" and res.success
     assert res.extra["auto"]["step"] == pytest.approx(c.step) and "stiff" in res.extra["auto"]["reason"]
