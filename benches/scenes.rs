@@ -4,6 +4,7 @@
 
 #[path = "../tests/common/mod.rs"]
 mod common;
+#[allow(unused_imports)] // each bench uses its own subset
 pub use common::{ancf_paper_scene, paper_scene, Lcg};
 
 use ukflex::{Data, Model};

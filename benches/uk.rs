@@ -1,6 +1,6 @@
 //! Criterion benches of the UK acceleration: the paper's scene (N = 1, both beam theories),
 //! the same scene with N = 2..64 coupler elements, the Euler-Bernoulli coupler as an FFRF beam
-//! and as an ANCF cable at N = 1..64 (`coupler`), a chain of K = 2..64 rigid links, and the
+//! (linear and nonlinear strain) and as an ANCF cable at N = 1..64 (`coupler`), a chain of K = 2..64 rigid links, and the
 //! stages separately. Run: `cargo bench --bench uk`.
 
 use std::hint::black_box;
@@ -47,7 +47,9 @@ fn elements(c: &mut Criterion) {
 fn coupler(c: &mut Criterion) {
     let mut g = c.benchmark_group("coupler");
     for n_el in [1usize, 2, 4, 8, 16, 32, 64] {
-        for (kind, json) in [("ffrf-eb", paper_scene("euler-bernoulli", n_el, true)), ("ancf", ancf_paper_scene(n_el, true))] {
+        let nonlinear = paper_scene("euler-bernoulli", n_el, true); // the core's default strain
+        let linear = nonlinear.replace(r#""kind": "beam","#, r#""kind": "beam", "strain": "linear","#);
+        for (kind, json) in [("ffrf-eb-linear", linear), ("ffrf-eb-nonlinear", nonlinear), ("ancf", ancf_paper_scene(n_el, true))] {
             let (model, mut data) = build(&json);
             let (q, qd) = bench_state(&model);
             g.bench_with_input(BenchmarkId::new(kind, n_el), &n_el, |b, _| {

@@ -102,35 +102,8 @@ def chord_deflection(r0: np.ndarray, r1: np.ndarray, rmid: np.ndarray) -> np.nda
     return np.einsum("ij,ij->i", en, rmid - r0)
 
 
-def refined_peak(t: np.ndarray, y: np.ndarray, t_max: float | None = None) -> tuple[float, float]:
-    """max |y| over t <= t_max with parabolic refinement around the discrete maximum.
-
-    Returns (peak, time of peak). The parabola goes through the three samples around the discrete
-    maximum of |y| (uniform or not); at the window's ends the sample value is returned.
-    """
-    t = np.asarray(t, float)
-    a = np.abs(np.asarray(y, float))
-    if t_max is not None:
-        keep = t <= t_max * (1.0 + 1e-12)
-        t, a = t[keep], a[keep]
-    k = int(np.argmax(a))
-    if k == 0 or k == len(a) - 1:
-        return float(a[k]), float(t[k])
-    t0, t1, t2 = t[k - 1], t[k], t[k + 1]
-    y0, y1, y2 = a[k - 1], a[k], a[k + 1]
-    # Lagrange parabola through the three points, vertex
-    d0 = (t0 - t1) * (t0 - t2)
-    d1 = (t1 - t0) * (t1 - t2)
-    d2 = (t2 - t0) * (t2 - t1)
-    c2 = y0 / d0 + y1 / d1 + y2 / d2
-    c1 = -(y0 * (t1 + t2) / d0 + y1 * (t0 + t2) / d1 + y2 * (t0 + t1) / d2)
-    c0 = y0 * t1 * t2 / d0 + y1 * t0 * t2 / d1 + y2 * t0 * t1 / d2
-    if c2 >= 0.0:
-        return float(y1), float(t1)
-    tv = -c1 / (2.0 * c2)
-    if not (t0 <= tv <= t2):
-        return float(y1), float(t1)
-    return float(c0 + c1 * tv + c2 * tv * tv), float(tv)
+# the peak rule of the studies, one definition for both codes
+from ukflex.studies.geometric import refined_peak  # noqa: E402,F401
 
 
 def interpolate(t_ref: np.ndarray, v_ref: np.ndarray, t: np.ndarray) -> np.ndarray:

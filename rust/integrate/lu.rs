@@ -50,9 +50,7 @@ pub(crate) fn lu_cm_solve(a: &[f64], piv: &[usize], n: usize, x: &mut [f64]) {
     for j in 0..n {
         let xj = x[j];
         if xj != 0.0 {
-            let (head, tail) = x.split_at_mut(j + 1);
-            let _ = head;
-            axpy(-xj, &a[j * n + j + 1..(j + 1) * n], &mut tail[..n - j - 1]);
+            axpy(-xj, &a[j * n + j + 1..(j + 1) * n], &mut x[j + 1..n]);
         }
     }
     for j in (0..n).rev() {

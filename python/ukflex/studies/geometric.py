@@ -226,7 +226,7 @@ def refined_peak(t: np.ndarray, y: np.ndarray, t_max: Optional[float] = None) ->
 
     Returns ``(peak, time of peak)``.  The parabola goes through the three samples around the
     discrete maximum of ``|y|`` (uniform or not); at the window's ends the sample value is kept.
-    (The same rule as ``benches/peers/exudyn_slider_crank.py``.)
+    (The Exudyn scripts in ``benches/peers`` use this function too.)
     """
     t = np.asarray(t, float)
     a = np.abs(np.asarray(y, float))
