@@ -94,3 +94,12 @@ def test_auto_on_the_papers_linear_scene_against_a_tight_explicit_run():
     peak = np.abs(vd).max()
     assert abs(np.abs(va).max() - peak) < 1e-3 * peak
     assert np.abs(va - vd).max() < 3e-2 * peak
+
+
+@pytest.mark.parametrize("kw,match", [(dict(t_end=0.0), "t_end"), (dict(t_end=float("nan")), "t_end"),
+                                      (dict(rtol=0.0), "rtol"), (dict(rtol=float("inf")), "rtol")])
+def test_bad_arguments_are_named(kw, match):
+    args = dict(t0=0.0, t_end=0.1, rtol=1e-6)
+    args.update(kw)
+    with pytest.raises(ValueError, match=match):
+        choose_method(scenes.pendulum().build(), **args)

@@ -109,6 +109,10 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
                   qd: Optional[np.ndarray] = None) -> MethodChoice:
     """The integrator ``method="auto"`` runs for ``system`` over ``[t0, t_end]`` at ``rtol``."""
     span = float(t_end) - float(t0)
+    if not (math.isfinite(span) and span > 0.0):
+        raise ValueError(f"t_end must be finite and greater than t0 = {t0}, got {t_end!r}")
+    if not (math.isfinite(rtol) and rtol > 0.0):
+        raise ValueError(f"rtol must be positive and finite, got {rtol!r}")
     if system.n_dof == 0:
         return MethodChoice("DOPRI5", reason="no degrees of freedom: the motion is prescribed")
     omega, shapes = system.frequencies(t0, q, qd, modes=True)
