@@ -75,8 +75,11 @@ def test_user_settings_win_and_scipy_options_map_to_scipy():
     assert res.method == "GENALPHA" and res.extra["naccept"] == 200
     res = simulate(sys_, 0.01, jac=sys_.jac)  # a scipy-only option: scipy Radau for a stiff scene
     assert res.method == "Radau" and "scipy" in res.extra["auto"]["reason"]
+    assert res.rtol == 1e-6  # scipy's rtol is the user's (GENALPHA's Newton tolerance is not carried over)
     res = simulate(sys_, 0.01, formulation="uk-numpy")
     assert res.method == "Radau"
+    res = simulate(scenes.pendulum(), 0.1, step=1e-3)  # GENALPHA's own option on a scene auto runs with DOPRI5
+    assert res.method == "GENALPHA" and res.extra["naccept"] == 100
 
 
 def test_auto_on_the_papers_linear_scene_against_a_tight_explicit_run():

@@ -135,9 +135,7 @@ def simulate(
     if formulation not in FORMULATIONS:
         raise ValueError(f"unknown formulation {formulation!r}; expected one of {FORMULATIONS}")
     if isinstance(method, str):
-        if method == "auto":
-            pass
-        elif method not in METHODS and method not in NATIVE_METHODS:
+        if method != "auto" and method not in METHODS and method not in NATIVE_METHODS:
             raise ValueError(
                 f"unknown method {method!r}; expected one of {METHODS}, a native method {NATIVE_METHODS} "
                 "or an OdeSolver subclass"
@@ -226,9 +224,13 @@ def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
     scipy_only = sorted(set(options) - set(_NATIVE_OPTIONS))
     if scipy_only:
         choice.method = "Radau" if choice.method == "GENALPHA" else "DOP853"
-        choice.options = {}
+        choice.options, choice.rtol = {}, None
         choice.reason += f"; scipy {choice.method} because of the scipy option(s) {scipy_only}"
         return choice.method, options, choice
+    genalpha_only = sorted(set(options) & {"step", "rho_inf"})
+    if genalpha_only and choice.method != "GENALPHA":
+        choice.method, choice.options, choice.rtol = "GENALPHA", {}, None
+        choice.reason += f"; GENALPHA because of the option(s) {genalpha_only}"
     merged = dict(choice.options)
     merged.update(options)  # the user's own settings win (e.g. step=...)
     return choice.method, merged, choice
