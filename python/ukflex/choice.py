@@ -26,7 +26,7 @@ docs/integrators.md.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any, Dict, Optional
 
 import numpy as np
@@ -63,9 +63,7 @@ class MethodChoice:
     rtol: Optional[float] = None
 
     def as_dict(self) -> Dict[str, Any]:
-        return {"method": self.method, "options": dict(self.options), "reason": self.reason,
-                "omega_elastic": self.omega_elastic, "omega_max": self.omega_max, "step": self.step,
-                "rtol": self.rtol}
+        return asdict(self)
 
 
 def elastic_shares(system, omega: np.ndarray, shapes: np.ndarray, q: np.ndarray) -> np.ndarray:
