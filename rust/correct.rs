@@ -177,13 +177,10 @@ pub fn project_in_place(model: &Model, data: &mut Data, ws: &mut ProjectWorkspac
     constraints(model, data, t, q, &ws.zeros, true);
     let mut iterations = 0;
     while max_abs(&data.phi) > tol && iterations < max_iter {
-        mass_and_forces(model, data, q, &ws.zeros);
-        crate::dynamics::factor_mass(model, data)?;
-        data.force.fill(0.0);
         for i in 0..model.m {
             data.gamma[i] = -data.phi[i];
         }
-        solve(model, data)?;
+        min_mass_norm_step(model, data, q, &ws.zeros)?;
         for i in 0..n {
             q[i] += data.qdd[i];
         }
@@ -194,19 +191,25 @@ pub fn project_in_place(model: &Model, data: &mut Data, ws: &mut ProjectWorkspac
     // velocities (A and Phi_t at the current q; A does not depend on qd)
     velocity_residual(model, data, qd, &mut ws.vres);
     if max_abs(&ws.vres) > velocity_tol {
-        mass_and_forces(model, data, q, &ws.zeros);
-        crate::dynamics::factor_mass(model, data)?;
-        data.force.fill(0.0);
         for i in 0..model.m {
             data.gamma[i] = -ws.vres[i];
         }
-        solve(model, data)?;
+        min_mass_norm_step(model, data, q, &ws.zeros)?;
         for i in 0..n {
             qd[i] += data.qdd[i];
         }
         changed = true;
     }
     Ok(changed)
+}
+
+/// The minimum mass-norm `dx` with `A dx = gamma` (`gamma` already in `data.gamma`) into
+/// `data.qdd`: the UK solve at `q` with zero forces.
+fn min_mass_norm_step(model: &Model, data: &mut Data, q: &[f64], zeros: &[f64]) -> Result<()> {
+    mass_and_forces(model, data, q, zeros);
+    crate::dynamics::factor_mass(model, data)?;
+    data.force.fill(0.0);
+    solve(model, data)
 }
 
 /// Settings of `correct`.

@@ -194,6 +194,23 @@ impl StructuredJacobian {
         }
     }
 
+    /// `[M, A^T; A, reg I]` from `self.m_dense` and the constraint Jacobian `jac` (m x n).
+    fn assemble_saddle(&mut self, jac: &[f64], n: usize, m: usize, reg: f64) {
+        let nm = n + m;
+        for i in 0..n {
+            self.saddle[i * nm..i * nm + n].copy_from_slice(&self.m_dense[i * n..(i + 1) * n]);
+            for r in 0..m {
+                self.saddle[i * nm + n + r] = jac[r * n + i];
+            }
+        }
+        for r in 0..m {
+            self.saddle[(n + r) * nm..(n + r) * nm + n].copy_from_slice(&jac[r * n..(r + 1) * n]);
+            for c in 0..m {
+                self.saddle[(n + r) * nm + n + c] = if r == c { reg } else { 0.0 };
+            }
+        }
+    }
+
     /// `jq`, `jv` (n x n row-major) at `(t, q, qd)`.
     pub fn evaluate(&mut self, model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], jq: &mut [f64], jv: &mut [f64]) -> Result<()> {
         use crate::dynamics;
@@ -204,32 +221,11 @@ impl StructuredJacobian {
         dynamics::dense_mass_into(model, data, &mut self.m_dense);
         dynamics::stiffness_into(model, data, q, qd, &mut self.k);
         dynamics::constraints(model, data, t, q, qd, false);
-        for i in 0..n {
-            self.saddle[i * nm..i * nm + n].copy_from_slice(&self.m_dense[i * n..(i + 1) * n]);
-            for r in 0..m {
-                self.saddle[i * nm + n + r] = data.jac[r * n + i];
-            }
-        }
-        for r in 0..m {
-            self.saddle[(n + r) * nm..(n + r) * nm + n].copy_from_slice(&data.jac[r * n..(r + 1) * n]);
-            self.saddle[(n + r) * nm + n..(n + r + 1) * nm].fill(0.0);
-        }
+        self.assemble_saddle(&data.jac, n, m, 0.0);
         if !lu_cm(&mut self.saddle, &mut self.piv, nm) {
             // redundant constraint rows: the multiplier block, slightly regularized
-            dynamics::constraints(model, data, t, q, qd, false);
             let scale = self.m_dense.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(f64::MIN_POSITIVE);
-            for i in 0..n {
-                self.saddle[i * nm..i * nm + n].copy_from_slice(&self.m_dense[i * n..(i + 1) * n]);
-                for r in 0..m {
-                    self.saddle[i * nm + n + r] = data.jac[r * n + i];
-                }
-            }
-            for r in 0..m {
-                self.saddle[(n + r) * nm..(n + r) * nm + n].copy_from_slice(&data.jac[r * n..(r + 1) * n]);
-                for s in 0..m {
-                    self.saddle[(n + r) * nm + n + s] = if r == s { -1e-12 * scale } else { 0.0 };
-                }
-            }
+            self.assemble_saddle(&data.jac, n, m, -1e-12 * scale);
             if !lu_cm(&mut self.saddle, &mut self.piv, nm) {
                 return Err(crate::error::Error::Solver("structured Jacobian: the saddle-point matrix is singular".into()));
             }
