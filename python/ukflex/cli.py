@@ -524,7 +524,7 @@ def _add_list_export_parsers(sub) -> None:
                    help="scene function argument, e.g. --param elements=4 (repeatable)")
     p.add_argument("-o", "--output", default=None, help="output file (default stdout)")
     p.add_argument("--t-end", type=_positive_float, default=0.1, help="[solver] t_end to write (default 0.1)")
-    p.add_argument("--method", default="DOP853", help="[solver] method to write (default DOP853)")
+    p.add_argument("--method", default="auto", help="[solver] method to write (default auto)")
     p.add_argument("--rtol", type=_positive_float, default=1e-6, help="[solver] rtol to write (default 1e-6)")
     p.set_defaults(func=_cmd_export)
 
