@@ -18,7 +18,7 @@ import numpy as np
 from .description import normalize
 from .errors import InconsistentInitialStateError, core as _core
 
-__all__ = ["System", "InitialCorrection"]
+__all__ = ["System", "InitialCorrection", "Equilibrium"]
 
 
 @dataclass
@@ -88,6 +88,17 @@ class InitialCorrection:
             f"max|A qd + Phi_t| {self.velocity_residual_before:.3e} -> {self.velocity_residual_after:.3e}; "
             f"max|dq| {worst(self.dq)}; max|dqd| {worst(self.dqd)}"
         )
+
+
+@dataclass
+class Equilibrium:
+    """A static equilibrium (:meth:`System.equilibrium`)."""
+
+    q: np.ndarray
+    multipliers: np.ndarray
+    iterations: int
+    force_residual: float
+    position_residual: float
 
 
 class System:
@@ -369,6 +380,97 @@ class System:
         lam, V = eigh(Kr, 0.5 * (Mr + Mr.T))
         omega = np.sign(lam) * np.sqrt(np.abs(lam))
         return (omega, N @ V) if modes else omega
+
+    def equilibrium(
+        self,
+        t: Optional[float] = None,
+        q: Optional[np.ndarray] = None,
+        tol: float = 1e-10,
+        max_iterations: int = 50,
+    ) -> "Equilibrium":
+        """Static equilibrium at time ``t`` (drivers held at their values there), from ``q``.
+
+        Newton on ``Q(t, q, 0) = A(q)^T lambda`` and ``Phi(t, q) = 0`` (zero velocities, so the
+        applied, elastic, spring and gravity forces balance the constraint forces), with the
+        tangent of both sides by central differences of the core's ``Q`` and ``A`` and a
+        backtracking line search on the residual.  Use it to start a run from a preloaded state
+        (``simulate(system, T, q0=eq.q, qd0=zeros)``) or to check a structure's static deflection.
+
+        Parameters
+        ----------
+        t, q : optional
+            Time and starting positions (default ``t0``, ``q0``).
+        tol : float
+            Converged when the Newton step is below ``tol`` (per coordinate, relative to
+            ``max(1, |q|)``), ``max |Phi| <= tol`` and the forces balance to 1e-8 of
+            ``max |Q|``.
+        max_iterations : int
+            Newton iterations.
+
+        Returns
+        -------
+        Equilibrium
+            ``q``, ``multipliers`` (with ``M qdd + A^T lambda = Q``), ``iterations``,
+            ``force_residual`` (``max |Q - A^T lambda|``), ``position_residual``.
+
+        Raises
+        ------
+        ValueError, NonFiniteError
+            Bad arguments.
+        SolverError
+            No convergence (e.g. no equilibrium: a free body under gravity).
+        """
+        from .errors import NonFiniteError, SolverError
+
+        n, m = self.n_coords, self.n_constraints
+        t = self.t0 if t is None else float(t)
+        q = np.array(self.q0 if q is None else q, dtype=float)
+        if q.shape != (n,):
+            raise ValueError(f"q: expected shape ({n},), got {q.shape}")
+        if not np.all(np.isfinite(q)) or not math.isfinite(t):
+            raise NonFiniteError("equilibrium: t and q must be finite")
+        if not (tol > 0 and math.isfinite(tol)) or int(max_iterations) < 1:
+            raise ValueError(f"tol must be positive and max_iterations >= 1, got {tol!r}, {max_iterations!r}")
+        zero = np.zeros(n)
+        lam = np.zeros(m)
+
+        def residual(q, lam):
+            A = np.asarray(self.A(q)).reshape(m, n)
+            return np.concatenate([np.asarray(self.Q(t, q, zero)) - A.T @ lam, np.asarray(self.phi(t, q))])
+
+        r = residual(q, lam)
+        for it in range(1, int(max_iterations) + 1):
+            J = np.zeros((n + m, n + m))
+            for j in range(n):
+                h = 1e-6 * max(1.0, abs(q[j]))
+                qp, qm = q.copy(), q.copy()
+                qp[j] += h
+                qm[j] -= h
+                J[:, j] = (residual(qp, lam) - residual(qm, lam)) / (2.0 * h)
+            A = np.asarray(self.A(q)).reshape(m, n)
+            J[:n, n:] = -A.T
+            step = np.linalg.lstsq(J, -r, rcond=None)[0]
+            alpha, norm0 = 1.0, np.linalg.norm(r)
+            while True:  # backtracking on |R|
+                q_new, lam_new = q + alpha * step[:n], lam + alpha * step[n:]
+                r_new = residual(q_new, lam_new)
+                if np.linalg.norm(r_new) <= (1.0 - 1e-4 * alpha) * norm0 or alpha < 1e-4:
+                    break
+                alpha *= 0.5
+            q, lam, r = q_new, lam_new, r_new
+            if not np.all(np.isfinite(r)):
+                break
+            small = np.all(np.abs(alpha * step[:n]) <= tol * np.maximum(1.0, np.abs(q)))
+            force_scale = max(float(np.max(np.abs(np.asarray(self.Q(t, q, zero))), initial=0.0)), 1e-300)
+            balanced = np.max(np.abs(r[:n]), initial=0.0) <= 1e-8 * force_scale
+            if small and balanced and np.max(np.abs(r[n:]), initial=0.0) <= tol:
+                return Equilibrium(q, lam, it, float(np.max(np.abs(r[:n]), initial=0.0)),
+                                   float(np.max(np.abs(r[n:]), initial=0.0)))
+        raise SolverError(
+            f"equilibrium: no convergence after {max_iterations} Newton iteration(s) at t = {t}: "
+            f"max |Q - A^T lambda| = {np.max(np.abs(r[:n]), initial=0.0):.3e}, max |Phi| = "
+            f"{np.max(np.abs(r[n:]), initial=0.0):.3e} (a scene without a static equilibrium, e.g. a free body "
+            "under gravity, or a start too far from it)")
 
     # ------------------------------------------------------------------------------ correction
     @staticmethod
