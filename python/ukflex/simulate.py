@@ -172,7 +172,6 @@ def simulate(
             raise ValueError(f"t_eval must lie within [t0, t_end] = [{t0}, {t_end_f}]")
     q_init = system.q0 if q0 is None else _finite_array("q0", q0, (n,))
     qd_init = system.qd0 if qd0 is None else _finite_array("qd0", qd0, (n,))
-    choice = None
     if method == "auto":
         start = time.perf_counter()
         method, options, choice = _resolve_auto(system, formulation, t0, t_end_f, rtol, q_init, qd_init, options)
