@@ -11,6 +11,8 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArray
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::PyType;
 use pyo3::Borrowed;
 
 use crate::error::Error;
@@ -38,13 +40,37 @@ impl<'py> std::ops::Deref for Vector<'py> {
 impl<'a, 'py> FromPyObject<'a, 'py> for Vector<'py> {
     type Error = PyErr;
     fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        if let Ok(a) = obj.extract::<PyReadonlyArray1<'py, f64>>() {
-            return Ok(Vector(a));
-        }
         let py = obj.py();
-        let converted = py
-            .import("numpy")?
-            .call_method1("asarray", (obj, "float64"))
+        // fast path: a plain (not subclassed: masked arrays are subclasses) float64 vector
+        static NDARRAY: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+        let ndarray = NDARRAY.import(py, "numpy", "ndarray")?;
+        if obj.get_type().is(ndarray) {
+            if let Ok(a) = obj.extract::<PyReadonlyArray1<'py, f64>>() {
+                return Ok(Vector(a));
+            }
+        }
+        let np = py.import("numpy")?;
+        if obj.is_none() {
+            return Err(PyValueError::new_err("expected a 1-D array of floats, got None"));
+        }
+        if np.getattr("ma")?.call_method1("isMaskedArray", (obj,))?.is_truthy()? {
+            return Err(PyValueError::new_err("expected a 1-D array of floats, got a masked array (fill or compress it first)"));
+        }
+        // refuse what float64 conversion would silently change: complex (imaginary part dropped),
+        // strings ("1.5" parsed), booleans, objects
+        let raw = np.call_method1("asarray", (obj,)).map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?;
+        let kind: String = raw.getattr("dtype")?.getattr("kind")?.extract()?;
+        if !matches!(kind.as_str(), "f" | "i" | "u") {
+            let what = match kind.as_str() {
+                "c" => "complex values".to_string(),
+                "U" | "S" => "strings".to_string(),
+                "b" => "booleans".to_string(),
+                _ => format!("values of dtype {}", raw.getattr("dtype")?.str()?),
+            };
+            return Err(PyValueError::new_err(format!("expected a 1-D array of floats, got {what}")));
+        }
+        let converted = np
+            .call_method1("asarray", (raw, "float64"))
             .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?;
         let arr = converted
             .cast_into::<numpy::PyArrayDyn<f64>>()
@@ -92,6 +118,16 @@ pub(crate) fn read_into(what: &str, src: &ArrayView1<f64>, dst: &mut [f64]) -> R
         *d = *s;
     }
     Ok(())
+}
+
+/// A per-call result must be finite: inputs beyond what double precision can evaluate (positions
+/// of 1e160, velocities whose squares overflow) end here as a `NonFiniteError` naming the stage,
+/// never as NaN handed back to the caller.
+pub(crate) fn finite_out(stage: &str, v: &[f64]) -> Result<(), Error> {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(index) => Err(Error::NonFinite { what: format!("{stage} result (inputs out of double-precision range?)"), index }),
+        None => Ok(()),
+    }
 }
 
 pub(crate) fn check_time(t: f64) -> Result<(), Error> {

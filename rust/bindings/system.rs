@@ -8,7 +8,7 @@ use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::{check_time, mat, read_into, to_py, SolverError, Vector};
+use super::{finite_out, check_time, mat, read_into, to_py, SolverError, Vector};
 use crate::body::{ancf_cable, BodyKind};
 use crate::linalg::Banded;
 use crate::correct::{self, CorrectOptions};
@@ -140,7 +140,9 @@ impl PySystem {
         let m = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
             dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
-            Ok(dynamics::dense_mass(model, &ws.data))
+            let m = dynamics::dense_mass(model, &ws.data);
+            finite_out("M(q)", &m)?;
+            Ok(m)
         })?;
         mat(py, m, n, n)
     }
@@ -152,6 +154,7 @@ impl PySystem {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
             dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            finite_out("Q(t, q, qd)", &ws.data.force)?;
             Ok(ws.data.force.clone())
         })?;
         Ok(PyArray1::from_vec(py, v))
@@ -164,6 +167,7 @@ impl PySystem {
         let v = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
             dynamics::constraints(model, &mut ws.data, 0.0, &ws.q, &ws.qd, false);
+            finite_out("A(q)", &ws.data.jac)?;
             Ok(ws.data.jac.clone())
         })?;
         mat(py, v, m, n)
@@ -175,6 +179,7 @@ impl PySystem {
             check_time(t)?;
             Self::load(ws, &q, None)?;
             dynamics::constraints(model, &mut ws.data, t, &ws.q, &ws.qd, true);
+            finite_out("phi(t, q)", &ws.data.phi)?;
             Ok(ws.data.phi.clone())
         })?;
         Ok(PyArray1::from_vec(py, v))
@@ -198,6 +203,7 @@ impl PySystem {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
             dynamics::constraints(model, &mut ws.data, t, &ws.q, &ws.qd, false);
+            finite_out("b(t, q, qd)", &ws.data.gamma)?;
             Ok(ws.data.gamma.clone())
         })?;
         Ok(PyArray1::from_vec(py, v))
@@ -210,6 +216,7 @@ impl PySystem {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
             uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+            finite_out("qdd(t, q, qd)", &ws.data.qdd)?;
             let mut w = out.readwrite();
             w.as_slice_mut().expect("fresh array is contiguous").copy_from_slice(&ws.data.qdd);
             Ok(())
@@ -230,6 +237,7 @@ impl PySystem {
             read_into("y[:n]", &ya.slice(numpy::ndarray::s![..n]), &mut ws.q)?;
             read_into("y[n:]", &ya.slice(numpy::ndarray::s![n..]), &mut ws.qd)?;
             uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+            finite_out("rhs(t, y)", &ws.data.qdd)?;
             let mut w = out.readwrite();
             let o = w.as_slice_mut().expect("fresh array is contiguous");
             o[..n].copy_from_slice(&ws.qd);
@@ -269,6 +277,7 @@ impl PySystem {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
             uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+            finite_out("multipliers(t, q, qd)", &ws.data.lambda)?;
             Ok(ws.data.lambda.clone())
         })?;
         Ok(PyArray1::from_vec(py, v))
@@ -284,6 +293,9 @@ impl PySystem {
             let (mut p, mut v, mut a) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
             let (q, qd) = (ws.q.clone(), ws.qd.clone());
             uk::residuals(model, &mut ws.data, t, &q, &qd, &mut p, &mut v, &mut a)?;
+            finite_out("residuals(t, q, qd)", &p)?;
+            finite_out("residuals(t, q, qd)", &v)?;
+            finite_out("residuals(t, q, qd)", &a)?;
             Ok((p, v, a))
         })?;
         Ok((PyArray1::from_vec(py, p), PyArray1::from_vec(py, v), PyArray1::from_vec(py, a)))
@@ -369,6 +381,7 @@ impl PySystem {
                 crate::jacobian::uk_jacobian(model, data, jws, t, &yv[..n], &yv[n..], jq, jv)?;
                 let mut out = vec![0.0; 4 * n * n];
                 assemble_first_order(n, jq, jv, &mut out);
+                finite_out("jac(t, y)", &out)?;
                 Ok(out)
             })
         })?;
@@ -672,7 +685,9 @@ impl PySystem {
     fn kinetic_energy(&self, q: Vector<'_>, qd: Vector<'_>) -> PyResult<f64> {
         self.with_ws(|model, ws| {
             Self::load(ws, &q, Some(&qd))?;
-            Ok(dynamics::kinetic_energy(model, &mut ws.data, &ws.q, &ws.qd))
+            let e = dynamics::kinetic_energy(model, &mut ws.data, &ws.q, &ws.qd);
+            finite_out("kinetic_energy(q, qd)", &[e])?;
+            Ok(e)
         })
     }
 
@@ -680,7 +695,9 @@ impl PySystem {
     fn potential_energy(&self, q: Vector<'_>) -> PyResult<f64> {
         self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
-            Ok(dynamics::potential_energy(model, &ws.q))
+            let e = dynamics::potential_energy(model, &ws.q);
+            finite_out("potential_energy(q)", &[e])?;
+            Ok(e)
         })
     }
 

@@ -1,0 +1,669 @@
+"""Fuzz categories: how a case is drawn (a hypothesis strategy) and what counts as wrong for it.
+
+A case is plain data (tuples, dicts, numbers, arrays), so its ``repr`` is the reproducer.  The
+checker of a category runs the case and returns the findings, each ``(kind, detail)``:
+
+* ``unnamed-exception`` -- an exception that is neither a :class:`ukflex.UkflexError` nor a
+  ``TypeError``/``ValueError`` naming the argument the case made hostile (``OverflowError``,
+  ``ZeroDivisionError``, ``AttributeError``, ``RecursionError``, ``MemoryError``, a bare
+  "must be real number, not str", ...).
+* ``silent-nonfinite`` -- a call that returned NaN/inf, or accepted NaN/inf/masked/complex input,
+  without an error.
+* ``wrong`` -- a finite answer that breaks an invariant: constraint residuals beyond a tolerance
+  relative to the scene's length scale, energy drift of a conservative scene, disagreement with
+  the NumPy reference, a threaded result that differs from the serial one.
+* ``cli-traceback`` -- the CLI exited with a status other than 0/2, printed a traceback, or wrote
+  outside its output folder.
+
+Hangs (a case running longer than the watchdog's limit) and crashes (the worker process dies)
+are found by :mod:`fuzz.runner`, not here.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import os
+import tempfile
+import threading
+import warnings
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Any, Callable, Dict, List, Sequence, Tuple
+
+import numpy as np
+from hypothesis import strategies as st
+
+from .values import WRONG_TYPES, hostile, hostile_array, maybe_hostile, scaled
+
+Finding = Tuple[str, str]
+
+
+@dataclass(frozen=True)
+class Category:
+    name: str
+    strategy: Callable[[], st.SearchStrategy]
+    check: Callable[[Any], List[Finding]]
+    doc: str
+
+
+# ----------------------------------------------------------------------------------- helpers
+def _ukflex():
+    import ukflex
+
+    return ukflex
+
+
+def _named(exc: BaseException, names: Sequence[str]) -> bool:
+    """A ukflex error, or a TypeError/ValueError whose message names one of ``names``."""
+    uk = _ukflex()
+    if isinstance(exc, uk.UkflexError):
+        return True
+    if isinstance(exc, (TypeError, ValueError)):
+        # pyo3 names the argument in an exception note ("while processing 'q'")
+        msg = " ".join([str(exc)] + [str(n) for n in getattr(exc, "__notes__", [])])
+        return any(n and n in msg for n in names)
+    return False
+
+
+def _exc(exc: BaseException) -> str:
+    return f"{type(exc).__name__}: {str(exc)[:300]}"
+
+
+def _finite(*arrays: Any) -> bool:
+    for a in arrays:
+        a = np.asarray(a)
+        if a.dtype.kind in "fc" and not np.all(np.isfinite(a)):
+            return False
+    return True
+
+
+def _is_bad_input(v: Any) -> bool:
+    """Input that a careful API must refuse (non-finite, masked, complex, wrong type)."""
+    if isinstance(v, np.ma.MaskedArray):
+        return True
+    if isinstance(v, (str, bytes, dict)) or v is None or isinstance(v, bool):
+        return True
+    try:
+        a = np.asarray(v)
+    except Exception:  # noqa: BLE001 - ragged etc.
+        return True
+    if a.dtype.kind == "c" or a.dtype.kind in "OUSV":
+        return True
+    if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
+        return True
+    return False
+
+
+@contextlib.contextmanager
+def _quiet():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with np.errstate(all="ignore"):
+            yield
+
+
+def _max_abs(a: Any) -> float:
+    a = np.asarray(a, dtype=float)
+    return float(np.max(np.abs(a))) if a.size else 0.0
+
+
+# ----------------------------------------------------------------------------------- scenes
+#: templates: plausible parameters (hypothesis strategies) and the length scale of the scene
+_TEMPLATES: Dict[str, Dict[str, st.SearchStrategy]] = {
+    "rigid_pendulum": dict(mass=scaled(0.1, 10.0), inertia=scaled(1e-3, 1.0), length=scaled(0.1, 2.0),
+                           angle=st.floats(-3.0, 3.0), angular_velocity=st.floats(-5.0, 5.0),
+                           gravity=scaled(1.0, 20.0), position=st.floats(-1.0, 1.0)),
+    "point_pendulum": dict(mass=scaled(0.1, 10.0), length=scaled(0.1, 2.0), angle=st.floats(-3.0, 3.0),
+                           gravity=scaled(1.0, 20.0), position=st.floats(-1.0, 1.0),
+                           velocity=st.floats(-2.0, 2.0)),
+    "beam": dict(length=scaled(0.1, 1.0), diameter=scaled(2e-3, 2e-2), density=scaled(1e3, 1e4),
+                 youngs_modulus=scaled(1e9, 3e11), elements=st.integers(1, 2),
+                 formulation=st.sampled_from(["ffrf", "ancf"]), strain=st.sampled_from(["linear", "nonlinear"]),
+                 damping=st.sampled_from([0.0, 1e-4]), angular_velocity=st.floats(-5.0, 5.0)),
+    "slider_crank": dict(omega=scaled(1.0, 200.0), elements=st.integers(1, 2), diameter=scaled(3e-3, 2e-2),
+                         crank_length=scaled(0.05, 0.2), coupler_length=scaled(0.25, 0.5),
+                         shear_factor=st.floats(0.5, 1.0), poisson_ratio=st.floats(0.0, 0.45)),
+    "spring": dict(mass=scaled(0.1, 10.0), stiffness=scaled(1.0, 1e4), damping=st.floats(0.0, 1.0),
+                   rest_length=scaled(0.1, 1.0), position=st.floats(0.2, 2.0)),
+}
+
+#: the argument names an error message may use for a template field
+_ALIASES = {"length": ["length", "x", "point", "offset", "rest_length"], "diameter": ["diameter", "section"],
+            "gravity": ["gravity", "g"], "position": ["position", "x", "y"], "velocity": ["velocity"],
+            "angle": ["angle"], "omega": ["omega", "motion", "speed"]}
+
+
+def _build_template(name: str, p: Dict[str, Any]):
+    uk = _ukflex()
+    if name == "rigid_pendulum":
+        s = uk.Scene(gravity=(0.0, -p["gravity"]) if isinstance(p["gravity"], (int, float)) else p["gravity"])
+        rod = s.rigid_body("rod", mass=p["mass"], inertia=p["inertia"], position=(p["position"], 0.0),
+                           angle=p["angle"], angular_velocity=p["angular_velocity"])
+        s.revolute(s.ground.point(0.0, 0.0), rod.point(-p["length"], 0.0))
+        return s
+    if name == "point_pendulum":
+        s = uk.Scene(gravity=(0.0, -p["gravity"]) if isinstance(p["gravity"], (int, float)) else p["gravity"])
+        bob = s.point_mass("bob", mass=p["mass"], position=(p["position"], -0.5), velocity=(p["velocity"], 0.0))
+        s.distance(s.ground.point(0.0, 0.0), bob.point(), length=p["length"])
+        return s
+    if name == "beam":
+        s = uk.Scene()
+        s.beam("b", length=p["length"], section=uk.Circular(p["diameter"]), density=p["density"],
+               youngs_modulus=p["youngs_modulus"], elements=p["elements"], formulation=p["formulation"],
+               strain=p["strain"], damping=p["damping"], angular_velocity=p["angular_velocity"])
+        return s
+    if name == "slider_crank":
+        return uk.scenes.slider_crank(**p)
+    if name == "spring":
+        s = uk.Scene()
+        m = s.point_mass("m", mass=p["mass"], position=(p["position"], 0.0))
+        s.point_on_line(m.point(), s.ground.line())
+        s.spring_damper(s.ground.point(0.0, 0.0), m.point(), stiffness=p["stiffness"], damping=p["damping"],
+                        rest_length=p["rest_length"])
+        return s
+    raise AssertionError(name)
+
+
+def _length_scale(name: str, p: Dict[str, Any]) -> float:
+    vals = [p.get(k) for k in ("length", "coupler_length", "crank_length", "rest_length")]
+    vals = [abs(float(v)) for v in vals if isinstance(v, (int, float)) and not isinstance(v, bool)
+            and math.isfinite(v)]
+    return max([1.0] + vals)
+
+
+@st.composite
+def _scene_case(draw):
+    name = draw(st.sampled_from(sorted(_TEMPLATES)))
+    fields = _TEMPLATES[name]
+    p = {k: draw(v) for k, v in fields.items()}
+    field = draw(st.sampled_from(sorted(fields)))
+    p[field] = draw(maybe_hostile(fields[field], 1))
+    return dict(template=name, field=field, params=p)
+
+
+def _check_scene(case: Dict[str, Any]) -> List[Finding]:
+    uk = _ukflex()
+    name, field, p = case["template"], case["field"], case["params"]
+    names = [field] + _ALIASES.get(field, [])
+    hostile_input = _is_bad_input(p[field]) if not isinstance(p[field], (list, tuple)) else True
+    with _quiet():
+        try:
+            system = uk.System(_build_template(name, p))
+        except RecursionError as exc:
+            return [("unnamed-exception", _exc(exc))]
+        except Exception as exc:  # noqa: BLE001 - the point of the check
+            return [] if _named(exc, names) else [("unnamed-exception", "build: " + _exc(exc))]
+        findings: List[Finding] = []
+        if hostile_input and not isinstance(p[field], (int, float)):
+            # wrong types that survived: acceptable only if they coerce exactly (np.float32, np.int64)
+            if isinstance(p[field], (str, bytes, dict, complex, np.ma.MaskedArray)) or p[field] is None:
+                findings.append(("wrong", f"build accepted {field}={p[field]!r}"))
+        if not _finite(system.q0, system.qd0):
+            return findings + [("silent-nonfinite", "build: q0/qd0 not finite")]
+        L = _length_scale(name, p)
+        phi = _max_abs(system.phi(system.t0, system.q0))
+        if phi > 1e-9 * L:
+            findings.append(("wrong", f"build: max|Phi(q0)| = {phi:.3g} > 1e-9 L (L = {L:g})"))
+        try:
+            res = uk.simulate(system, system.t0 + 0.02, method="DOPRI5", rtol=1e-8, max_steps=20000)
+        except Exception as exc:  # noqa: BLE001
+            return findings + ([] if _named(exc, names) else [("unnamed-exception", "simulate: " + _exc(exc))])
+        t = np.asarray(res.t)
+        if t.size == 0:
+            return findings + [("wrong", f"simulate: empty result (status {res.status}: {res.message})")]
+        if res.status < 0:
+            if not str(res.message).strip():
+                findings.append(("wrong", "simulate failed without a message"))
+            return findings
+        q = np.array([res.coordinate(c) for c in system.coordinate_names])
+        qd = np.array([res.velocity(c) for c in system.coordinate_names])
+        if not _finite(q, qd):
+            return findings + [("silent-nonfinite", "simulate: status 0 with non-finite states")]
+        rp = max(_max_abs(system.phi(ti, q[:, k])) for k, ti in enumerate(t))
+        if rp > 1e-6 * L:
+            findings.append(("wrong", f"simulate: max|Phi| = {rp:.3g} > 1e-6 L (L = {L:g})"))
+        conservative = name in ("rigid_pendulum", "point_pendulum") or (name == "beam" and p["damping"] == 0.0)
+        if conservative:
+            e = np.array([system.kinetic_energy(q[:, k], qd[:, k]) + system.potential_energy(q[:, k])
+                          for k in range(t.size)])
+            kin = max(abs(system.kinetic_energy(q[:, k], qd[:, k])) for k in range(t.size))
+            m = p.get("mass", 1.0) if isinstance(p.get("mass"), float) else 1.0
+            g = p.get("gravity", 0.0) if isinstance(p.get("gravity"), float) else 0.0
+            scale = kin + abs(m * g * L) + 1e-12
+            drift = float(np.max(np.abs(e - e[0])))
+            if not math.isfinite(drift) or drift > 1e-4 * scale:
+                findings.append(("wrong", f"conservative scene: energy drift {drift:.3g} > 1e-4 x {scale:.3g}"))
+        return findings
+
+
+# ----------------------------------------------------------------------------------- TOML
+_TOML_BASE = """\
+[scene]
+name = "{name}"
+gravity = [0.0, -9.81]
+
+[[bodies]]
+name = "rod"
+kind = "rigid"
+mass = {mass}
+inertia = {inertia}
+position = [0.5, 0.0]
+
+[[joints]]
+kind = "revolute"
+a = {{ body = "ground", point = [0.0, 0.0] }}
+b = {{ body = "rod", point = [-0.5, 0.0] }}
+
+[solver]
+t_end = {t_end}
+"""
+
+_TOML_LITERALS = ["1e400", "-1e400", "nan", "inf", "1" + "0" * 400, "0", "-1", '"1"', "[]", "{}", "true",
+                  "[1, 2, 3]", "1e-320", "0x7fffffffffffffff", "9223372036854775808"]
+
+
+@st.composite
+def _toml_case(draw):
+    fields = dict(name=draw(st.sampled_from(["pend", "my scene", "..", "../../escape", "a/b", "", "x" * 300])),
+                  mass=draw(st.sampled_from(["1.0", "2.5"] * 4 + _TOML_LITERALS)),
+                  inertia=draw(st.sampled_from(["0.1"] * 8 + _TOML_LITERALS)),
+                  t_end=draw(st.sampled_from(["0.01"] * 8 + _TOML_LITERALS)))
+    text = _TOML_BASE.format(**fields)
+    mutation = draw(st.sampled_from(["none", "none", "deep", "drop_line", "dup_key", "kind_list", "garbage",
+                                     "many_bodies", "truncate"]))
+    if mutation == "deep":
+        depth = draw(st.sampled_from([50, 1000, 20000]))
+        text += "\n[extra]\nx = " + "[" * depth + "]" * depth + "\n"
+    elif mutation == "drop_line":
+        lines = text.splitlines()
+        del lines[draw(st.integers(0, len(lines) - 1))]
+        text = "\n".join(lines)
+    elif mutation == "dup_key":
+        text = text.replace("mass = ", "mass = 1.0\nmass = ", 1)
+    elif mutation == "kind_list":
+        text = text.replace('kind = "rigid"', "kind = []")
+    elif mutation == "garbage":
+        text = text[: draw(st.integers(0, len(text)))] + draw(st.text(max_size=40))
+    elif mutation == "many_bodies":
+        k = draw(st.sampled_from([300, 3000]))
+        extra = "".join(f'\n[[bodies]]\nname = "b{i}"\nkind = "rigid"\nmass = 1.0\ninertia = 0.1\n' for i in range(k))
+        text += extra + '\n[[bodies]]\nname = "bad"\nkind = "rigid"\nmass = -1.0\ninertia = 0.1\n'
+    elif mutation == "truncate":
+        text = text[: draw(st.integers(0, len(text)))]
+    return dict(mutation=mutation, fields=fields, text=text)
+
+
+def _check_toml(case: Dict[str, Any]) -> List[Finding]:
+    uk = _ukflex()
+    from ukflex import scenefile
+
+    with _quiet():
+        try:
+            sf = scenefile.loads(case["text"], path="fuzz.toml")
+        except RecursionError as exc:
+            return [("unnamed-exception", "loads: " + _exc(exc))]
+        except Exception as exc:  # noqa: BLE001
+            if isinstance(exc, uk.UkflexError) and "fuzz.toml" not in str(exc):
+                return [("unnamed-exception", "loads: error does not name the file: " + _exc(exc))]
+            return [] if _named(exc, ["fuzz.toml"]) else [("unnamed-exception", "loads: " + _exc(exc))]
+        try:
+            uk.System(sf.scene)
+        except Exception as exc:  # noqa: BLE001
+            return [] if isinstance(exc, uk.UkflexError) else [("unnamed-exception", "build: " + _exc(exc))]
+    return []
+
+
+# ----------------------------------------------------------------------------------- core
+@st.composite
+def _core_case(draw):
+    uk = _ukflex()
+    base = draw(st.sampled_from(["pendulum", "slider_crank", "every_joint"]))
+    d = getattr(uk.scenes, base)().to_dict()
+    section = draw(st.sampled_from([k for k in ("bodies", "joints", "drivers", "forces") if d.get(k)]))
+    items = d[section]
+    i = draw(st.integers(0, len(items) - 1))
+    keys = sorted(items[i])
+    key = draw(st.sampled_from(keys + ["__new__"]))
+    value = draw(st.one_of(hostile(), st.sampled_from([[[[]]], {"body": "nope"}, "unknown", -1, 2 ** 64,
+                                                      10 ** 30, [1e308, 1e308], [float("nan"), 0.0]])))
+    return dict(base=base, section=section, index=i, key=key, value=value, description=d)
+
+
+def _jsonable(v: Any) -> Any:
+    if isinstance(v, np.ma.MaskedArray):
+        return v.tolist()
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, complex):
+        return [v.real, v.imag]
+    if isinstance(v, bytes):
+        return v.decode("latin-1")
+    return v
+
+
+def _check_core(case: Dict[str, Any]) -> List[Finding]:
+    import json
+
+    uk = _ukflex()
+    d = case["description"]
+    d[case["section"]][case["index"]][case["key"]] = _jsonable(case["value"])
+    try:
+        text = json.dumps(d)
+    except (TypeError, ValueError):
+        return []
+    with _quiet():
+        try:
+            core = uk._core.System(text)
+        except Exception as exc:  # noqa: BLE001
+            return [] if isinstance(exc, uk.UkflexError) else [("unnamed-exception", "core: " + _exc(exc))]
+        try:
+            q, qd = core.initial_guess()
+            out = core.qdd(0.0, np.asarray(q), np.asarray(qd))
+        except Exception as exc:  # noqa: BLE001
+            return [] if isinstance(exc, uk.UkflexError) else [("unnamed-exception", "core qdd: " + _exc(exc))]
+        if not _finite(out):
+            return [("silent-nonfinite", "core: qdd at the initial guess is not finite")]
+    return []
+
+
+# ----------------------------------------------------------------------------------- arrays
+_SYSTEMS: Dict[str, Any] = {}
+
+
+def _system(name: str):
+    if name not in _SYSTEMS:
+        uk = _ukflex()
+        scene = {"slider_crank": lambda: uk.scenes.slider_crank(elements=2),
+                 "pendulum": lambda: uk.scenes.pendulum(),
+                 "cantilever_ancf": lambda: uk.scenes.cantilever(elements=2, formulation="ancf"),
+                 "every_joint": lambda: uk.scenes.every_joint()}[name]()
+        _SYSTEMS[name] = uk.System(scene)
+    return _SYSTEMS[name]
+
+
+_METHODS = {  # method -> argument names (t: scalar, q/qd: (n,), y: (2n,))
+    "qdd": ("t", "q", "qd"), "rhs": ("t", "y"), "M": ("q",), "Q": ("t", "q", "qd"), "phi": ("t", "q"),
+    "A": ("q",), "b": ("t", "q", "qd"), "multipliers": ("t", "q", "qd"), "residuals": ("t", "q", "qd"),
+    "kinetic_energy": ("q", "qd"), "potential_energy": ("q",), "jac": ("t", "y"),
+}
+
+
+@st.composite
+def _array_case(draw):
+    sysname = draw(st.sampled_from(["slider_crank", "pendulum", "cantilever_ancf", "every_joint"]))
+    n = _system(sysname).n_coords
+    method = draw(st.sampled_from(sorted(_METHODS)))
+    args = {}
+    bad = draw(st.sampled_from(_METHODS[method]))
+    for a in _METHODS[method]:
+        size = 2 * n if a == "y" else n
+        if a == "t":
+            args[a] = draw(maybe_hostile(st.floats(0.0, 1.0), 1)) if a == bad else draw(st.floats(0.0, 1.0))
+        elif a == bad:
+            args[a] = draw(hostile_array(size))
+        else:
+            args[a] = np.array(draw(st.lists(st.floats(-1.0, 1.0), min_size=size, max_size=size)))
+    return dict(system=sysname, method=method, bad=bad, args=args)
+
+
+def _check_array(case: Dict[str, Any]) -> List[Finding]:
+    uk = _ukflex()
+    system = _system(case["system"])
+    fn = getattr(system, case["method"])
+    args = case["args"]
+    bad = case["bad"]
+    with _quiet():
+        try:
+            out = fn(*[args[a] for a in _METHODS[case["method"]]])
+        except Exception as exc:  # noqa: BLE001
+            return [] if _named(exc, [bad, f"'{bad}'"]) else [("unnamed-exception", _exc(exc))]
+    v = args[bad]
+    outs = out if isinstance(out, tuple) else (out,)
+    if _is_bad_input(v):
+        if isinstance(v, (list, tuple)) and all(isinstance(x, float) for x in v):
+            pass  # a plain list of floats is fine
+        else:
+            return [("wrong", f"{case['method']} accepted {bad} = {_short(v)}")]
+    if not _finite(*outs):
+        return [("silent-nonfinite", f"{case['method']} returned non-finite values for {bad} = {_short(v)}")]
+    if case["method"] == "qdd" and np.asarray(v).shape == np.asarray(args.get("q", v)).shape:
+        from ukflex.reference.uk import uk_qdd
+
+        q = np.asarray(args["q"], dtype=float)
+        qd = np.asarray(args["qd"], dtype=float)
+        t = float(args["t"])
+        if q.shape == (system.n_coords,) and qd.shape == (system.n_coords,) and _finite(q, qd):
+            ref = uk_qdd(system.M(q), system.Q(t, q, qd), system.A(q), system.b(t, q, qd))
+            err = _max_abs(np.asarray(out) - ref)
+            scale = 1.0 + _max_abs(ref)
+            if err > 1e-6 * scale:
+                return [("wrong", f"qdd differs from the NumPy reference by {err:.3g} (scale {scale:.3g})")]
+    return []
+
+
+def _short(v: Any) -> str:
+    r = repr(v)
+    return r if len(r) < 120 else r[:117] + "..."
+
+
+# ----------------------------------------------------------------------------------- simulate options
+_OPTION_VALUES = {
+    "max_step": maybe_hostile(scaled(1e-4, 1e-2), 1), "first_step": maybe_hostile(scaled(1e-6, 1e-3), 1),
+    "max_steps": st.one_of(st.integers(1, 10 ** 5), st.sampled_from([0, -1, 1.5, 10 ** 30, "10", None])),
+    "projection_tol": maybe_hostile(scaled(1e-12, 1e-6), 1), "rho_inf": maybe_hostile(st.floats(0.0, 1.0), 1),
+    "step": maybe_hostile(scaled(1e-5, 1e-3), 1), "max_stpe": st.just(1e-3), "jacobian": st.sampled_from(
+        ["analytic", "structured", "fd", "nope", 3]),
+}
+
+
+@st.composite
+def _options_case(draw):
+    method = draw(st.sampled_from(["auto", "RK45", "DOP853", "Radau", "BDF", "LSODA", "DOPRI5", "RADAU5", "GENALPHA",
+                                   "dopri5", "genalpha", "rk45", "nope", "", 3]))
+    t_end = draw(maybe_hostile(st.floats(0.005, 0.05), 2))
+    rtol = draw(maybe_hostile(scaled(1e-9, 1e-3), 2))
+    atol = draw(st.one_of(st.none(), maybe_hostile(scaled(1e-12, 1e-6), 2), hostile_array(6)))
+    t_eval = draw(st.one_of(st.none(), st.none(), hostile_array(5),
+                            st.just([0.0, 0.001, 0.002]), st.just([0.002, 0.001]), st.just([-1.0, 0.5]),
+                            st.just(np.linspace(0.0, 1e9, 3))))
+    keys = draw(st.lists(st.sampled_from(sorted(_OPTION_VALUES)), max_size=3, unique=True))
+    options = {k: draw(_OPTION_VALUES[k]) for k in keys}
+    return dict(method=method, t_end=t_end, rtol=rtol, atol=atol, t_eval=t_eval, options=options)
+
+
+def _check_options(case: Dict[str, Any]) -> List[Finding]:
+    uk = _ukflex()
+    system = _system("pendulum")
+    names = ["method", "t_end", "rtol", "atol", "t_eval"] + list(case["options"])
+    with _quiet():
+        try:
+            res = uk.simulate(system, case["t_end"], method=case["method"], rtol=case["rtol"], atol=case["atol"],
+                              t_eval=case["t_eval"], **case["options"])
+        except Exception as exc:  # noqa: BLE001
+            return [] if _named(exc, names) else [("unnamed-exception", _exc(exc))]
+    findings: List[Finding] = []
+    for k in ("t_end", "rtol"):
+        if _is_bad_input(case[k]) or (isinstance(case[k], (int, float)) and not isinstance(case[k], bool)
+                                      and case[k] <= 0):
+            findings.append(("wrong", f"simulate accepted {k} = {_short(case[k])}"))
+    for k, v in case["options"].items():
+        if k == "max_steps" and not (isinstance(v, int) and not isinstance(v, bool) and v > 0):
+            findings.append(("wrong", f"simulate accepted max_steps = {_short(v)}"))
+        elif k != "max_steps" and k != "jacobian" and _is_bad_input(v):
+            findings.append(("wrong", f"simulate accepted {k} = {_short(v)}"))
+    if "max_stpe" in case["options"]:
+        findings.append(("wrong", "simulate accepted the misspelt option max_stpe"))
+    t = np.asarray(res.t)
+    if res.status >= 0:
+        q = np.array([res.coordinate(c) for c in system.coordinate_names])
+        if not _finite(t, q):
+            findings.append(("silent-nonfinite", "status >= 0 with non-finite states"))
+        elif t.size:
+            rp = max(_max_abs(system.phi(ti, q[:, k])) for k, ti in enumerate(t))
+            if rp > 1e-5:
+                findings.append(("wrong", f"max|Phi| = {rp:.3g} m on a 1 m pendulum"))
+    elif not str(res.message).strip() or t.size == 0:
+        findings.append(("wrong", f"failed run without message or partial result (t.size = {t.size})"))
+    return findings
+
+
+# ----------------------------------------------------------------------------------- CLI
+@st.composite
+def _cli_case(draw):
+    target = draw(st.sampled_from(["pendulum", "examples/pendulum.toml", "fifo", "devzero", "dir", "missing",
+                                   "spaces", "deep", "bigint", "empty", "binary", "dotdot_name", "kind_list"]))
+    command = draw(st.sampled_from(["run", "run", "run", "export", "list"]))
+    out = draw(st.sampled_from(["tmp", "tmp", "file", "proc", "dotdot"]))
+    samples = draw(st.sampled_from(["11", "11", "1e11", "-3", "0", "abc", "99999999999"]))
+    t_end = draw(st.sampled_from(["0.01", "0.01", "-1", "nan", "1e300", "x"]))
+    return dict(target=target, command=command, out=out, samples=samples, t_end=t_end)
+
+
+def _cli_target(kind: str, work: str, repo: str) -> str:
+    p = os.path.join(work, "in")
+    os.makedirs(p, exist_ok=True)
+    good = _TOML_BASE.format(name="pend", mass="1.0", inertia="0.1", t_end="0.01")
+    files = {"spaces": ("my scene.toml", good), "deep": ("deep.toml", "x = " + "[" * 5000 + "]" * 5000),
+             "bigint": ("big.toml", good.replace("mass = 1.0", "mass = 1" + "0" * 400)), "empty": ("empty.toml", ""),
+             "binary": ("bin.toml", "\x00\xff\x01garbage"),
+             "dotdot_name": ("dd.toml", good.replace('name = "pend"', 'name = "../../escaped"')),
+             "kind_list": ("kl.toml", good.replace('kind = "rigid"', "kind = []"))}
+    if kind in files:
+        fname, text = files[kind]
+        path = os.path.join(p, fname)
+        with open(path, "w", encoding="utf-8", errors="surrogateescape") as f:
+            f.write(text)
+        return path
+    if kind == "fifo":
+        path = os.path.join(p, "fifo.toml")
+        if not os.path.exists(path):
+            os.mkfifo(path)
+        return path
+    if kind == "devzero":
+        return "/dev/zero"
+    if kind == "dir":
+        return p
+    if kind == "missing":
+        return os.path.join(p, "missing.toml")
+    if kind == "examples/pendulum.toml":
+        return os.path.join(repo, kind)
+    return kind
+
+
+def _check_cli(case: Dict[str, Any]) -> List[Finding]:
+    from ukflex import cli
+
+    repo = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    with tempfile.TemporaryDirectory() as root:
+        work = os.path.join(root, "a", "b", "work")
+        os.makedirs(work)
+        target = _cli_target(case["target"], work, repo)
+        outs = {"tmp": os.path.join(work, "out"), "file": os.path.join(work, "in"), "proc": "/proc/ukflex-fuzz",
+                "dotdot": os.path.join(work, "..", "..")}
+        out = outs[case["out"]]
+        if case["out"] == "file":
+            out = os.path.join(work, "a_file")
+            open(out, "w").close()
+        if case["command"] == "run":
+            argv = ["run", target, "--t-end", case["t_end"], "--samples", case["samples"], "--no-plot",
+                    "--method", "DOPRI5", "--no-progress"]
+            if case["out"] != "tmp" or case["target"] != "dotdot_name":
+                argv += ["--out", out]
+        elif case["command"] == "export":
+            argv = ["export", case["target"] if case["target"] == "pendulum" else "pendulum", "-o",
+                    out if case["out"] != "tmp" else os.path.join(work, "exp.toml")]
+        else:
+            argv = ["list"]
+        before = {d: set(os.listdir(d)) for d in (root, os.path.join(root, "a"), os.path.join(root, "a", "b"))}
+        err, stdout = io.StringIO(), io.StringIO()
+        cwd = os.getcwd()
+        os.chdir(work)
+        try:
+            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(stdout), _quiet():
+                try:
+                    code = cli.main(argv)
+                except SystemExit as exc:
+                    code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+        except Exception as exc:  # noqa: BLE001
+            return [("cli-traceback", f"{argv[:2]}: {_exc(exc)}")]
+        finally:
+            os.chdir(cwd)
+        findings: List[Finding] = []
+        text = err.getvalue()
+        if code not in (0, 2):
+            findings.append(("cli-traceback", f"{argv}: exit status {code}: {text[-300:]}"))
+        if "Traceback" in text:
+            findings.append(("cli-traceback", f"{argv}: traceback printed: {text[-300:]}"))
+        if code == 2 and "error" not in text.lower():
+            findings.append(("cli-traceback", f"{argv}: exit 2 without an error line: {text[-200:]!r}"))
+        after = {d: set(os.listdir(d)) for d in before}
+        for d in before:
+            new = after[d] - before[d]
+            if new:
+                findings.append(("cli-traceback", f"{argv}: wrote outside its folder: {sorted(new)} in {d}"))
+        return findings
+
+
+# ----------------------------------------------------------------------------------- threads
+@st.composite
+def _thread_case(draw):
+    return dict(system=draw(st.sampled_from(["slider_crank", "pendulum"])),
+                rtols=draw(st.lists(st.sampled_from([1e-4, 1e-6, 1e-8]), min_size=2, max_size=4)),
+                method=draw(st.sampled_from(["DOPRI5", "RADAU5", "GENALPHA"])),
+                seed=draw(st.integers(0, 2 ** 16)))
+
+
+def _check_threads(case: Dict[str, Any]) -> List[Finding]:
+    system = _system(case["system"])
+    te = np.linspace(0.0, 0.003, 4)
+    rng = np.random.default_rng(case["seed"])
+    n = system.n_coords
+    states = [(0.01 * k, system.y0 + np.concatenate([np.zeros(n), 1e-3 * rng.standard_normal(n)]))
+              for k in range(4)]
+
+    def run(rtol):
+        r = system.integrate(0.0, system.y0, 0.003, case["method"], rtol, None, te)
+        return np.asarray(r["y"])
+
+    def calls(s):
+        t, y = s
+        return np.concatenate([system.rhs(t, y), system.multipliers(t, y[:n], y[n:])])
+
+    serial = [run(r) for r in case["rtols"]]
+    serial_calls = [calls(s) for s in states]
+    barrier = threading.Barrier(len(case["rtols"]) + len(states))
+
+    def job(k):
+        barrier.wait()
+        if k < len(case["rtols"]):
+            return run(case["rtols"][k])
+        return calls(states[k - len(case["rtols"])])
+
+    with ThreadPoolExecutor(len(case["rtols"]) + len(states)) as ex:
+        got = list(ex.map(job, range(len(case["rtols"]) + len(states))))
+    for k, ref in enumerate(serial + serial_calls):
+        if not np.array_equal(ref, got[k]):
+            return [("wrong", f"threaded result {k} differs from serial (max diff {_max_abs(ref - got[k]):.3g})")]
+    return []
+
+
+CATEGORIES: Dict[str, Category] = {
+    c.name: c
+    for c in [
+        Category("scene", _scene_case, _check_scene,
+                 "scenes through the Python API with one hostile property; build, correct, simulate 20 ms"),
+        Category("toml", _toml_case, _check_toml, "TOML scene text with hostile values and broken structure"),
+        Category("core", _core_case, _check_core, "description dicts with one hostile entry straight to the core"),
+        Category("arrays", _array_case, _check_array, "System per-call methods with hostile arrays"),
+        Category("options", _options_case, _check_options, "simulate with hostile options"),
+        Category("cli", _cli_case, _check_cli, "the CLI with hostile files, paths and options"),
+        Category("threads", _thread_case, _check_threads, "concurrent integrations and calls on one System"),
+    ]
+}
+
+#: relative weights of the categories in a mixed run (the CLI and threads cases cost the most)
+WEIGHTS = {"scene": 3, "toml": 2, "core": 3, "arrays": 4, "options": 2, "cli": 1, "threads": 1}
+
+__all__ = ["CATEGORIES", "WEIGHTS", "Category", "Finding", "WRONG_TYPES"]
