@@ -197,7 +197,7 @@ def pendulum(
     rod = s.rigid_body(
         "rod",
         mass=mass,
-        inertia=mass * length**2 / 12.0,
+        inertia=mass * length * length / 12.0,
         position=(h * c, h * si),
         angle=angle,
         velocity=(-h * si * angular_velocity, h * c * angular_velocity),
@@ -221,8 +221,8 @@ def double_pendulum(
     p1 = (0.5 * l1 * math.cos(a1), 0.5 * l1 * math.sin(a1))
     tip = (l1 * math.cos(a1), l1 * math.sin(a1))
     p2 = (tip[0] + 0.5 * l2 * math.cos(a2), tip[1] + 0.5 * l2 * math.sin(a2))
-    r1 = s.rigid_body("rod1", mass=m1, inertia=m1 * l1**2 / 12, position=p1, angle=a1)
-    r2 = s.rigid_body("rod2", mass=m2, inertia=m2 * l2**2 / 12, position=p2, angle=a2)
+    r1 = s.rigid_body("rod1", mass=m1, inertia=m1 * l1 * l1 / 12, position=p1, angle=a1)
+    r2 = s.rigid_body("rod2", mass=m2, inertia=m2 * l2 * l2 / 12, position=p2, angle=a2)
     s.revolute(s.ground.point(0, 0), r1.point(-l1 / 2, 0), name="pivot")
     s.revolute(r1.point(l1 / 2, 0), r2.point(-l2 / 2, 0), name="elbow")
     return s

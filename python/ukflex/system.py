@@ -16,7 +16,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from .description import normalize
-from .errors import InconsistentInitialStateError, core as _core
+from .errors import InconsistentInitialStateError, InvalidSceneError, NonFiniteError, core as _core
 
 __all__ = ["System", "InitialCorrection", "Equilibrium"]
 
@@ -224,7 +224,14 @@ class System:
         self.qd_guess = np.asarray(qd_guess, dtype=float)
         # Let the core check the mass matrix (and everything else a step needs) at the guess:
         # raises SingularMassError if M is not positive definite.
-        core.qdd(self.t0, self.q_guess, self.qd_guess)
+        try:
+            core.qdd(self.t0, self.q_guess, self.qd_guess)
+        except NonFiniteError as exc:
+            raise InvalidSceneError(
+                "the scene's properties are out of the range double precision can evaluate: the "
+                f"accelerations at the initial guess are not finite ({exc}); check masses, gravity, "
+                "stiffnesses, initial velocities and their units"
+            ) from exc
 
         if correct:
             self.q0, self.qd0, self.initial_correction = self._correct(
@@ -420,7 +427,7 @@ class System:
         SolverError
             No convergence (e.g. no equilibrium: a free body under gravity).
         """
-        from .errors import NonFiniteError, SolverError
+        from .errors import SolverError
 
         n, m = self.n_coords, self.n_constraints
         t = self.t0 if t is None else float(t)

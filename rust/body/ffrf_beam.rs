@@ -257,6 +257,7 @@ pub fn beam_section(d: &BeamDesc, item: &str) -> Result<(f64, BeamSection)> {
         }
     };
     non_negative(item, "damping", d.damping)?;
+    derived_scales(item, length / d.elements as f64, density, e, area, second_moment, shear_stiffness)?;
     let rotary_inertia = d.rotary_inertia.unwrap_or(d.theory == BeamTheory::Timoshenko);
     let section = BeamSection {
         area,
@@ -268,6 +269,42 @@ pub fn beam_section(d: &BeamDesc, item: &str) -> Result<(f64, BeamSection)> {
         theory: d.theory,
     };
     Ok((length, section))
+}
+
+/// Highest elastic circular frequency a beam may have [rad/s]: beyond it no integrator can
+/// resolve its modes or step over them in double precision (and the element matrices' products
+/// approach overflow); such a scene is a unit mistake (E in N/mm^2 with lengths in m, ...).
+pub const MAX_ELEMENT_OMEGA: f64 = 1e60;
+
+/// Check the products the element matrices are made of (mass and stiffness per length, element
+/// stiffnesses) for overflow/underflow, and the fastest element mode against
+/// [`MAX_ELEMENT_OMEGA`]. Each property alone may be in range while a product is not
+/// (area 1e-300 with I 1e300, density 1e308 times an area).
+fn derived_scales(item: &str, le: f64, density: f64, e: f64, area: f64, second_moment: f64, shear_stiffness: f64) -> Result<()> {
+    let products = [
+        ("density x area (mass per length)", density * area),
+        ("density x second_moment (rotary inertia per length)", density * second_moment),
+        ("youngs_modulus x area (axial stiffness)", e * area),
+        ("youngs_modulus x second_moment (bending stiffness)", e * second_moment),
+        ("element mass", density * area * le),
+        ("element axial stiffness EA/l", e * area / le),
+        ("element bending stiffness 12 EI/l^3", 12.0 * e * second_moment / (le * le * le)),
+    ];
+    for (what, v) in products {
+        if !(v.is_finite() && v > 0.0 && v.is_normal()) {
+            return Err(Error::invalid(item, format!("{what} = {v:e} is out of double-precision range; check the units of density, youngs_modulus and the section")));
+        }
+    }
+    // fastest element mode, order of magnitude: axial/shear waves over one element and its
+    // bending mode (free-free element: omega^2 ~ 500 EI / (rho A l^4))
+    let c2 = (e.max(shear_stiffness)) / density;
+    let omega2 = 12.0 * c2 / (le * le) + 500.0 * e * second_moment / (density * area * le.powi(4));
+    if !(omega2.is_finite() && omega2.sqrt() <= MAX_ELEMENT_OMEGA) {
+        return Err(Error::invalid(item, format!(
+            "elastic frequencies of about {:e} rad/s (youngs_modulus / density = {:e} m^2/s^2 over elements of {le:e} m) exceed {MAX_ELEMENT_OMEGA:e} rad/s, beyond any integrator; check the units",
+            omega2.sqrt(), e / density)));
+    }
+    Ok(())
 }
 
 impl Beam {

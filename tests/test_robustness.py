@@ -1,0 +1,69 @@
+"""Issue-15 robustness at the API: absurd but finite properties, hostile arrays and inputs that
+overflow double precision end in a named error, never in NaN or garbage."""
+import warnings
+
+import numpy as np
+import pytest
+
+import ukflex
+from ukflex import InvalidSceneError, NonFiniteError, scenes
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(youngs_modulus=1e300), "elastic frequencies"),         # was: "mass matrix is not positive definite" mid-run
+    (dict(youngs_modulus=1e-300), "bending stiffness"),
+    (dict(shear_factor=1e308), "elastic frequencies"),
+    (dict(coupler_length=1e-200), "out of double-precision range"),
+    (dict(diameter=1e100), "second_moment"),
+    (dict(omega=1e200), "accelerations at the initial guess are not finite"),
+])
+def test_absurd_beam_scene_properties_are_refused_at_build(kwargs, match):
+    with pytest.raises(InvalidSceneError, match=match):
+        ukflex.System(scenes.slider_crank(**kwargs))
+
+
+@pytest.mark.parametrize("kwargs", [dict(mass=1e308), dict(angular_velocity=1e200), dict(length=1e200)])
+def test_absurd_rigid_scene_properties_are_refused_at_build(kwargs):
+    with pytest.raises(InvalidSceneError):
+        ukflex.System(scenes.pendulum(**kwargs))
+
+
+def test_plausible_extremes_still_build():
+    # a soft rubber-like rod of many short elements and a very stiff short one stay legal
+    ukflex.System(scenes.slider_crank(youngs_modulus=1e6, elements=8))
+    ukflex.System(scenes.slider_crank(youngs_modulus=1e13, coupler_length=0.05))
+
+
+@pytest.fixture(scope="module")
+def crank():
+    return ukflex.System(scenes.slider_crank(elements=2))
+
+
+@pytest.mark.parametrize("bad, what", [
+    (lambda q: np.ma.masked_array(q), "masked array"),
+    (lambda q: q + 0j, "complex"),
+    (lambda q: [str(x) for x in q], "strings"),
+    (lambda q: None, "None"),
+    (lambda q: q > 0, "booleans"),
+])
+def test_hostile_arrays_are_refused_naming_the_argument(crank, bad, what):
+    with pytest.raises(ValueError, match=what) as info:
+        crank.phi(0.0, bad(crank.q0))
+    assert any("'q'" in n for n in getattr(info.value, "__notes__", [])), info.value
+
+
+@pytest.mark.parametrize("method", ["M", "Q", "qdd", "multipliers", "kinetic_energy", "potential_energy", "jac"])
+def test_inputs_beyond_double_range_give_non_finite_error_not_nan(crank, method):
+    q, qd = crank.q0.copy(), crank.qd0.copy()
+    q[3] = 1e200
+    qd[4] = 1e200
+    args = {"M": (q,), "Q": (0.0, q, qd), "qdd": (0.0, q, qd), "multipliers": (0.0, q, qd),
+            "kinetic_energy": (q, qd), "potential_energy": (q,), "jac": (0.0, np.concatenate([q, qd]))}[method]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            out = getattr(crank, method)(*args)
+        except NonFiniteError as exc:
+            assert "result" in str(exc)
+            return
+    assert np.all(np.isfinite(out))
