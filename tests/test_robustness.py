@@ -67,3 +67,22 @@ def test_inputs_beyond_double_range_give_non_finite_error_not_nan(crank, method)
             assert "result" in str(exc)
             return
     assert np.all(np.isfinite(out))
+
+
+@pytest.mark.parametrize("pivot_x", [1e17, 1e8])
+def test_mechanism_far_from_the_origin_fails_loudly(pivot_x):
+    # at 1e17 m positions move in steps of 16 m: the constraints read zero whatever happens and a
+    # run used to "succeed" with garbage (issue 15); 1e8 m still resolves only 1.5e-8 m
+    s = ukflex.Scene(gravity=(0.0, -9.81))
+    link = s.rigid_body("link", mass=1.0, inertia=0.1)
+    s.revolute(s.ground.point(pivot_x, 0.0), link.point(-0.5, 0.0))
+    with pytest.raises(InvalidSceneError, match="length scale 0.5 m"):
+        s.build()
+
+
+def test_mechanism_at_a_resolvable_offset_builds():
+    s = ukflex.Scene(gravity=(0.0, -9.81))
+    link = s.rigid_body("link", mass=1.0, inertia=0.1)
+    s.revolute(s.ground.point(1e5, 0.0), link.point(-0.5, 0.0))
+    system = s.build()
+    assert system.q0[0] == pytest.approx(1e5 + 0.5)

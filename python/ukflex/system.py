@@ -101,6 +101,28 @@ class Equilibrium:
     position_residual: float
 
 
+def length_scale(description: Dict[str, Any]) -> float:
+    """The scene's length scale [m]: the largest body dimension -- beam lengths, centre-of-mass
+    and marker offsets on bodies (not on the ground: those place the mechanism), distance and
+    rest lengths; 1 m for a scene without any."""
+    sizes: List[float] = []
+    for b in description.get("bodies", []):
+        for key in ("length",):
+            if isinstance(b.get(key), (int, float)):
+                sizes.append(abs(float(b[key])))
+        if isinstance(b.get("com"), (list, tuple)):
+            sizes.extend(abs(float(v)) for v in b["com"])
+    for section in ("joints", "drivers", "forces"):
+        for item in description.get(section, []):
+            for key, v in item.items():
+                if key in ("length", "rest_length") and isinstance(v, (int, float)):
+                    sizes.append(abs(float(v)))
+                elif isinstance(v, dict) and v.get("body", "ground") != "ground":
+                    sizes.extend(abs(float(x)) for x in (v.get("point") or []) if isinstance(x, (int, float)))
+    sizes = [s for s in sizes if np.isfinite(s) and s > 0.0]
+    return max(sizes) if sizes else 1.0
+
+
 class System:
     """A compiled multibody system (Rust core) with a consistent initial state.
 
@@ -244,6 +266,7 @@ class System:
             self.initial_correction = InitialCorrection(
                 0, rp, rp, rv, rv, np.zeros(self.n_coords), np.zeros(self.n_coords), [], self.coordinate_names
             )
+        self._check_resolution(self.q0)
 
     # ------------------------------------------------------------------------------ info
     @property
@@ -504,6 +527,27 @@ class System:
     def _detail(self, residual: np.ndarray, k: int = 3) -> str:
         order = [i for i in np.argsort(-np.abs(residual))[:k] if abs(residual[i]) > 0.0]
         return ", ".join(f"{self.constraint_names[i]} = {residual[i]:.3e}" for i in order)
+
+    #: positions must be resolved by double precision to this fraction of the scene's length scale
+    RESOLUTION = 1e-9
+
+    def _check_resolution(self, q: np.ndarray) -> None:
+        """Refuse a state whose positions are too far from the origin for double precision to
+        resolve the mechanism: at 1e17 m a coordinate moves in steps of 16 m, the constraints
+        read zero whatever the motion, and a run would "succeed" with garbage."""
+        scale = length_scale(self.description)
+        idx = [i for i, c in enumerate(self.coordinate_names) if c.endswith((".x", ".y"))]
+        if not idx:
+            return
+        far = int(idx[int(np.argmax(np.abs(q[idx])))])
+        r = abs(float(q[far]))
+        if r * np.finfo(float).eps > self.RESOLUTION * scale:
+            raise InvalidSceneError(
+                f"{self.coordinate_names[far]} = {q[far]:.3g} m is {r / scale:.2g} times the scene's length scale "
+                f"{scale:.3g} m: double precision resolves positions there only to {np.spacing(r):.2g} m "
+                f"(resolving {self.RESOLUTION:g} of the length scale needs |r| <= "
+                f"{self.RESOLUTION * scale / np.finfo(float).eps:.3g} m); place the origin near the mechanism"
+            )
 
     def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations):
         held = self._held_mask(hold)
