@@ -72,8 +72,9 @@ class System:
     def beam_point(self, body: str, xi: float, q: _F64) -> _F64:
         """Columns x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
         the ends), psi of the axis point at xi; shape (5,) for q (n,), (nt, 5) for q (nt, n)."""
-    def rank_info(self) -> Dict[str, Any]:
-        """rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the last UK solve."""
+    def rank_info(self, t: Optional[float] = None, q: Optional[_F64] = None, qd: Optional[_F64] = None) -> Dict[str, Any]:
+        """rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the UK solve at (t, q, qd)
+        (one lock: thread-safe), or of the last solve of any thread without a state."""
     def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None:
         """Drop singular values of A F^-T at or below max(atol, rcond sigma_max)."""
     def set_pseudoinverse(self, kind: str = "auto") -> None:

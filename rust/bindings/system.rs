@@ -309,11 +309,26 @@ impl PySystem {
         })
     }
 
-    /// Everything the last pseudoinverse decided: rank, sigma_max, sigma_min_kept,
-    /// sigma_max_dropped, tolerance (exact singular values: when the acceleration took the
-    /// certified full-rank path they are computed here, on demand).
-    fn rank_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let info = self.with_ws(|model, ws| uk::exact_rank_info(model, &mut ws.data))?;
+    /// Everything a pseudoinverse decided: rank, sigma_max, sigma_min_kept, sigma_max_dropped,
+    /// tolerance (exact singular values: when the acceleration took the certified full-rank path
+    /// they are computed here, on demand). With a state `(t, q, qd)` the UK solve at that state
+    /// and its rank report happen under one lock, so the answer belongs to that state even when
+    /// other threads use the System; without one it describes the last solve of any thread.
+    #[pyo3(signature = (t=None, q=None, qd=None))]
+    fn rank_info<'py>(&self, py: Python<'py>, t: Option<f64>, q: Option<Vector<'py>>, qd: Option<Vector<'py>>) -> PyResult<Bound<'py, PyDict>> {
+        let state = match (t, &q, &qd) {
+            (Some(t), Some(q), Some(qd)) => Some((t, q, qd)),
+            (None, None, None) => None,
+            _ => return Err(PyValueError::new_err("rank_info: give all of t, q, qd (a state) or none of them (the last solve)")),
+        };
+        let info = self.with_ws(|model, ws| {
+            if let Some((t, q, qd)) = state {
+                check_time(t)?;
+                Self::load(ws, q, Some(qd))?;
+                uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+            }
+            uk::exact_rank_info(model, &mut ws.data)
+        })?;
         let d = PyDict::new(py);
         d.set_item("rank", info.rank)?;
         d.set_item("sigma_max", info.sigma_max)?;
