@@ -203,8 +203,8 @@ fn num(nodes: &mut Vec<Node>, v: f64) -> usize {
 fn add(nodes: &mut Vec<Node>, a: usize, b: usize) -> usize {
     match (num_of(nodes, a), num_of(nodes, b)) {
         (Some(x), Some(y)) => num(nodes, x + y),
-        (Some(x), _) if x == 0.0 => b,
-        (_, Some(y)) if y == 0.0 => a,
+        (Some(0.0), _) => b,
+        (_, Some(0.0)) => a,
         _ => push(nodes, Node::Add(a, b)),
     }
 }
@@ -212,8 +212,8 @@ fn add(nodes: &mut Vec<Node>, a: usize, b: usize) -> usize {
 fn sub(nodes: &mut Vec<Node>, a: usize, b: usize) -> usize {
     match (num_of(nodes, a), num_of(nodes, b)) {
         (Some(x), Some(y)) => num(nodes, x - y),
-        (Some(x), _) if x == 0.0 => neg(nodes, b),
-        (_, Some(y)) if y == 0.0 => a,
+        (Some(0.0), _) => neg(nodes, b),
+        (_, Some(0.0)) => a,
         _ => push(nodes, Node::Sub(a, b)),
     }
 }
@@ -221,9 +221,9 @@ fn sub(nodes: &mut Vec<Node>, a: usize, b: usize) -> usize {
 fn mul(nodes: &mut Vec<Node>, a: usize, b: usize) -> usize {
     match (num_of(nodes, a), num_of(nodes, b)) {
         (Some(x), Some(y)) => num(nodes, x * y),
-        (Some(x), _) | (_, Some(x)) if x == 0.0 => num(nodes, 0.0),
-        (Some(x), _) if x == 1.0 => b,
-        (_, Some(y)) if y == 1.0 => a,
+        (Some(0.0), _) | (_, Some(0.0)) => num(nodes, 0.0),
+        (Some(1.0), _) => b,
+        (_, Some(1.0)) => a,
         _ => push(nodes, Node::Mul(a, b)),
     }
 }
@@ -231,8 +231,8 @@ fn mul(nodes: &mut Vec<Node>, a: usize, b: usize) -> usize {
 fn div(nodes: &mut Vec<Node>, a: usize, b: usize) -> usize {
     match (num_of(nodes, a), num_of(nodes, b)) {
         (Some(x), Some(y)) if y != 0.0 => num(nodes, x / y),
-        (Some(x), _) if x == 0.0 => num(nodes, 0.0),
-        (_, Some(y)) if y == 1.0 => a,
+        (Some(0.0), None) => num(nodes, 0.0),
+        (_, Some(1.0)) => a,
         _ => push(nodes, Node::Div(a, b)),
     }
 }
@@ -248,8 +248,8 @@ fn neg(nodes: &mut Vec<Node>, a: usize) -> usize {
 fn powr(nodes: &mut Vec<Node>, a: usize, b: usize) -> usize {
     match (num_of(nodes, a), num_of(nodes, b)) {
         (Some(x), Some(y)) => num(nodes, pow(x, y)),
-        (_, Some(y)) if y == 0.0 => num(nodes, 1.0),
-        (_, Some(y)) if y == 1.0 => a,
+        (_, Some(0.0)) => num(nodes, 1.0),
+        (_, Some(1.0)) => a,
         _ => push(nodes, Node::Pow(a, b)),
     }
 }
@@ -528,7 +528,7 @@ impl Parser {
             }
             if digits(&mut q, &self.chars) {
                 p = q;
-            } else if q < n && !self.chars[q].is_ascii_alphabetic() || q >= n {
+            } else if q >= n || !self.chars[q].is_ascii_alphabetic() {
                 return self.err(p, "malformed exponent of a number");
             }
         }
@@ -557,6 +557,7 @@ mod tests {
         assert_eq!(ev("1 - 2 - 3", 0.0).0, -4.0);
         assert_eq!(ev("8 / 2 / 2", 0.0).0, 2.0);
         assert_eq!(ev("2 ** 3", 0.0).0, 8.0);
+        assert!(ev("0/0", 0.0).0.is_nan());
         assert_eq!(ev("1.5e1 + .5", 0.0).0, 15.5);
         let (f, d1, d2) = ev("3*t^2 + sin(2*t)", 0.7);
         assert!((f - (3.0 * 0.49 + 1.4f64.sin())).abs() < 1e-15);
