@@ -355,3 +355,33 @@ def test_cli_reports_the_driver_work_and_writes_sensor_outputs(tmp_path):
         rows = list(csv.reader(fh))
     assert rows[0] == ["t", "reaction(crank_speed).torque", "M(coupler, 0.5)", "work.drivers"]
     assert len(rows) > 3 and all(np.isfinite(float(x)) for x in rows[-1])
+
+
+def test_reactions_of_weld_prismatic_and_distance_are_the_statics():
+    """Each joint kind against Newton at a state from rest: a welded overhanging rod carries its
+    weight and moment; a block on a prismatic guide its weight; a particle on a rod released at
+    angle th pulls with the tension m g cos(th) (no speed yet)."""
+    m, g, h, th, L = 2.0, 9.81, 0.4, 0.5, 0.8
+    s = Scene(gravity=(0.0, -g))
+    rod = s.rigid_body("rod", mass=m, inertia=0.1, position=(h, 0.0))
+    s.weld(rod.point(-h, 0.0), s.ground.point(0.0, 0.0), name="clamp")
+    block = s.rigid_body("block", mass=m, inertia=0.1, position=(0.0, 1.0), angle=0.3)
+    s.prismatic(block.frame(), s.ground.frame(angle=0.3), name="guide")  # a guide tilted by 0.3 rad
+    bob = s.point_mass("bob", mass=m, position=(L * math.sin(th), -1.0 - L * math.cos(th)))
+    s.distance(bob.point(), s.ground.point(0.0, -1.0), name="string")
+    res = ukflex.simulate(s.build(), 1e-9, method="DOPRI5", rtol=1e-12, t_eval=[0.0])
+    sn = res.sensors
+    r = {k: {c: v[0] if isinstance(v, np.ndarray) else v for c, v in sn.reaction(k).items()} for k in
+         ("clamp", "guide", "string")}
+    assert r["clamp"]["body"] == "rod"
+    np.testing.assert_allclose([r["clamp"]["fx"], r["clamp"]["fy"], r["clamp"]["torque"]], [0, m * g, m * g * h],
+                               atol=1e-9)
+    # the block slides freely along the tilted guide: the guide carries the normal part of its
+    # weight, in the joint frame (the guide's axis) all in fy_local, and no torque
+    np.testing.assert_allclose([r["guide"]["fx_local"], r["guide"]["fy_local"], r["guide"]["torque"]],
+                               [0, m * g * math.cos(0.3), 0], atol=1e-9)
+    # the string: tension m g cos(th) pulling the bob to the pivot; fx_local = -tension
+    np.testing.assert_allclose(r["string"]["fx_local"], -m * g * math.cos(th), rtol=1e-10)
+    np.testing.assert_allclose(np.hypot(r["string"]["fx"], r["string"]["fy"]), m * g * math.cos(th), rtol=1e-10)
+    for k in r:
+        assert abs(r[k]["power"]) < 1e-12
