@@ -307,6 +307,10 @@ pub enum MotionDesc {
     ConstantSpeed { #[serde(default)] initial: f64, speed: f64 },
     Polynomial { coefficients: Vec<f64> },
     Harmonic { #[serde(default)] offset: f64, amplitude: f64, frequency: f64, #[serde(default)] phase: f64 },
+    /// `f(t)` written as an expression of `t` (`rust/constraint/expr.rs`).
+    Expression { expression: String },
+    /// A C2 cubic spline through `(times, values)`; natural ends unless `slopes = [f'(t0), f'(tn)]`.
+    Spline { times: Vec<f64>, values: Vec<f64>, #[serde(default, skip_serializing_if = "Option::is_none")] slopes: Option<[f64; 2]> },
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize)]

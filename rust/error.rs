@@ -28,6 +28,9 @@ pub enum Error {
     /// A function argument (not the scene) is out of range: tolerances, times, options.
     #[error("{what}: {message}")]
     Argument { what: String, message: String },
+    /// A driver's motion expression does not parse (`position`: 0-based character index).
+    #[error("{item}: cannot parse the motion expression {text:?} at position {position}: {message}")]
+    Expression { item: String, text: String, message: String, position: usize },
     /// A solver kernel could not produce a result (e.g. SVD did not converge).
     #[error("solver failure: {0}")]
     Solver(String),

@@ -23,6 +23,7 @@ pub mod integrate;
 pub mod jacobian;
 pub mod linalg;
 pub mod model;
+pub mod sensors;
 pub mod small_svd;
 pub mod uk;
 

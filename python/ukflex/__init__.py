@@ -14,6 +14,7 @@ Rust core (``ukflex._core``, private) + Python API:
 """
 
 from .errors import (
+    ExpressionError,
     InconsistentInitialStateError,
     InvalidSceneError,
     NonFiniteError,
@@ -26,6 +27,7 @@ from .scene import (
     Circular,
     ConstantSpeed,
     CustomSection,
+    Expression,
     GroundRef,
     Harmonic,
     Marker,
@@ -34,6 +36,7 @@ from .scene import (
     Rectangular,
     RigidBodyRef,
     Scene,
+    Spline,
 )
 from .system import InitialCorrection, System
 from .results import SimulationResult
@@ -55,6 +58,8 @@ __all__ = [
     "ConstantSpeed",
     "Polynomial",
     "Harmonic",
+    "Expression",
+    "Spline",
     "System",
     "InitialCorrection",
     "SimulationResult",
@@ -66,4 +71,5 @@ __all__ = [
     "SolverError",
     "NonFiniteError",
     "InconsistentInitialStateError",
+    "ExpressionError",
 ]

@@ -16,11 +16,13 @@ __all__ = [
     "SceneChecker",
     "item_name",
     "beam_elastic_dofs",
+    "motion_values",
     "UkflexError",
     "InvalidSceneError",
     "SingularMassError",
     "NonFiniteError",
     "SolverError",
+    "ExpressionError",
 ]
 
 class UkflexError(Exception): ...
@@ -28,6 +30,9 @@ class InvalidSceneError(UkflexError): ...
 class SingularMassError(UkflexError): ...
 class SolverError(UkflexError): ...
 class NonFiniteError(UkflexError): ...
+class ExpressionError(InvalidSceneError):
+    position: int
+    expression: str
 
 @final
 class System:
@@ -105,6 +110,12 @@ class System:
         self, t: float, q: _F64, qd: _F64, tol: float = 1e-12, max_iter: int = 20
     ) -> Tuple[_F64, _F64, Dict[str, Any]]:
         """Project (q, qd) onto Phi = 0, A qd + Phi_t = 0 in the mass metric."""
+    def sensors(self, t: _F64, q: _F64, qd: _F64, reactions: bool = True) -> Dict[str, Any]:
+        """Reactions (nt, items, 6), body energies (nt, bodies, 3), force potentials, dissipation power."""
+        ...
+    def beam_internal_forces(self, body: str, xi: _F64, q: _F64) -> _F64:
+        """(nt, nx, 5): N, V, M, eps, kappa at the axis points xi."""
+        ...
     def kinetic_energy(self, q: _F64, qd: _F64) -> float:
         """1/2 qd^T M(q) qd."""
     def potential_energy(self, q: _F64) -> float:
@@ -157,5 +168,8 @@ class SceneChecker:
 def item_name(section: str, kind: str, name: Optional[str], index: int) -> str:
     """How errors name a scene item."""
 
+def motion_values(motion_json: str, t: _F64) -> _F64:
+    """(f, f', f'') of a driver motion at the times t, shape (3, nt)."""
+    ...
 def beam_elastic_dofs(elements: int, frame: str) -> int:
     """Number of elastic coordinates of a beam."""

@@ -281,14 +281,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
                        progress=prog.callback(name, solver["t_end"]), **extra)
     finally:
         prog.done()
-    e = res.energy()
     print(f"{res.method} rtol={res.rtol:g} ({res.formulation}): status {res.status} ({res.message}); nfev {res.nfev}, "
           f"njev {res.njev}, nlu {res.nlu}; integration {res.wall_time:.3f} s")
     if "auto" in res.extra:
         print(f"method auto -> {res.method}: {res.extra['auto']['reason']}")
     print(f"max ||Phi|| = {res.max_residual('position'):.3e}, max ||A qd + Phi_t|| = "
           f"{res.max_residual('velocity'):.3e}, max ||A qdd - b|| = {res.max_residual('acceleration'):.3e}")
-    print(f"energy T + V: {e[0]:.9g} -> {e[-1]:.9g} (change {e[-1] - e[0]:+.3e})")
+    print(res.sensors.energy_line())
 
     os.makedirs(out, exist_ok=True)
     base = os.path.join(out, name)

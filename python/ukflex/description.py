@@ -83,6 +83,8 @@ class Checker:
             Naming the item; nothing is added.
         """
         d = plain(self.label(section, item), "", dict(item))
+        if section == "drivers" and isinstance(d.get("motion"), str):  # a motion written as an expression of t
+            d["motion"] = {"kind": "expression", "expression": d["motion"]}
         info = dict(getattr(self._core, "add_" + _WORD[section])(json.dumps(d, allow_nan=False)))
         self.items[section].append(json.loads(info.pop("item")))
         self.info[section].append(info)

@@ -26,12 +26,14 @@ __all__ = [
     "SolverError",
     "NonFiniteError",
     "InconsistentInitialStateError",
+    "ExpressionError",
 ]
 
 UkflexError = core.UkflexError
 InvalidSceneError = core.InvalidSceneError
 SingularMassError = core.SingularMassError
 SolverError = core.SolverError
+ExpressionError = core.ExpressionError
 NonFiniteError = core.NonFiniteError
 
 

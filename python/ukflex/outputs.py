@@ -13,7 +13,12 @@ An *output expression* is one of
   ``v(coupler, 0.5)`` is the paper's midpoint deflection); append ``/L`` to divide by the beam
   length (``v(coupler, 0.5)/L``, the paper's Fig. 4);
 * ``psi(BEAM, XI)``: cross-section rotation relative to the beam frame;
-* ``x(BEAM, XI)``, ``y(BEAM, XI)``: world position of the deformed beam axis point.
+* ``x(BEAM, XI)``, ``y(BEAM, XI)``: world position of the deformed beam axis point;
+* sensors (:mod:`ukflex.sensors`, docs/outputs.md): ``reaction(JOINT).fx`` (``fy``, ``torque``,
+  ``fx_local``, ``fy_local``, ``power``), ``work(DRIVER)``, ``energy.kinetic`` (``strain``,
+  ``gravity``, ``springs``, ``loads``, ``total``), ``energy(BODY).kinetic``, ``work.drivers``,
+  ``work.external``, ``dissipated``, ``balance``, ``N(BEAM, XI)`` (``V``, ``M``, ``eps``,
+  ``kappa``).
 """
 
 from __future__ import annotations
@@ -23,6 +28,8 @@ from typing import List, Tuple
 
 import numpy as np
 
+from .sensors import SENSOR_HELP, Sensors
+
 __all__ = ["evaluate", "validate", "default_outputs", "beam_names", "OUTPUT_HELP", "BEAM_KINDS"]
 
 #: Body kinds that are beams (``System.body_kind``): FFRF and ANCF.
@@ -30,7 +37,7 @@ BEAM_KINDS = ("beam", "ancf_beam")
 
 OUTPUT_HELP = (
     "t, a coordinate (crank.theta), d:<coordinate> (rate), residual.position|velocity|acceleration, energy, "
-    "u(BEAM, XI), v(BEAM, XI) [optionally /L], psi(BEAM, XI), x(BEAM, XI), y(BEAM, XI)"
+    "u(BEAM, XI), v(BEAM, XI) [optionally /L], psi(BEAM, XI), x(BEAM, XI), y(BEAM, XI), " + SENSOR_HELP
 )
 
 _BEAM_EXPR = re.compile(r"^(u|v|psi|x|y)\(\s*([^,()\s]+)\s*,\s*([^()\s]+)\s*\)\s*(/\s*L)?$")
@@ -47,6 +54,9 @@ def _parse(system, expr: str):
         if kind not in _RESIDUALS:
             raise ValueError(f"output {expr!r}: residual kind must be one of {_RESIDUALS}")
         return ("residual", kind)
+    sensor = Sensors.parse(system, e)
+    if sensor is not None:
+        return ("sensor", sensor)
     m = _BEAM_EXPR.match(e)
     if m:
         what, body, xi_text, per_length = m.groups()
@@ -99,6 +109,8 @@ def evaluate(res, expr: str) -> Tuple[str, np.ndarray]:
         return "T + V [J]", res.energy()
     if p[0] == "residual":
         return f"||residual {p[1]}||", res.residuals[p[1]]
+    if p[0] == "sensor":
+        return res.sensors.evaluate(p[1])
     if p[0] in ("coord", "rate"):
         name = p[1]
         unit = "rad" if name.endswith(".theta") else ("-" if ".qf" in name else "m")

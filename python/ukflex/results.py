@@ -132,6 +132,13 @@ class SimulationResult:
             f"t_end={t_end:g}, status={self.status}, nfev={self.nfev}, wall_time={self.wall_time:.3g}s)"
         )
 
+    @property
+    def sensors(self):
+        """Reactions, energies, work, beam internal forces (:class:`ukflex.sensors.Sensors`)."""
+        from .sensors import Sensors
+
+        return self.__dict__.setdefault("_sensors", Sensors(self))
+
     # ------------------------------------------------------------------------------ access
     def coordinate(self, name: str) -> np.ndarray:
         """History of coordinate ``name`` (e.g. ``"crank.theta"``), shape (nt,)."""

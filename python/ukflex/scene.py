@@ -22,6 +22,7 @@ Example
 from __future__ import annotations
 
 import copy
+import warnings
 from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
@@ -43,6 +44,8 @@ __all__ = [
     "ConstantSpeed",
     "Polynomial",
     "Harmonic",
+    "Expression",
+    "Spline",
     "elastic_dofs",
 ]
 
@@ -132,6 +135,46 @@ class Harmonic:
             "frequency": float(self.frequency),
             "phase": float(self.phase),
         }
+
+
+@dataclass(frozen=True)
+class Expression:
+    """Motion ``f(t)`` written as an expression of ``t``, e.g. ``"0.1 * sin(2*pi*t) + t^2"``.
+
+    Evaluated in Rust, with ``f'`` and ``f''`` by symbolic differentiation (exact). Operators
+    ``+ - * / ^`` (``**`` too; ``^`` binds tighter than a unary minus), numbers, ``t``, ``pi``,
+    ``e``, functions ``sin cos tan exp log sqrt abs tanh sinh cosh atan sign``. A string given
+    as a driver's ``motion`` means the same. Parse errors: :class:`ukflex.ExpressionError`
+    (``.position``: the 0-based character index).
+    """
+
+    expression: str
+
+    def to_dict(self) -> Dict[str, Any]:
+        return {"kind": "expression", "expression": str(self.expression)}
+
+
+@dataclass(frozen=True)
+class Spline:
+    """Motion from tabulated data: the C2 cubic spline through ``(times, values)``, natural
+    (``f'' = 0`` at both ends) unless ``slopes = (f'(t_0), f'(t_n))`` clamps it. Outside the
+    table the end pieces continue."""
+
+    times: Sequence[float]
+    values: Sequence[float]
+    slopes: Optional[Sequence[float]] = None
+
+    def to_dict(self) -> Dict[str, Any]:
+        d: Dict[str, Any] = {"kind": "spline", "times": [float(x) for x in self.times],
+                             "values": [float(x) for x in self.values]}
+        if self.slopes is not None:
+            d["slopes"] = [float(x) for x in self.slopes]
+        return d
+
+
+def _motion(motion: Any) -> Any:
+    """A string motion is an :class:`Expression`."""
+    return Expression(motion) if isinstance(motion, str) else motion
 
 
 # --------------------------------------------------------------------------------------------
@@ -279,6 +322,23 @@ _REFS = {"rigid": RigidBodyRef, "beam": BeamRef, "ancf_beam": BeamRef, "point_ma
 # --------------------------------------------------------------------------------------------
 # the scene
 # --------------------------------------------------------------------------------------------
+
+
+def _positional_spring_args(args: Sequence[Any], stiffness: Any, damping: Any, rest_length: Any, name: Any):
+    """The deprecated positional ``spring_damper(a, b, stiffness, damping, rest_length, name)``."""
+    order = ("stiffness", "damping", "rest_length", "name")
+    if len(args) > len(order):
+        raise TypeError(f"spring_damper() takes at most {2 + len(order)} positional arguments, got {2 + len(args)}")
+    given = {"stiffness": stiffness, "damping": damping, "rest_length": rest_length, "name": name}
+    defaults = {"stiffness": None, "damping": 0.0, "rest_length": None, "name": None}
+    for key, value in zip(order, args):
+        if given[key] != defaults[key]:
+            raise TypeError(f"spring_damper() got {key} both by position and by keyword")
+        given[key] = value
+    warnings.warn("spring_damper(a, b, stiffness, damping, ...) with positional values is deprecated: write "
+                  f"spring_damper(a, b, {', '.join(f'{k}=...' for k in order[:len(args)])})",
+                  DeprecationWarning, stacklevel=3)
+    return given["stiffness"], given["damping"], given["rest_length"], given["name"]
 
 
 def _given(**fields: Any) -> Dict[str, Any]:
@@ -494,11 +554,11 @@ class Scene:
         self, a: MarkerLike, motion: Any, b: Optional[MarkerLike] = None, name: Optional[str] = None
     ) -> str:
         """Rheonomic constraint ``phi_a - phi_b - f(t) = 0`` (``b`` defaults to the ground)."""
-        return self._add("drivers", dict(kind="angle", a=a, motion=motion, **_given(b=b)), name)
+        return self._add("drivers", dict(kind="angle", a=a, motion=_motion(motion), **_given(b=b)), name)
 
     def coordinate_driver(self, point: MarkerLike, axis: str, motion: Any, name: Optional[str] = None) -> str:
         """Rheonomic constraint ``r_point[axis] - f(t) = 0``, ``axis`` in ``{"x", "y"}``."""
-        return self._add("drivers", dict(kind="coordinate", point=point, axis=axis, motion=motion), name)
+        return self._add("drivers", dict(kind="coordinate", point=point, axis=axis, motion=_motion(motion)), name)
 
     # ----------------------------------------------------------------------------- forces
     def point_force(self, point: MarkerLike, force: Sequence[float], name: Optional[str] = None) -> str:
@@ -513,16 +573,24 @@ class Scene:
         self,
         a: MarkerLike,
         b: MarkerLike,
-        stiffness: float,
+        *args: Any,
+        stiffness: Optional[float] = None,
         damping: float = 0.0,
         rest_length: Optional[float] = None,
         name: Optional[str] = None,
     ) -> str:
-        """Linear spring-damper between two markers.
+        """Linear spring-damper between two markers: ``spring_damper(a, b, stiffness=k,
+        damping=c, rest_length=l0, name=...)``, everything after the markers by keyword.
 
-        ``rest_length=None`` takes the distance between the markers at the initial guess
-        (undeformed beams), so the spring starts unloaded; the description records the value.
+        ``rest_length=None`` (the default) takes the distance between the markers at the
+        initial guess (undeformed beams), so the spring starts unloaded; the description
+        records the value. The old positional form ``spring_damper(a, b, k, c, l0, name)``
+        still works with a ``DeprecationWarning``.
         """
+        if args:
+            stiffness, damping, rest_length, name = _positional_spring_args(args, stiffness, damping, rest_length, name)
+        if stiffness is None:
+            raise TypeError("spring_damper() missing the keyword argument 'stiffness'")
         d = dict(kind="spring_damper", a=a, b=b, stiffness=stiffness, damping=damping, **_given(rest_length=rest_length))
         return self._add("forces", d, name)
 

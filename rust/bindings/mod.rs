@@ -4,6 +4,7 @@
 //! `scene.rs`: the item-by-item scene checker used by the Python `Scene` builder.
 
 mod scene;
+mod sensors;
 mod system;
 
 use numpy::ndarray::ArrayView1;
@@ -24,6 +25,7 @@ create_exception!(ukflex, InvalidSceneError, UkflexError, "Malformed or non-phys
 create_exception!(ukflex, SingularMassError, UkflexError, "The mass matrix is not positive definite.");
 create_exception!(ukflex, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
 create_exception!(ukflex, SolverError, UkflexError, "A solver kernel failed.");
+create_exception!(ukflex, ExpressionError, InvalidSceneError, "A driver's motion expression does not parse; `position` is the 0-based character index.");
 
 /// A 1-D float64 input. float64 vectors (what scipy passes) are read in place, strided or
 /// not; anything else array-like is converted once with `numpy.asarray(x, dtype=float64)`, and
@@ -96,6 +98,14 @@ pub(crate) fn to_py(e: Error) -> PyErr {
         Error::NonFinite { .. } => NonFiniteError::new_err(msg),
         Error::SingularMass { .. } => SingularMassError::new_err(msg),
         Error::Solver(_) => SolverError::new_err(msg),
+        Error::Expression { text, position, .. } => Python::attach(|py| {
+            let err = ExpressionError::new_err(msg);
+            let v = err.value(py);
+            // best effort: the message already carries both
+            let _ = v.setattr("position", position);
+            let _ = v.setattr("expression", text);
+            err
+        }),
     }
 }
 
@@ -145,11 +155,13 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySceneChecker>()?;
     m.add_function(wrap_pyfunction!(item_name, m)?)?;
     m.add_function(wrap_pyfunction!(beam_elastic_dofs, m)?)?;
+    m.add_function(wrap_pyfunction!(sensors::motion_values, m)?)?;
     m.add("UkflexError", py.get_type::<UkflexError>())?;
     m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
     m.add("SingularMassError", py.get_type::<SingularMassError>())?;
     m.add("NonFiniteError", py.get_type::<NonFiniteError>())?;
     m.add("SolverError", py.get_type::<SolverError>())?;
+    m.add("ExpressionError", py.get_type::<ExpressionError>())?;
     Ok(())
 }
 

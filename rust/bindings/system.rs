@@ -8,7 +8,8 @@ use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::{finite_out, check_time, mat, read_into, to_py, SolverError, Vector};
+use super::sensors::read_states;
+use super::{check_time, finite_out, mat, read_into, to_py, SolverError, Vector};
 use crate::body::{ancf_cable, BodyKind};
 use crate::linalg::Banded;
 use crate::correct::{self, CorrectOptions};
@@ -18,6 +19,7 @@ use crate::error::Error;
 use crate::integrate::{integrate_uk, Method, Options};
 use crate::jacobian::{assemble_first_order, Differences, JacobianWorkspace};
 use crate::model::Model;
+use crate::sensors;
 use crate::uk;
 
 /// Workspace behind the lock: the kernel buffers plus contiguous copies of the inputs.
@@ -694,6 +696,83 @@ impl PySystem {
         } else {
             Ok(mat(py, out, rows, 5)?.into_any())
         }
+    }
+
+    /// Sensors at the states `(t[k], q[k], qd[k])` (`t` (nt,), `q`, `qd` (nt, n)), computed in
+    /// Rust (`rust/sensors.rs`): a dict with `reactions` (nt, n_items, 6: fx, fy, torque in the
+    /// world frame on the first marker's body, fx_local, fy_local in the joint frame, power),
+    /// `reaction_names`, `reaction_bodies` (body of the first marker, None = ground),
+    /// `body_energies` (nt, n_bodies, 3: kinetic, strain, gravity), `body_names`,
+    /// `force_potentials` (nt, n_forces), `force_names`, `dissipation_power` (nt,).
+    #[pyo3(signature = (t, q, qd, reactions=true))]
+    fn sensors<'py>(&self, py: Python<'py>, t: Vector<'py>, q: &Bound<'py, PyAny>, qd: &Bound<'py, PyAny>, reactions: bool) -> PyResult<Bound<'py, PyDict>> {
+        let n = self.model.n;
+        let (qs, nt) = read_states(q, n, "q")?;
+        let (qds, nt2) = read_states(qd, n, "qd")?;
+        let ts: Vec<f64> = t.as_array().iter().copied().collect();
+        if nt2 != nt || ts.len() != nt {
+            return Err(PyValueError::new_err(format!("t, q and qd must hold the same number of states, got {}, {nt} and {nt2}", ts.len())));
+        }
+        crate::error::check_finite("t", &ts).map_err(to_py)?;
+        let (nc, nb, nf) = (self.model.constraints.len(), self.model.bodies.len(), self.model.forces.len());
+        let mut rx = vec![0.0; if reactions { nt * nc * 6 } else { 0 }];
+        let mut be = vec![0.0; nt * nb * 3];
+        let mut fp = vec![0.0; nt * nf];
+        let mut dp = vec![0.0; nt];
+        self.with_ws(|model, ws| {
+            let (mut v, mut f) = (vec![0.0; n], vec![0.0; n]);
+            for k in 0..nt {
+                let (qk, qdk) = (&qs[k * n..(k + 1) * n], &qds[k * n..(k + 1) * n]);
+                if reactions {
+                    sensors::reactions_into(model, &mut ws.data, ts[k], qk, qdk, &mut rx[k * nc * 6..(k + 1) * nc * 6])?;
+                }
+                sensors::energies_into(model, &mut ws.data, qk, qdk, &mut be[k * nb * 3..(k + 1) * nb * 3], &mut fp[k * nf..(k + 1) * nf]);
+                dp[k] = sensors::dissipation_power(model, &mut ws.data, qk, qdk, &mut v, &mut f);
+            }
+            Ok(())
+        })?;
+        let d = PyDict::new(py);
+        if reactions {
+            d.set_item("reactions", PyArray1::from_vec(py, rx).reshape([nt, nc, 6])?)?;
+        }
+        let names = |it: &mut dyn Iterator<Item = String>| it.collect::<Vec<String>>();
+        d.set_item("reaction_names", names(&mut self.model.constraints.iter().map(|c| c.name.clone())))?;
+        let bodies: Vec<Option<String>> = self.model.constraints.iter().map(|c| c.first_body().map(|b| self.model.bodies[b].name.clone())).collect();
+        d.set_item("reaction_bodies", bodies)?;
+        d.set_item("reaction_columns", sensors::REACTION_COLUMNS.to_vec())?;
+        d.set_item("body_energies", PyArray1::from_vec(py, be).reshape([nt, nb, 3])?)?;
+        d.set_item("energy_columns", sensors::ENERGY_COLUMNS.to_vec())?;
+        d.set_item("body_names", self.body_names())?;
+        d.set_item("force_potentials", mat(py, fp, nt, nf)?)?;
+        d.set_item("force_names", names(&mut self.model.forces.iter().map(|f| f.name.clone())))?;
+        d.set_item("dissipation_power", PyArray1::from_vec(py, dp))?;
+        Ok(d)
+    }
+
+    /// Internal forces and strains of beam `body` at the axis points `xi` (nx,) for the states
+    /// `q` (nt, n): shape (nt, nx, 5) with columns N (axial force, tension positive), V (shear
+    /// force), M (bending moment), eps (axial strain), kappa (curvature), in the beam frame,
+    /// from the body's kinematics and elastic law (`Beam::internal_forces`).
+    fn beam_internal_forces<'py>(&self, py: Python<'py>, body: &str, xi: Vector<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let bi = self.body(body)?;
+        let b = &self.model.bodies[bi];
+        if b.internal_forces(0.0, &self.model.q0).is_none() {
+            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+        }
+        let xs: Vec<f64> = xi.as_array().iter().copied().collect();
+        if let Some(x) = xs.iter().find(|x| !x.is_finite() || !(0.0..=1.0).contains(*x)) {
+            return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {x}")));
+        }
+        let n = self.model.n;
+        let (qs, nt) = read_states(q, n, "q")?;
+        let nx = xs.len();
+        let mut out = Vec::with_capacity(nt * nx * 5);
+        for k in 0..nt {
+            for &x in &xs {
+                out.extend_from_slice(&b.internal_forces(x, &qs[k * n..(k + 1) * n]).expect("checked: a beam"));
+            }
+        }
+        Ok(PyArray1::from_vec(py, out).reshape([nt, nx, 5])?.into_any())
     }
 
     /// Kinetic energy 1/2 qd^T M(q) qd (from the body blocks).

@@ -515,6 +515,27 @@ impl AncfCable {
         u
     }
 
+    /// Internal forces and strains of the elastic law at the axis point `xi` (body coordinates
+    /// `q`), in the section frame (x along `r'`): `[N, V, M, eps, K]` with `eps = |r'| - 1`,
+    /// `N = E A eps`, the material curvature `K = (r' x r'') / |r'|^2`, `M = E I K` and
+    /// `V = -dM/dx = -E I K'`, `K' = (r' x r''') / g - 2 K (r' . r'') / g`, `g = |r'|^2`
+    /// (signs as `ffrf_beam::Beam::internal_forces`). Elastic parts only (no strain-rate
+    /// damping); `x` is the undeformed arc length.
+    pub fn internal_forces(&self, xi: f64, q: &[f64]) -> [f64; 5] {
+        let t = xi * self.elements as f64;
+        let el = (t.floor() as usize).min(self.elements - 1);
+        let (s, l) = (t - el as f64, self.element_length);
+        let (_, d, dd) = hermite(s, l);
+        let ddd = [12.0 / (l * l * l), 6.0 / (l * l), -12.0 / (l * l * l), 6.0 / (l * l)];
+        let e = &q[4 * el..4 * el + 8];
+        let (rx, rxx, rxxx) = (map(&d, e), map(&dd, e), map(&ddd, e));
+        let g = dot2(rx, rx);
+        let eps = g.sqrt() - 1.0;
+        let k = cross(rx, rxx) / g;
+        let dk = cross(rx, rxxx) / g - 2.0 * k * dot2(rx, rxx) / g;
+        [self.ea * eps, -self.ei * dk, self.ei * k, eps, k]
+    }
+
     /// `int rho A r dx = sum_a load_a e_a`.
     pub fn mass_moment(&self, q: &[f64]) -> [f64; 2] {
         let mut r = [0.0; 2];

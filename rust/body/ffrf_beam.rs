@@ -866,6 +866,31 @@ impl Beam {
         u
     }
 
+    /// Internal forces and strains of the elastic law at the axis point `xi` (body
+    /// coordinates `q`), in the beam frame: `[N, V, M, eps, kappa]` -- the force and moment the
+    /// part beyond `xi` exerts on the part before it (tension, shear along +y of the frame,
+    /// counterclockwise moment positive). `eps` is the axial strain the model uses (linear:
+    /// `u'`; nonlinear: the element's averaged `u' + v'^2/2`), `N = E a eps`,
+    /// `kappa = psi'`, `M = E I kappa`, and `V = -dM/dx = -E I psi''` (constant in an
+    /// element; for the Davis element it equals `k G a (v' - psi)`, the element being exact
+    /// in statics). Elastic parts only (no strain-rate damping).
+    pub fn internal_forces(&self, xi: f64, q: &[f64]) -> [f64; 5] {
+        let n = self.elements;
+        let t = xi * n as f64;
+        let el = (t.floor() as usize).min(n - 1);
+        let l = self.element_length;
+        let sh = element_shape(t - el as f64, l, self.phi);
+        let d = self.element_dofs(el, &q[3..]);
+        let (eps_lin, gamma, _) = self.element_strain(&d);
+        let eps = if self.strain == Strain::Nonlinear { eps_lin + gamma } else { eps_lin };
+        let kappa: f64 = (0..6).map(|a| sh.dnpsi[a] * d[a]).sum();
+        // psi'' of the element (the s-derivative of dnpsi over l): linear in s, so constant
+        let c = 1.0 / (1.0 + self.phi);
+        let d2psi = c * (12.0 / (l * l * l) * (d[1] - d[4]) + 6.0 / (l * l) * (d[2] + d[5]));
+        let (ea, ei) = (self.eal / l, self.section.youngs_modulus * self.section.second_moment);
+        [ea * eps, -ei * d2psi, ei * kappa, eps, kappa]
+    }
+
     /// `int rho r dV = m R + A Sigma`.
     pub fn mass_moment(&self, q: &[f64]) -> [f64; 2] {
         frame_mass_moment(self.mass, self.first_moment(&q[3..]), q)

@@ -322,6 +322,20 @@ impl Body {
     }
 }
 
+impl Body {
+    /// `[N, V, M, eps, kappa]` at the axis point `xi` of a beam at `q` (see
+    /// `ffrf_beam::Beam::internal_forces`, `ancf_cable::AncfCable::internal_forces`); `None`
+    /// for other kinds.
+    pub fn internal_forces(&self, xi: f64, q: &[f64]) -> Option<[f64; 5]> {
+        let qb = self.seg(q);
+        match &self.kind {
+            BodyKind::Beam(k) => Some(k.internal_forces(xi, qb)),
+            BodyKind::AncfBeam(k) => Some(k.internal_forces(xi, qb)),
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) => None,
+        }
+    }
+}
+
 /// Where a marker sits on its body (one variant per kind that carries markers).
 #[derive(Debug, Clone)]
 pub enum MarkerShape {

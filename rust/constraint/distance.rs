@@ -2,7 +2,7 @@
 //! (1 row). With `d = r_a - r_b`, `l = |d|`, `e = d / l`:
 //! `A = e . (r_a - r_b)_q`, `gamma = -e . (h_a - h_b) - (|d_dot|^2 - (e . d_dot)^2) / l`.
 
-use super::{BuildContext, ConstraintOut};
+use super::{Reaction, BuildContext, ConstraintOut};
 use crate::body::{Body, Marker};
 use crate::description::MarkerDesc;
 use crate::error::{positive, Result};
@@ -53,5 +53,16 @@ impl Distance {
         let edd = e[0] * dd[0] + e[1] * dd[1];
         let hd = [sa.h[0] - sb.h[0], sa.h[1] - sb.h[1]];
         out.gamma[0] = -(e[0] * hd[0] + e[1] * hd[1]) - (dd[0] * dd[0] + dd[1] * dd[1] - edd * edd) / l;
+    }
+
+    /// Reaction on `a`'s body (force `-lambda e` along the rod, `e = (r_a - r_b)/l`; joint frame: x along `e`, so the local x component is the rod force, compression positive).
+    pub fn reaction(&self, bodies: &[Body], q: &[f64], qd: &[f64], lam: &[f64]) -> Reaction {
+        let (sa, sb) = (self.a.state(bodies, q, qd), self.b.state(bodies, q, qd));
+        let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];
+        let l = d[0].hypot(d[1]);
+        if l == 0.0 {
+            return Reaction::default();
+        }
+        Reaction { force: [-lam[0] * d[0] / l, -lam[0] * d[1] / l], torque: 0.0, frame: d[1].atan2(d[0]) }
     }
 }

@@ -1,7 +1,7 @@
 //! Drivers (rheonomic constraints, 1 row each): a relative angle `phi_a - phi_b - f(t) = 0`
 //! (`b` defaults to the ground frame) or a world coordinate of a point `r[axis] - f(t) = 0`.
 
-use super::{rows, BuildContext, ConstraintOut, Motion};
+use super::{rows, BuildContext, ConstraintOut, Motion, Reaction};
 use crate::body::{Body, Marker};
 use crate::description::{Axis, MarkerDesc, MotionDesc};
 use crate::error::{Error, Result};
@@ -34,6 +34,12 @@ impl AngleDriver {
     pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
         let (sa, sb) = (self.a.state(bodies, q, qd), self.b.state(bodies, q, qd));
         rows::angle(bodies, &self.a, &self.b, &sa, &sb, self.motion.eval(t), n, out, 0);
+    }
+
+    /// Reaction on `a`'s body: the driving torque `-lambda`; joint frame: marker `a`.
+    pub fn reaction(&self, bodies: &[Body], q: &[f64], qd: &[f64], lam: &[f64]) -> Reaction {
+        let sa = self.a.state(bodies, q, qd);
+        Reaction { force: [0.0, 0.0], torque: -lam[0], frame: sa.phi }
     }
 }
 
@@ -71,5 +77,13 @@ impl CoordinateDriver {
         self.point.add_point_jacobian(bodies, &sp, w, &mut out.jac[0..n]);
         out.phi_t[0] = -f.1;
         out.gamma[0] = -sp.h[k] + f.2;
+    }
+
+    /// Reaction on the point's body: the driving force `-lambda` along the axis; joint frame:
+    /// the world.
+    pub fn reaction(&self, _bodies: &[Body], _q: &[f64], _qd: &[f64], lam: &[f64]) -> Reaction {
+        let mut force = [0.0; 2];
+        force[matches!(self.axis, Axis::Y) as usize] = -lam[0];
+        Reaction { force, torque: 0.0, frame: 0.0 }
     }
 }

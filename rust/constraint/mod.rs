@@ -9,6 +9,7 @@
 
 pub mod distance;
 pub mod driver;
+pub mod expr;
 pub mod motion;
 pub mod point_on_line;
 pub mod prismatic;
@@ -47,6 +48,18 @@ pub struct Constraint {
     /// First row in `Phi`.
     pub row: usize,
     pub kind: ConstraintKind,
+}
+
+/// What a joint or driver exerts on the body of its first marker (`a`, `point`), at that
+/// marker, from its multipliers (`M qdd + A^T lambda = Q`: the constraint force on the
+/// coordinates is `-A^T lambda`): a force in the world frame, a torque, and the angle of the
+/// joint frame in which `force` is also reported (`rust/sensors.rs`). The second marker's body
+/// receives the opposite force at the same point.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Reaction {
+    pub force: [f64; 2],
+    pub torque: f64,
+    pub frame: f64,
 }
 
 /// Output of one constraint evaluation. Slices are the constraint's own rows.
@@ -162,6 +175,33 @@ impl Constraint {
 
     pub fn is_driver(&self) -> bool {
         matches!(self.kind, ConstraintKind::AngleDriver(_) | ConstraintKind::CoordinateDriver(_))
+    }
+
+    /// The reaction on the first marker's body from this constraint's multipliers `lam` (its
+    /// own rows) at `(q, qd)`.
+    pub fn reaction(&self, bodies: &[Body], q: &[f64], qd: &[f64], lam: &[f64]) -> Reaction {
+        match &self.kind {
+            ConstraintKind::Revolute(c) => c.reaction(bodies, q, qd, lam),
+            ConstraintKind::PointOnLine(c) => c.reaction(bodies, q, qd, lam),
+            ConstraintKind::Prismatic(c) => c.reaction(bodies, q, qd, lam),
+            ConstraintKind::Weld(c) => c.reaction(bodies, q, qd, lam),
+            ConstraintKind::Distance(c) => c.reaction(bodies, q, qd, lam),
+            ConstraintKind::AngleDriver(c) => c.reaction(bodies, q, qd, lam),
+            ConstraintKind::CoordinateDriver(c) => c.reaction(bodies, q, qd, lam),
+        }
+    }
+
+    /// Name of the body the reaction acts on (`None`: the ground).
+    pub fn first_body(&self) -> Option<usize> {
+        match &self.kind {
+            ConstraintKind::Revolute(c) => c.a.body,
+            ConstraintKind::PointOnLine(c) => c.point.body,
+            ConstraintKind::Prismatic(c) => c.a.body,
+            ConstraintKind::Weld(c) => c.a.body,
+            ConstraintKind::Distance(c) => c.a.body,
+            ConstraintKind::AngleDriver(c) => c.a.body,
+            ConstraintKind::CoordinateDriver(c) => c.point.body,
+        }
     }
 
     /// Evaluate this constraint's rows at `(t, q, qd)`.

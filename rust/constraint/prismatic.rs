@@ -1,7 +1,7 @@
 //! Prismatic joint: `a`'s origin on `b`'s x axis and no relative rotation,
 //! `phi_a - phi_b - phi0 = 0` with `phi0` from the initial guess (2 rows).
 
-use super::{rows, BuildContext, ConstraintOut};
+use super::{Reaction, rows, BuildContext, ConstraintOut};
 use crate::body::{Body, Marker};
 use crate::description::MarkerDesc;
 use crate::error::Result;
@@ -27,5 +27,12 @@ impl Prismatic {
         let (sa, sb) = (self.a.state(bodies, q, qd), self.b.state(bodies, q, qd));
         rows::point_on_line(bodies, &self.a, &self.b, &sa, &sb, n, out, 0);
         rows::angle(bodies, &self.a, &self.b, &sa, &sb, (self.phi0, 0.0, 0.0), n, out, 1);
+    }
+
+    /// Reaction on `a`'s body (force `-lambda_line n` normal to `b`'s axis, torque `-lambda_angle`; joint frame: `b`'s axis).
+    pub fn reaction(&self, bodies: &[Body], q: &[f64], qd: &[f64], lam: &[f64]) -> Reaction {
+        let sb = self.b.state(bodies, q, qd);
+        let (s, c) = sb.phi.sin_cos();
+        Reaction { force: [lam[0] * s, -lam[0] * c], torque: -lam[1], frame: sb.phi }
     }
 }

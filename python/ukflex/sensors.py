@@ -1,0 +1,300 @@
+"""Sensors of a simulation result: joint reactions, driver power and work, energies per body and
+per kind, an energy balance, and beam internal forces (docs/outputs.md).
+
+Everything per state is computed in Rust from the stored states (``System.sensors``,
+``System.beam_internal_forces``: one call for the whole history, no Python per state); this
+module names the numbers, integrates powers over time and closes the balance::
+
+    >>> s = res.sensors                                   # doctest: +SKIP
+    >>> s.reaction("crank_pin")["fx"]                     # doctest: +SKIP
+    >>> s.energy_balance()["relative_error"]              # doctest: +SKIP
+    >>> s.internal_forces("coupler", [0.0, 0.5, 1.0])["M"]  # doctest: +SKIP
+
+Sign conventions
+----------------
+* ``M qdd + A^T lambda = Q``. A joint's reaction is what it exerts on the body of its *first*
+  marker (``a``; ``point`` of a point-on-line joint or a coordinate driver), at that marker: a
+  force (world frame ``fx, fy``; joint frame ``fx_local, fy_local``) and a torque. The other
+  body receives the opposite force at the same point.
+* The power of a constraint item is ``-lambda^T A qd`` (its constraint forces on the whole
+  system): zero for joints, the input power for drivers.
+* Beam internal forces act from the part beyond ``xi`` on the part before it, in the beam frame:
+  ``N`` tension positive, ``V`` along +y, ``M`` counterclockwise (``M = E I kappa``,
+  ``V = -dM/dx``): a cantilever with an upward tip load ``P`` has ``M(x) = P (L - x)``,
+  ``V = P``.
+"""
+
+from __future__ import annotations
+
+import re
+from functools import cached_property
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+__all__ = ["Sensors", "cumulative_integral", "energy_line", "SENSOR_HELP"]
+
+#: Columns of a reaction (``System.sensors``).
+REACTION_COLUMNS = ("fx", "fy", "torque", "fx_local", "fy_local", "power")
+#: Columns of beam internal forces.
+INTERNAL_COLUMNS = ("N", "V", "M", "eps", "kappa")
+
+SENSOR_HELP = (
+    "reaction(JOINT).fx|fy|torque|fx_local|fy_local|power, work(DRIVER), "
+    "energy.kinetic|strain|gravity|springs|loads|total, energy(BODY).kinetic|strain|gravity, "
+    "work.drivers|external, dissipated, balance, N|V|M|eps|kappa(BEAM, XI)"
+)
+
+
+def cumulative_integral(t: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``int_{t_0}^{t_k} p dt`` at every sample, by the integral of the C2 cubic spline through
+    the samples (error O(h^4) for a smooth ``p``; trapezoid below four samples)."""
+    t = np.asarray(t, dtype=float)
+    p = np.asarray(p, dtype=float)
+    if t.size < 2:
+        return np.zeros_like(t)
+    if t.size < 4 or np.any(np.diff(t) <= 0):
+        return np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))])
+    from scipy.interpolate import CubicSpline
+
+    return CubicSpline(t, p, bc_type="not-a-knot").antiderivative()(t)
+
+
+def _states(res) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(t, q, qd)`` of a result with q, qd of shape (nt, n) (orientation-free: named
+    accessors only)."""
+    names = res.system.coordinate_names
+    q = np.stack([np.asarray(res.coordinate(nm), dtype=float) for nm in names], axis=1)
+    qd = np.stack([np.asarray(res.velocity(nm), dtype=float) for nm in names], axis=1)
+    return np.asarray(res.t, dtype=float), q, qd
+
+
+class Sensors:
+    """Sensors of one :class:`ukflex.SimulationResult` (``res.sensors``), computed once on first
+    use and cached."""
+
+    def __init__(self, res):
+        self.result = res
+        self.system = res.system
+
+    @cached_property
+    def _raw(self) -> Dict[str, Any]:
+        t, q, qd = _states(self.result)
+        self._t = t
+        return dict(self.system.core.sensors(t, q, qd))
+
+    @property
+    def t(self) -> np.ndarray:
+        return np.asarray(self.result.t, dtype=float)
+
+    # ----------------------------------------------------------------------- reactions
+    @property
+    def joint_names(self) -> List[str]:
+        """Names of the joints and drivers, in order (``reaction`` takes these)."""
+        return list(self._raw["reaction_names"])
+
+    @cached_property
+    def driver_names(self) -> List[str]:
+        """Names of the drivers."""
+        # the core orders constraint items joints first, then drivers
+        nd = len(self.system.description.get("drivers") or [])
+        return self.joint_names[len(self.joint_names) - nd:]
+
+    def reaction(self, joint: str) -> Dict[str, Any]:
+        """Reaction of ``joint`` (or driver) on its first marker's body: ``fx, fy, torque``
+        (world), ``fx_local, fy_local`` (joint frame), ``power``, each (nt,), and ``body``."""
+        names = self.joint_names
+        if joint not in names:
+            raise KeyError(f"unknown joint {joint!r}; joints and drivers are {names}")
+        k = names.index(joint)
+        r = np.asarray(self._raw["reactions"])[:, k, :]
+        out: Dict[str, Any] = {c: r[:, i].copy() for i, c in enumerate(REACTION_COLUMNS)}
+        out["body"] = self._raw["reaction_bodies"][k]
+        return out
+
+    def driver_work(self, driver: Optional[str] = None) -> np.ndarray:
+        """Work done by one driver (or all drivers), accumulated from ``t_0``, shape (nt,)."""
+        names = [driver] if driver is not None else self.driver_names
+        p = sum((self.reaction(d)["power"] for d in names), np.zeros_like(self.t))
+        return cumulative_integral(self.t, p)
+
+    # ----------------------------------------------------------------------- energies
+    def body_energies(self, body: str) -> Dict[str, np.ndarray]:
+        """``kinetic``, ``strain``, ``gravity`` energy of one body, each (nt,)."""
+        names = list(self._raw["body_names"])
+        if body not in names:
+            raise KeyError(f"unknown body {body!r}; bodies are {names}")
+        e = np.asarray(self._raw["body_energies"])[:, names.index(body), :]
+        return {"kinetic": e[:, 0].copy(), "strain": e[:, 1].copy(), "gravity": e[:, 2].copy()}
+
+    @cached_property
+    def _force_kinds(self) -> List[str]:
+        return [f["kind"] for f in (self.system.description.get("forces") or [])]
+
+    def energies(self) -> Dict[str, np.ndarray]:
+        """Energies by kind, each (nt,): ``kinetic``, ``strain`` (elastic), ``gravity``,
+        ``springs`` (spring-dampers), ``loads`` (potential ``-F . r``, ``-tau phi`` of the
+        constant loads) and ``total = kinetic + strain + gravity + springs`` (the loads appear
+        as external work instead)."""
+        e = np.asarray(self._raw["body_energies"])
+        fp = np.asarray(self._raw["force_potentials"])
+        kinds = np.array(self._force_kinds, dtype=object)
+        springs = fp[:, kinds == "spring_damper"].sum(axis=1) if fp.size else np.zeros(e.shape[0])
+        loads = fp[:, kinds != "spring_damper"].sum(axis=1) if fp.size else np.zeros(e.shape[0])
+        out = {"kinetic": e[:, :, 0].sum(axis=1), "strain": e[:, :, 1].sum(axis=1),
+               "gravity": e[:, :, 2].sum(axis=1), "springs": springs, "loads": loads}
+        out["total"] = out["kinetic"] + out["strain"] + out["gravity"] + out["springs"]
+        return out
+
+    def external_work(self) -> np.ndarray:
+        """Work of the constant external loads (point forces, torques) from ``t_0``: exactly
+        minus the change of their potential, shape (nt,)."""
+        loads = self.energies()["loads"]
+        return -(loads - loads[0])
+
+    def dissipated(self) -> np.ndarray:
+        """Energy dissipated by damping (spring-dampers, beam strain-rate damping) from ``t_0``,
+        the integral of ``System.sensors``' ``dissipation_power``, shape (nt,)."""
+        return cumulative_integral(self.t, np.asarray(self._raw["dissipation_power"]))
+
+    def energy_balance(self) -> Dict[str, Any]:
+        """``E(t) - E(0) = W_drivers + W_external - dissipated`` term by term, each (nt,), with
+        ``residual`` (left minus right side), ``scale`` (the largest term) and
+        ``relative_error = max |residual| / scale``. The residual is what the integrator (and
+        the quadrature of the powers over the output samples) lost or gained: at a tight
+        tolerance with a non-dissipative method it is small; a dissipative method
+        (generalized-alpha) shows its numerical dissipation here."""
+        e = self.energies()["total"]
+        de = e - e[0]
+        wd = self.driver_work() if self.driver_names else np.zeros_like(de)
+        we = self.external_work()
+        d = self.dissipated()
+        res = de - wd - we + d
+        scale = max(float(np.max(np.abs(x))) for x in (de, wd, we, d, e))
+        return {"t": self.t, "energy": e, "change": de, "driver_work": wd, "external_work": we, "dissipated": d,
+                "residual": res, "scale": scale,
+                "relative_error": float(np.max(np.abs(res)) / scale) if scale > 0 else 0.0}
+
+    def energy_line(self) -> str:
+        """One line: ``T + V`` at both ends, the drivers' and external work, the dissipated
+        energy and whether the balance closes (its residual relative to the largest term)."""
+        bal = self.energy_balance()
+        e, r = bal["energy"], bal["residual"][-1]
+        parts = [f"energy T + V: {e[0]:.9g} -> {e[-1]:.9g} (change {e[-1] - e[0]:+.3e})"]
+        if np.any(bal["driver_work"]):
+            parts.append(f"driver work {bal['driver_work'][-1]:+.3e}")
+        if np.any(bal["external_work"]):
+            parts.append(f"external work {bal['external_work'][-1]:+.3e}")
+        if np.any(bal["dissipated"]):
+            parts.append(f"damping {bal['dissipated'][-1]:.3e}")
+        closes = bal["relative_error"] <= 1e-5
+        verdict = "closes" if closes else ("open: the integrator lost energy" if r < 0 else "open: the integrator gained energy")
+        parts.append(f"balance {verdict} (residual {r:+.3e}, {bal['relative_error']:.1e} of the largest term)")
+        return ", ".join(parts)
+
+    # ----------------------------------------------------------------------- beams
+    def internal_forces(self, body: str, xi: Sequence[float]) -> Dict[str, np.ndarray]:
+        """Internal forces and strains of beam ``body`` at the axis points ``xi`` in [0, 1]:
+        ``N, V, M, eps, kappa``, each (nt, len(xi)), in the beam frame (module docs)."""
+        xi = np.atleast_1d(np.asarray(xi, dtype=float))
+        _, q, _ = _states(self.result)
+        a = np.asarray(self.system.core.beam_internal_forces(body, xi, q))
+        return {c: a[:, :, i] for i, c in enumerate(INTERNAL_COLUMNS)}
+
+    # ----------------------------------------------------------------------- export
+    def columns(self) -> Dict[str, np.ndarray]:
+        """Every sensor as a named column (nt,): reactions, energies, work, balance."""
+        out: Dict[str, np.ndarray] = {}
+        for j in self.joint_names:
+            r = self.reaction(j)
+            for c in REACTION_COLUMNS:
+                out[f"reaction({j}).{c}"] = r[c]
+        for d in self.driver_names:
+            out[f"work({d})"] = self.driver_work(d)
+        for b in self._raw["body_names"]:
+            for k, v in self.body_energies(b).items():
+                out[f"energy({b}).{k}"] = v
+        for k, v in self.energies().items():
+            out[f"energy.{k}"] = v
+        bal = self.energy_balance()
+        out["work.drivers"] = bal["driver_work"]
+        out["work.external"] = bal["external_work"]
+        out["dissipated"] = bal["dissipated"]
+        out["balance"] = bal["residual"]
+        return out
+
+    def save_npz(self, path: str) -> None:
+        """Write ``t`` and :meth:`columns` to a NumPy .npz file."""
+        np.savez(path, t=self.t, **self.columns())
+
+    # ----------------------------------------------------------------------- expressions
+    _INTERNAL = re.compile(r"^(N|V|M|eps|kappa)\(\s*([^,()\s]+)\s*,\s*([^()\s]+)\s*\)$")
+    _REACTION = re.compile(r"^reaction\(\s*([^()\s]+)\s*\)\.(\w+)$")
+    _WORK = re.compile(r"^work\(\s*([^()\s]+)\s*\)$")
+    _BODY_ENERGY = re.compile(r"^energy\(\s*([^()\s]+)\s*\)\.(\w+)$")
+
+    @classmethod
+    def parse(cls, system, expr: str) -> Optional[Tuple[Any, ...]]:
+        """A parsed sensor expression (see ``SENSOR_HELP``), ``None`` if ``expr`` is not one;
+        ``ValueError`` naming the problem if it is one with a wrong argument."""
+        e = expr.strip()
+        if e in ("work.drivers", "work.external", "dissipated", "balance"):
+            return ("scalar", e)
+        if e.startswith("energy.") and e[7:] in ("kinetic", "strain", "gravity", "springs", "loads", "total"):
+            return ("energy", e[7:])
+        m = cls._REACTION.match(e)
+        if m:
+            if m.group(2) not in REACTION_COLUMNS:
+                raise ValueError(f"output {expr!r}: reaction columns are {REACTION_COLUMNS}")
+            return ("reaction", m.group(1), m.group(2))
+        m = cls._WORK.match(e)
+        if m:
+            return ("work", m.group(1))
+        m = cls._BODY_ENERGY.match(e)
+        if m:
+            if m.group(1) not in system.body_names:
+                raise ValueError(f"output {expr!r}: unknown body {m.group(1)!r}; bodies are {system.body_names}")
+            if m.group(2) not in ("kinetic", "strain", "gravity"):
+                raise ValueError(f"output {expr!r}: body energies are kinetic, strain, gravity")
+            return ("body_energy", m.group(1), m.group(2))
+        m = cls._INTERNAL.match(e)
+        if m:
+            what, body, xi_text = m.groups()
+            if body not in system.body_names or system.body_kind(body) not in ("beam", "ancf_beam"):
+                raise ValueError(f"output {expr!r}: {body!r} is not a beam")
+            try:
+                xi = float(xi_text)
+            except ValueError:
+                raise ValueError(f"output {expr!r}: XI must be a number in [0, 1], got {xi_text!r}") from None
+            if not 0.0 <= xi <= 1.0:
+                raise ValueError(f"output {expr!r}: XI must lie in [0, 1], got {xi}")
+            return ("internal", what, body, xi)
+        return None
+
+    def evaluate(self, p: Tuple[Any, ...]) -> Tuple[str, np.ndarray]:
+        """``(label, values (nt,))`` of a parsed expression (:meth:`parse`)."""
+        kind = p[0]
+        if kind == "scalar":
+            bal = self.energy_balance()
+            key = {"work.drivers": "driver_work", "work.external": "external_work", "dissipated": "dissipated",
+                   "balance": "residual"}[p[1]]
+            return f"{p[1]} [J]", bal[key]
+        if kind == "energy":
+            return f"energy.{p[1]} [J]", self.energies()[p[1]]
+        if kind == "reaction":
+            unit = {"torque": "N m", "power": "W"}.get(p[2], "N")
+            return f"reaction({p[1]}).{p[2]} [{unit}]", self.reaction(p[1])[p[2]]
+        if kind == "work":
+            if p[1] not in self.driver_names:
+                raise ValueError(f"work({p[1]}): not a driver; drivers are {self.driver_names}")
+            return f"work({p[1]}) [J]", self.driver_work(p[1])
+        if kind == "body_energy":
+            return f"energy({p[1]}).{p[2]} [J]", self.body_energies(p[1])[p[2]]
+        _, what, body, xi = p
+        unit = {"N": "N", "V": "N", "M": "N m", "eps": "-", "kappa": "1/m"}[what]
+        return f"{what}({body}, {xi:g}) [{unit}]", self.internal_forces(body, [xi])[what][:, 0]
+
+
+def energy_line(res) -> str:
+    """The CLI's energy summary of a result (:meth:`Sensors.energy_line`)."""
+    return Sensors(res).energy_line()

@@ -1,0 +1,78 @@
+//! Sensors evaluated at a stored state (after a run, not in the integration loop): joint
+//! reactions from the multipliers, energies per body and per force element, the power of the
+//! constraint forces (the drivers' power) and the dissipated power. `bindings` loops these over
+//! the output times so that no Python runs per state; `python/ukflex/sensors.py` names them.
+
+use crate::data::Data;
+use crate::dynamics;
+use crate::error::Result;
+use crate::model::Model;
+use crate::uk;
+
+/// Columns of one constraint's reaction row (see [`reactions_into`]).
+pub const REACTION_COLUMNS: [&str; 6] = ["fx", "fy", "torque", "fx_local", "fy_local", "power"];
+
+/// Columns of one body's energy row (see [`energies_into`]).
+pub const ENERGY_COLUMNS: [&str; 3] = ["kinetic", "strain", "gravity"];
+
+/// For each constraint item (joint or driver, in `model.constraints` order), 6 numbers into
+/// `out` (length `6 * model.constraints.len()`): the force (world frame) and torque it exerts on
+/// its first marker's body (`Constraint::reaction`), the force in the joint frame, and the power
+/// of its constraint forces on the whole system, `-lambda^T A qd = lambda^T Phi_t` (on the
+/// velocity manifold; zero for scleronomic joints, the input power for drivers). Solves the UK
+/// acceleration at `(t, q, qd)` for the multipliers.
+pub fn reactions_into(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> Result<()> {
+    uk::acceleration(model, data, t, q, qd)?;
+    let n = model.n;
+    for (k, c) in model.constraints.iter().enumerate() {
+        let rows = c.row..c.row + c.rows();
+        let lam = &data.lambda[rows.clone()];
+        let r = c.reaction(&model.bodies, q, qd, lam);
+        // -lambda^T A qd (exact at any state, also off the velocity manifold)
+        let mut power = 0.0;
+        for row in rows {
+            let a = &data.jac[row * n..(row + 1) * n];
+            power -= data.lambda[row] * a.iter().zip(qd).map(|(x, y)| x * y).sum::<f64>();
+        }
+        let (s, co) = r.frame.sin_cos();
+        let o = &mut out[6 * k..6 * k + 6];
+        o[0] = r.force[0];
+        o[1] = r.force[1];
+        o[2] = r.torque;
+        o[3] = co * r.force[0] + s * r.force[1];
+        o[4] = -s * r.force[0] + co * r.force[1];
+        o[5] = power;
+    }
+    Ok(())
+}
+
+/// Energies at `(q, qd)`: per body `[kinetic, strain, gravity]` into `bodies`
+/// (`3 * model.bodies.len()`), per force element its potential into `forces`
+/// (`model.forces.len()`: a spring's `k (l - l0)^2 / 2`, a constant load's `-F . r`,
+/// `-tau phi`).
+pub fn energies_into(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], bodies: &mut [f64], forces: &mut [f64]) {
+    dynamics::mass_and_forces(model, data, q, qd);
+    for (i, (b, bd)) in model.bodies.iter().zip(&data.bodies).enumerate() {
+        bodies[3 * i] = b.kinetic_energy(bd, qd);
+        bodies[3 * i + 1] = b.strain_energy(q);
+        bodies[3 * i + 2] = model.gravity.map_or(0.0, |g| b.gravity_energy(q, g));
+    }
+    for (f, o) in model.forces.iter().zip(forces.iter_mut()) {
+        *o = f.potential(&model.bodies, q);
+    }
+}
+
+/// Power dissipated by the damping forces at `(q, qd)` (>= 0): `-qd . Q_odd` with
+/// `Q_odd = (Q(q, qd) - Q(q, -qd)) / 2`, the part of the generalized forces odd in `qd`. The
+/// inertial velocity terms are quadratic in `qd` and the elastic, gravity and constant loads do
+/// not depend on it, so `Q_odd` is exactly the damping (spring-dampers, beam strain-rate
+/// damping) for every body kind. `v` and `f` are n-long scratch vectors.
+pub fn dissipation_power(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], v: &mut [f64], f: &mut [f64]) -> f64 {
+    dynamics::mass_and_forces(model, data, q, qd);
+    f.copy_from_slice(&data.force);
+    for (vi, x) in v.iter_mut().zip(qd) {
+        *vi = -x;
+    }
+    dynamics::mass_and_forces(model, data, q, v);
+    -qd.iter().zip(f.iter().zip(&data.force)).map(|(x, (a, b))| x * 0.5 * (a - b)).sum::<f64>()
+}
