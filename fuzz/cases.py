@@ -114,7 +114,7 @@ def _max_abs(a: Any) -> float:
 _TEMPLATES: Dict[str, Dict[str, st.SearchStrategy]] = {
     "rigid_pendulum": dict(mass=scaled(0.1, 10.0), inertia=scaled(1e-3, 1.0), length=scaled(0.1, 2.0),
                            angle=st.floats(-3.0, 3.0), angular_velocity=st.floats(-5.0, 5.0),
-                           gravity=scaled(1.0, 20.0), position=st.floats(-1.0, 1.0)),
+                           gravity=scaled(1.0, 20.0), position=st.floats(-1.0, 1.0), pivot_x=st.floats(-10.0, 10.0)),
     "point_pendulum": dict(mass=scaled(0.1, 10.0), length=scaled(0.1, 2.0), angle=st.floats(-3.0, 3.0),
                            gravity=scaled(1.0, 20.0), position=st.floats(-1.0, 1.0),
                            velocity=st.floats(-2.0, 2.0)),
@@ -131,7 +131,7 @@ _TEMPLATES: Dict[str, Dict[str, st.SearchStrategy]] = {
 
 #: the argument names an error message may use for a template field
 _ALIASES = {"length": ["length", "x", "point", "offset", "rest_length"], "diameter": ["diameter", "section"],
-            "gravity": ["gravity", "g"], "position": ["position", "x", "y"], "velocity": ["velocity"],
+            "gravity": ["gravity", "g"], "position": ["position", "x", "y"], "pivot_x": ["x", "point"], "velocity": ["velocity"],
             "angle": ["angle"], "omega": ["omega", "motion", "speed"]}
 
 
@@ -141,7 +141,7 @@ def _build_template(name: str, p: Dict[str, Any]):
         s = uk.Scene(gravity=(0.0, -p["gravity"]) if isinstance(p["gravity"], (int, float)) else p["gravity"])
         rod = s.rigid_body("rod", mass=p["mass"], inertia=p["inertia"], position=(p["position"], 0.0),
                            angle=p["angle"], angular_velocity=p["angular_velocity"])
-        s.revolute(s.ground.point(0.0, 0.0), rod.point(-p["length"], 0.0))
+        s.revolute(s.ground.point(p["pivot_x"], 0.0), rod.point(-p["length"], 0.0))
         return s
     if name == "point_pendulum":
         s = uk.Scene(gravity=(0.0, -p["gravity"]) if isinstance(p["gravity"], (int, float)) else p["gravity"])
