@@ -5,6 +5,7 @@ Rust core (``ukflex._core``, private) + Python API:
 * :class:`Scene` -- scene description builder (bodies, joints, drivers, forces, initial guess);
 * :class:`System` -- compiled Rust-backed system with a consistent initial state;
 * :func:`simulate` -- time integration with ``scipy.integrate.solve_ivp``;
+* :func:`sweep` -- parameter sweeps (serial, a process pool or Dask), a DataFrame per sweep;
 * :mod:`ukflex.scenes` -- built-in scenes (the paper's slider-crank, pendulums, ...);
 * :mod:`ukflex.stability` -- stabilization and diagnostics (rank loss, drift, buckling, FFRF
   validity);
@@ -38,6 +39,7 @@ from .scene import (
 from .system import InitialCorrection, System
 from .results import SimulationResult
 from .simulate import simulate
+from .sweep import sweep
 from . import scenes
 
 __version__ = "0.1.0"
@@ -59,6 +61,7 @@ __all__ = [
     "InitialCorrection",
     "SimulationResult",
     "simulate",
+    "sweep",
     "scenes",
     "UkflexError",
     "InvalidSceneError",
