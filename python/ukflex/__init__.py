@@ -17,6 +17,7 @@ Rust core (``ukflex._core``, private) + Python API:
 from .errors import (
     InconsistentInitialStateError,
     InvalidSceneError,
+    MissingDependencyError,
     NonFiniteError,
     SingularMassError,
     SolverError,
@@ -42,7 +43,17 @@ from .simulate import simulate
 from .sweep import sweep
 from . import scenes
 
-__version__ = "0.1.0"
+def _version() -> str:
+    """The installed distribution's version (single source: Cargo.toml, through maturin)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("ukflex")
+    except PackageNotFoundError:  # pragma: no cover - imported from a source tree without installing
+        return "0+unknown"
+
+
+__version__ = _version()
 
 __all__ = [
     "Scene",
@@ -69,4 +80,5 @@ __all__ = [
     "SolverError",
     "NonFiniteError",
     "InconsistentInitialStateError",
+    "MissingDependencyError",
 ]

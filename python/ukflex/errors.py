@@ -26,6 +26,7 @@ __all__ = [
     "SolverError",
     "NonFiniteError",
     "InconsistentInitialStateError",
+    "MissingDependencyError",
 ]
 
 UkflexError = core.UkflexError
@@ -51,3 +52,8 @@ class InconsistentInitialStateError(UkflexError):  # type: ignore[misc, valid-ty
         super().__init__(message)
         self.rows = list(rows)
         self.residuals = residuals
+
+
+class MissingDependencyError(UkflexError, ImportError):  # type: ignore[misc, valid-type]
+    """An optional dependency is not installed (matplotlib for plots, pandas/dask for sweeps);
+    the message names the feature and the ``pip install 'ukflex[extra]'`` that provides it."""

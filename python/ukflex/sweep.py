@@ -142,22 +142,18 @@ def run_case(build: Callable[..., Any], outputs: Callable[[Any], Mapping[str, An
     return row
 
 
-def _run_pickled(payload: bytes, case: Dict[str, Any], defaults: Dict[str, Any], blas: Optional[int]) -> Dict[str, Any]:
-    """Worker entry: ``payload`` is ``cloudpickle.dumps((build, outputs))``."""
-    build, outputs = pickle.loads(payload)
-    return run_case(build, outputs, case, defaults, blas)
-
-
 _WORKER_FUNCS: Dict[bytes, Tuple[Callable[..., Any], Callable[..., Any]]] = {}
 
 
-def _run_cached(payload: bytes, case: Dict[str, Any], defaults: Dict[str, Any], blas: Optional[int]) -> Dict[str, Any]:
-    """Process-pool worker entry: unpickles ``(build, outputs)`` once per worker process."""
+def _run_chunk(payload: bytes, chunk: List[Tuple[int, Dict[str, Any]]], defaults: Dict[str, Any],
+               blas: Optional[int]) -> List[Tuple[int, Dict[str, Any]]]:
+    """Worker entry (process pool and Dask): ``payload`` is ``cloudpickle.dumps((build, outputs))``,
+    unpickled once per worker process; ``chunk`` is a list of ``(case index, case)``."""
     funcs = _WORKER_FUNCS.get(payload)
     if funcs is None:
         _WORKER_FUNCS.clear()
         funcs = _WORKER_FUNCS[payload] = pickle.loads(payload)
-    return run_case(funcs[0], funcs[1], case, defaults, blas)
+    return [(i, run_case(funcs[0], funcs[1], case, defaults, blas)) for i, case in chunk]
 
 
 def _failed_row(case: Dict[str, Any], exc: BaseException) -> Dict[str, Any]:
@@ -178,6 +174,28 @@ def _progress_bar(total: int, progress: Optional[bool], label: str) -> Any:
     except ImportError:
         return None
     return tqdm(total=total, desc=label, unit="case", file=sys.stderr)
+
+
+def _chunks(cases: List[Dict[str, Any]], nworkers: int, chunksize: Optional[int]) -> List[List[Tuple[int, Dict[str, Any]]]]:
+    if chunksize is None:
+        chunksize = min(64, max(1, -(-len(cases) // (8 * nworkers))))
+    elif int(chunksize) < 1:
+        raise ValueError(f"sweep: chunksize must be >= 1, got {chunksize!r}")
+    indexed = list(enumerate(cases))
+    return [indexed[k:k + int(chunksize)] for k in range(0, len(indexed), int(chunksize))]
+
+
+def _collect(rows: List[Optional[Dict[str, Any]]], chunk: List[Tuple[int, Dict[str, Any]]], fut: Any,
+             cases: List[Dict[str, Any]], bar: Any) -> None:
+    """Store a finished task's rows; a lost worker (BrokenProcessPool, KilledWorker) fails its cases."""
+    try:
+        for i, row in fut.result():
+            rows[i] = row
+    except Exception as exc:
+        for i, _ in chunk:
+            rows[i] = _failed_row(cases[i], exc)
+    if bar is not None:
+        bar.update(len(chunk))
 
 
 def _is_dask_client(executor: Any) -> bool:
@@ -204,6 +222,7 @@ def sweep(
     executor: Any = "serial",
     *,
     workers: Optional[int] = None,
+    chunksize: Optional[int] = None,
     progress: Optional[bool] = None,
     blas_threads: Optional[int] = 1,
     **simulate_options: Any,
@@ -225,6 +244,9 @@ def sweep(
         Where the cases run (see the module docs).
     workers : int, optional
         Processes of the ``"processes"`` pool (default ``os.cpu_count()``).
+    chunksize : int, optional
+        Cases per task sent to a worker (process pool and Dask); default: about 8 tasks per
+        worker, at most 64 cases each (fewer round trips for short cases, still balanced).
     progress : bool, optional
         A tqdm progress bar on stderr; default: only when stderr is a terminal (and tqdm is
         installed).
@@ -269,36 +291,25 @@ def sweep(
             raise ValueError(f"sweep: workers must be >= 1, got {workers!r}")
         name = "processes"
         payload = _payload(build, outputs)
+        chunks = _chunks(cases, nworkers, chunksize)
         bar = _progress_bar(len(cases), progress, f"sweep ({nworkers} processes)")
         with ProcessPoolExecutor(max_workers=nworkers) as pool:
-            futures = {pool.submit(_run_cached, payload, case, simulate_options, blas): i
-                       for i, case in enumerate(cases)}
+            futures = {pool.submit(_run_chunk, payload, chunk, simulate_options, blas): chunk for chunk in chunks}
             for fut in as_completed(futures):
-                i = futures[fut]
-                try:
-                    rows[i] = fut.result()
-                except Exception as exc:  # a worker died (BrokenProcessPool): record, go on
-                    rows[i] = _failed_row(cases[i], exc)
-                if bar is not None:
-                    bar.update(1)
+                _collect(rows, futures[fut], fut, cases, bar)
     elif _is_dask_client(executor):
         distributed = _need("distributed", "ukflex.sweep on Dask")
         name = "dask"
         nworkers = len(executor.scheduler_info().get("workers", {}))
         payload = _payload(build, outputs)
         [remote] = executor.scatter([payload], broadcast=True)
+        chunks = _chunks(cases, max(nworkers, 1), chunksize)
         bar = _progress_bar(len(cases), progress, "sweep (dask)")
-        futures = [executor.submit(_run_pickled, remote, case, simulate_options, blas, pure=False) for case in cases]
-        index = {f.key: i for i, f in enumerate(futures)}
+        futures = [executor.submit(_run_chunk, remote, chunk, simulate_options, blas, pure=False) for chunk in chunks]
+        by_key = {f.key: chunk for f, chunk in zip(futures, chunks)}
         try:
             for fut in distributed.as_completed(futures):
-                i = index[fut.key]
-                try:
-                    rows[i] = fut.result()
-                except Exception as exc:  # a worker was lost (KilledWorker) or the task could not run
-                    rows[i] = _failed_row(cases[i], exc)
-                if bar is not None:
-                    bar.update(1)
+                _collect(rows, by_key[fut.key], fut, cases, bar)
         finally:
             executor.cancel([f for f in futures if not f.done()])
     else:

@@ -65,14 +65,13 @@ def crank_study(omegas: Sequence[float] = OMEGAS, diameters: Sequence[float] = D
 
 
 def _contours(df: Any, path: str) -> None:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from .._plotting import figure
+
+    fig = figure((11.0, 4.2), "the sweep's contour plot")
     from matplotlib.colors import LogNorm
-    from matplotlib.figure import Figure
 
     om = np.array(sorted(df["omega"].unique()))
     d = np.array(sorted(df["diameter"].unique()))
-    fig = Figure(figsize=(11.0, 4.2))
-    FigureCanvasAgg(fig)
     axes = fig.subplots(1, 2)
     for ax, col, scale, label in ((axes[0], "peak_deflection", 1e3, "peak |v(coupler, 0.5)| [mm]"),
                                   (axes[1], "max_axial_force", 1.0, "max |axial force| [N]")):
