@@ -452,6 +452,10 @@ def _cmd_bench_wp(args: argparse.Namespace) -> int:
     from .studies.workprecision import run_work_precision
 
     rtols = args.rtols or ([1e-3, 1e-5, 1e-7] if args.quick else None)
+    if args.quick and args.formulations is None:
+        args.formulations = ["uk"]  # the NumPy references take ~15 min even with 3 tolerances
+    if args.budget is None:
+        args.budget = 15.0 if args.quick else 60.0
     kw: Dict[str, Any] = {}
     if rtols:
         kw["rtols"] = rtols
@@ -645,14 +649,16 @@ def _add_bench_parsers(sub) -> None:
     bsub.required = True
     rt = ",".join(f"{r:.0e}" for r in DEFAULT_RTOLS)
 
-    def common(q: argparse.ArgumentParser, ref_rtol: float) -> None:
+    def common(q: argparse.ArgumentParser, ref_rtol: float, budget: Optional[float] = 60.0,
+               budget_help: str = "") -> None:
         q.add_argument("--out", required=True, help="output directory")
         _add_theory_option(q)
         q.add_argument("--t-end", type=_positive_float, default=0.1, help="end time [s] (default 0.1)")
         q.add_argument("--samples", type=_positive_int, default=1001,
                        help="output times where the error is measured (default 1001)")
         q.add_argument("--rtols", type=_float_list, default=None, help=f"comma-separated rtols (default {rt})")
-        q.add_argument("--budget", type=_positive_float, default=60.0, help="wall-time budget per run [s] (default 60)")
+        q.add_argument("--budget", type=_positive_float, default=budget,
+                       help="wall-time budget per run [s] (default " + (budget_help or f"{budget:g}") + ")")
         q.add_argument("--ref-rtol", type=_positive_float, default=ref_rtol,
                        help=f"rtol of the reference solutions (default {ref_rtol:g})")
         q.add_argument("--no-skip", action="store_true",
@@ -668,9 +674,10 @@ def _add_bench_parsers(sub) -> None:
                     "DOPRI5 checked by native RADAU5), the constraint drift at the end, the wall time and the\n"
                     "rhs evaluations. Writes work_precision.csv, work_precision.png (log-log error vs time,\n"
                     "over-budget runs marked) and work_precision.md (best method per accuracy level).\n"
-                    "The full grid takes an hour or more; --quick runs 3 tolerances.",
+                    "The full grid takes an hour or more; --quick runs 3 tolerances of the Rust formulation and\n"
+                    "the native integrators with a 15 s budget per run (under 3 minutes).",
     )
-    common(q, 1e-13)
+    common(q, 1e-13, None, "60; 15 with --quick")
     q.add_argument("--elements", type=_positive_int, default=1, help="coupler elements (default 1)")
     q.add_argument("--methods", type=_str_list(SCIPY_METHODS + ("RK23",)), default=None,
                    help=f"comma-separated scipy methods (default {','.join(SCIPY_METHODS)})")
@@ -678,7 +685,8 @@ def _add_bench_parsers(sub) -> None:
                    help=f"comma-separated formulations (default {','.join(FORMULATIONS)})")
     q.add_argument("--native", type=_str_list(NATIVE_METHODS), default=None,
                    help=f"comma-separated native integrators (default {','.join(NATIVE_METHODS)}; '' for none)")
-    q.add_argument("--quick", action="store_true", help="rtols 1e-3, 1e-5, 1e-7 only")
+    q.add_argument("--quick", action="store_true",
+                   help="rtols 1e-3, 1e-5, 1e-7, formulation uk (unless --formulations), budget 15 s (unless --budget)")
     q.set_defaults(func=_cmd_bench_wp)
 
     q = bsub.add_parser(

@@ -99,7 +99,9 @@ def run_study(out: str, omegas: Sequence[float] = OMEGAS, diameters: Sequence[fl
     os.makedirs(out, exist_ok=True)
     times: Dict[str, float] = {}
     frames: Dict[str, Any] = {}
+    load: List[str] = []
     for name in executors:
+        load.append(f"{name} {os.getloadavg()[0]:.1f}" if hasattr(os, "getloadavg") else "")
         tic = time.perf_counter()
         if name == "dask":
             from distributed import Client, LocalCluster
@@ -127,7 +129,8 @@ def run_study(out: str, omegas: Sequence[float] = OMEGAS, diameters: Sequence[fl
         f"# Sweep timing: {len(first)} cases (omega x diameter = {len(omegas)} x {len(diameters)})",
         "",
         f"Machine: {os.cpu_count()} cores (shared); workers: {workers}; run: "
-        f"`python -m ukflex.studies.sweeps --out {out}`.",
+        f"`python -m ukflex.studies.sweeps --out {out}`; 1-minute load average when each started: "
+        f"{', '.join(load)}.",
         "",
         "| executor | wall time [s] | vs serial |",
         "|---|---:|---:|",
