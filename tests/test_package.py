@@ -92,7 +92,7 @@ def test_cli_run_without_matplotlib_fails_before_running(no_matplotlib, tmp_path
 
 def test_blas_threads_context():
     threadpoolctl = pytest.importorskip("threadpoolctl")
-    from ukflex._threads import blas_threads
+    from ukflex.reference._blas import blas_threads
     from ukflex.reference import single_blas_thread
 
     def counts():
@@ -108,7 +108,7 @@ def test_blas_threads_context():
 
 def test_blas_threads_without_threadpoolctl(monkeypatch):
     monkeypatch.setitem(sys.modules, "threadpoolctl", None)
-    from ukflex._threads import blas_threads, have_threadpoolctl
+    from ukflex.reference._blas import blas_threads, have_threadpoolctl
 
     assert not have_threadpoolctl()
     with blas_threads(1):  # graceful: does nothing

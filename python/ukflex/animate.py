@@ -184,7 +184,7 @@ class MechanismDrawer:
 
 
 def _new_figure(size: Tuple[float, float], dpi: int):
-    from ._plotting import figure
+    from .plotting import figure
 
     return figure(size, "the animation", dpi=dpi)
 
@@ -270,8 +270,9 @@ def animate(
     int
         Number of frames written.
     """
-    from ._plotting import require
+    from .plotting import require
 
+    require("matplotlib", "the animation (a GIF)")
     Image = require("PIL.Image", "the animation (a GIF)")
     if res.t.size == 0:
         raise ValueError("the result has no output times to animate")

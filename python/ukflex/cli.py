@@ -316,7 +316,7 @@ def _write_outputs_csv(path: str, t: np.ndarray, names: Sequence[str], values: S
 
 def _plot_outputs(path: str, name: str, t: np.ndarray, labels: Sequence[str], values: Sequence[np.ndarray],
                   subtitle: str) -> None:
-    from ._plotting import figure
+    from .plotting import figure
 
     k = len(values)
     fig = figure((7.0, 1.2 + 2.0 * k), "the output plot (ukflex run; --no-plot skips it)")
@@ -353,7 +353,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     fps = args.fps if args.fps is not None else file_output.get("fps", 25)
     frames = args.frames if args.frames is not None else file_output.get("frames", 150)
     if not args.no_plot or animate:  # matplotlib is optional: say so before the run, not after it
-        from ._plotting import require
+        from .plotting import require
 
         require("matplotlib", "the output plot and the animation (--no-plot, without --animate, skips both)")
     out = args.out or _default_out(args.scene, name, args.param, source)

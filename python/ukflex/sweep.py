@@ -36,12 +36,9 @@ Grid = Union[Mapping[str, Any], Sequence[Mapping[str, Any]]]
 
 
 def _need(module: str, what: str) -> Any:
-    import importlib
+    from .plotting import require  # the one place that names a missing optional dependency
 
-    try:
-        return importlib.import_module(module)
-    except ImportError:
-        raise ImportError(f"{what} needs {module!r}: pip install 'ukflex[sweep]' (or {module} alone)") from None
+    return require(module, what, extra="sweep")
 
 
 def cases_of(grid: Grid) -> List[Dict[str, Any]]:
@@ -104,7 +101,7 @@ def run_case(build: Callable[..., Any], outputs: Callable[[Any], Mapping[str, An
 
     Never raises for a problem of the case itself: it is reported in ``status``/``error``.
     """
-    from ._threads import blas_threads
+    from .reference._blas import blas_threads
     from .simulate import simulate
 
     row: Dict[str, Any] = dict(case)

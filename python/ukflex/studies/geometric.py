@@ -853,7 +853,7 @@ COLORS = {"linear-ffrf": "tab:gray", "nonlinear-ffrf": "tab:blue", "nonlinear-ff
 
 
 def _figure(w: float = 7.0, h: float = 4.2, rows: int = 1, cols: int = 1, **kw):
-    from .._plotting import figure
+    from ..plotting import figure
 
     fig = figure((w, h), "the geometric study's plots (--no-plot skips them)", dpi=90)
     axes = fig.subplots(rows, cols, squeeze=False, **kw)

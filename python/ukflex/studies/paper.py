@@ -166,7 +166,7 @@ def run_fig4(
 
 def _plot_fig4(path: str, t: np.ndarray, curves: Dict[str, np.ndarray], elements: int, gravity: bool,
                method: str = "", rtol: float = float("nan")) -> None:
-    from .._plotting import figure
+    from ..plotting import figure
 
     fig = figure((7.0, 4.2), "Fig. 4 (--no-plot skips it)")
     ax = fig.add_subplot(1, 1, 1)

@@ -518,7 +518,7 @@ _FORM_STYLE = {"uk": ("-", "o"), "uk-numpy": ("--", "s"), "cp": (":", "^"), "nat
 
 
 def _figure(size):
-    from .._plotting import figure
+    from ..plotting import figure
 
     fig = figure(size, "the work-precision plot (--no-plot skips it)")
     return fig

@@ -19,7 +19,7 @@ def require(module: str, what: str, extra: str = "plot") -> Any:
     try:
         return importlib.import_module(module)
     except ImportError:
-        pkg = module.split(".")[0]
+        pkg = {"PIL": "pillow", "skfem": "scikit-fem"}.get(module.split(".")[0], module.split(".")[0])
         raise MissingDependencyError(
             f"{what} needs {pkg!r}, which is not installed: pip install 'ukflex[{extra}]' (or {pkg} alone)"
         ) from None
