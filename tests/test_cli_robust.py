@@ -107,7 +107,8 @@ def test_fifo_is_refused_without_blocking(cwd, capsys):
 @pytest.mark.parametrize("text, match", [
     ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nested too deeply"),
     ("bodies = " + "[" * 3000 + "]" * 3000 + "\n", "nested too deeply"),
-    (PENDULUM.replace("mass = 1.0", "mass = 1" + "0" * 400), "[[bodies]] #1"),
+    (PENDULUM.replace("mass = 1.0", "mass = 1" + "0" * 400), "[[bodies]] #1 (line 9): mass: integer 1000000000...(401 digits) is out of range"),
+    (PENDULUM.replace("point = [-0.5, 0.0]", "point = [-0.5, 10000000000000000000]"), "b.point[1]: integer"),
     (PENDULUM.replace('kind = "rigid"', "kind = []"), '[[bodies]] #1 (line 9): kind: must be a string'),
     (PENDULUM.replace('kind = "revolute"', "kind = {a = 1}"), "[[joints]] #1"),
     (PENDULUM.replace("[solver]", "[solver]\nsamples = 100000000000"), "too large"),

@@ -104,3 +104,13 @@ def test_study_tiny():
         assert sub["peak_deflection"].iloc[1] > 2 * sub["peak_deflection"].iloc[0]
         assert sub["max_axial_force"].iloc[1] > sub["max_axial_force"].iloc[0]
     assert all(math.isfinite(v) for v in df["peak_deflection"])
+
+
+def test_progress_bar_on_request(capsys):
+    pytest.importorskip("tqdm")
+    ukflex.sweep(lambda x: ukflex.scenes.pendulum(), [{"x": 0}, {"x": 1}], lambda r: {}, t_end=0.01,
+                 method="DOPRI5", progress=True)
+    err = capsys.readouterr().err
+    assert "sweep (serial)" in err and "2/2" in err
+    ukflex.sweep(lambda x: ukflex.scenes.pendulum(), [{"x": 0}], lambda r: {}, t_end=0.01, method="DOPRI5")
+    assert "sweep" not in capsys.readouterr().err  # not a terminal: quiet by default

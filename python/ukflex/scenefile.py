@@ -52,7 +52,7 @@ import math
 import os
 import re
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from .errors import InvalidSceneError
 from .scene import Scene
@@ -196,18 +196,32 @@ def _loads(text: str, path: str) -> SceneFile:
     description = {k: copy.deepcopy(data[k]) for k in ("gravity",) + ITEM_ARRAYS if k in data}
     for key in ITEM_ARRAYS:  # "kind" selects the entry's schema: name the entry if it is not a string
         items = description.get(key)
-        if isinstance(items, list):
-            lines = _array_lines(text, key)
-            for i, item in enumerate(items):
-                if isinstance(item, dict) and "kind" in item and not isinstance(item["kind"], str):
-                    line = f" (line {lines[i]})" if i < len(lines) and len(lines) == len(items) else ""
-                    raise SceneFileError(f"{path}: [[{key}]] #{i + 1}{line}: kind: must be a string such as "
-                                         f"\"rigid\", got {item['kind']!r}")
+        for i, item in enumerate(items if isinstance(items, list) else []):
+            if isinstance(item, dict) and "kind" in item and not isinstance(item["kind"], str):
+                raise SceneFileError(f"{path}: {_where((key, i), description, text)}kind: must be a string such as "
+                                     f"\"rigid\", got {item['kind']!r}")
+            huge = _huge_integer(item)
+            if huge:
+                raise SceneFileError(f"{path}: {_where((key, i), description, text)}{huge[0]}: integer {huge[1]} is "
+                                     "out of range (|n| < 2**53; write a float such as 1e30 if you mean one)")
     if "bodies" not in description:
         raise SceneFileError(f"{path}: no [[bodies]]: a scene needs at least one body")
     scene = _scene(path, text, description)
     return SceneFile(path=path, name=name, description=desc_text, scene=scene, initial=initial,
                      solver=solver, output=output)
+
+
+def _huge_integer(value: Any, where: str = "") -> Optional[Tuple[str, str]]:
+    """``(key path, shortened digits)`` of the first integer beyond 2**53 in ``value``, else None."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 2**53:
+        digits = str(value)
+        return where or "value", digits if len(digits) <= 24 else f"{digits[:10]}...({len(digits)} digits)"
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for k, v in items:
+        found = _huge_integer(v, f"{where}.{k}" if where and isinstance(k, str) else f"{where}[{k}]" if where else str(k))
+        if found:
+            return found
+    return None
 
 
 def _table(path: str, data: Dict[str, Any], key: str) -> Dict[str, Any]:
