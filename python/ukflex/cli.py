@@ -297,6 +297,8 @@ def _default_out(scene: str, name: str, params: Sequence[str], source: str) -> s
         mark = os.path.join(out, _SOURCE_MARK)
         if not os.path.exists(out):
             return out
+        if not os.path.exists(mark):  # written before output folders were marked: as before, reuse it
+            return out
         try:
             with open(mark, encoding="utf-8") as fh:
                 if fh.read().strip() == source:
