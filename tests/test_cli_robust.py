@@ -16,7 +16,10 @@ PENDULUM = (ROOT / "examples" / "pendulum.toml").read_text()
 
 
 def run(capsys, *argv):
-    code = main([str(a) for a in argv])
+    try:
+        code = main([str(a) for a in argv])
+    except SystemExit as exc:  # argparse: argument errors exit 2 with one line
+        code = exc.code
     out, err = capsys.readouterr()
     return code, out, err
 

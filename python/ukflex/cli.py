@@ -823,10 +823,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     from .errors import UkflexError
 
     parser = _build_parser()
-    try:
-        args = parser.parse_args(argv)
-    except SystemExit as exc:  # --help (0) or a one-line argument error (2): a status, also in-process
-        return int(exc.code or 0) if not isinstance(exc.code, str) else 2
+    args = parser.parse_args(argv)  # argument errors: one line, SystemExit(2) (--help: SystemExit(0))
     with warnings.catch_warnings():
         # old parameter names (--param beam=..., g=...) still work: say so on stderr
         warnings.filterwarnings("default", category=DeprecationWarning, module=r"ukflex(\.|$)")
