@@ -122,7 +122,7 @@ def four_bar():
     print("\n5. Second scene: flexible four-bar (examples/four_bar_flexible.toml, Timoshenko coupler N = 2,")
     print("   crank 10 rad/s, one revolution 0.63 s); error of the coupler midpoint v(0.5) history against")
     print("   DOP853 at rtol 1e-11, relative to its peak")
-    sc = ukflex.scenes.four_bar(flexible_coupler="timoshenko")
+    sc = ukflex.scenes.four_bar(theory="timoshenko")
     s = sc.build()
     t_end = 0.63
     te = np.linspace(0.0, t_end, 6301)

@@ -118,7 +118,8 @@ def test_run_command_line_overrides_file(tiny, tmp_path):
 def test_run_default_output_folder(tiny, tmp_path):
     r = ukflex_cli("run", tiny, "--t-end", "0.001", "--no-plot", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
-    assert (tmp_path / "results" / "tiny" / "tiny.csv").exists()
+    # a scene file's default folder is results/STEM-toml (a built-in scene's is results/NAME)
+    assert (tmp_path / "results" / "tiny-toml" / "tiny.csv").exists()
 
 
 @pytest.mark.parametrize(

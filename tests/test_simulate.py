@@ -237,7 +237,7 @@ def test_rigid_scenes_keep_constraints(name):
 
 
 def test_four_bar_with_flexible_coupler():
-    res = simulate(scenes.four_bar(flexible_coupler="timoshenko"), 0.3, method="DOP853", rtol=1e-6,
+    res = simulate(scenes.four_bar(theory="timoshenko"), 0.3, method="DOP853", rtol=1e-6,
                    t_eval=np.linspace(0, 0.3, 31))
     assert res.success
     assert res.max_residual("position") < 1e-6

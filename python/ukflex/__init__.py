@@ -5,6 +5,7 @@ Rust core (``ukflex._core``, private) + Python API:
 * :class:`Scene` -- scene description builder (bodies, joints, drivers, forces, initial guess);
 * :class:`System` -- compiled Rust-backed system with a consistent initial state;
 * :func:`simulate` -- time integration with ``scipy.integrate.solve_ivp``;
+* :func:`sweep` -- parameter sweeps (serial, a process pool or Dask), a DataFrame per sweep;
 * :mod:`ukflex.scenes` -- built-in scenes (the paper's slider-crank, pendulums, ...);
 * :mod:`ukflex.stability` -- stabilization and diagnostics (rank loss, drift, buckling, FFRF
   validity);
@@ -17,6 +18,7 @@ from .errors import (
     ExpressionError,
     InconsistentInitialStateError,
     InvalidSceneError,
+    MissingDependencyError,
     NonFiniteError,
     SingularMassError,
     SolverError,
@@ -41,9 +43,20 @@ from .scene import (
 from .system import InitialCorrection, System
 from .results import SimulationResult
 from .simulate import simulate
+from .sweep import sweep
 from . import scenes
 
-__version__ = "0.1.0"
+def _version() -> str:
+    """The installed distribution's version (single source: Cargo.toml, through maturin)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("ukflex")
+    except PackageNotFoundError:  # pragma: no cover - imported from a source tree without installing
+        return "0+unknown"
+
+
+__version__ = _version()
 
 __all__ = [
     "Scene",
@@ -64,6 +77,7 @@ __all__ = [
     "InitialCorrection",
     "SimulationResult",
     "simulate",
+    "sweep",
     "scenes",
     "UkflexError",
     "InvalidSceneError",
@@ -72,4 +86,5 @@ __all__ = [
     "NonFiniteError",
     "InconsistentInitialStateError",
     "ExpressionError",
+    "MissingDependencyError",
 ]

@@ -30,6 +30,7 @@ def renamed_parameters(**old_to_new: str) -> Callable[[Callable[..., Any]], Call
                     kwargs[new] = kwargs.pop(old)
             return fn(*args, **kwargs)
 
+        wrapper.__renamed_parameters__ = dict(old_to_new)  # type: ignore[attr-defined]
         return wrapper
 
     return decorate

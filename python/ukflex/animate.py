@@ -184,12 +184,9 @@ class MechanismDrawer:
 
 
 def _new_figure(size: Tuple[float, float], dpi: int):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from .plotting import figure
 
-    fig = Figure(figsize=size, dpi=dpi)
-    FigureCanvasAgg(fig)
-    return fig
+    return figure(size, "the animation", dpi=dpi)
 
 
 class _Scene2D:
@@ -273,8 +270,10 @@ def animate(
     int
         Number of frames written.
     """
-    from PIL import Image
+    from .plotting import require
 
+    require("matplotlib", "the animation (a GIF)")
+    Image = require("PIL.Image", "the animation (a GIF)")
     if res.t.size == 0:
         raise ValueError("the result has no output times to animate")
     idx = np.unique(np.linspace(0, res.t.size - 1, min(int(frames), res.t.size)).round().astype(int))

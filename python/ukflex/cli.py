@@ -58,13 +58,68 @@ def _positive_float(text: str) -> float:
 
 
 def _positive_int(text: str) -> int:
+    from .scenefile import MAX_COUNT
+
     try:
         x = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
     if x < 1:
         raise argparse.ArgumentTypeError(f"must be >= 1: {text!r}")
+    if x > MAX_COUNT:
+        raise argparse.ArgumentTypeError(f"{text!r} is too large (at most {MAX_COUNT:,})")
     return x
+
+
+class UserError(Exception):
+    """A problem with what the user asked for (paths, sizes, options): one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """Argument errors on one line (``ukflex run: error: ...``), exit status 2."""
+
+    def error(self, message: str):  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def _safe_name(name: str) -> str:
+    """``name`` as a file/folder name that stays inside its folder: letters, digits, ``_ . + -``
+    (anything else becomes ``_``), no leading dot (so neither ``.`` nor ``..``)."""
+    import re
+
+    safe = re.sub(r"[^A-Za-z0-9_.+-]", "_", name).lstrip(".")
+    return safe or "scene"
+
+
+def _writable_dir(path: str, what: str) -> str:
+    """Create directory ``path`` if needed and check that a file can be written there, before any
+    work is done; raise :class:`UserError` otherwise."""
+    import tempfile
+
+    if os.path.exists(path) and not os.path.isdir(path):
+        raise UserError(f"{what} {path!r} exists and is not a directory")
+    try:
+        os.makedirs(path, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=path, prefix=".ukflex-write-check-"):
+            pass
+    except OSError as exc:
+        raise UserError(f"{what} {path!r} is not writable ({exc.strerror or exc})") from None
+    return path
+
+
+def _writable_file(path: str, what: str) -> None:
+    """Check that file ``path`` can be written (not a directory or a special file) before writing it."""
+    import stat
+
+    if os.path.isdir(path):
+        raise UserError(f"{what} {path!r} is a directory; give a file name")
+    if os.path.exists(path) and not stat.S_ISREG(os.stat(path).st_mode):
+        raise UserError(f"{what} {path!r} is not a regular file")
+    parent = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(parent):
+        raise UserError(f"{what} {path!r}: directory {parent!r} does not exist")
+    if not os.access(parent, os.W_OK) or (os.path.exists(path) and not os.access(path, os.W_OK)):
+        raise UserError(f"{what} {path!r} is not writable")
 
 
 def _float_list(text: str) -> List[float]:
@@ -206,20 +261,51 @@ def _parse_params(items: Sequence[str]) -> Dict[str, Any]:
 
 
 def _load_scene(scene: str, params: Sequence[str]):
-    """(name, System, solver settings, output settings) for a built-in name or a scene file."""
+    """(name, System, solver settings, output settings, source) for a built-in name or a scene file.
+
+    ``source`` identifies what was run (``builtin:NAME [params]`` or the file's absolute path);
+    :func:`_default_out` keeps different sources in different folders.
+    """
     from .scenefile import SceneFileError, load
     from .scenes import SCENES
 
     looks_like_file = scene.endswith(".toml") or os.sep in scene or os.path.exists(scene)
     if scene in SCENES and not os.path.exists(scene):
         system = SCENES[scene](**_parse_params(params)).build()
-        return scene, system, {}, {}
+        return scene, system, {}, {}, "builtin:" + " ".join([scene] + list(params))
     if not looks_like_file:
         raise SceneFileError(f"{scene!r} is neither a built-in scene ({', '.join(SCENES)}) nor a scene file")
     if params:
         raise ValueError("--param applies to built-in scenes only; edit the scene file instead")
     sf = load(scene)
-    return sf.name, sf.build(), sf.solver, sf.output
+    return sf.name, sf.build(), sf.solver, sf.output, "file:" + os.path.abspath(scene)
+
+
+_SOURCE_MARK = ".ukflex-source"
+
+
+def _default_out(scene: str, name: str, params: Sequence[str], source: str) -> str:
+    """``results/NAME`` for a built-in scene (``results/NAME_key-value...`` with ``--param``),
+    ``results/STEM-toml`` for a scene file; if that folder holds the outputs of another source
+    (``.ukflex-source``), ``-2``, ``-3``, ... is appended, so runs never overwrite each other."""
+    if source.startswith("builtin:"):
+        base = _safe_name(name + "".join("_" + p.replace("=", "-") for p in params))
+    else:
+        base = _safe_name(os.path.splitext(os.path.basename(scene))[0]) + "-toml"
+    for k in range(1, 1000):
+        out = os.path.join("results", base if k == 1 else f"{base}-{k}")
+        mark = os.path.join(out, _SOURCE_MARK)
+        if not os.path.exists(out):
+            return out
+        if not os.path.exists(mark):  # written before output folders were marked: as before, reuse it
+            return out
+        try:
+            with open(mark, encoding="utf-8") as fh:
+                if fh.read().strip() == source:
+                    return out
+        except OSError:
+            continue
+    raise UserError(f"no free output folder for {base!r} under results/; give --out")
 
 
 def _write_outputs_csv(path: str, t: np.ndarray, names: Sequence[str], values: Sequence[np.ndarray]) -> None:
@@ -232,12 +318,10 @@ def _write_outputs_csv(path: str, t: np.ndarray, names: Sequence[str], values: S
 
 def _plot_outputs(path: str, name: str, t: np.ndarray, labels: Sequence[str], values: Sequence[np.ndarray],
                   subtitle: str) -> None:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from .plotting import figure
 
     k = len(values)
-    fig = Figure(figsize=(7.0, 1.2 + 2.0 * k))
-    FigureCanvasAgg(fig)
+    fig = figure((7.0, 1.2 + 2.0 * k), "the output plot (ukflex run; --no-plot skips it)")
     axes = fig.subplots(k, 1, sharex=True, squeeze=False)[:, 0]
     for ax, lab, v in zip(axes, labels, values):
         ax.plot(t, v, lw=1.1)
@@ -253,7 +337,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from . import outputs
     from .simulate import simulate
 
-    name, system, file_solver, file_output = _load_scene(args.scene, args.param)
+    if args.out is not None:  # fail before loading or running anything
+        _writable_dir(args.out, "--out")
+    name, system, file_solver, file_output, source = _load_scene(args.scene, args.param)
     solver = dict(RUN_DEFAULTS)
     solver.update(file_solver)
     for key in ("t_end", "method", "rtol", "atol", "formulation", "samples"):
@@ -268,7 +354,15 @@ def _cmd_run(args: argparse.Namespace) -> int:
     deform_scale = args.deform_scale if args.deform_scale is not None else file_output.get("deform_scale", 1.0)
     fps = args.fps if args.fps is not None else file_output.get("fps", 25)
     frames = args.frames if args.frames is not None else file_output.get("frames", 150)
-    out = args.out or os.path.join("results", name)
+    if not args.no_plot or animate:  # matplotlib is optional: say so before the run, not after it
+        from .plotting import require
+
+        require("matplotlib", "the output plot and the animation (--no-plot, without --animate, skips both)")
+    out = args.out or _default_out(args.scene, name, args.param, source)
+    _writable_dir(out, "output folder")
+    with open(os.path.join(out, _SOURCE_MARK), "w", encoding="utf-8") as fh:
+        fh.write(source + "\n")
+    name = _safe_name(name)  # file names inside the folder never leave it
 
     print(f"scene {name}: n = {system.n_coords} coordinates, m = {system.n_constraints} constraints, "
           f"{system.n_dof} degree(s) of freedom")
@@ -289,7 +383,6 @@ def _cmd_run(args: argparse.Namespace) -> int:
           f"{res.max_residual('velocity'):.3e}, max ||A qdd - b|| = {res.max_residual('acceleration'):.3e}")
     print(res.sensors.energy_line())
 
-    os.makedirs(out, exist_ok=True)
     base = os.path.join(out, name)
     res.to_csv(base + ".csv")
     res.save_npz(base + ".npz")
@@ -312,12 +405,24 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0 if res.success else 1
 
 
+def _scene_summary(fn: Callable[..., Any]) -> str:
+    """The first sentence of a scene function's docstring (may span lines)."""
+    import re
+
+    doc = (fn.__doc__ or "").strip().split("\n\n")[0]
+    doc = re.sub(r":\w+:`~?([^`]+)`", r"\1", doc).replace("``", "")  # reST roles and literals -> text
+    return " ".join(doc.split())
+
+
 def _cmd_list(args: argparse.Namespace) -> int:
-    from .scenes import SCENES
+    from .scenes import SCENES, scene_parameters
 
     for name, fn in SCENES.items():
-        doc = (fn.__doc__ or "").strip().splitlines()[0]
-        print(f"{name:16s} {doc}")
+        print(f"{name}: {_scene_summary(fn)}")
+        for p, default, aliases in scene_parameters(fn):
+            old = f"  (deprecated alias: {', '.join(aliases)})" if aliases else ""
+            print(f"    --param {p}={default!r}{old}")
+    print("Run 'ukflex run NAME --param KEY=VALUE ...'; 'ukflex export NAME' writes a scene as a TOML file.")
     return 0
 
 
@@ -325,8 +430,10 @@ def _cmd_export(args: argparse.Namespace) -> int:
     from .scenefile import dumps
     from .scenes import SCENES
 
+    if args.output not in (None, "-"):
+        _writable_file(args.output, "-o")
     scene = SCENES[args.scene](**_parse_params(args.param))
-    doc = (SCENES[args.scene].__doc__ or "").strip().splitlines()[0]
+    doc = _scene_summary(SCENES[args.scene])
     params = " ".join(f"--param {p}" for p in args.param)
     text = dumps(scene, name=args.scene, description=doc,
                  solver={"t_end": args.t_end, "method": args.method, "rtol": args.rtol},
@@ -346,6 +453,10 @@ def _cmd_bench_wp(args: argparse.Namespace) -> int:
     from .studies.workprecision import run_work_precision
 
     rtols = args.rtols or ([1e-3, 1e-5, 1e-7] if args.quick else None)
+    if args.quick and args.formulations is None:
+        args.formulations = ["uk"]  # the NumPy references take ~15 min even with 3 tolerances
+    if args.budget is None:
+        args.budget = 15.0 if args.quick else 60.0
     kw: Dict[str, Any] = {}
     if rtols:
         kw["rtols"] = rtols
@@ -539,14 +650,16 @@ def _add_bench_parsers(sub) -> None:
     bsub.required = True
     rt = ",".join(f"{r:.0e}" for r in DEFAULT_RTOLS)
 
-    def common(q: argparse.ArgumentParser, ref_rtol: float) -> None:
+    def common(q: argparse.ArgumentParser, ref_rtol: float, budget: Optional[float] = 60.0,
+               budget_help: str = "") -> None:
         q.add_argument("--out", required=True, help="output directory")
         _add_theory_option(q)
         q.add_argument("--t-end", type=_positive_float, default=0.1, help="end time [s] (default 0.1)")
         q.add_argument("--samples", type=_positive_int, default=1001,
                        help="output times where the error is measured (default 1001)")
         q.add_argument("--rtols", type=_float_list, default=None, help=f"comma-separated rtols (default {rt})")
-        q.add_argument("--budget", type=_positive_float, default=60.0, help="wall-time budget per run [s] (default 60)")
+        q.add_argument("--budget", type=_positive_float, default=budget,
+                       help="wall-time budget per run [s] (default " + (budget_help or f"{budget:g}") + ")")
         q.add_argument("--ref-rtol", type=_positive_float, default=ref_rtol,
                        help=f"rtol of the reference solutions (default {ref_rtol:g})")
         q.add_argument("--no-skip", action="store_true",
@@ -562,9 +675,10 @@ def _add_bench_parsers(sub) -> None:
                     "DOPRI5 checked by native RADAU5), the constraint drift at the end, the wall time and the\n"
                     "rhs evaluations. Writes work_precision.csv, work_precision.png (log-log error vs time,\n"
                     "over-budget runs marked) and work_precision.md (best method per accuracy level).\n"
-                    "The full grid takes an hour or more; --quick runs 3 tolerances.",
+                    "The full grid takes an hour or more; --quick runs 3 tolerances of the Rust formulation and\n"
+                    "the native integrators with a 15 s budget per run (under 3 minutes).",
     )
-    common(q, 1e-13)
+    common(q, 1e-13, None, "60; 15 with --quick")
     q.add_argument("--elements", type=_positive_int, default=1, help="coupler elements (default 1)")
     q.add_argument("--methods", type=_str_list(SCIPY_METHODS + ("RK23",)), default=None,
                    help=f"comma-separated scipy methods (default {','.join(SCIPY_METHODS)})")
@@ -572,7 +686,8 @@ def _add_bench_parsers(sub) -> None:
                    help=f"comma-separated formulations (default {','.join(FORMULATIONS)})")
     q.add_argument("--native", type=_str_list(NATIVE_METHODS), default=None,
                    help=f"comma-separated native integrators (default {','.join(NATIVE_METHODS)}; '' for none)")
-    q.add_argument("--quick", action="store_true", help="rtols 1e-3, 1e-5, 1e-7 only")
+    q.add_argument("--quick", action="store_true",
+                   help="rtols 1e-3, 1e-5, 1e-7, formulation uk (unless --formulations), budget 15 s (unless --budget)")
     q.set_defaults(func=_cmd_bench_wp)
 
     q = bsub.add_parser(
@@ -678,7 +793,7 @@ def _add_study_geometric_parser(sub) -> None:
 
 
 def _build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="ukflex",
         formatter_class=_FMT,
         description="Planar flexible multibody dynamics with the Udwadia-Kalaba formulation (Rust core), "
@@ -694,7 +809,7 @@ def _build_parser() -> argparse.ArgumentParser:
                "  ukflex study-geometric --out results/geometric --quick\n"
                "\nRun 'ukflex COMMAND --help' for the options of a command.",
     )
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for add in (_add_run_parser, _add_list_export_parsers, _add_paper_parser, _add_bench_parsers,
                 _add_stability_parser, _add_crosscheck_parser, _add_study_geometric_parser):
@@ -707,16 +822,22 @@ def main(argv: Optional[List[str]] = None) -> int:
     from .errors import UkflexError
 
     parser = _build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(argv)  # argument errors: one line, SystemExit(2) (--help: SystemExit(0))
     with warnings.catch_warnings():
         # old parameter names (--param beam=..., g=...) still work: say so on stderr
         warnings.filterwarnings("default", category=DeprecationWarning, module=r"ukflex(\.|$)")
         try:
+            if getattr(args, "out", None):  # an unwritable output folder fails now, not after the work
+                _writable_dir(args.out, "--out")
             return int(args.func(args) or 0)
-        except (UkflexError, ValueError, TypeError, NotImplementedError, KeyError) as exc:
-            # user-facing problems (bad scene files or parameters, inconsistent scenes): one line, exit 2
+        except (UkflexError, UserError, ValueError, TypeError, NotImplementedError, KeyError, OverflowError,
+                RecursionError, MemoryError, OSError) as exc:
+            # user-facing problems (bad scene files, paths or parameters, inconsistent scenes, sizes
+            # beyond this machine): one line, exit 2
             msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
-            print(f"ukflex {args.command}: error: {type(exc).__name__}: {msg}", file=sys.stderr)
+            text = " ".join(f"{msg}".split()) or type(exc).__name__
+            label = "" if isinstance(exc, UserError) else f"{type(exc).__name__}: "
+            print(f"ukflex {args.command}: error: {label}{text}", file=sys.stderr)
             return 2
         except KeyboardInterrupt:
             print(f"ukflex {args.command}: interrupted", file=sys.stderr)

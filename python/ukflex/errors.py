@@ -27,6 +27,7 @@ __all__ = [
     "NonFiniteError",
     "InconsistentInitialStateError",
     "ExpressionError",
+    "MissingDependencyError",
 ]
 
 UkflexError = core.UkflexError
@@ -53,3 +54,8 @@ class InconsistentInitialStateError(UkflexError):  # type: ignore[misc, valid-ty
         super().__init__(message)
         self.rows = list(rows)
         self.residuals = residuals
+
+
+class MissingDependencyError(UkflexError, ImportError):  # type: ignore[misc, valid-type]
+    """An optional dependency is not installed (matplotlib for plots, pandas/dask for sweeps);
+    the message names the feature and the ``pip install 'ukflex[extra]'`` that provides it."""

@@ -52,7 +52,7 @@ import math
 import os
 import re
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from .errors import InvalidSceneError
 from .scene import Scene
@@ -73,6 +73,11 @@ SCENE_KEYS = ("name", "description")
 INITIAL_KEYS = ("correct", "hold", "position_tol", "velocity_tol", "max_iterations", "t0")
 SOLVER_KEYS = ("t_end", "method", "rtol", "atol", "formulation", "samples", "max_step", "first_step")
 OUTPUT_KEYS = ("plot", "animate", "deform_scale", "fps", "frames")
+#: Largest count accepted for sizes (samples, frames) in a scene file or on the command line:
+#: above it the arrays alone would need gigabytes; refused before anything is allocated.
+MAX_COUNT = 10_000_000
+#: Largest scene file read (bytes): a scene with 100,000 bodies is ~10 MB of TOML.
+MAX_FILE_BYTES = 64 * 1024 * 1024
 
 
 class SceneFileError(InvalidSceneError):
@@ -128,10 +133,22 @@ def load(path: Union[str, "os.PathLike[str]"]) -> SceneFile:
     SceneFileError
         Unreadable file, TOML syntax error, unknown or malformed key, invalid scene.
     """
+    import stat
+
     path = os.fspath(path)
     try:
+        st = os.stat(path)  # never open a FIFO, a device or a directory: reading them blocks or never ends
+        if not stat.S_ISREG(st.st_mode):
+            kind = ("a directory" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode)
+                    else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "a special file")
+            raise SceneFileError(f"{path}: not a regular file ({kind}); a scene file is a TOML text file")
+        if st.st_size > MAX_FILE_BYTES:
+            raise SceneFileError(f"{path}: {st.st_size:,} bytes is too large for a scene file "
+                                 f"(at most {MAX_FILE_BYTES:,})")
         with open(path, "rb") as fh:
-            raw = fh.read()
+            raw = fh.read(MAX_FILE_BYTES + 1)
+        if len(raw) > MAX_FILE_BYTES:
+            raise SceneFileError(f"{path}: too large for a scene file (at most {MAX_FILE_BYTES:,} bytes)")
     except OSError as exc:
         raise SceneFileError(f"{path}: cannot read the scene file ({exc.strerror or exc})") from None
     try:
@@ -146,6 +163,13 @@ def loads(text: str, path: str = "<string>") -> SceneFile:
     if _toml is None:  # pragma: no cover
         raise SceneFileError("reading TOML scene files needs Python >= 3.11 or the 'tomli' package")
     try:
+        return _loads(text, path)
+    except RecursionError:
+        raise SceneFileError(f"{path}: arrays or tables nested too deeply for a scene file") from None
+
+
+def _loads(text: str, path: str) -> SceneFile:
+    try:
         data = _toml.loads(text)
     except _toml.TOMLDecodeError as exc:
         raise SceneFileError(f"{path}: TOML syntax error: {exc}") from None
@@ -153,10 +177,14 @@ def loads(text: str, path: str = "<string>") -> SceneFile:
     _check_keys(path, "top level", data, TOP_KEYS)
     meta = _table(path, data, "scene")
     _check_keys(path, "[scene]", meta, SCENE_KEYS)
-    name = meta.get("name", os.path.splitext(os.path.basename(path))[0] if path != "<string>" else "scene")
-    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_.+-]+", name):
-        raise SceneFileError(f"{path}: [scene] name: must be a file-name-safe string (letters, digits, _ . + -), "
-                             f"got {name!r}")
+    if "name" in meta:
+        name = meta["name"]
+        if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_+-][A-Za-z0-9_.+-]*", name):
+            raise SceneFileError(f"{path}: [scene] name: must be a file-name-safe string (letters, digits, _ . + -, "
+                                 f"not starting with a dot), got {name!r}")
+    else:  # the file's name, made file-name-safe ("my scene.toml" -> "my_scene")
+        stem = os.path.splitext(os.path.basename(path))[0] if path != "<string>" else "scene"
+        name = re.sub(r"[^A-Za-z0-9_.+-]", "_", stem).lstrip(".") or "scene"
     desc_text = meta.get("description", "")
     if not isinstance(desc_text, str):
         raise SceneFileError(f"{path}: [scene] description: must be a string, got {desc_text!r}")
@@ -166,11 +194,34 @@ def loads(text: str, path: str = "<string>") -> SceneFile:
     output = _output(path, _table(path, data, "output"))
 
     description = {k: copy.deepcopy(data[k]) for k in ("gravity",) + ITEM_ARRAYS if k in data}
+    for key in ITEM_ARRAYS:  # "kind" selects the entry's schema: name the entry if it is not a string
+        items = description.get(key)
+        for i, item in enumerate(items if isinstance(items, list) else []):
+            if isinstance(item, dict) and "kind" in item and not isinstance(item["kind"], str):
+                raise SceneFileError(f"{path}: {_where((key, i), description, text)}kind: must be a string such as "
+                                     f"\"rigid\", got {item['kind']!r}")
+            huge = _huge_integer(item)
+            if huge:
+                raise SceneFileError(f"{path}: {_where((key, i), description, text)}{huge[0]}: integer {huge[1]} is "
+                                     "out of range (|n| < 2**53; write a float such as 1e30 if you mean one)")
     if "bodies" not in description:
         raise SceneFileError(f"{path}: no [[bodies]]: a scene needs at least one body")
     scene = _scene(path, text, description)
     return SceneFile(path=path, name=name, description=desc_text, scene=scene, initial=initial,
                      solver=solver, output=output)
+
+
+def _huge_integer(value: Any, where: str = "") -> Optional[Tuple[str, str]]:
+    """``(key path, shortened digits)`` of the first integer beyond 2**53 in ``value``, else None."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 2**53:
+        digits = str(value)
+        return where or "value", digits if len(digits) <= 24 else f"{digits[:10]}...({len(digits)} digits)"
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for k, v in items:
+        found = _huge_integer(v, f"{where}.{k}" if where and isinstance(k, str) else f"{where}[{k}]" if where else str(k))
+        if found:
+            return found
+    return None
 
 
 def _table(path: str, data: Dict[str, Any], key: str) -> Dict[str, Any]:
@@ -251,6 +302,8 @@ def _solver(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
             out[key] = float(_number(path, "[solver]", key, d[key], positive=True))
     if "samples" in d:
         out["samples"] = _number(path, "[solver]", "samples", d["samples"], integer=True, minimum=2)
+        if out["samples"] > MAX_COUNT:
+            raise SceneFileError(f"{path}: [solver] samples: {out['samples']} is too large (at most {MAX_COUNT:,})")
     if "method" in d:
         if d["method"] not in METHODS:
             raise SceneFileError(f"{path}: [solver] method: unknown method {d['method']!r}; expected one of "
@@ -284,6 +337,8 @@ def _output(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
         out["fps"] = _number(path, "[output]", "fps", d["fps"], integer=True, minimum=1)
     if "frames" in d:
         out["frames"] = _number(path, "[output]", "frames", d["frames"], integer=True, minimum=2)
+        if out["frames"] > MAX_COUNT:
+            raise SceneFileError(f"{path}: [output] frames: {out['frames']} is too large (at most {MAX_COUNT:,})")
     return out
 
 

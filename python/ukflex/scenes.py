@@ -3,18 +3,22 @@
 Every function returns a :class:`ukflex.Scene` (call ``.build()`` or pass it to
 :func:`ukflex.simulate`).  ``SCENES`` maps the names used by ``ukflex run`` to the functions.
 
-Parameter names are the same in every scene (and in ``ukflex run NAME --param KEY=VALUE``):
-``theory`` is a beam theory (``"timoshenko"`` or ``"euler-bernoulli"``), ``elements`` a beam's
+Parameter names are the same in every scene (and in ``ukflex run NAME --param KEY=VALUE``;
+``ukflex list`` prints them all): ``theory`` is a beam theory (``"timoshenko"`` or
+``"euler-bernoulli"``; on the four-bar ``None`` keeps the coupler rigid), ``elements`` a beam's
 element count, ``gravity`` is ``True`` (9.81 m/s^2 along -Y), ``False``, a magnitude along -Y or
-a vector (:func:`gravity_vector`).  The old spellings ``beam=`` (slider_crank) and ``g=``
-(pendulum, double_pendulum) still work for one release, with a ``DeprecationWarning``.
+a vector (:func:`gravity_vector`), ``<link>_length`` a link length, ``omega`` a crank speed,
+``density``, ``youngs_modulus``, ``poisson_ratio``, ``shear_factor`` the material.  The old
+spellings ``beam=`` (slider_crank), ``g=`` (pendulum, double_pendulum), ``flexible_coupler=``,
+``crank=``, ``coupler=``, ``rocker=``, ``ground=`` (four_bar) still work for one release, with a
+``DeprecationWarning``.
 """
 
 from __future__ import annotations
 
 import math
 import numbers
-from typing import Any, Callable, Dict, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from ._deprecation import renamed_parameters
 from .scene import Circular, ConstantSpeed, Harmonic, Polynomial, Rectangular, Scene
@@ -28,11 +32,12 @@ __all__ = [
     "pinned_beam",
     "every_joint",
     "gravity_vector",
+    "scene_parameters",
     "SCENES",
     "PAPER",
 ]
 
-#: Data of the paper's slider-crank (Pennestri, Valentini, de Falco 2010), DESIGN.md section 3.
+#: Data of the paper's slider-crank (Pennestri, Valentini, de Falco 2010), docs/paper.md.
 PAPER = {
     "crank_length": 0.1524,
     "coupler_length": 0.3048,
@@ -101,7 +106,7 @@ def slider_crank(
     strain: str = "linear",
     formulation: str = "ffrf",
 ) -> Scene:
-    """The paper's flexible slider-crank (section 5, Fig. 3; data in DESIGN.md section 3).
+    """The paper's flexible slider-crank (section 5, Fig. 3; data: :data:`ukflex.scenes.PAPER`).
 
     Rigid crank (mass ``rho a L``, inertia ``m L^2 / 12`` about its centre, body frame at the
     ground pivot, centre of mass ``(L/2, 0)``) driven at constant speed ``omega``; coupler = FFRF
@@ -228,15 +233,17 @@ def double_pendulum(
     return s
 
 
+@renamed_parameters(crank="crank_length", coupler="coupler_length", rocker="rocker_length", ground="ground_length",
+                    flexible_coupler="theory")
 def four_bar(
-    crank: float = 0.1,
-    coupler: float = 0.3,
-    rocker: float = 0.25,
-    ground: float = 0.3,
+    crank_length: float = 0.1,
+    coupler_length: float = 0.3,
+    rocker_length: float = 0.25,
+    ground_length: float = 0.3,
     crank_angle: float = math.pi / 2,
     omega: Optional[float] = 10.0,
     gravity: Any = True,
-    flexible_coupler: Optional[str] = None,
+    theory: Optional[str] = None,
     elements: int = 2,
 ) -> Scene:
     """Four-bar linkage (Grashof crank-rocker for the defaults), rigid or with a flexible coupler.
@@ -248,11 +255,15 @@ def four_bar(
 
     Parameters
     ----------
-    flexible_coupler : {None, "timoshenko", "euler-bernoulli"}
-        Model the coupler as a pinned-pinned steel beam (rectangular 10 x 5 mm section).
+    crank_length, coupler_length, rocker_length, ground_length : float
+        Link lengths [m] (deprecated aliases: ``crank``, ``coupler``, ``rocker``, ``ground``).
+    theory : {None, "timoshenko", "euler-bernoulli"}
+        ``None``: rigid coupler; else the coupler is a pinned-pinned steel beam (rectangular
+        10 x 5 mm section) with ``elements`` elements of this theory (deprecated alias:
+        ``flexible_coupler``).
     """
     s = Scene(gravity=gravity_vector(gravity))
-    a, b, c, d = crank, coupler, rocker, ground
+    a, b, c, d = crank_length, coupler_length, rocker_length, ground_length
     A = (a * math.cos(crank_angle), a * math.sin(crank_angle))
     # B: |B - A| = b, |B - D| = c, D = (d, 0); take the intersection above the line A-D
     D = (d, 0.0)
@@ -274,7 +285,7 @@ def four_bar(
         angle=crank_angle,
         angular_velocity=omega or 0.0,
     )
-    if flexible_coupler is None:
+    if theory is None:
         cp = s.rigid_body(
             "coupler", mass=m_per_length * b, inertia=m_per_length * b**3 / 12, com=(b / 2, 0), position=A, angle=th_b
         )
@@ -285,14 +296,14 @@ def four_bar(
             "coupler",
             length=b,
             elements=elements,
-            theory=flexible_coupler,
+            theory=theory,
             section=Rectangular(0.01, 0.005),
             density=STEEL["density"],
             youngs_modulus=STEEL["youngs_modulus"],
             frame="pinned-pinned",
             position=A,
             angle=th_b,
-            **(kw if flexible_coupler == "timoshenko" else {}),
+            **(kw if theory == "timoshenko" else {}),
         )
         cp_start, cp_end = cp.at(0.0), cp.at(1.0)
     rk = s.rigid_body(
@@ -316,18 +327,22 @@ def cantilever(
     tip_force: Tuple[float, float] = (0.0, 0.0),
     damping: float = 0.0,
     strain: Optional[str] = None,
-    **material,
+    *,
+    density: float = STEEL["density"],
+    youngs_modulus: float = STEEL["youngs_modulus"],
+    poisson_ratio: float = STEEL["poisson_ratio"],
+    shear_factor: float = STEEL["shear_factor"],
 ) -> Scene:
     """Horizontal cantilever: a beam along +X, clamped frame, welded to the ground at ``xi = 0``.
 
     Loaded by its weight (``gravity``) and a constant ``tip_force`` [N] at ``xi = 1``.  Default
-    section: rectangular 20 x 10 mm steel (``material`` overrides ``density``,
-    ``youngs_modulus``, ``poisson_ratio``, ``shear_factor``).  Static tip deflection under a tip
+    section: rectangular 20 x 10 mm steel (``density``, ``youngs_modulus``, ``poisson_ratio``,
+    ``shear_factor`` change the material).  Static tip deflection under a tip
     load ``P``: ``P L^3 / (3 E I)`` (linear theory; ``strain`` defaults to the core's
     ``"nonlinear"``, which settles at the same deflection to second order).
     """
-    mat = dict(STEEL)
-    mat.update(material)
+    mat = {"density": density, "youngs_modulus": youngs_modulus, "poisson_ratio": poisson_ratio,
+           "shear_factor": shear_factor}
     s = Scene(gravity=gravity_vector(gravity))
     kw = {}
     if theory == "timoshenko":
@@ -450,3 +465,16 @@ SCENES: Dict[str, Callable[..., Scene]] = {
     "pinned_beam": pinned_beam,
     "every_joint": every_joint,
 }
+
+
+def scene_parameters(fn: Callable[..., Scene]) -> List[Tuple[str, Any, List[str]]]:
+    """``[(name, default, deprecated aliases)]`` of a scene function's parameters (``ukflex list``)."""
+    import inspect
+
+    renamed: Dict[str, str] = getattr(fn, "__renamed_parameters__", {})
+    out = []
+    for p in inspect.signature(fn).parameters.values():
+        if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
+            continue
+        out.append((p.name, p.default, [old for old, new in renamed.items() if new == p.name]))
+    return out

@@ -198,48 +198,13 @@ class System:
             self.description = description.to_dict()
         else:
             raise TypeError(f"System needs a Scene or a description dict, got {type(description).__name__}")
-        core = _core.System(json.dumps(self.description))
-        self.core = core
-
-        # hot per-step methods: the compiled object's bound methods, no Python layer
-        self.rhs = core.rhs
-        self.qdd = core.qdd
-        self.M = core.M
-        self.Q = core.Q
-        self.phi = core.phi
-        self.A = core.A
-        self.phi_t = core.phi_t
-        self.b = core.b
-        self.multipliers = core.multipliers
-        self.residuals = core.residuals
-        self.rank = core.rank
-        self.beam_shape = core.beam_shape
-        self.beam_point = core.beam_point
-        self.tangent_stiffness = core.tangent_stiffness
-        self.kinetic_energy = core.kinetic_energy
-        self.potential_energy = core.potential_energy
-        # Jacobian of rhs, d[qd, qdd]/d[q, qd], shape (2n, 2n): finite differences in Rust (GIL released)
-        self.jac = core.jac
-        # solver settings, diagnostics and native integration (the compiled object's methods)
-        self.set_stabilization = core.set_stabilization
-        self.set_rank_tolerance = core.set_rank_tolerance
-        self.set_pseudoinverse = core.set_pseudoinverse
-        self.rank_info = core.rank_info
-        self.project = core.project
-        self.integrate = core.integrate
-        # benchmark helper: seconds per Rust UK call (minimum over batches, GIL released)
-        self.time_acceleration = core.time_acceleration
-
-        self.n_coords: int = int(core.n_coords)
-        self.n_constraints: int = int(core.n_constraints)
-        self.body_names: List[str] = list(core.body_names)
-        self.body_slices: Dict[str, Tuple[int, int]] = {k: (int(v[0]), int(v[1])) for k, v in dict(core.body_slices).items()}
-        self.coordinate_names: List[str] = list(core.coordinate_names)
-        self.constraint_names: List[str] = list(core.constraint_names)
-        self.body_kind = core.body_kind
-        self.body_info = core.body_info
-        self.axial_forces = core.axial_forces
-
+        self._build_options: Dict[str, Any] = {
+            "correct": correct, "hold": hold if hold is None or isinstance(hold, str) else list(hold),
+            "position_tol": position_tol, "velocity_tol": velocity_tol, "max_iterations": max_iterations, "t0": t0,
+        }
+        self._settings: Dict[str, tuple] = {}
+        self._bind(_core.System(json.dumps(self.description)))
+        core = self.core
         self.t0 = float(t0)
         q_guess, qd_guess = core.initial_guess()
         self.q_guess = np.asarray(q_guess, dtype=float)
@@ -267,6 +232,88 @@ class System:
                 0, rp, rp, rv, rv, np.zeros(self.n_coords), np.zeros(self.n_coords), [], self.coordinate_names
             )
         self._check_resolution(self.q0)
+
+    def _bind(self, core: Any) -> None:
+        """Attach the compiled object and its bound per-step methods (no Python layer per call)."""
+        self.core = core
+
+        # hot per-step methods: the compiled object's bound methods, no Python layer
+        self.rhs = core.rhs
+        self.qdd = core.qdd
+        self.M = core.M
+        self.Q = core.Q
+        self.phi = core.phi
+        self.A = core.A
+        self.phi_t = core.phi_t
+        self.b = core.b
+        self.multipliers = core.multipliers
+        self.residuals = core.residuals
+        self.rank = core.rank
+        self.beam_shape = core.beam_shape
+        self.beam_point = core.beam_point
+        self.tangent_stiffness = core.tangent_stiffness
+        self.kinetic_energy = core.kinetic_energy
+        self.potential_energy = core.potential_energy
+        # Jacobian of rhs, d[qd, qdd]/d[q, qd], shape (2n, 2n): finite differences in Rust (GIL released)
+        self.jac = core.jac
+        # solver settings, diagnostics and native integration (the compiled object's methods)
+        self.rank_info = core.rank_info
+        self.project = core.project
+        self.integrate = core.integrate
+        # benchmark helper: seconds per Rust UK call (minimum over batches, GIL released)
+        self.time_acceleration = core.time_acceleration
+
+        self.n_coords: int = int(core.n_coords)
+        self.n_constraints: int = int(core.n_constraints)
+        self.body_names: List[str] = list(core.body_names)
+        self.body_slices: Dict[str, Tuple[int, int]] = {k: (int(v[0]), int(v[1])) for k, v in dict(core.body_slices).items()}
+        self.coordinate_names: List[str] = list(core.coordinate_names)
+        self.constraint_names: List[str] = list(core.constraint_names)
+        self.body_kind = core.body_kind
+        self.body_info = core.body_info
+        self.axial_forces = core.axial_forces
+
+    # ------------------------------------------------------------------------------ settings
+    def set_stabilization(self, *args: Any) -> None:
+        """Constraint stabilization of the UK accelerations (core ``set_stabilization``)."""
+        self.core.set_stabilization(*args)
+        self._settings["set_stabilization"] = args
+
+    def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None:
+        """Drop singular values of ``A F^-T`` at or below ``max(atol, rcond sigma_max)``."""
+        self.core.set_rank_tolerance(rcond, atol)
+        self._settings["set_rank_tolerance"] = (rcond, atol)
+
+    def set_pseudoinverse(self, kind: str = "auto") -> None:
+        """Pseudoinverse backend: ``"auto"``, ``"qr-jacobi"`` or ``"faer"``."""
+        self.core.set_pseudoinverse(kind)
+        self._settings["set_pseudoinverse"] = (kind,)
+
+    # ------------------------------------------------------------------------------ pickling
+    def __getstate__(self) -> Dict[str, Any]:
+        """The description, build options, solver settings and the initial state (not the compiled
+        object: :meth:`__setstate__` rebuilds it from the description)."""
+        return {
+            "description": self.description,
+            "build_options": self._build_options,
+            "settings": self._settings,
+            "t0": self.t0,
+            "q_guess": self.q_guess,
+            "qd_guess": self.qd_guess,
+            "q0": self.q0,
+            "qd0": self.qd0,
+            "initial_correction": self.initial_correction,
+        }
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        self.description = state["description"]
+        self._build_options = dict(state["build_options"])
+        self._settings = {}
+        self._bind(_core.System(json.dumps(self.description)))
+        for name, args in state["settings"].items():
+            getattr(self, name)(*args)
+        for key in ("t0", "q_guess", "qd_guess", "q0", "qd0", "initial_correction"):
+            setattr(self, key, state[key])
 
     # ------------------------------------------------------------------------------ info
     @property

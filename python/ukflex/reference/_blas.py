@@ -1,64 +1,61 @@
-"""Limit OpenBLAS to one thread while the reference integrates (small matrices).
+"""Limit the threads of the BLAS libraries NumPy/SciPy loaded (threadpoolctl, optional).
 
-The reference works with matrices of size ~10-50. On a loaded machine, multithreaded
-OpenBLAS makes a 6x6 solve or a 30x30 eigh 10-100x slower than single-threaded (measured:
-``scipy.linalg.lu_solve`` 6x6: 10 us with one thread, 440 us with two on a busy 2-core box).
-This context manager finds the OpenBLAS libraries already loaded by NumPy/SciPy
-(``/proc/self/maps``) and sets their thread count to 1, restoring it on exit. Best effort:
-silently does nothing where that is not possible.
+The NumPy reference and the Python side of a run work with small matrices (~10-50): on a loaded
+machine a multithreaded BLAS makes a 6x6 solve or a 30x30 ``eigh`` 10-100x slower than a single
+thread (measured: ``scipy.linalg.lu_solve`` 6x6: 10 us with one thread, 440 us with two on a busy
+2-core box), and in a parameter sweep every worker process would otherwise start one BLAS thread
+per core.  :func:`blas_threads` uses ``threadpoolctl`` (``pip install ukflex[sweep]`` or
+``threadpoolctl`` alone) on every platform; without it the context does nothing.  It lives in the
+reference package because the reference may import nothing else of ukflex; :func:`ukflex.sweep`
+uses it too.
 """
+
+from __future__ import annotations
+
 import contextlib
-import ctypes
+from typing import Any, Iterator, Optional
 
-_LIBS = None
+__all__ = ["blas_threads", "have_threadpoolctl", "single_blas_thread"]
+
+_CONTROLLER: Any = None
 
 
-def _openblas_libs():
-    global _LIBS
-    if _LIBS is not None:
-        return _LIBS
-    libs = []
+def have_threadpoolctl() -> bool:
+    """Whether ``threadpoolctl`` is importable (so that :func:`blas_threads` acts)."""
     try:
-        with open("/proc/self/maps") as fh:
-            paths = {line.split()[-1] for line in fh if "openblas" in line.lower() and "/" in line}
-        for p in sorted(paths):
-            try:
-                lib = ctypes.CDLL(p)
-            except OSError:
-                continue
-            for sfx in ("scipy_openblas_{}_num_threads64_", "scipy_openblas_{}_num_threads",
-                        "openblas_{}_num_threads"):
-                try:
-                    get = getattr(lib, sfx.format("get"))
-                    set_ = getattr(lib, sfx.format("set"))
-                except AttributeError:
-                    continue
-                get.restype = ctypes.c_int
-                set_.argtypes = [ctypes.c_int]
-                libs.append((get, set_))
-                break
-    except OSError:
-        pass
-    _LIBS = libs
-    return libs
+        import threadpoolctl  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _controller() -> Any:
+    """One ``ThreadpoolController`` per process (finding the libraries costs ~1 ms)."""
+    global _CONTROLLER
+    if _CONTROLLER is None:
+        import numpy  # noqa: F401  (make sure the libraries are loaded before they are listed)
+        import scipy.linalg  # noqa: F401
+        from threadpoolctl import ThreadpoolController
+
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER
 
 
 @contextlib.contextmanager
-def single_blas_thread():
-    import numpy  # noqa: F401  (make sure the libraries are loaded)
-    import scipy.linalg  # noqa: F401
-    saved = []
-    for get, set_ in _openblas_libs():
-        try:
-            saved.append((set_, int(get())))
-            set_(1)
-        except Exception:  # pragma: no cover
-            pass
-    try:
+def blas_threads(n: Optional[int] = 1) -> Iterator[None]:
+    """Within the context, BLAS libraries use at most ``n`` threads (``None``: leave them alone).
+
+    Restores the previous limits on exit.  Without ``threadpoolctl`` it does nothing.
+    """
+    if n is None or not have_threadpoolctl():
         yield
-    finally:
-        for set_, n in saved:
-            try:
-                set_(n)
-            except Exception:  # pragma: no cover
-                pass
+        return
+    with _controller().limit(limits=int(n), user_api="blas"):
+        yield
+
+
+@contextlib.contextmanager
+def single_blas_thread() -> Iterator[None]:
+    """BLAS limited to one thread inside the context."""
+    with blas_threads(1):
+        yield

@@ -853,11 +853,9 @@ COLORS = {"linear-ffrf": "tab:gray", "nonlinear-ffrf": "tab:blue", "nonlinear-ff
 
 
 def _figure(w: float = 7.0, h: float = 4.2, rows: int = 1, cols: int = 1, **kw):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from ..plotting import figure
 
-    fig = Figure(figsize=(w, h), dpi=90)
-    FigureCanvasAgg(fig)
+    fig = figure((w, h), "the geometric study's plots (--no-plot skips them)", dpi=90)
     axes = fig.subplots(rows, cols, squeeze=False, **kw)
     return fig, axes
 

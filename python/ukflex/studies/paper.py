@@ -166,11 +166,9 @@ def run_fig4(
 
 def _plot_fig4(path: str, t: np.ndarray, curves: Dict[str, np.ndarray], elements: int, gravity: bool,
                method: str = "", rtol: float = float("nan")) -> None:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from ..plotting import figure
 
-    fig = Figure(figsize=(7.0, 4.2))
-    FigureCanvasAgg(fig)
+    fig = figure((7.0, 4.2), "Fig. 4 (--no-plot skips it)")
     ax = fig.add_subplot(1, 1, 1)
     ax.plot(t, curves["euler-bernoulli"], "-", lw=1.2, label="Euler-Bernoulli")
     ax.plot(t, curves["timoshenko"], "--", lw=1.2, label="Timoshenko")

@@ -518,11 +518,9 @@ _FORM_STYLE = {"uk": ("-", "o"), "uk-numpy": ("--", "s"), "cp": (":", "^"), "nat
 
 
 def _figure(size):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from ..plotting import figure
 
-    fig = Figure(figsize=size)
-    FigureCanvasAgg(fig)
+    fig = figure(size, "the work-precision plot (--no-plot skips it)")
     return fig
 
 

@@ -1,0 +1,326 @@
+"""Parameter sweeps: one simulation per case, serial, on a local process pool or on Dask.
+
+:func:`sweep` runs ``build(**case)`` -> simulate -> ``outputs(result)`` for every case of a grid
+and returns a pandas DataFrame with one row per case.  The same call runs
+
+* ``executor="serial"``: in this process, one case after the other;
+* ``executor="processes"``: on a local pool of ``workers`` processes
+  (:class:`concurrent.futures.ProcessPoolExecutor`);
+* ``executor=client``: on a Dask ``distributed.Client`` -- a ``LocalCluster`` on this machine,
+  or the scheduler of a real cluster (the same code; the workers need ukflex installed).
+
+``build`` and ``outputs`` may be lambdas or closures: they are sent to the workers with
+``cloudpickle`` (installed with Dask).  A case that raises (a bad parameter, an inconsistent
+initial state, a solver failure) becomes a row with ``status = "failed"`` and its message in
+``error``; it never aborts the sweep.  Needs the ``sweep`` extra:
+``pip install ukflex[sweep]`` (dask[distributed], pandas, tqdm, threadpoolctl).  See
+docs/sweeps.md.
+"""
+
+from __future__ import annotations
+
+import itertools
+import numbers
+import os
+import pickle
+import sys
+import time
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+__all__ = ["sweep", "cases_of", "RESERVED_COLUMNS"]
+
+#: Columns :func:`sweep` adds to the case parameters and outputs.
+RESERVED_COLUMNS = ("status", "error", "wall_time", "method", "solver_status")
+
+Grid = Union[Mapping[str, Any], Sequence[Mapping[str, Any]]]
+
+
+def _need(module: str, what: str) -> Any:
+    from .plotting import require  # the one place that names a missing optional dependency
+
+    return require(module, what, extra="sweep")
+
+
+def cases_of(grid: Grid) -> List[Dict[str, Any]]:
+    """The list of cases (keyword dicts for ``build``) of a grid.
+
+    ``grid`` is a dict of lists (the full factorial, in ``itertools.product`` order: the last key
+    varies fastest; a value that is not a list/tuple/array is a fixed parameter) or a list of case
+    dicts (taken as they are).
+    """
+    if isinstance(grid, Mapping):
+        if not grid:
+            raise ValueError("sweep: the grid is empty (give a dict of lists or a list of case dicts)")
+        keys = list(grid)
+        values = []
+        for k in keys:
+            if not isinstance(k, str) or not k.isidentifier():
+                raise ValueError(f"sweep: grid keys must be keyword names, got {k!r}")
+            v = grid[k]
+            if isinstance(v, (list, tuple, range)) or type(v).__name__ == "ndarray":
+                v = list(v)
+                if not v:
+                    raise ValueError(f"sweep: grid[{k!r}] is an empty list")
+            else:
+                v = [v]
+            values.append(v)
+        cases = [dict(zip(keys, combo)) for combo in itertools.product(*values)]
+    elif isinstance(grid, (list, tuple)):
+        cases = []
+        for i, c in enumerate(grid):
+            if not isinstance(c, Mapping):
+                raise TypeError(f"sweep: case {i} must be a dict of keyword arguments, got {type(c).__name__}")
+            cases.append(dict(c))
+        if not cases:
+            raise ValueError("sweep: the list of cases is empty")
+    else:
+        raise TypeError(f"sweep: grid must be a dict of lists or a list of dicts, got {type(grid).__name__}")
+    for c in cases:
+        bad = [k for k in c if k in RESERVED_COLUMNS]
+        if bad:
+            raise ValueError(f"sweep: case parameter name(s) {bad} clash with the result columns {RESERVED_COLUMNS}")
+    return cases
+
+
+# ----------------------------------------------------------------------------------- one case
+def _scalar(name: str, v: Any) -> Any:
+    if isinstance(v, (bool, str)) or v is None:
+        return v
+    if isinstance(v, numbers.Integral):
+        return int(v)
+    if isinstance(v, numbers.Real):
+        return float(v)
+    if getattr(v, "shape", None) == () and hasattr(v, "item"):
+        return v.item()
+    raise TypeError(f"output {name!r} must be a scalar (number, bool or str), got {type(v).__name__}")
+
+
+def run_case(build: Callable[..., Any], outputs: Callable[[Any], Mapping[str, Any]], case: Dict[str, Any],
+             defaults: Dict[str, Any], blas: Optional[int] = 1) -> Dict[str, Any]:
+    """One case: ``build(**case)`` -> :func:`ukflex.simulate` -> ``outputs(result)``, as a row dict.
+
+    Never raises for a problem of the case itself: it is reported in ``status``/``error``.
+    """
+    from .reference._blas import blas_threads
+    from .simulate import simulate
+
+    row: Dict[str, Any] = dict(case)
+    tic = time.perf_counter()
+    try:
+        with blas_threads(blas):
+            built = build(**case)
+            options = dict(defaults)
+            if isinstance(built, tuple):
+                if len(built) != 2 or not isinstance(built[1], Mapping):
+                    raise TypeError("build must return a Scene/System or (Scene/System, dict of simulate options)")
+                built, extra = built
+                options.update(extra)
+            if "t_end" not in options:
+                raise TypeError("no t_end: give sweep(..., t_end=...) or return (scene, {'t_end': ...}) from build")
+            t_end = options.pop("t_end")
+            res = simulate(built, t_end, **options)
+            out = outputs(res)
+            if not isinstance(out, Mapping):
+                raise TypeError(f"outputs must return a dict of scalars, got {type(out).__name__}")
+            for k, v in out.items():
+                if k in row or k in RESERVED_COLUMNS:
+                    raise ValueError(f"output name {k!r} clashes with a case parameter or a result column")
+                row[k] = _scalar(k, v)
+        row["status"] = "ok" if res.success else "unfinished"
+        row["error"] = "" if res.success else f"solver status {res.status}: {res.message}"
+        row["method"] = str(res.method)
+        row["solver_status"] = int(res.status)
+    except Exception as exc:  # a failed case is a row, never the end of the sweep
+        row["status"] = "failed"
+        row["error"] = f"{type(exc).__name__}: {exc}".splitlines()[0] if str(exc) else type(exc).__name__
+        row["method"] = ""
+        row["solver_status"] = None
+    row["wall_time"] = time.perf_counter() - tic
+    return row
+
+
+_WORKER_FUNCS: Dict[bytes, Tuple[Callable[..., Any], Callable[..., Any]]] = {}
+
+
+def _run_chunk(payload: bytes, chunk: List[Tuple[int, Dict[str, Any]]], defaults: Dict[str, Any],
+               blas: Optional[int]) -> List[Tuple[int, Dict[str, Any]]]:
+    """Worker entry (process pool and Dask): ``payload`` is ``cloudpickle.dumps((build, outputs))``,
+    unpickled once per worker process; ``chunk`` is a list of ``(case index, case)``."""
+    funcs = _WORKER_FUNCS.get(payload)
+    if funcs is None:
+        _WORKER_FUNCS.clear()
+        funcs = _WORKER_FUNCS[payload] = pickle.loads(payload)
+    return [(i, run_case(funcs[0], funcs[1], case, defaults, blas)) for i, case in chunk]
+
+
+def _failed_row(case: Dict[str, Any], exc: BaseException) -> Dict[str, Any]:
+    row = dict(case)
+    row.update(status="failed", error=f"{type(exc).__name__}: {exc}".splitlines()[0], method="",
+               solver_status=None, wall_time=float("nan"))
+    return row
+
+
+# ----------------------------------------------------------------------------------- executors
+def _progress_bar(total: int, progress: Optional[bool], label: str) -> Any:
+    if progress is None:
+        progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    if not progress:
+        return None
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        return None
+    return tqdm(total=total, desc=label, unit="case", file=sys.stderr)
+
+
+def _chunks(cases: List[Dict[str, Any]], nworkers: int, chunksize: Optional[int]) -> List[List[Tuple[int, Dict[str, Any]]]]:
+    if chunksize is None:
+        chunksize = min(64, max(1, -(-len(cases) // (8 * nworkers))))
+    elif int(chunksize) < 1:
+        raise ValueError(f"sweep: chunksize must be >= 1, got {chunksize!r}")
+    indexed = list(enumerate(cases))
+    return [indexed[k:k + int(chunksize)] for k in range(0, len(indexed), int(chunksize))]
+
+
+def _collect(rows: List[Optional[Dict[str, Any]]], chunk: List[Tuple[int, Dict[str, Any]]], fut: Any,
+             cases: List[Dict[str, Any]], bar: Any) -> None:
+    """Store a finished task's rows; a lost worker (BrokenProcessPool, KilledWorker) fails its cases."""
+    try:
+        for i, row in fut.result():
+            rows[i] = row
+    except Exception as exc:
+        for i, _ in chunk:
+            rows[i] = _failed_row(cases[i], exc)
+    if bar is not None:
+        bar.update(len(chunk))
+
+
+def _is_dask_client(executor: Any) -> bool:
+    return type(executor).__module__.split(".")[0] == "distributed" and hasattr(executor, "submit")
+
+
+def _payload(build: Callable[..., Any], outputs: Callable[..., Any]) -> bytes:
+    try:
+        import cloudpickle
+
+        return cloudpickle.dumps((build, outputs))
+    except ImportError:
+        try:
+            return pickle.dumps((build, outputs))
+        except Exception as exc:
+            raise TypeError(f"build/outputs cannot be pickled for worker processes ({exc}); define them at module "
+                            "level or install cloudpickle (it comes with dask)") from None
+
+
+def sweep(
+    build: Callable[..., Any],
+    grid: Grid,
+    outputs: Callable[[Any], Mapping[str, Any]],
+    executor: Any = "serial",
+    *,
+    workers: Optional[int] = None,
+    chunksize: Optional[int] = None,
+    progress: Optional[bool] = None,
+    blas_threads: Optional[int] = 1,
+    **simulate_options: Any,
+) -> Any:
+    """Simulate every case of ``grid`` and collect scalar outputs in a DataFrame.
+
+    Parameters
+    ----------
+    build : callable
+        ``build(**case)`` returns what :func:`ukflex.simulate` takes (a Scene, description dict
+        or System), or a pair ``(scene, options)`` whose dict of :func:`ukflex.simulate` options
+        (``t_end``, ``method``, ``rtol``, ``t_eval``, ...) overrides ``simulate_options``.
+    grid : dict of lists, or list of dicts
+        Dict: the full factorial of its value lists (:func:`cases_of`); list: the cases.
+    outputs : callable
+        ``outputs(result)`` -> dict ``{name: scalar}`` from a
+        :class:`ukflex.SimulationResult`.
+    executor : "serial", "processes" or a dask ``distributed.Client``
+        Where the cases run (see the module docs).
+    workers : int, optional
+        Processes of the ``"processes"`` pool (default ``os.cpu_count()``).
+    chunksize : int, optional
+        Cases per task sent to a worker (process pool and Dask); default: about 8 tasks per
+        worker, at most 64 cases each (fewer round trips for short cases, still balanced).
+    progress : bool, optional
+        A tqdm progress bar on stderr; default: only when stderr is a terminal (and tqdm is
+        installed).
+    blas_threads : int or None
+        BLAS threads per case (threadpoolctl; default 1, so that workers do not oversubscribe
+        the cores); ``None`` leaves BLAS alone.
+    **simulate_options
+        Defaults for :func:`ukflex.simulate` (``t_end`` is required here or from ``build``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per case, in case order: the case parameters, the outputs, ``status``
+        (``"ok"``; ``"unfinished"``: the integrator stopped early, outputs computed from what it
+        returned; ``"failed"``: an exception, no outputs), ``error`` (one line), ``method`` (the
+        integrator, useful with ``method="auto"``), ``solver_status`` and ``wall_time`` (seconds
+        for build + simulate + outputs in the worker).  ``df.attrs`` holds ``executor``,
+        ``workers``, ``wall_time`` (the whole sweep) and ``failed`` (count).
+    """
+    pd = _need("pandas", "ukflex.sweep")
+    if not callable(build) or not callable(outputs):
+        raise TypeError("sweep: build and outputs must be callables")
+    cases = cases_of(grid)
+    blas = None if blas_threads is None else int(blas_threads)
+    if blas is not None and blas < 1:
+        raise ValueError(f"sweep: blas_threads must be >= 1 or None, got {blas_threads!r}")
+    rows: List[Optional[Dict[str, Any]]] = [None] * len(cases)
+    tic = time.perf_counter()
+
+    if isinstance(executor, str) and executor == "serial":
+        name, nworkers = "serial", 1
+        bar = _progress_bar(len(cases), progress, "sweep (serial)")
+        for i, case in enumerate(cases):
+            rows[i] = run_case(build, outputs, case, simulate_options, blas)
+            if bar is not None:
+                bar.update(1)
+    elif isinstance(executor, str) and executor == "processes":
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        nworkers = int(workers) if workers is not None else (os.cpu_count() or 1)
+        if nworkers < 1:
+            raise ValueError(f"sweep: workers must be >= 1, got {workers!r}")
+        name = "processes"
+        payload = _payload(build, outputs)
+        chunks = _chunks(cases, nworkers, chunksize)
+        bar = _progress_bar(len(cases), progress, f"sweep ({nworkers} processes)")
+        with ProcessPoolExecutor(max_workers=nworkers) as pool:
+            futures = {pool.submit(_run_chunk, payload, chunk, simulate_options, blas): chunk for chunk in chunks}
+            for fut in as_completed(futures):
+                _collect(rows, futures[fut], fut, cases, bar)
+    elif _is_dask_client(executor):
+        distributed = _need("distributed", "ukflex.sweep on Dask")
+        name = "dask"
+        nworkers = len(executor.scheduler_info().get("workers", {}))
+        payload = _payload(build, outputs)
+        [remote] = executor.scatter([payload], broadcast=True)
+        chunks = _chunks(cases, max(nworkers, 1), chunksize)
+        bar = _progress_bar(len(cases), progress, "sweep (dask)")
+        futures = [executor.submit(_run_chunk, remote, chunk, simulate_options, blas, pure=False) for chunk in chunks]
+        by_key = {f.key: chunk for f, chunk in zip(futures, chunks)}
+        try:
+            for fut in distributed.as_completed(futures):
+                _collect(rows, by_key[fut.key], fut, cases, bar)
+        finally:
+            executor.cancel([f for f in futures if not f.done()])
+    else:
+        raise ValueError(f"sweep: executor must be 'serial', 'processes' or a dask distributed Client, got {executor!r}")
+    if bar is not None:
+        bar.close()
+
+    columns: List[str] = []
+    for r in rows:
+        for k in r or {}:
+            if k not in columns and k not in RESERVED_COLUMNS:
+                columns.append(k)
+    df = pd.DataFrame(rows, columns=columns + list(RESERVED_COLUMNS))
+    df["solver_status"] = df["solver_status"].astype("Int64")  # None for failed cases
+    df.attrs.update(executor=name, workers=nworkers, wall_time=time.perf_counter() - tic,
+                    failed=int((df["status"] == "failed").sum()))
+    return df
