@@ -372,12 +372,21 @@ def _check_core(case: Dict[str, Any]) -> List[Finding]:
 _SYSTEMS: Dict[str, Any] = {}
 
 
+def _ancf_cantilever():
+    uk = _ukflex()
+    s = uk.Scene(gravity=(0.0, -9.81))
+    b = s.beam("beam", length=1.0, section=uk.Rectangular(0.02, 0.01), density=7850.0, youngs_modulus=2.1e11,
+               elements=2, formulation="ancf")
+    s.weld(s.ground.frame(), b.at(0.0), name="clamp")
+    return s
+
+
 def _system(name: str):
     if name not in _SYSTEMS:
         uk = _ukflex()
         scene = {"slider_crank": lambda: uk.scenes.slider_crank(elements=2),
                  "pendulum": lambda: uk.scenes.pendulum(),
-                 "cantilever_ancf": lambda: uk.scenes.cantilever(elements=2, formulation="ancf"),
+                 "cantilever_ancf": _ancf_cantilever,
                  "every_joint": lambda: uk.scenes.every_joint()}[name]()
         _SYSTEMS[name] = uk.System(scene)
     return _SYSTEMS[name]
@@ -421,7 +430,9 @@ def _check_array(case: Dict[str, Any]) -> List[Finding]:
             return [] if _named(exc, [bad, f"'{bad}'"]) else [("unnamed-exception", _exc(exc))]
     v = args[bad]
     outs = out if isinstance(out, tuple) else (out,)
-    if _is_bad_input(v):
+    # the per-call methods take t as a C double, like float(): a Python bool is 0.0 / 1.0 there
+    # (simulate, the user-facing entry point, refuses booleans)
+    if _is_bad_input(v) and not (bad == "t" and isinstance(v, bool)):
         if isinstance(v, (list, tuple)) and all(isinstance(x, float) for x in v):
             pass  # a plain list of floats is fine
         else:

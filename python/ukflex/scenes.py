@@ -21,6 +21,7 @@ import numbers
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from ._deprecation import renamed_parameters
+from .errors import InvalidSceneError
 from .scene import Circular, ConstantSpeed, Harmonic, Polynomial, Rectangular, Scene
 
 __all__ = [
@@ -51,6 +52,38 @@ PAPER = {
 }
 
 STEEL = {"density": 7850.0, "youngs_modulus": 2.1e11, "poisson_ratio": 0.3, "shear_factor": 5.0 / 6.0}
+
+
+def _checked(fn: Callable[..., Scene]) -> Callable[..., Scene]:
+    """Check a built-in scene's numeric arguments (real, finite; integers where the default is one)
+    before the function computes with them, and name the scene and arguments when its arithmetic
+    fails (a zero length dividing, an overflow): a bad argument is a named error, never a bare
+    ``ZeroDivisionError`` or ``unsupported operand type``."""
+    import functools
+    import inspect
+
+    sig = inspect.signature(fn)
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Scene:
+        bound = sig.bind(*args, **kwargs)
+        for name, value in bound.arguments.items():
+            default = sig.parameters[name].default
+            if isinstance(default, bool) or not isinstance(default, (int, float)) or default is value:
+                continue
+            if isinstance(default, int) and not isinstance(value, numbers.Integral) or isinstance(value, bool):
+                raise TypeError(f"{fn.__name__}: {name} must be an integer, got {value!r}")
+            if not isinstance(value, numbers.Real):
+                raise TypeError(f"{fn.__name__}: {name} must be a real number, got {value!r}")
+            if isinstance(default, float) and not math.isfinite(float(value)):
+                raise ValueError(f"{fn.__name__}: {name} must be finite, got {value!r}")
+        try:
+            return fn(*args, **kwargs)
+        except (ZeroDivisionError, OverflowError) as exc:
+            given = ", ".join(f"{k}={v!r}" for k, v in bound.arguments.items())
+            raise InvalidSceneError(f"{fn.__name__}({given}): {exc}") from exc
+
+    return wrapper
 
 
 def gravity_vector(gravity: Any) -> Optional[Tuple[float, float]]:
@@ -89,6 +122,7 @@ def _round_beam(s: Scene, name: str, length: float, elements: int, theory: str, 
 
 
 @renamed_parameters(beam="theory")
+@_checked
 def slider_crank(
     theory: Optional[str] = None,
     elements: int = 1,
@@ -182,6 +216,7 @@ def slider_crank(
 
 
 @renamed_parameters(g="gravity")
+@_checked
 def pendulum(
     length: float = 1.0,
     mass: float = 1.0,
@@ -213,6 +248,7 @@ def pendulum(
 
 
 @renamed_parameters(g="gravity")
+@_checked
 def double_pendulum(
     lengths: Tuple[float, float] = (1.0, 0.7),
     masses: Tuple[float, float] = (1.0, 0.5),
@@ -235,6 +271,7 @@ def double_pendulum(
 
 @renamed_parameters(crank="crank_length", coupler="coupler_length", rocker="rocker_length", ground="ground_length",
                     flexible_coupler="theory")
+@_checked
 def four_bar(
     crank_length: float = 0.1,
     coupler_length: float = 0.3,
@@ -318,6 +355,7 @@ def four_bar(
     return s
 
 
+@_checked
 def cantilever(
     length: float = 1.0,
     elements: int = 4,
@@ -366,6 +404,7 @@ def cantilever(
     return s
 
 
+@_checked
 def pinned_beam(
     length: float = PAPER["coupler_length"],
     elements: int = 1,
@@ -392,6 +431,7 @@ def pinned_beam(
     return s
 
 
+@_checked
 def every_joint(gravity: Any = True) -> Scene:
     """A scene using every joint, driver and force kind, with rigid and beam bodies.
 
