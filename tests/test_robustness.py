@@ -86,3 +86,15 @@ def test_mechanism_at_a_resolvable_offset_builds():
     s.revolute(s.ground.point(1e5, 0.0), link.point(-0.5, 0.0))
     system = s.build()
     assert system.q0[0] == pytest.approx(1e5 + 0.5)
+
+
+@pytest.mark.parametrize("kwargs, exc, match", [
+    (dict(coupler_length=0.0), InvalidSceneError, r"slider_crank\(coupler_length=0.0\)"),   # was ZeroDivisionError
+    (dict(coupler_length="abc"), TypeError, "coupler_length must be a real number"),
+    (dict(crank_length={"a": 1}), TypeError, "crank_length must be a real number"),
+    (dict(elements=1.5), TypeError, "elements must be an integer"),
+    (dict(omega=float("nan")), ValueError, "omega must be finite"),
+])
+def test_builtin_scene_arguments_are_checked_by_name(kwargs, exc, match):
+    with pytest.raises(exc, match=match):
+        scenes.slider_crank(**kwargs)
