@@ -103,3 +103,36 @@ def test_native_run_releases_the_gil():
         assert fut.result() == 0
     inside = sum(1 for t in stamps if box["t0"] < t < box["t1"])
     assert inside >= 3, f"main thread made {inside} iterations during a {box['t1'] - box['t0']:.3f} s native run"
+
+
+def test_concurrent_runs_with_different_settings_on_one_system_match_serial():
+    # issue 15: settings used to live on the shared System, so two threads with different
+    # stabilizations got each other's (35 of 40 scipy runs wrong here without the copy); stability.run
+    # now works on a copy
+    from ukflex import stability
+
+    shared = ukflex.System(ukflex.scenes.slider_crank(elements=2))
+    settings = [None, ("baumgarte", 50.0, 50.0), ("baumgarte", 500.0, 500.0), "projection"] * 2
+    te = np.linspace(0.0, 0.004, 5)
+
+    def run(st):
+        r = stability.run(shared, 0.004, "RK45", rtol=1e-6, t_eval=te, stabilization=st)  # rhs reads settings per call
+        return r.y
+
+    serial = [run(st) for st in settings]
+    with ThreadPoolExecutor(len(settings)) as ex:
+        threaded = list(ex.map(run, settings))
+    for a, b in zip(serial, threaded):
+        np.testing.assert_array_equal(a, b)
+    # and the shared System itself was not reconfigured
+    assert "set_stabilization" not in shared._settings
+
+
+def test_rank_info_with_a_state_is_that_states(system):
+    n = system.n_coords
+    states = _states(system)
+    serial = [system.rank_info(t, y[:n], y[n:]) for t, y in states]
+    with ThreadPoolExecutor(4) as ex:
+        threaded = list(ex.map(lambda s: system.rank_info(s[0], s[1][:n], s[1][n:]), states * 4))
+    for k, info in enumerate(threaded):
+        assert info == serial[k % len(states)]

@@ -208,6 +208,9 @@ def run(
         ``extra`` holds ``stabilization``, ``projections`` (scipy) and the native statistics.
     """
     system = as_system(scene_or_system)
+    if system is scene_or_system:
+        # never change the caller's System: another thread may be using it with other settings
+        system = system.copy()
     label, proj_tol, interval = _configure(system, stabilization, rank_tolerance, pseudoinverse)
     atol_v = 1e-3 * rtol if atol is None else float(atol)
     te = None if t_eval is None else np.asarray(t_eval, dtype=float)
@@ -299,9 +302,9 @@ def _run_scipy(system, t_end, method, rtol, atol, t_eval, proj_tol, interval, ma
             first = 0 if k == 0 else 1
             ts.extend(sol.t[first:])
             ys.extend(sol.y[:, first:].T)
-        else:
+        else:  # a segment without requested outputs gives an empty list from solve_ivp
             ts.extend(sol.t)
-            ys.extend(sol.y.T)
+            ys.extend(np.asarray(sol.y, dtype=float).reshape(len(y), -1).T)
         if sol.status < 0:
             status, message = -1, sol.message
             break
@@ -344,13 +347,15 @@ def rank_history(result: SimulationResult, rcond: Optional[float] = None, atol: 
     if m == 0:
         return {"rank": rank, "ratio": ratio, "dropped": dropped, "changes": changes, "full": 0, "min_rank": 0,
                 "closeness": np.zeros(nt), "max_closeness": 0.0}
-    # evaluate with the plain UK right-hand side (no Baumgarte term: the rank depends on q only)
+    # evaluate with the plain UK right-hand side (no Baumgarte term: the rank depends on q only),
+    # on a private copy: the result's System may be in use by other threads
+    s = s.copy()
+    s.set_stabilization("none")
     s.set_rank_tolerance(rcond, atol)
     prev = None
     closeness = np.zeros(nt)
     for k in range(nt):
-        s.qdd(result.t[k], result.q[k], result.qd[k])
-        info = s.rank_info()
+        info = s.rank_info(result.t[k], result.q[k], result.qd[k])
         rank[k] = int(info["rank"])
         ratio[k] = info["sigma_min_kept"] / info["sigma_max"] if info["sigma_max"] > 0 else 0.0
         dropped[k] = info["sigma_max_dropped"]

@@ -315,6 +315,16 @@ class System:
         for key in ("t0", "q_guess", "qd_guess", "q0", "qd0", "initial_correction"):
             setattr(self, key, state[key])
 
+    def copy(self) -> "System":
+        """An independent System: same description, build options, settings and initial state,
+        its own compiled object and workspace.  Settings (``set_stabilization``,
+        ``set_rank_tolerance``, ``set_pseudoinverse``) belong to a System object; threads that
+        need different settings at the same time each use their own copy (``stability.run`` and
+        ``stability.rank_history`` do this for you)."""
+        new = System.__new__(System)
+        new.__setstate__(self.__getstate__())
+        return new
+
     # ------------------------------------------------------------------------------ info
     @property
     def y0(self) -> np.ndarray:
