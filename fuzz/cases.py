@@ -623,7 +623,9 @@ def _thread_case(draw):
     return dict(system=draw(st.sampled_from(["slider_crank", "pendulum"])),
                 rtols=draw(st.lists(st.sampled_from([1e-4, 1e-6, 1e-8]), min_size=2, max_size=4)),
                 method=draw(st.sampled_from(["DOPRI5", "RADAU5", "GENALPHA"])),
-                seed=draw(st.integers(0, 2 ** 16)))
+                seed=draw(st.integers(0, 2 ** 16)),
+                settings=draw(st.lists(st.sampled_from([None, "projection", ("baumgarte", 50.0, 50.0),
+                                                        ("baumgarte", 500.0, 500.0)]), min_size=0, max_size=3)))
 
 
 def _check_threads(case: Dict[str, Any]) -> List[Finding]:
@@ -642,19 +644,23 @@ def _check_threads(case: Dict[str, Any]) -> List[Finding]:
         t, y = s
         return np.concatenate([system.rhs(t, y), system.multipliers(t, y[:n], y[n:])])
 
-    serial = [run(r) for r in case["rtols"]]
-    serial_calls = [calls(s) for s in states]
-    barrier = threading.Barrier(len(case["rtols"]) + len(states))
+    def configured(st):  # per-run settings on the shared System (stability.run must not leak them)
+        from ukflex import stability
+
+        return np.asarray(stability.run(system, 0.002, "RK45", rtol=1e-6, t_eval=te[:3], stabilization=st).y)
+
+    jobs = ([lambda r=r: run(r) for r in case["rtols"]] + [lambda s=s: calls(s) for s in states]
+            + [lambda st=st: configured(st) for st in case.get("settings", [])])
+    serial = [j() for j in jobs]
+    barrier = threading.Barrier(len(jobs))
 
     def job(k):
         barrier.wait()
-        if k < len(case["rtols"]):
-            return run(case["rtols"][k])
-        return calls(states[k - len(case["rtols"])])
+        return jobs[k]()
 
-    with ThreadPoolExecutor(len(case["rtols"]) + len(states)) as ex:
-        got = list(ex.map(job, range(len(case["rtols"]) + len(states))))
-    for k, ref in enumerate(serial + serial_calls):
+    with ThreadPoolExecutor(len(jobs)) as ex:
+        got = list(ex.map(job, range(len(jobs))))
+    for k, ref in enumerate(serial):
         if not np.array_equal(ref, got[k]):
             return [("wrong", f"threaded result {k} differs from serial (max diff {_max_abs(ref - got[k]):.3g})")]
     return []
