@@ -80,7 +80,15 @@ def _unresolved_positions() -> None:
     system_module.System._check_resolution = lambda self, q: None
 
 
+def _shared_settings() -> None:
+    """stability.run configuring the caller's System (settings shared across threads)."""
+    from ukflex import system as system_module
+
+    system_module.System.copy = lambda self: self
+
+
 REGRESSIONS: Dict[str, Tuple[str, Callable[[], None]]] = {
+    "shared-settings": ("threads", _shared_settings),
     "cli-tracebacks": ("cli", _cli_tracebacks),
     "lenient-arrays": ("arrays", _lenient_arrays),
     "nan-results": ("arrays", _nan_results),
