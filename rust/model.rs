@@ -157,6 +157,7 @@ fn describe(item: &str, e: serde_path_to_error::Error<serde_json::Error>) -> Err
         None => inner,
     }
     .replace('`', "'");
+    let msg = plain_words(&msg);
     // an unknown field names itself: the path of its parent is the context
     let path = if msg.starts_with("unknown field") {
         path.rsplit_once('.').map(|(p, _)| p.to_string()).unwrap_or_default()
@@ -168,6 +169,36 @@ fn describe(item: &str, e: serde_path_to_error::Error<serde_json::Error>) -> Err
     } else {
         Error::invalid(item, format!("{path}: {msg}"))
     }
+}
+
+/// serde's "invalid type: floating point '1e+30', expected usize" in the user's words:
+/// "expected a whole number >= 0, got 1e+30".
+fn plain_words(msg: &str) -> String {
+    let Some(rest) = msg.strip_prefix("invalid type: ").or_else(|| msg.strip_prefix("invalid value: ")) else {
+        return msg.to_string();
+    };
+    let Some((got, expected)) = rest.rsplit_once(", expected ") else {
+        return msg.to_string();
+    };
+    let got = if let Some(v) = got.strip_prefix("floating point ").or_else(|| got.strip_prefix("integer ")) {
+        v.trim_matches('\'').to_string()
+    } else if let Some(v) = got.strip_prefix("boolean ") {
+        v.trim_matches('\'').to_string()
+    } else if got == "sequence" {
+        "a list".to_string()
+    } else if got == "map" {
+        "a table".to_string()
+    } else {
+        got.to_string()
+    };
+    let expected = match expected {
+        "usize" | "u64" | "u32" | "u16" | "u8" => "a whole number >= 0 (small enough to count with)",
+        "f64" | "f32" => "a number",
+        "a sequence" => "a list",
+        "a boolean" => "true or false",
+        other => other,
+    };
+    format!("expected {expected}, got {got}")
 }
 
 /// A field path as the user wrote it: the variant keys that `to_external` introduced (the

@@ -98,3 +98,17 @@ def test_mechanism_at_a_resolvable_offset_builds():
 def test_builtin_scene_arguments_are_checked_by_name(kwargs, exc, match):
     with pytest.raises(exc, match=match):
         scenes.slider_crank(**kwargs)
+
+
+@pytest.mark.parametrize("field, value, match", [
+    ("elements", 10 ** 30, "elements: expected a whole number >= 0 .*got 1e\\+30"),  # was "invalid type: floating point"
+    ("density", "x", 'density: expected a number, got string "x"'),
+    ("density", True, "density: expected a number, got true"),
+])
+def test_type_errors_in_the_description_speak_the_users_words(field, value, match):
+    kwargs = dict(length=0.3, section=ukflex.Circular(0.006), density=7800.0, youngs_modulus=2e11, elements=2)
+    kwargs[field] = value
+    s = ukflex.Scene()
+    with pytest.raises(InvalidSceneError, match=match):
+        s.beam("b", **kwargs)
+        s.build()
