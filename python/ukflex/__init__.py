@@ -26,6 +26,7 @@ from .scene import (
     Circular,
     ConstantSpeed,
     CustomSection,
+    FlexibleBodyRef,
     GroundRef,
     Harmonic,
     Marker,
@@ -35,6 +36,7 @@ from .scene import (
     RigidBodyRef,
     Scene,
 )
+from .flexible import FlexibleData, InterfacePoint
 from .system import InitialCorrection, System
 from .results import SimulationResult
 from .simulate import simulate
@@ -48,6 +50,9 @@ __all__ = [
     "RigidBodyRef",
     "PointMassRef",
     "BeamRef",
+    "FlexibleBodyRef",
+    "FlexibleData",
+    "InterfacePoint",
     "GroundRef",
     "Circular",
     "Rectangular",

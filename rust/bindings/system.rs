@@ -755,6 +755,14 @@ impl PySystem {
                 d.set_item("axial_quadrature", "lobatto-3")?;
                 d.set_item("bending_quadrature", "gauss-2")?;
             }
+            BodyKind::Flexible(f) => {
+                d.set_item("markers", f.markers.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>())?;
+                d.set_item("strain", match f.strain {
+                    crate::description::Strain::Linear => "linear",
+                    crate::description::Strain::Nonlinear => "nonlinear",
+                })?;
+                d.set_item("damping", f.d_ff.is_some())?;
+            }
             BodyKind::PointMass(_) => {}
         }
         Ok(d)
