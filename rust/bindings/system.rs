@@ -626,7 +626,12 @@ impl PySystem {
                 beam.elastic_tangent(&qv[b.elastic_range()], &mut |i, j, v| k[(3 + i) * nb + 3 + j] += v);
                 k
             }
-            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam"))),
+            BodyKind::Flexible(flex) => {
+                let mut k = vec![0.0; nb * nb];
+                flex.elastic_tangent(&qv[b.elastic_range()], &mut |i, j, v| k[(3 + i) * nb + 3 + j] += v);
+                k
+            }
+            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam or a flexible body"))),
         };
         mat(py, k, nb, nb)
     }

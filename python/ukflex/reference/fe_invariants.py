@@ -36,14 +36,17 @@ def beam_shape(s: float, l: float, phi: float):
 
 def beam_invariants(length: float, elements: int, density: float, youngs_modulus: float, area: float,
                     second_moment: float, shear_stiffness: Optional[float] = None, rotary_inertia: bool = True,
-                    frame: str = "pinned-pinned", markers: Sequence[float] = (0.0, 1.0), order: int = 6) -> Dict[str, Any]:
+                    frame: str = "pinned-pinned", markers: Sequence[float] = (0.0, 1.0), order: int = 6,
+                    nonlinear: bool = False) -> Dict[str, Any]:
     """Invariants of a uniform beam of ``elements`` elements on its floating frame.
 
     ``shear_stiffness`` is ``k G`` (Timoshenko); ``None`` gives Euler-Bernoulli.  ``frame``:
     ``"pinned-pinned"`` removes ``u_1, v_1, v_N+1``, ``"clamped"`` ``u_1, v_1, psi_1``.
     ``markers``: abscissas ``xi`` of interface points (named ``"xi=<value>"``).  Returns a dict
     with the fields of a flexible body (``mass, inertia, com, s_bar, s_u0, s_ju0, s_tilde, m_ff,
-    m_ff_tr, k_ff, markers``).
+    m_ff_tr, k_ff, markers``; with ``nonlinear`` also ``k3``, ``k4``: the cubic and quartic
+    strain energy of the element-averaged second-order axial strain
+    ``eps = (u_2 - u_1) / l + int v'^2 dx / (2 l)``, ``U = E a l eps^2 / 2`` per element).
     """
     n = int(elements)
     l = length / n
@@ -84,6 +87,24 @@ def beam_invariants(length: float, elements: int, density: float, youngs_modulus
             k_full[ix] += wl * kk
     sel = np.ix_(keep, keep)
     com = (sx / mass, 0.0)
+    extra: Dict[str, Any] = {}
+    if nonlinear:
+        k3 = np.zeros((nd, nd, nd))
+        k4 = np.zeros((nd, nd, nd, nd))
+        for e in range(n):
+            dofs = np.arange(3 * e, 3 * e + 6)
+            bvec = np.zeros(6)
+            bvec[0], bvec[3] = -1.0 / l, 1.0 / l
+            gmat = np.zeros((6, 6))
+            for s, w in zip(sg, wg):
+                dnv = beam_shape(s, l, phi)[4]
+                gmat += w * l * np.outer(dnv, dnv)
+            t3 = ea * (np.einsum("i,jk->ijk", bvec, gmat) + np.einsum("j,ik->ijk", bvec, gmat) + np.einsum("k,ij->ijk", bvec, gmat))
+            t4 = ea / l * (np.einsum("ij,kl->ijkl", gmat, gmat) + np.einsum("ik,jl->ijkl", gmat, gmat)
+                           + np.einsum("il,jk->ijkl", gmat, gmat))
+            k3[np.ix_(dofs, dofs, dofs)] += t3
+            k4[np.ix_(dofs, dofs, dofs, dofs)] += t4
+        extra = dict(k3=k3[np.ix_(keep, keep, keep)], k4=k4[np.ix_(keep, keep, keep, keep)])
     out_markers = {}
     for xi in markers:
         t = xi * n
@@ -95,7 +116,7 @@ def beam_invariants(length: float, elements: int, density: float, youngs_modulus
         out_markers[f"xi={xi:g}"] = dict(point=(xi * length, 0.0), displacement=d[:, keep], rotation=r[keep])
     return dict(mass=mass, inertia=j0 - mass * com[0] ** 2, com=com, s_bar=s_bar[:, keep], s_u0=s_u0[keep],
                 s_ju0=s_ju0[keep], s_tilde=s_tilde[sel], m_ff=m_full[sel], m_ff_tr=m_tr[sel], k_ff=k_full[sel],
-                markers=out_markers)
+                markers=out_markers, **extra)
 
 
 def triangle_invariants(nodes: np.ndarray, triangles: np.ndarray, thickness: float, density: float,
