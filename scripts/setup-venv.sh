@@ -5,3 +5,5 @@ cd "$(dirname "$0")/.."
 [ -x .venv/bin/python ] || python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip
 .venv/bin/python -m pip install --quiet "maturin>=1.9.4,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" "pytest>=8" "tomli>=1.1; python_version < '3.11'"
+# the optional 'fe' extra (flexible bodies from planar meshes: ukflex.fe.from_mesh)
+.venv/bin/python -m pip install --quiet "scikit-fem>=9" "meshio>=5"

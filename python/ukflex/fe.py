@@ -33,7 +33,7 @@ import scipy.linalg as sla
 
 from .flexible import FlexibleData, InterfacePoint
 
-__all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices"]
+__all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices", "reduce"]
 
 Interface = Union[int, Sequence[int]]
 
@@ -245,3 +245,26 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
                       damping_ratio=damping_ratio)
     data.info.update(points=points, cells=np.asarray(cells))
     return data
+
+
+def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0) -> FlexibleData:
+    """Reduce a flexible body (e.g. nodal, with its frame fixed by reference conditions) to its
+    ``modes`` lowest eigenmodes of ``(K_ff, M_ff)``: every invariant is projected on the modal
+    basis (``k3``/``k4`` too).  ``info["frequencies"]`` holds the kept frequencies (rad/s)."""
+    k, m = np.asarray(data.k_ff, dtype=float), np.asarray(data.m_ff, dtype=float)
+    if not 1 <= modes <= k.shape[0]:
+        raise ValueError(f"modes must be in 1..{k.shape[0]}, got {modes}")
+    lam, p = sla.eigh(k, m, subset_by_index=[0, modes - 1])
+    proj = lambda a: None if a is None else p.T @ np.asarray(a, dtype=float) @ p  # noqa: E731
+    k3 = None if data.k3 is None else np.einsum("ijk,ia,jb,kc->abc", np.asarray(data.k3), p, p, p)
+    k4 = None if data.k4 is None else np.einsum("ijkl,ia,jb,kc,ld->abcd", np.asarray(data.k4), p, p, p, p)
+    w = np.sqrt(np.maximum(lam, 0.0))
+    d_ff = proj(data.d_ff)
+    if damping_ratio > 0.0:
+        d_ff = (d_ff if d_ff is not None else 0.0) + np.diag(2.0 * damping_ratio * w)
+    markers = {name: InterfacePoint(pt.point, np.asarray(pt.displacement) @ p, None if pt.rotation is None else np.asarray(pt.rotation) @ p)
+               for name, pt in data.markers.items()}
+    return FlexibleData(mass=data.mass, inertia=data.inertia, com=data.com, s_bar=np.asarray(data.s_bar) @ p,
+                        s_u0=p.T @ np.asarray(data.s_u0), s_ju0=p.T @ np.asarray(data.s_ju0), s_tilde=proj(data.s_tilde),
+                        m_ff=np.eye(modes), k_ff=np.diag(lam), d_ff=d_ff, m_ff_tr=proj(data.m_ff_tr), k3=k3, k4=k4,
+                        markers=markers, info={"frequencies": w, "modes": p})
