@@ -90,7 +90,7 @@ def crank_state(system: Any, y: np.ndarray) -> tuple:
     """ukflex ``(q, qd)`` of the Test Set's ``y = (p, q, p_t, q_t)`` (14 components): the rod's
     frame sits at the crank pin, the slider on the x axis."""
     p, v = y[:7], y[7:14]
-    n = system.core.n_coords
+    n = np.asarray(system.q0).size
     q, qd = np.zeros(n), np.zeros(n)
     idx = system.coordinate_index
     c1, s1 = np.cos(p[0]), np.sin(p[0])
