@@ -608,7 +608,7 @@ impl PySystem {
     /// Tangent stiffness -dQ_el/dq_b of a beam's elastic forces at q (n,), shape (n_b, n_b) over
     /// the body's coordinates: ANCF beam: the analytic K_t = d2U/dq_b2 (undamped); FFRF beam:
     /// the elastic block, K_ff plus, with nonlinear strain, the geometric and second-order axial
-    /// stiffness of its averaged axial strain.
+    /// stiffness of its averaged axial strain; flexible body: K_ff + k3 q_f + k4 q_f q_f / 2.
     fn tangent_stiffness<'py>(&self, py: Python<'py>, body: &str, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let bi = self.body(body)?;
         let b = &self.model.bodies[bi];
