@@ -11,7 +11,7 @@ stiffness without rigid-body modes, markers that fit.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -138,7 +138,3 @@ class FlexibleData:
 
 def arr_or_none(v: Optional[Sequence[float]]) -> Optional[np.ndarray]:
     return None if v is None else np.asarray(v, dtype=float)
-
-
-def _marker_names(d: Dict[str, Any]) -> List[str]:
-    return [m["name"] for m in d.get("markers", [])]
