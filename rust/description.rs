@@ -92,6 +92,7 @@ pub enum BodyDesc {
     Rigid(RigidDesc),
     Beam(BeamDesc),
     PointMass(PointMassDesc),
+    Flexible(FlexibleDesc),
 }
 
 impl BodyDesc {
@@ -100,6 +101,7 @@ impl BodyDesc {
             BodyDesc::Rigid(r) => &r.name,
             BodyDesc::Beam(b) => &b.name,
             BodyDesc::PointMass(p) => &p.name,
+            BodyDesc::Flexible(f) => &f.name,
         }
     }
 
@@ -109,8 +111,78 @@ impl BodyDesc {
             BodyDesc::Rigid(_) => "rigid",
             BodyDesc::Beam(_) => "beam",
             BodyDesc::PointMass(_) => "point_mass",
+            BodyDesc::Flexible(_) => "flexible",
         }
     }
+}
+
+/// A general planar FFRF body given by its inertia invariants and elastic matrices (body frame,
+/// `n_f` elastic coordinates; `rust/body/modal.rs`, docs/flexible-bodies.md). Matrices are lists
+/// of rows.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlexibleDesc {
+    pub name: String,
+    pub mass: f64,
+    /// Moment of inertia of the undeformed body about its centre of mass.
+    pub inertia: f64,
+    /// Centre of mass of the undeformed body in the body frame.
+    #[serde(default)]
+    pub com: Vec2,
+    /// `S_bar = int rho S dV` (2 x n_f).
+    pub s_bar: Vec<Vec<f64>>,
+    /// `int rho S^T u0 dV` (n_f).
+    pub s_u0: Vec<f64>,
+    /// `int rho S^T J u0 dV` (n_f), `J` the +90 deg turn (plus any rotary part).
+    pub s_ju0: Vec<f64>,
+    /// `S_tilde = int rho S^T I~ S dV` (n_f x n_f, antisymmetric): `S_u,i S_v,j - S_v,i S_u,j`.
+    pub s_tilde: Vec<Vec<f64>>,
+    /// Elastic mass block `M_ff` (n_f x n_f, symmetric positive definite).
+    pub m_ff: Vec<Vec<f64>>,
+    /// `int rho S^T S dV`, the part of `M_ff` in `m_thetatheta` and the centrifugal forces
+    /// (default `M_ff`; differs from it by rotary inertia).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub m_ff_tr: Option<Vec<Vec<f64>>>,
+    /// Stiffness `K_ff` (n_f x n_f, symmetric positive definite: no rigid-body modes).
+    pub k_ff: Vec<Vec<f64>>,
+    /// Damping `D_ff` (n_f x n_f, symmetric positive semi-definite).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d_ff: Option<Vec<Vec<f64>>>,
+    /// Default linear; `nonlinear` adds the strain energy `k3 q q q / 6 (+ k4 q q q q / 24)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub strain: Option<Strain>,
+    /// Third-order stiffness tensor (n_f^3, row-major, symmetric), with `strain = nonlinear`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k3: Option<Vec<f64>>,
+    /// Fourth-order stiffness tensor (n_f^4, row-major, symmetric), optional.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k4: Option<Vec<f64>>,
+    /// Interface points: markers on this body are given by one of these points.
+    pub markers: Vec<FlexibleMarkerDesc>,
+    #[serde(default)]
+    pub position: Vec2,
+    #[serde(default)]
+    pub angle: f64,
+    #[serde(default)]
+    pub velocity: Vec2,
+    #[serde(default)]
+    pub angular_velocity: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elastic: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elastic_rates: Option<Vec<f64>>,
+}
+
+/// An interface point of a flexible body: undeformed position, the rows of its displacement
+/// `u = D q_f` (2 x n_f) and, optionally, of its rotation `psi = r . q_f` (n_f).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlexibleMarkerDesc {
+    pub name: String,
+    pub point: Vec2,
+    pub displacement: Vec<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation: Option<Vec<f64>>,
 }
 
 /// A particle: coordinates `(x, y)`, no orientation.

@@ -84,6 +84,7 @@ impl Model {
         self.bodies.iter().any(|b| match &b.kind {
             BodyKind::Beam(beam) => beam.damping > 0.0,
             BodyKind::AncfBeam(cable) => cable.damping > 0.0,
+            BodyKind::Flexible(f) => f.d_ff.is_some(),
             BodyKind::Rigid(_) | BodyKind::PointMass(_) => false,
         })
     }

@@ -30,6 +30,7 @@ from .scene import (
     ConstantSpeed,
     CustomSection,
     Expression,
+    FlexibleBodyRef,
     GroundRef,
     Harmonic,
     Marker,
@@ -40,6 +41,7 @@ from .scene import (
     Scene,
     Spline,
 )
+from .flexible import FlexibleData, InterfacePoint
 from .system import InitialCorrection, System
 from .results import SimulationResult
 from .simulate import simulate
@@ -64,6 +66,9 @@ __all__ = [
     "RigidBodyRef",
     "PointMassRef",
     "BeamRef",
+    "FlexibleBodyRef",
+    "FlexibleData",
+    "InterfacePoint",
     "GroundRef",
     "Circular",
     "Rectangular",

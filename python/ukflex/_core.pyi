@@ -73,7 +73,7 @@ class System:
         """Constant elastic blocks (M_ff, K_ff) of beam ``body``, each (n_f, n_f); ANCF: the
         constant mass matrix and the stiffness at the undeformed guess, each (n_b, n_b)."""
     def tangent_stiffness(self, body: str, q: _F64) -> _F64:
-        """-dQ_el/dq_b of beam ``body``'s elastic forces at q (n,), shape (n_b, n_b)."""
+        """-dQ_el/dq_b of beam or flexible body ``body``'s elastic forces at q (n,), shape (n_b, n_b)."""
     def beam_point(self, body: str, xi: float, q: _F64) -> _F64:
         """Columns x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
         the ends), psi of the axis point at xi; shape (5,) for q (n,), (nt, 5) for q (nt, n)."""

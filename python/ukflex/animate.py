@@ -78,6 +78,14 @@ class MechanismDrawer:
                 info = system.body_info(name)
                 self._length[name] = float(info["length"])
                 self._cable_xi[name] = np.linspace(0.0, 1.0, max(2, points_per_element * int(info["elements"])) + 1)
+        # flexible bodies: drawn through their interface points (declaration order, closed),
+        # each with its displacement rows
+        self._flex: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
+        for b in desc["bodies"]:
+            if b.get("kind") == "flexible" and b["markers"]:
+                pts = np.array([m["point"] for m in b["markers"]], dtype=float)
+                disp = np.array([m["displacement"] for m in b["markers"]], dtype=float)  # (k, 2, n_f)
+                self._flex[b["name"]] = (pts, disp)
         self._marker_S: Dict[int, np.ndarray] = {}
         for i, (_, m, _) in enumerate(self.markers):
             body = m["body"]
@@ -122,6 +130,10 @@ class MechanismDrawer:
         r, R = self._frame(q, name)
         if self.bodies[name] == "point_mass":
             return r[None, :]
+        if self.bodies[name] == "flexible":
+            pts, disp = self._flex[name]
+            local = pts + self.scale * (disp @ q[self.system.elastic_slice(name)])
+            return r + np.vstack([local, local[:1]]) @ R.T
         if self.bodies[name] == "beam":
             x, S = self._beam_S[name]
             disp = S @ q[self.system.elastic_slice(name)]  # (k, 2)
@@ -149,6 +161,10 @@ class MechanismDrawer:
         if self.bodies[body] == "ancf_beam":
             return self._cable_points(q, body, [float(m["xi"])])[0]
         r, R = self._frame(q, body)
+        if self.bodies[body] == "flexible":
+            pts, disp = self._flex[body]
+            k = int(np.argmin(np.sum((pts - np.asarray(m["point"], dtype=float)) ** 2, axis=1)))
+            return r + R @ (pts[k] + self.scale * disp[k] @ q[self.system.elastic_slice(body)])
         if i in self._marker_S:
             d = self._marker_S[i] @ q[self.system.elastic_slice(body)]
             local = np.array([m["xi"] * self._length[body] + self.scale * d[0], self.scale * d[1]])

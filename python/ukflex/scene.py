@@ -37,6 +37,7 @@ __all__ = [
     "RigidBodyRef",
     "BeamRef",
     "PointMassRef",
+    "FlexibleBodyRef",
     "GroundRef",
     "Circular",
     "Rectangular",
@@ -315,8 +316,33 @@ class BeamRef(BodyRef):
         return int(self._scene._info(self.name)["n_f"])
 
 
+class FlexibleBodyRef(BodyRef):
+    """Handle to a flexible body (:meth:`Scene.flexible_body`): ``marker(name)`` is one of its
+    interface points."""
+
+    kind = "flexible"
+
+    def marker(self, name: str, angle: float = 0.0) -> Marker:
+        """Marker at the interface point ``name``; its world angle is ``theta + angle + psi``
+        (``psi`` its elastic rotation, if the body gives one)."""
+        for m in self._scene._body(self.name)["markers"]:
+            if m["name"] == name:
+                return Marker(self.name, point=(float(m["point"][0]), float(m["point"][1])), angle=float(angle))
+        names = [m["name"] for m in self._scene._body(self.name)["markers"]]
+        raise InvalidSceneError(f"flexible body {self.name!r} has no interface point {name!r}; its points are {names}")
+
+    @property
+    def marker_names(self) -> List[str]:
+        return [m["name"] for m in self._scene._body(self.name)["markers"]]
+
+    @property
+    def n_f(self) -> int:
+        """Number of elastic coordinates."""
+        return int(self._scene._info(self.name)["n_f"])
+
+
 MarkerLike = Union[Marker, Dict[str, Any]]
-_REFS = {"rigid": RigidBodyRef, "beam": BeamRef, "ancf_beam": BeamRef, "point_mass": PointMassRef}
+_REFS = {"rigid": RigidBodyRef, "beam": BeamRef, "ancf_beam": BeamRef, "point_mass": PointMassRef, "flexible": FlexibleBodyRef}
 
 
 # --------------------------------------------------------------------------------------------
@@ -522,6 +548,47 @@ class Scene:
                         rotary_inertia=rotary_inertia, elastic=elastic, elastic_rates=elastic_rates))
         d["formulation"] = formulation  # the core records it only when it is not the default
         return self._add_body(d)
+
+    def flexible_body(
+        self,
+        name: str,
+        data: Any,
+        *,
+        strain: Optional[str] = None,
+        position: Sequence[float] = (0.0, 0.0),
+        angle: float = 0.0,
+        velocity: Sequence[float] = (0.0, 0.0),
+        angular_velocity: float = 0.0,
+        elastic: Optional[Sequence[float]] = None,
+        elastic_rates: Optional[Sequence[float]] = None,
+    ) -> FlexibleBodyRef:
+        """Add a general flexible body on a floating frame (FFRF) given by its invariants.
+
+        Parameters
+        ----------
+        name : str
+            Unique body name.
+        data : ukflex.FlexibleData or dict
+            Mass, inertia, centre of mass, shape integrals, ``m_ff``, ``k_ff`` (optional ``d_ff``,
+            ``k3``/``k4``) and interface points (docs/flexible-bodies.md).  The builders of
+            :mod:`ukflex.fe` compute it from finite-element data.
+        strain : {"linear", "nonlinear"}, optional
+            Default (the core's) ``"linear"``; ``"nonlinear"`` adds the strain energy of the
+            stiffness tensors ``k3`` (and ``k4``) of ``data``.
+        position, angle, velocity, angular_velocity
+            Initial guess of the floating frame.
+        elastic, elastic_rates : (n_f,) sequence, optional
+            Initial elastic coordinates and rates (default zeros).
+
+        Returns
+        -------
+        FlexibleBodyRef
+        """
+        fields = data.to_dict() if hasattr(data, "to_dict") else dict(data)
+        d = dict(name=name, kind="flexible", **fields)
+        d.update(position=position, angle=angle, velocity=velocity, angular_velocity=angular_velocity)
+        d.update(_given(strain=strain, elastic=elastic, elastic_rates=elastic_rates))
+        return self._add_body(d)  # type: ignore[return-value]
 
     # ----------------------------------------------------------------------------- joints
     def revolute(self, a: MarkerLike, b: MarkerLike, name: Optional[str] = None) -> str:

@@ -638,7 +638,7 @@ impl PySystem {
     /// Tangent stiffness -dQ_el/dq_b of a beam's elastic forces at q (n,), shape (n_b, n_b) over
     /// the body's coordinates: ANCF beam: the analytic K_t = d2U/dq_b2 (undamped); FFRF beam:
     /// the elastic block, K_ff plus, with nonlinear strain, the geometric and second-order axial
-    /// stiffness of its averaged axial strain.
+    /// stiffness of its averaged axial strain; flexible body: K_ff + k3 q_f + k4 q_f q_f / 2.
     fn tangent_stiffness<'py>(&self, py: Python<'py>, body: &str, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let bi = self.body(body)?;
         let b = &self.model.bodies[bi];
@@ -656,7 +656,12 @@ impl PySystem {
                 beam.elastic_tangent(&qv[b.elastic_range()], &mut |i, j, v| k[(3 + i) * nb + 3 + j] += v);
                 k
             }
-            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam"))),
+            BodyKind::Flexible(flex) => {
+                let mut k = vec![0.0; nb * nb];
+                flex.elastic_tangent(&qv[b.elastic_range()], &mut |i, j, v| k[(3 + i) * nb + 3 + j] += v);
+                k
+            }
+            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam or a flexible body"))),
         };
         mat(py, k, nb, nb)
     }
@@ -865,6 +870,14 @@ impl PySystem {
                 d.set_item("damping", cable.damping)?;
                 d.set_item("axial_quadrature", "lobatto-3")?;
                 d.set_item("bending_quadrature", "gauss-2")?;
+            }
+            BodyKind::Flexible(f) => {
+                d.set_item("markers", f.markers.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>())?;
+                d.set_item("strain", match f.strain {
+                    crate::description::Strain::Linear => "linear",
+                    crate::description::Strain::Nonlinear => "nonlinear",
+                })?;
+                d.set_item("damping", f.d_ff.is_some())?;
             }
             BodyKind::PointMass(_) => {}
         }

@@ -181,6 +181,8 @@ const TRANSVERSE: [usize; 4] = [1, 2, 4, 5];
 #[derive(Debug, Clone, Default)]
 pub struct PointShape {
     pub x: f64,
+    /// Undeformed body-frame `y` (0 on a beam axis; interface points of flexible bodies).
+    pub y: f64,
     pub entries: Vec<(usize, f64, f64, f64)>,
 }
 
@@ -422,7 +424,7 @@ impl Beam {
                 }
             }
         }
-        PointShape { x: xi * self.length, entries }
+        PointShape { x: xi * self.length, y: 0.0, entries }
     }
 }
 
@@ -459,7 +461,7 @@ pub struct BeamData {
 }
 
 #[inline]
-fn dot(x: &[f64], y: &[f64]) -> f64 {
+pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(p, q)| p * q).sum()
 }
 
@@ -488,22 +490,7 @@ impl Beam {
     }
 
     pub fn new_data(&self) -> BeamData {
-        let (mut a, mut b) = (self.s_bar[0].clone(), self.s_bar[1].clone());
-        self.l_ff.solve_lower(&mut a);
-        self.l_ff.solve_lower(&mut b);
-        let nf = self.n_f;
-        BeamData {
-            m_rr: [[0.0; 3]; 3],
-            cs: [1.0, 0.0],
-            m_thf: vec![0.0; nf],
-            ab: [dot(&a, &a), dot(&a, &b), dot(&b, &b)],
-            a,
-            b,
-            x2: vec![0.0; nf],
-            ls: [[0.0; 3]; 3],
-            w: vec![0.0; nf],
-            axial_force: vec![0.0; self.elements],
-        }
+        BeamData::new(&self.s_bar, &self.l_ff, self.elements)
     }
 
     /// Nodal dofs `(u_j, v_j, psi_j, u_j+1, v_j+1, psi_j+1)` of element `el` from `q_f`
@@ -725,130 +712,33 @@ impl Beam {
         }
     }
 
-    /// `M_b = F_b F_b^T` in the order `[r; f]`: `F_b = [[L_s, X], [0, L_ff]]` with the constant
-    /// `L_ff L_ff^T = M_ff`, `X = M_rf L_ff^-T` and `L_s L_s^T = m_rr - X X^T`. A call costs one
-    /// banded solve (`X_2`), three dot products and a 3x3 Cholesky.
     #[inline]
     pub fn factor(&self, bd: &mut BeamData) -> bool {
-        let mut ls = bd.m_rr;
-        bd.x2.copy_from_slice(&bd.m_thf);
-        self.l_ff.solve_lower(&mut bd.x2);
-        let (mut ax, mut bx, mut xx) = (0.0, 0.0, 0.0);
-        for ((x, a), bb) in bd.x2.iter().zip(&bd.a).zip(&bd.b) {
-            ax += a * x;
-            bx += bb * x;
-            xx += x * x;
-        }
-        let [c, s] = bd.cs;
-        let [aa, ab, bb] = bd.ab;
-        ls[0][0] -= c * c * aa - 2.0 * c * s * ab + s * s * bb;
-        ls[1][0] -= s * c * (aa - bb) + (c * c - s * s) * ab;
-        ls[1][1] -= s * s * aa + 2.0 * s * c * ab + c * c * bb;
-        ls[2][0] -= c * ax - s * bx;
-        ls[2][1] -= s * ax + c * bx;
-        ls[2][2] -= xx;
-        let ok = cholesky3(&mut ls);
-        bd.ls = ls;
-        ok
+        frame_factor(&self.l_ff, bd)
     }
 
-    /// `v <- F^-1 v`: `v_f <- L_ff^-1 v_f`, `v_r <- L_s^-1 (v_r - X v_f)`.
     #[inline]
     pub fn finv(&self, bd: &BeamData, v: &mut [f64]) {
-        let (vr, vf) = v.split_at_mut(3);
-        self.l_ff.solve_lower(vf);
-        let (mut pa, mut pb, mut px) = (0.0, 0.0, 0.0);
-        for (((f, a), bb), x) in vf.iter().zip(&bd.a).zip(&bd.b).zip(&bd.x2) {
-            pa += a * f;
-            pb += bb * f;
-            px += x * f;
-        }
-        let [c, s] = bd.cs;
-        vr[0] -= c * pa - s * pb;
-        vr[1] -= s * pa + c * pb;
-        vr[2] -= px;
-        solve_lower3(&bd.ls, vr);
+        frame_finv(&self.l_ff, bd, v)
     }
 
-    /// `v <- F^-T v`: `v_r <- L_s^-T v_r`, `v_f <- L_ff^-T (v_f - X^T v_r)`.
     #[inline]
     pub fn finvt(&self, bd: &BeamData, v: &mut [f64]) {
-        let (vr, vf) = v.split_at_mut(3);
-        solve_upper3(&bd.ls, vr);
-        let [c, s] = bd.cs;
-        // X^T v_r = (c v0 + s v1) a + (-s v0 + c v1) b + v2 X_2
-        let (ka, kb, kx) = (c * vr[0] + s * vr[1], -s * vr[0] + c * vr[1], vr[2]);
-        for (((f, a), bb), x) in vf.iter_mut().zip(&bd.a).zip(&bd.b).zip(&bd.x2) {
-            *f -= ka * a + kb * bb + kx * x;
-        }
-        self.l_ff.solve_upper(vf);
-    }
-
-    /// `M_Rf = A S_bar` entry `(i, j)`, `i` in 0..3 (row 2: `m_thetaf`).
-    #[inline]
-    fn m_rf(&self, bd: &BeamData, i: usize, j: usize) -> f64 {
-        let [c, s] = bd.cs;
-        match i {
-            0 => c * self.s_bar[0][j] - s * self.s_bar[1][j],
-            1 => s * self.s_bar[0][j] + c * self.s_bar[1][j],
-            _ => bd.m_thf[j],
-        }
+        frame_finvt(&self.l_ff, bd, v)
     }
 
     /// `out += M_b x` from the blocks (`x`, `out`: the body's segments).
     pub fn mass_times(&self, bd: &BeamData, x: &[f64], out: &mut [f64]) {
-        let (xr, xf) = x.split_at(3);
-        let (or, of) = out.split_at_mut(3);
-        let [c, s] = bd.cs;
-        let (s0, s1, t) = (dot(&self.s_bar[0], xf), dot(&self.s_bar[1], xf), dot(&bd.m_thf, xf));
-        for i in 0..3 {
-            or[i] += bd.m_rr[i][0] * xr[0] + bd.m_rr[i][1] * xr[1] + bd.m_rr[i][2] * xr[2];
-        }
-        or[0] += c * s0 - s * s1;
-        or[1] += s * s0 + c * s1;
-        or[2] += t;
-        let (ka, kb) = (c * xr[0] + s * xr[1], -s * xr[0] + c * xr[1]);
-        for (((o, a), b), m) in of.iter_mut().zip(&self.s_bar[0]).zip(&self.s_bar[1]).zip(&bd.m_thf) {
-            *o += ka * a + kb * b + xr[2] * m;
-        }
-        self.m_ff.mul_add(1.0, xf, of);
+        frame_mass_times(&self.s_bar, &self.m_ff, bd, x, out)
     }
 
     pub fn dense_block(&self, bd: &BeamData, put: &mut impl FnMut(usize, usize, f64)) {
-        let nf = self.n_f;
-        for i in 0..3 {
-            for j in 0..3 {
-                put(i, j, bd.m_rr[i][j]);
-            }
-            for j in 0..nf {
-                let v = self.m_rf(bd, i, j);
-                put(i, 3 + j, v);
-                put(3 + j, i, v);
-            }
-        }
-        for i in 0..nf {
-            for j in i.saturating_sub(self.m_ff.hb)..(i + self.m_ff.hb + 1).min(nf) {
-                put(3 + i, 3 + j, self.m_ff.get(i, j));
-            }
-        }
+        frame_dense_block(&self.s_bar, &self.m_ff, bd, put)
     }
 
     /// `1/2 qd^T M_b qd` from the blocks (no dense matrix).
     pub fn kinetic_energy(&self, bd: &BeamData, qd: &[f64]) -> f64 {
-        let (qr, qf) = qd.split_at(3);
-        let mut e = 0.0;
-        for i in 0..3 {
-            for j in 0..3 {
-                e += qr[i] * bd.m_rr[i][j] * qr[j];
-            }
-            let mut cross = 0.0;
-            for (j, v) in qf.iter().enumerate() {
-                cross += self.m_rf(bd, i, j) * v;
-            }
-            e += 2.0 * qr[i] * cross;
-        }
-        e += self.m_ff.bilinear(qf, qf);
-        0.5 * e
+        frame_kinetic_energy(&self.s_bar, &self.m_ff, bd, qd)
     }
 
     /// `1/2 q_f^T K_ff q_f`, plus `E a l (eps^2 - eps_lin^2) / 2` per element with nonlinear
@@ -902,11 +792,167 @@ impl Beam {
     }
 }
 
-/// Axis point: body-frame position `(x + u, v)`, elastic velocity, rotation `psi`.
+// ------------------------------------------------------------------------------------------
+// The block factor and products of an FFRF body with a constant elastic mass block, shared by
+// the beam and the general flexible body (`modal.rs`): they read only `S_bar`, `M_ff`, its
+// Cholesky factor and the per-call blocks in `BeamData`.
+// ------------------------------------------------------------------------------------------
+
+impl BeamData {
+    /// Workspace of an FFRF body with `S_bar` and `L_ff L_ff^T = M_ff` (`elements`: length of
+    /// `axial_force`, 0 for a body without elements).
+    pub fn new(s_bar: &[Vec<f64>; 2], l_ff: &BandedCholesky, elements: usize) -> BeamData {
+        let (mut a, mut b) = (s_bar[0].clone(), s_bar[1].clone());
+        l_ff.solve_lower(&mut a);
+        l_ff.solve_lower(&mut b);
+        let nf = a.len();
+        BeamData {
+            m_rr: [[0.0; 3]; 3],
+            cs: [1.0, 0.0],
+            m_thf: vec![0.0; nf],
+            ab: [dot(&a, &a), dot(&a, &b), dot(&b, &b)],
+            a,
+            b,
+            x2: vec![0.0; nf],
+            ls: [[0.0; 3]; 3],
+            w: vec![0.0; nf],
+            axial_force: vec![0.0; elements],
+        }
+    }
+}
+
+/// `M_b = F_b F_b^T` in the order `[r; f]`: `F_b = [[L_s, X], [0, L_ff]]` with the constant
+/// `L_ff L_ff^T = M_ff`, `X = M_rf L_ff^-T` and `L_s L_s^T = m_rr - X X^T`. A call costs one
+/// banded solve (`X_2`), three dot products and a 3x3 Cholesky.
+#[inline]
+pub(crate) fn frame_factor(l_ff: &BandedCholesky, bd: &mut BeamData) -> bool {
+    let mut ls = bd.m_rr;
+    bd.x2.copy_from_slice(&bd.m_thf);
+    l_ff.solve_lower(&mut bd.x2);
+    let (mut ax, mut bx, mut xx) = (0.0, 0.0, 0.0);
+    for ((x, a), bb) in bd.x2.iter().zip(&bd.a).zip(&bd.b) {
+        ax += a * x;
+        bx += bb * x;
+        xx += x * x;
+    }
+    let [c, s] = bd.cs;
+    let [aa, ab, bb] = bd.ab;
+    ls[0][0] -= c * c * aa - 2.0 * c * s * ab + s * s * bb;
+    ls[1][0] -= s * c * (aa - bb) + (c * c - s * s) * ab;
+    ls[1][1] -= s * s * aa + 2.0 * s * c * ab + c * c * bb;
+    ls[2][0] -= c * ax - s * bx;
+    ls[2][1] -= s * ax + c * bx;
+    ls[2][2] -= xx;
+    let ok = cholesky3(&mut ls);
+    bd.ls = ls;
+    ok
+}
+
+/// `v <- F^-1 v`: `v_f <- L_ff^-1 v_f`, `v_r <- L_s^-1 (v_r - X v_f)`.
+#[inline]
+pub(crate) fn frame_finv(l_ff: &BandedCholesky, bd: &BeamData, v: &mut [f64]) {
+    let (vr, vf) = v.split_at_mut(3);
+    l_ff.solve_lower(vf);
+    let (mut pa, mut pb, mut px) = (0.0, 0.0, 0.0);
+    for (((f, a), bb), x) in vf.iter().zip(&bd.a).zip(&bd.b).zip(&bd.x2) {
+        pa += a * f;
+        pb += bb * f;
+        px += x * f;
+    }
+    let [c, s] = bd.cs;
+    vr[0] -= c * pa - s * pb;
+    vr[1] -= s * pa + c * pb;
+    vr[2] -= px;
+    solve_lower3(&bd.ls, vr);
+}
+
+/// `v <- F^-T v`: `v_r <- L_s^-T v_r`, `v_f <- L_ff^-T (v_f - X^T v_r)`.
+#[inline]
+pub(crate) fn frame_finvt(l_ff: &BandedCholesky, bd: &BeamData, v: &mut [f64]) {
+    let (vr, vf) = v.split_at_mut(3);
+    solve_upper3(&bd.ls, vr);
+    let [c, s] = bd.cs;
+    // X^T v_r = (c v0 + s v1) a + (-s v0 + c v1) b + v2 X_2
+    let (ka, kb, kx) = (c * vr[0] + s * vr[1], -s * vr[0] + c * vr[1], vr[2]);
+    for (((f, a), bb), x) in vf.iter_mut().zip(&bd.a).zip(&bd.b).zip(&bd.x2) {
+        *f -= ka * a + kb * bb + kx * x;
+    }
+    l_ff.solve_upper(vf);
+}
+
+/// `M_Rf = A S_bar` entry `(i, j)`, `i` in 0..3 (row 2: `m_thetaf`).
+#[inline]
+fn frame_m_rf(s_bar: &[Vec<f64>; 2], bd: &BeamData, i: usize, j: usize) -> f64 {
+    let [c, s] = bd.cs;
+    match i {
+        0 => c * s_bar[0][j] - s * s_bar[1][j],
+        1 => s * s_bar[0][j] + c * s_bar[1][j],
+        _ => bd.m_thf[j],
+    }
+}
+
+/// `out += M_b x` from the blocks (`x`, `out`: the body's segments).
+pub(crate) fn frame_mass_times(s_bar: &[Vec<f64>; 2], m_ff: &Banded, bd: &BeamData, x: &[f64], out: &mut [f64]) {
+    let (xr, xf) = x.split_at(3);
+    let (or, of) = out.split_at_mut(3);
+    let [c, s] = bd.cs;
+    let (s0, s1, t) = (dot(&s_bar[0], xf), dot(&s_bar[1], xf), dot(&bd.m_thf, xf));
+    for i in 0..3 {
+        or[i] += bd.m_rr[i][0] * xr[0] + bd.m_rr[i][1] * xr[1] + bd.m_rr[i][2] * xr[2];
+    }
+    or[0] += c * s0 - s * s1;
+    or[1] += s * s0 + c * s1;
+    or[2] += t;
+    let (ka, kb) = (c * xr[0] + s * xr[1], -s * xr[0] + c * xr[1]);
+    for (((o, a), b), m) in of.iter_mut().zip(&s_bar[0]).zip(&s_bar[1]).zip(&bd.m_thf) {
+        *o += ka * a + kb * b + xr[2] * m;
+    }
+    m_ff.mul_add(1.0, xf, of);
+}
+
+/// Visit the entries of `M_b` (body coordinates).
+pub(crate) fn frame_dense_block(s_bar: &[Vec<f64>; 2], m_ff: &Banded, bd: &BeamData, put: &mut impl FnMut(usize, usize, f64)) {
+    let nf = s_bar[0].len();
+    for i in 0..3 {
+        for j in 0..3 {
+            put(i, j, bd.m_rr[i][j]);
+        }
+        for j in 0..nf {
+            let v = frame_m_rf(s_bar, bd, i, j);
+            put(i, 3 + j, v);
+            put(3 + j, i, v);
+        }
+    }
+    for i in 0..nf {
+        for j in i.saturating_sub(m_ff.hb)..(i + m_ff.hb + 1).min(nf) {
+            put(3 + i, 3 + j, m_ff.get(i, j));
+        }
+    }
+}
+
+/// `1/2 qd^T M_b qd` from the blocks (no dense matrix).
+pub(crate) fn frame_kinetic_energy(s_bar: &[Vec<f64>; 2], m_ff: &Banded, bd: &BeamData, qd: &[f64]) -> f64 {
+    let (qr, qf) = qd.split_at(3);
+    let mut e = 0.0;
+    for i in 0..3 {
+        for j in 0..3 {
+            e += qr[i] * bd.m_rr[i][j] * qr[j];
+        }
+        let mut cross = 0.0;
+        for (j, v) in qf.iter().enumerate() {
+            cross += frame_m_rf(s_bar, bd, i, j) * v;
+        }
+        e += 2.0 * qr[i] * cross;
+    }
+    e += m_ff.bilinear(qf, qf);
+    0.5 * e
+}
+
+/// Marker point: body-frame position `(x + u, y + v)`, elastic velocity, rotation `psi`.
 #[inline]
 pub fn marker_state(ps: &PointShape, angle: f64, q: &[f64], qd: &[f64]) -> MarkerState {
     let (qf, qfd) = (&q[3..], &qd[3..]);
-    let (mut pl, mut vl, mut psi, mut psid) = ([ps.x, 0.0], [0.0; 2], 0.0, 0.0);
+    let (mut pl, mut vl, mut psi, mut psid) = ([ps.x, ps.y], [0.0; 2], 0.0, 0.0);
     for &(i, su, sv, sp) in &ps.entries {
         pl[0] += su * qf[i];
         pl[1] += sv * qf[i];

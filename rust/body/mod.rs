@@ -10,11 +10,13 @@
 
 pub mod ancf_cable;
 pub mod ffrf_beam;
+pub mod modal;
 pub mod point_mass;
 pub mod rigid;
 
 pub use ancf_cable::{AncfCable, AncfCableData, CablePoint};
 pub use ffrf_beam::{Beam, BeamData, PointShape};
+pub use modal::Modal;
 pub use point_mass::{PointMass, PointMassData};
 pub use rigid::{Rigid, RigidData};
 
@@ -30,6 +32,7 @@ pub enum BodyKind {
     Beam(Beam),
     PointMass(PointMass),
     AncfBeam(AncfCable),
+    Flexible(Modal),
 }
 
 /// Per-body workspace, one variant per kind (sized once in `Data::new`).
@@ -40,6 +43,7 @@ pub enum BodyData {
     Beam(BeamData),
     PointMass(PointMassData),
     AncfBeam(AncfCableData),
+    Flexible(BeamData),
 }
 
 #[derive(Debug, Clone)]
@@ -87,6 +91,11 @@ impl Body {
                 let init = k.initial_state(p, &item)?;
                 (BodyKind::PointMass(k), init)
             }
+            BodyDesc::Flexible(f) => {
+                let k = Modal::from_desc(f, &item)?;
+                let init = k.initial_state(f, &item)?;
+                (BodyKind::Flexible(k), init)
+            }
         };
         for (what, v) in [("initial state", &init.q), ("initial rates", &init.qd)] {
             check_finite_item(&item, what, v)?;
@@ -102,6 +111,7 @@ impl Body {
             BodyKind::Beam(_) => "beam",
             BodyKind::PointMass(_) => "point_mass",
             BodyKind::AncfBeam(_) => "ancf_beam",
+            BodyKind::Flexible(_) => "flexible",
         }
     }
 
@@ -109,7 +119,7 @@ impl Body {
     /// and for an ANCF cable, whose nodal coordinates carry its motion and deformation together).
     pub fn elastic_range(&self) -> std::ops::Range<usize> {
         match &self.kind {
-            BodyKind::Beam(_) => self.offset + 3..self.offset + self.n_coords,
+            BodyKind::Beam(_) | BodyKind::Flexible(_) => self.offset + 3..self.offset + self.n_coords,
             BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::AncfBeam(_) => self.offset..self.offset,
         }
     }
@@ -125,6 +135,7 @@ impl Body {
             BodyKind::Beam(k) => k.mass,
             BodyKind::PointMass(k) => k.mass,
             BodyKind::AncfBeam(k) => k.mass,
+            BodyKind::Flexible(k) => k.mass,
         }
     }
 
@@ -134,6 +145,7 @@ impl Body {
             BodyKind::Beam(k) => BodyData::Beam(k.new_data()),
             BodyKind::PointMass(k) => BodyData::PointMass(k.new_data()),
             BodyKind::AncfBeam(k) => BodyData::AncfBeam(k.new_data()),
+            BodyKind::Flexible(k) => BodyData::Flexible(k.new_data()),
         }
     }
 
@@ -153,6 +165,7 @@ impl Body {
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
             (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
+            (BodyKind::Flexible(k), BodyData::Flexible(d)) => k.mass_and_forces(d, qb, qdb, gravity, f),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -165,6 +178,7 @@ impl Body {
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.factor(d),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.factor(d),
             (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.factor(d),
+            (BodyKind::Flexible(k), BodyData::Flexible(d)) => k.factor(d),
             _ => unreachable!("body data of another kind"),
         };
         if ok {
@@ -182,6 +196,7 @@ impl Body {
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.finv(d, v),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.finv(d, v),
             (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.finv(d, v),
+            (BodyKind::Flexible(k), BodyData::Flexible(d)) => k.finv(d, v),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -194,6 +209,7 @@ impl Body {
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.finvt(d, v),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.finvt(d, v),
             (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.finvt(d, v),
+            (BodyKind::Flexible(k), BodyData::Flexible(d)) => k.finvt(d, v),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -213,6 +229,7 @@ impl Body {
                 out[1] += k.mass * x[1];
             }
             (BodyKind::AncfBeam(k), BodyData::AncfBeam(_)) => k.mass_times(x, out),
+            (BodyKind::Flexible(k), BodyData::Flexible(d)) => k.mass_times(d, x, out),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -225,6 +242,7 @@ impl Body {
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.dense_block(d, put),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.dense_block(d, put),
             (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.dense_block(d, put),
+            (BodyKind::Flexible(k), BodyData::Flexible(d)) => k.dense_block(d, put),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -247,6 +265,11 @@ impl Body {
                     b.visit_element_matrices(qb, true, c);
                 }
             }
+            BodyKind::Flexible(b) => {
+                let qf = &self.seg(q)[3..];
+                b.elastic_tangent(qf, &mut |i, j, v| k(3 + i, 3 + j, v));
+                b.damping_tangent(&mut |i, j, v| c(3 + i, 3 + j, v));
+            }
             BodyKind::Rigid(_) | BodyKind::PointMass(_) => {}
         }
     }
@@ -259,6 +282,7 @@ impl Body {
             (BodyKind::Beam(k), BodyData::Beam(d)) => k.kinetic_energy(d, qdb),
             (BodyKind::PointMass(k), BodyData::PointMass(d)) => k.kinetic_energy(d, qdb),
             (BodyKind::AncfBeam(k), BodyData::AncfBeam(d)) => k.kinetic_energy(d, qdb),
+            (BodyKind::Flexible(k), BodyData::Flexible(d)) => k.kinetic_energy(d, qdb),
             _ => unreachable!("body data of another kind"),
         }
     }
@@ -268,6 +292,7 @@ impl Body {
         match &self.kind {
             BodyKind::Beam(k) => k.strain_energy(self.seg(q)),
             BodyKind::AncfBeam(k) => k.strain_energy(self.seg(q)),
+            BodyKind::Flexible(k) => k.strain_energy(self.seg(q)),
             BodyKind::Rigid(_) | BodyKind::PointMass(_) => 0.0,
         }
     }
@@ -280,6 +305,7 @@ impl Body {
             BodyKind::Beam(k) => k.mass_moment(qb),
             BodyKind::PointMass(k) => k.mass_moment(qb),
             BodyKind::AncfBeam(k) => k.mass_moment(qb),
+            BodyKind::Flexible(k) => k.mass_moment(qb),
         };
         -(g[0] * r[0] + g[1] * r[1])
     }
@@ -290,6 +316,7 @@ impl Body {
             BodyKind::Rigid(_) => MarkerShape::Rigid(rigid::marker_point(md, &self.name, item)?),
             BodyKind::Beam(k) => MarkerShape::Beam(k.marker_shape(md, &self.name, item)?),
             BodyKind::AncfBeam(k) => MarkerShape::Cable(k.marker_shape(md, &self.name, item)?),
+            BodyKind::Flexible(k) => MarkerShape::Beam(k.marker_shape(md, &self.name, item)?),
             BodyKind::PointMass(_) => {
                 point_mass::check_marker(md, &self.name, item)?;
                 MarkerShape::Particle
@@ -317,7 +344,7 @@ impl Body {
                 Some([ms.r[0], ms.r[1], u, v, ms.phi - qb[2]])
             }
             BodyKind::AncfBeam(k) => Some(k.chord_displacement(xi, qb)),
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) => None,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Flexible(_) => None,
         }
     }
 }
@@ -343,7 +370,8 @@ pub enum MarkerShape {
     Ground([f64; 2]),
     /// A point in the frame of a rigid body.
     Rigid([f64; 2]),
-    /// An axis point of a beam (elastic displacement included).
+    /// An axis point of a beam or an interface point of a flexible body (elastic displacement
+    /// included).
     Beam(PointShape),
     /// The particle itself (a point mass has no orientation).
     Particle,

@@ -1,0 +1,270 @@
+"""Flexible bodies from finite-element data: the invariants of :class:`ukflex.FlexibleData`
+computed from a planar FE model reduced to a few modes (docs/flexible-bodies.md).
+
+* :func:`from_nodal` -- node coordinates and assembled nodal mass and stiffness matrices (two
+  translations per node, dof order ``x_1, y_1, x_2, ...``; consistent or lumped mass of the form
+  ``m (x) I_2``, as every isotropic continuum element gives);
+* :func:`from_mesh` -- a planar mesh (points + triangles or quads, or any meshio-readable file)
+  assembled by scikit-fem as a plane-stress part of given thickness, density, Young's modulus
+  and Poisson's ratio (optional extra ``fe``: ``pip install scikit-fem meshio``).
+
+Interfaces (where joints attach) are nodes or rigid averages of several nodes (RBE3-like: the
+point is their centroid, its displacement their mean displacement, its rotation their mean
+rotation about it).  Reduction (``frame``):
+
+* ``"mean-axis"`` -- free-free eigenmodes without the three rigid-body modes (the floating
+  frame then satisfies the mean-axis conditions ``S_bar q = 0``, ``s_ju0 . q = 0``);
+* ``"fixed"`` -- reference conditions ``fixed = [(interface, "x"|"y"), ...]`` (three of them,
+  e.g. pinned-pinned: ``[("A", "x"), ("A", "y"), ("B", "y")]``, the chord frame of the beams),
+  then the eigenmodes of the constrained model;
+* ``"craig-bampton"`` -- the same reference conditions, plus the remaining dofs of the
+  interfaces as boundary: static constraint modes for each of them and fixed-interface normal
+  modes.
+
+``modes`` is the number of normal modes kept; ``damping_ratio`` gives modal damping.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import scipy.linalg as sla
+
+from .flexible import FlexibleData, InterfacePoint
+
+__all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices", "reduce"]
+
+Interface = Union[int, Sequence[int]]
+
+
+def _interface_rows(nodes: np.ndarray, spec: Interface) -> Tuple[Tuple[float, float], np.ndarray, Optional[np.ndarray]]:
+    """Point, displacement rows (2, 2N) and rotation row (2N,) of an interface (one node or the
+    rigid average of several)."""
+    ndof = 2 * nodes.shape[0]
+    idx = np.atleast_1d(np.asarray(spec, dtype=int))
+    if idx.size == 0 or idx.min() < 0 or idx.max() >= nodes.shape[0]:
+        raise ValueError(f"interface nodes {idx.tolist()} are not nodes of the mesh (0..{nodes.shape[0] - 1})")
+    c = nodes[idx].mean(axis=0)
+    d = np.zeros((2, ndof))
+    for i in idx:
+        d[0, 2 * i] += 1.0 / idx.size
+        d[1, 2 * i + 1] += 1.0 / idx.size
+    if idx.size == 1:
+        return (float(c[0]), float(c[1])), d, None
+    r = nodes[idx] - c
+    r2 = float(np.sum(r * r))
+    rot = np.zeros(ndof)
+    for i, (rx, ry) in zip(idx, r):
+        rot[2 * i] += -ry / r2
+        rot[2 * i + 1] += rx / r2
+    return (float(c[0]), float(c[1])), d, rot
+
+
+def _scalar_mass(mm: np.ndarray) -> np.ndarray:
+    m = mm[0::2, 0::2]
+    scale = np.max(np.abs(mm))
+    if (np.max(np.abs(mm[1::2, 1::2] - m)) > 1e-10 * scale or np.max(np.abs(mm[0::2, 1::2])) > 1e-10 * scale):
+        raise ValueError("the mass matrix must act alike on x and y (m (x) I_2, dof order x_1, y_1, x_2, ...): "
+                         "give a consistent or lumped mass of a planar continuum")
+    return m
+
+
+def from_nodal(
+    nodes: np.ndarray,
+    mass_matrix: np.ndarray,
+    stiffness_matrix: np.ndarray,
+    *,
+    interfaces: Mapping[str, Interface],
+    modes: int = 4,
+    frame: str = "mean-axis",
+    fixed: Optional[Sequence[Tuple[str, str]]] = None,
+    damping_ratio: float = 0.0,
+) -> FlexibleData:
+    """A :class:`FlexibleData` from nodal coordinates (N, 2) and the assembled mass and stiffness
+    matrices (2N, 2N) of a planar FE model (see the module docs for ``frame`` and ``fixed``).
+
+    The returned data carries ``info["frequencies"]`` (rad/s, the kept normal modes; for
+    Craig-Bampton those of the reduced model) and ``info["modes"]`` (2N, n_f), the nodal shapes.
+    """
+    x = np.asarray(nodes, dtype=float)
+    mm = np.asarray(mass_matrix, dtype=float)
+    kk = np.asarray(stiffness_matrix, dtype=float)
+    n = 2 * x.shape[0]
+    if x.ndim != 2 or x.shape[1] != 2 or mm.shape != (n, n) or kk.shape != (n, n):
+        raise ValueError(f"nodes must be (N, 2) and the matrices (2N, 2N); got {x.shape}, {mm.shape}, {kk.shape}")
+    m_scalar = _scalar_mass(mm)
+    iface = {name: _interface_rows(x, spec) for name, spec in interfaces.items()}
+    if frame == "mean-axis":
+        lam, vec = sla.eigh(kk, mm)
+        if modes + 3 > n:
+            raise ValueError(f"{modes} modes do not fit a model with {n} dofs")
+        lam_rigid = lam[:3]
+        if np.max(np.abs(lam_rigid)) > 1e-6 * abs(lam[3]):
+            raise ValueError("the stiffness matrix does not have the three rigid-body modes of a free planar part "
+                             f"(lowest eigenvalues {lam[:4]}): is the part supported or disconnected?")
+        phi = vec[:, 3:3 + modes]
+        freq = np.sqrt(np.maximum(lam[3:3 + modes], 0.0))
+    elif frame in ("fixed", "craig-bampton"):
+        if fixed is None or len(fixed) != 3:
+            raise ValueError("frame 'fixed' and 'craig-bampton' need fixed = three (interface, 'x'|'y') reference conditions")
+        ref = []
+        for name, ax in fixed:
+            if name not in iface or ax not in ("x", "y"):
+                raise ValueError(f"fixed entry ({name!r}, {ax!r}): expected an interface name {list(iface)} and 'x' or 'y'")
+            ref.append(iface[name][1][0 if ax == "x" else 1])
+        c = np.array(ref)  # (3, n) constraint rows c u = 0
+        if frame == "craig-bampton":
+            rows = [iface[nm][1][k] for nm in iface for k in range(2)]
+            rows = [r for r in rows if np.linalg.matrix_rank(np.vstack([c, r])) > np.linalg.matrix_rank(c)]
+            b = np.array(rows) if rows else np.zeros((0, n))
+        else:
+            b = np.zeros((0, n))
+        phi = _constrained_basis(kk, mm, c, b, modes)
+        kr, mr = phi.T @ kk @ phi, phi.T @ mm @ phi
+        lam = sla.eigh(kr, mr, eigvals_only=True)
+        freq = np.sqrt(np.maximum(lam, 0.0))
+    else:
+        raise ValueError(f"unknown frame {frame!r}; expected 'mean-axis', 'fixed' or 'craig-bampton'")
+    inv = _invariants(x, mm, m_scalar, phi)
+    k_ff = phi.T @ kk @ phi
+    k_ff = 0.5 * (k_ff + k_ff.T)
+    d_ff = None
+    if damping_ratio > 0.0:
+        m_ff = inv["m_ff"]
+        lam_r, v = sla.eigh(k_ff, m_ff)
+        w = np.sqrt(np.maximum(lam_r, 0.0))
+        mv = m_ff @ v
+        d_ff = mv @ np.diag(2.0 * damping_ratio * w) @ mv.T
+    markers = {name: InterfacePoint(p, d @ phi, None if r is None else r @ phi) for name, (p, d, r) in iface.items()}
+    return FlexibleData(k_ff=k_ff, d_ff=d_ff, markers=markers, info={"frequencies": freq, "modes": phi}, **inv)
+
+
+def _constrained_basis(kk: np.ndarray, mm: np.ndarray, c: np.ndarray, b: np.ndarray, modes: int) -> np.ndarray:
+    """Basis (n, n_f) satisfying ``c u = 0``: ``b.shape[0]`` static constraint modes (unit value
+    of each boundary row ``b`` with the others zero, the rest statically condensed) followed by
+    ``modes`` normal modes with ``c u = 0`` and ``b u = 0``."""
+    n = kk.shape[0]
+    nb = b.shape[0]
+    # null space of all constraints (c and b): interior motions
+    cb = np.vstack([c, b]) if nb else c
+    z = sla.null_space(cb)
+    kz, mz = z.T @ kk @ z, z.T @ mm @ z
+    if modes > kz.shape[0]:
+        raise ValueError(f"{modes} modes do not fit: only {kz.shape[0]} interior dofs")
+    lam, v = sla.eigh(kz, mz, subset_by_index=[0, modes - 1])
+    normal = z @ v
+    if not nb:
+        return normal
+    # constraint modes: minimize u K u subject to c u = 0, b u = e_i
+    kkt = np.block([[kk, cb.T], [cb, np.zeros((cb.shape[0], cb.shape[0]))]])
+    rhs = np.zeros((n + cb.shape[0], nb))
+    rhs[n + c.shape[0]:, :] = np.eye(nb)
+    static = np.linalg.solve(kkt, rhs)[:n]
+    return np.hstack([static, normal])
+
+
+def _invariants(x: np.ndarray, mm: np.ndarray, m_scalar: np.ndarray, phi: np.ndarray) -> Dict[str, Any]:
+    """The inertia invariants from the assembled mass matrix (exact where the element fields
+    interpolate rigid motions and ``u0``: ``int rho N^T N dV = M``)."""
+    ex = np.zeros(mm.shape[0])
+    ex[0::2] = 1.0
+    ey = np.zeros(mm.shape[0])
+    ey[1::2] = 1.0
+    u0 = x.ravel()
+    ju0 = np.column_stack([-x[:, 1], x[:, 0]]).ravel()
+    mass = float(ex @ mm @ ex)
+    com = np.array([ex @ mm @ u0, ey @ mm @ u0]) / mass
+    j0 = float(u0 @ mm @ u0)
+    tilde = np.kron(m_scalar, np.array([[0.0, 1.0], [-1.0, 0.0]]))
+    m_ff = phi.T @ mm @ phi
+    return dict(mass=mass, inertia=j0 - mass * float(com @ com), com=(float(com[0]), float(com[1])),
+                s_bar=np.vstack([ex @ mm @ phi, ey @ mm @ phi]), s_u0=phi.T @ mm @ u0, s_ju0=phi.T @ mm @ ju0,
+                s_tilde=phi.T @ tilde @ phi, m_ff=0.5 * (m_ff + m_ff.T))
+
+
+def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickness: float, density: float,
+                               youngs_modulus: float, poisson_ratio: float) -> Tuple[np.ndarray, np.ndarray]:
+    """Consistent mass and stiffness matrices (2N, 2N; dof order ``x_1, y_1, ...``) of a planar
+    mesh of triangles (``cells`` (E, 3)) or quadrilaterals ((E, 4)), plane stress, assembled by
+    scikit-fem with P1/Q1 elements."""
+    try:
+        import skfem
+        from skfem.models.elasticity import lame_parameters, linear_elasticity
+        from skfem.helpers import dot
+    except ImportError as e:  # pragma: no cover - optional extra
+        raise ImportError("from_mesh needs scikit-fem (the optional 'fe' extra: pip install scikit-fem meshio)") from e
+    p = np.asarray(points, dtype=float)[:, :2].T
+    t = np.asarray(cells, dtype=int).T
+    if t.shape[0] == 3:
+        mesh, elem = skfem.MeshTri(p, t), skfem.ElementVector(skfem.ElementTriP1())
+    elif t.shape[0] == 4:
+        mesh, elem = skfem.MeshQuad(p, t), skfem.ElementVector(skfem.ElementQuad1())
+    else:
+        raise ValueError("cells must be triangles (E, 3) or quadrilaterals (E, 4)")
+    basis = skfem.Basis(mesh, elem)
+    # plane stress: lambda* = 2 lambda mu / (lambda + 2 mu)
+    lam, mu = lame_parameters(youngs_modulus, poisson_ratio)
+    lam_ps = 2.0 * lam * mu / (lam + 2.0 * mu)
+    kk = (thickness * skfem.asm(linear_elasticity(lam_ps, mu), basis)).toarray()
+
+    @skfem.BilinearForm
+    def mass(u, v, w):
+        return density * thickness * dot(u, v)
+
+    mm = skfem.asm(mass, basis).toarray()
+    # scikit-fem orders vector dofs node-wise (x_1, y_1, ...) for ElementVector of nodal elements
+    order = basis.nodal_dofs.T.ravel()
+    return mm[np.ix_(order, order)], kk[np.ix_(order, order)]
+
+
+def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: float, poisson_ratio: float,
+              interfaces: Mapping[str, Interface], modes: int = 4, frame: str = "mean-axis",
+              fixed: Optional[Sequence[Tuple[str, str]]] = None, damping_ratio: float = 0.0,
+              cells: Optional[np.ndarray] = None) -> FlexibleData:
+    """A :class:`FlexibleData` of a planar part meshed with triangles or quads.
+
+    ``mesh``: a path of any meshio-readable file, a ``meshio.Mesh``, or a points array (N, 2|3)
+    with ``cells``.  The part is plane stress of ``thickness``; see :func:`from_nodal` for the
+    rest.  ``info["points"]`` and ``info["cells"]`` keep the mesh (for drawing).
+    """
+    if cells is None:
+        if isinstance(mesh, str):
+            import meshio
+
+            mesh = meshio.read(mesh)
+        blocks = [c for c in mesh.cells if c.type in ("triangle", "quad")]
+        if not blocks:
+            raise ValueError("the mesh has no triangle or quad cells")
+        points, cells = np.asarray(mesh.points)[:, :2], blocks[0].data
+    else:
+        points = np.asarray(mesh, dtype=float)[:, :2]
+    mm, kk = plane_stress_mesh_matrices(points, cells, thickness=thickness, density=density,
+                                        youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio)
+    data = from_nodal(points, mm, kk, interfaces=interfaces, modes=modes, frame=frame, fixed=fixed,
+                      damping_ratio=damping_ratio)
+    data.info.update(points=points, cells=np.asarray(cells))
+    return data
+
+
+def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0) -> FlexibleData:
+    """Reduce a flexible body (e.g. nodal, with its frame fixed by reference conditions) to its
+    ``modes`` lowest eigenmodes of ``(K_ff, M_ff)``: every invariant is projected on the modal
+    basis (``k3``/``k4`` too).  ``info["frequencies"]`` holds the kept frequencies (rad/s)."""
+    k, m = np.asarray(data.k_ff, dtype=float), np.asarray(data.m_ff, dtype=float)
+    if not 1 <= modes <= k.shape[0]:
+        raise ValueError(f"modes must be in 1..{k.shape[0]}, got {modes}")
+    lam, p = sla.eigh(k, m, subset_by_index=[0, modes - 1])
+    proj = lambda a: None if a is None else p.T @ np.asarray(a, dtype=float) @ p  # noqa: E731
+    k3 = None if data.k3 is None else np.einsum("ijk,ia,jb,kc->abc", np.asarray(data.k3), p, p, p)
+    k4 = None if data.k4 is None else np.einsum("ijkl,ia,jb,kc,ld->abcd", np.asarray(data.k4), p, p, p, p)
+    w = np.sqrt(np.maximum(lam, 0.0))
+    d_ff = proj(data.d_ff)
+    if damping_ratio > 0.0:
+        d_ff = (d_ff if d_ff is not None else 0.0) + np.diag(2.0 * damping_ratio * w)
+    markers = {name: InterfacePoint(pt.point, np.asarray(pt.displacement) @ p, None if pt.rotation is None else np.asarray(pt.rotation) @ p)
+               for name, pt in data.markers.items()}
+    return FlexibleData(mass=data.mass, inertia=data.inertia, com=data.com, s_bar=np.asarray(data.s_bar) @ p,
+                        s_u0=p.T @ np.asarray(data.s_u0), s_ju0=p.T @ np.asarray(data.s_ju0), s_tilde=proj(data.s_tilde),
+                        m_ff=np.eye(modes), k_ff=np.diag(lam), d_ff=d_ff, m_ff_tr=proj(data.m_ff_tr), k3=k3, k4=k4,
+                        markers=markers, info={"frequencies": w, "modes": p})
