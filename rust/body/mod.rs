@@ -358,7 +358,7 @@ impl Body {
         match &self.kind {
             BodyKind::Beam(k) => Some(k.internal_forces(xi, qb)),
             BodyKind::AncfBeam(k) => Some(k.internal_forces(xi, qb)),
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) => None,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Flexible(_) => None,
         }
     }
 }
