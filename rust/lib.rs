@@ -24,11 +24,12 @@ pub mod jacobian;
 pub mod linalg;
 pub mod model;
 pub mod small_svd;
+pub mod sparse_uk;
 pub mod uk;
 
 #[cfg(feature = "python")]
 mod bindings;
 
-pub use data::{Data, RankInfo, RankTolerance, SvdBackend};
+pub use data::{Data, RankInfo, RankTolerance, SvdBackend, UkSolver};
 pub use error::{Error, Result};
 pub use model::Model;
