@@ -32,7 +32,7 @@ pub enum Error {
     #[error("solver failure: {0}")]
     Solver(String),
     /// An allocation would exceed the configured memory limit (refused before allocating).
-    #[error("{what} needs about {} MiB, above the memory limit of {} MiB; {hint}", bytes / (1 << 20), limit / (1 << 20))]
+    #[error("{what} needs about {:.1} MiB, above the memory limit of {:.1} MiB; {hint}", *bytes as f64 / 1048576.0, *limit as f64 / 1048576.0)]
     Memory { what: String, bytes: u64, limit: u64, hint: String },
 }
 

@@ -313,18 +313,15 @@ impl SparseUk {
         s
     }
 
-    /// The correction with the current factorization: `r = b - A a` (into `residual`),
+    /// The correction with the current factorization, `y = F^-1 Q` on entry:
+    /// `r = b - A a = b - B y` (into `residual`),
     /// `x = S^-1 r` plus one refinement step with `B` (`x += S^-1 (r - B B^T x)`),
     /// `y += B^T x`, `lambda = -x`.
-    pub fn correct(&mut self, jac: &[f64], gamma: &[f64], qdd_free: &[f64], residual: &mut [f64], y: &mut [f64], lambda: &mut [f64]) {
-        let (n, m, hb) = (self.n, self.m, self.hb);
+    pub fn correct(&mut self, gamma: &[f64], residual: &mut [f64], y: &mut [f64], lambda: &mut [f64]) {
+        let (m, hb) = (self.m, self.hb);
+        // A a = B F^T a = B y with y = F^-1 Q (a = F^-T y): no pass over the rows of A
         for i in 0..m {
-            let mut aa = 0.0;
-            for sg in &self.segs[self.seg_ptr[i]..self.seg_ptr[i + 1]] {
-                let row = &jac[i * n + sg.col..i * n + sg.col + sg.len];
-                aa += row.iter().zip(&qdd_free[sg.col..sg.col + sg.len]).map(|(a, b)| a * b).sum::<f64>();
-            }
-            residual[i] = gamma[i] - aa;
+            residual[i] = gamma[i] - self.b_row_dot(i, y);
             self.x[self.perm[i]] = residual[i];
         }
         Self::solve(&self.band, &self.inv_diag, hb, &mut self.x);

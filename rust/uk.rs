@@ -209,6 +209,13 @@ pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
 /// The constraint correction with the current factorization: `r = b - A a`,
 /// `y += U S^+ V^T r`, `lambda = -V S^+ S^+ V^T r`, `qdd = F^-T y`.
 pub fn correct(model: &Model, data: &mut Data) {
+    if data.factored_with == Factored::SparseGram {
+        let sp = data.sparse.as_mut().expect("factored sparse");
+        sp.correct(&data.gamma, &mut data.residual, &mut data.y, &mut data.lambda);
+        data.qdd.copy_from_slice(&data.y);
+        apply_finvt(model, &data.bodies, &mut data.qdd);
+        return;
+    }
     let (n, m) = (model.n, model.m);
     let k = n.min(m);
     let rank = data.rank_info.rank;
@@ -216,13 +223,6 @@ pub fn correct(model: &Model, data: &mut Data) {
         let row = &data.jac[i * n..(i + 1) * n];
         let aa: f64 = row.iter().zip(&data.qdd_free).map(|(x, y)| x * y).sum();
         data.residual[i] = data.gamma[i] - aa;
-    }
-    if data.factored_with == Factored::SparseGram {
-        let sp = data.sparse.as_mut().expect("factored sparse");
-        sp.correct(&data.jac, &data.gamma, &data.qdd_free, &mut data.residual, &mut data.y, &mut data.lambda);
-        data.qdd.copy_from_slice(&data.y);
-        apply_finvt(model, &data.bodies, &mut data.qdd);
-        return;
     }
     if data.factored_with == Factored::FullRankQr {
         let qrj = data.qrj.as_mut().expect("factored with QR");

@@ -124,7 +124,7 @@ fn sparse_path_covers_every_body_and_joint_kind() {
 
 #[test]
 fn auto_picks_dense_for_small_and_sparse_for_long_chains() {
-    let small = Model::from_json(&chain_scene(4)).unwrap();
+    let small = Model::from_json(&chain_scene(2)).unwrap();
     assert!(Data::new(&small).sparse.is_none());
     let paper = Model::from_json(&paper_scene("timoshenko", 64, true)).unwrap();
     assert!(Data::new(&paper).sparse.is_none());

@@ -16,6 +16,7 @@ Rust core (``ukflex._core``, private) + Python API:
 from .errors import (
     InconsistentInitialStateError,
     InvalidSceneError,
+    MemoryLimitError,
     NonFiniteError,
     SingularMassError,
     SolverError,
@@ -65,5 +66,6 @@ __all__ = [
     "SingularMassError",
     "SolverError",
     "NonFiniteError",
+    "MemoryLimitError",
     "InconsistentInitialStateError",
 ]

@@ -25,6 +25,7 @@ __all__ = [
     "SingularMassError",
     "SolverError",
     "NonFiniteError",
+    "MemoryLimitError",
     "InconsistentInitialStateError",
 ]
 
@@ -33,6 +34,9 @@ InvalidSceneError = core.InvalidSceneError
 SingularMassError = core.SingularMassError
 SolverError = core.SolverError
 NonFiniteError = core.NonFiniteError
+#: An allocation would exceed the System's ``memory_limit`` (refused before allocating; the
+#: message names the buffers and a way out).
+MemoryLimitError = core.MemoryLimitError
 
 
 class InconsistentInitialStateError(UkflexError):  # type: ignore[misc, valid-type]

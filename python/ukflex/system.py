@@ -124,6 +124,15 @@ class System:
         Newton iteration limit.
     t0 : float
         Initial time (drivers are evaluated there).
+    uk_solver : {"auto", "dense", "sparse"}
+        How the UK correction is solved: ``"dense"`` (pseudoinverse of ``A F^-T``),
+        ``"sparse"`` (band Cholesky of ``A M^-1 A^T`` with a full-rank certificate, dense
+        rank-revealing fallback) or ``"auto"`` (sparse for long chains, ropes and tracks).
+        See docs/scale.md. ``core.uk_solver`` tells which path the last call took.
+    memory_limit : float, optional
+        Bytes any lazily sized group of buffers may take (default 2 GiB): the dense
+        ``n x n`` matrices of ``jac`` and of the implicit native integrators, the dense UK
+        fallback. Above it :class:`ukflex.MemoryLimitError` is raised before allocating.
 
     Attributes
     ----------
@@ -168,6 +177,8 @@ class System:
         velocity_tol: float = 1e-10,
         max_iterations: int = 50,
         t0: float = 0.0,
+        uk_solver: str = "auto",
+        memory_limit: Optional[float] = None,
     ):
         if isinstance(description, dict):
             _, self.description = normalize(description)
@@ -176,7 +187,7 @@ class System:
             self.description = description.to_dict()
         else:
             raise TypeError(f"System needs a Scene or a description dict, got {type(description).__name__}")
-        core = _core.System(json.dumps(self.description))
+        core = _core.System(json.dumps(self.description), uk_solver=uk_solver, memory_limit=memory_limit)
         self.core = core
 
         # hot per-step methods: the compiled object's bound methods, no Python layer

@@ -22,6 +22,7 @@ create_exception!(ukflex, InvalidSceneError, UkflexError, "Malformed or non-phys
 create_exception!(ukflex, SingularMassError, UkflexError, "The mass matrix is not positive definite.");
 create_exception!(ukflex, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
 create_exception!(ukflex, SolverError, UkflexError, "A solver kernel failed.");
+create_exception!(ukflex, MemoryLimitError, UkflexError, "An allocation would exceed the System's memory limit (refused before allocating).");
 
 /// A 1-D float64 input. float64 vectors (what scipy passes) are read in place, strided or
 /// not; anything else array-like is converted once with `numpy.asarray(x, dtype=float64)`, and
@@ -70,6 +71,7 @@ pub(crate) fn to_py(e: Error) -> PyErr {
         Error::NonFinite { .. } => NonFiniteError::new_err(msg),
         Error::SingularMass { .. } => SingularMassError::new_err(msg),
         Error::Solver(_) => SolverError::new_err(msg),
+        Error::Memory { .. } => MemoryLimitError::new_err(msg),
     }
 }
 
@@ -114,6 +116,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SingularMassError", py.get_type::<SingularMassError>())?;
     m.add("NonFiniteError", py.get_type::<NonFiniteError>())?;
     m.add("SolverError", py.get_type::<SolverError>())?;
+    m.add("MemoryLimitError", py.get_type::<MemoryLimitError>())?;
     Ok(())
 }
 
