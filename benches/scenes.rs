@@ -5,34 +5,9 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 #[allow(unused_imports)] // each bench uses its own subset
-pub use common::{ancf_paper_scene, paper_scene, Lcg};
+pub use common::{ancf_paper_scene, chain_scene, paper_scene, Lcg};
 
 use ukflex::{Data, Model};
-
-/// K rigid links of length 0.2 m hanging in a chain from a ground pivot, laid out
-/// horizontally at rest; gravity -Y. n = 3K coordinates, m = 2K constraint rows.
-pub fn chain_scene(k: usize) -> String {
-    let len = 0.2;
-    let mut bodies = Vec::new();
-    let mut joints = vec![format!(
-        r#"{{"kind": "revolute", "a": {{"body": "ground"}}, "b": {{"body": "link0", "point": [0.0, 0.0]}}}}"#
-    )];
-    for i in 0..k {
-        bodies.push(format!(
-            r#"{{"name": "link{i}", "kind": "rigid", "mass": 1.0, "inertia": {inertia}, "com": [{half}, 0.0], "position": [{x}, 0.0]}}"#,
-            inertia = len * len / 12.0,
-            half = len / 2.0,
-            x = i as f64 * len
-        ));
-        if i > 0 {
-            joints.push(format!(
-                r#"{{"kind": "revolute", "a": {{"body": "link{p}", "point": [{len}, 0.0]}}, "b": {{"body": "link{i}", "point": [0.0, 0.0]}}}}"#,
-                p = i - 1
-            ));
-        }
-    }
-    format!(r#"{{"gravity": [0.0, -9.81], "bodies": [{}], "joints": [{}]}}"#, bodies.join(","), joints.join(","))
-}
 
 /// A representative (not exactly consistent) state: the initial guess with a small elastic
 /// deformation, a small elastic rate and, for chains, a bent configuration. The cost of a call

@@ -8,7 +8,58 @@ use faer::{Mat, Par};
 
 use crate::body::BodyData;
 use crate::model::Model;
+use crate::error::{Error, Result};
 use crate::small_svd::QrJacobi;
+use crate::sparse_uk::SparseUk;
+
+/// Which UK correction path a `Data` uses (a build option of the System).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum UkSolver {
+    /// Sparse when `prefer_sparse` says it pays (measured crossover, docs/scale.md), dense
+    /// otherwise.
+    #[default]
+    Auto,
+    /// The dense pseudoinverse of `B^T` (`svd_backend`) every call.
+    Dense,
+    /// The band Cholesky of `A M^-1 A^T` with its full-rank certificate (`sparse_uk`); the
+    /// dense rank-revealing path when the certificate fails.
+    Sparse,
+}
+
+impl UkSolver {
+    pub fn parse(s: &str) -> Result<UkSolver> {
+        match s {
+            "auto" => Ok(UkSolver::Auto),
+            "dense" => Ok(UkSolver::Dense),
+            "sparse" => Ok(UkSolver::Sparse),
+            other => Err(Error::argument("uk_solver", format!("unknown UK solver '{other}' (use 'auto', 'dense' or 'sparse')"))),
+        }
+    }
+}
+
+/// Below this many constraint rows `UkSolver::Auto` stays dense: measured on the chain
+/// (`cargo bench --bench scale`), sparse and dense are level at K = 4 (m = 8, 3.4 vs 3.7 us)
+/// and sparse wins 2.3x at K = 8 (m = 16); the dense path keeps the small mechanisms (the
+/// paper's m = 6) where its certified QR is already ~1 us. docs/scale.md.
+pub const SPARSE_MIN_ROWS: usize = 8;
+
+/// `UkSolver::Auto`: sparse when there are enough rows and the band work is well below the
+/// dense `O(n m^2)` (a narrow band after RCM).
+pub fn prefer_sparse(model: &Model, sp: &SparseUk) -> bool {
+    let (n, m) = (model.n as f64, model.m as f64);
+    model.m >= SPARSE_MIN_ROWS && 4.0 * sp.flops() < 2.0 * n * m * m
+}
+
+/// Bytes of the dense UK buffers (`B^T`, thin SVD, QR + Jacobi, faer scratch).
+pub fn dense_uk_bytes(model: &Model) -> u64 {
+    let (n, m) = (model.n as u64, model.m as u64);
+    if m == 0 {
+        return 0;
+    }
+    let k = n.min(m);
+    let req = svd_scratch::<f64>(model.n, model.m, ComputeSvdVectors::Thin, ComputeSvdVectors::Thin, Par::Seq, Default::default());
+    8 * (n * m + n * k + m * k + k + if m <= n { n * m + 3 * m * m + n } else { 0 }) + req.size_bytes() as u64
+}
 
 /// How the UK pseudoinverse `(A F^-T)^+` is computed. Every choice is allocation free per
 /// call and gives the `scipy.linalg.pinv` semantics (singular values at or below
@@ -40,6 +91,8 @@ pub enum Factored {
     Jacobi,
     /// faer SVD in `svd_u`, `svd_s`, `svd_v`.
     Faer,
+    /// Certified full-rank band Cholesky of `A M^-1 A^T` in `sparse` (`sparse_uk`).
+    SparseGram,
 }
 
 /// Rank decision of the pseudoinverse: singular values below
@@ -123,19 +176,42 @@ pub struct Data {
     pub tolerance: RankTolerance,
     pub stabilization: Stabilization,
     pub rank_info: RankInfo,
+    /// The UK path asked for at build, and the sparse workspace when it is used.
+    pub uk_solver: UkSolver,
+    pub sparse: Option<Box<SparseUk>>,
+    /// Whether the dense UK buffers (`bt`, `svd_*`, `qrj`, `mem`) are allocated: at build on
+    /// the dense path, on the first certificate failure on the sparse one.
+    pub dense_ready: bool,
+    /// Largest allocation (bytes) a lazily sized buffer may take (`Error::Memory` above).
+    pub memory_limit: u64,
 }
 
 impl Data {
+    /// Workspace with the automatic UK path and no memory limit.
     pub fn new(model: &Model) -> Data {
+        Data::build(model, UkSolver::Auto, u64::MAX).expect("no memory limit")
+    }
+
+    /// Workspace for the UK path `solver`; refuses (before allocating) when the buffers would
+    /// take more than `memory_limit` bytes.
+    pub fn build(model: &Model, solver: UkSolver, memory_limit: u64) -> Result<Data> {
         let (n, m) = (model.n, model.m);
-        let k = n.min(m);
-        let bodies = model.bodies.iter().map(|b| b.new_data()).collect();
-        let req = if m > 0 {
-            svd_scratch::<f64>(n, m, ComputeSvdVectors::Thin, ComputeSvdVectors::Thin, Par::Seq, Default::default())
-        } else {
-            StackReq::EMPTY
+        let sparse = match solver {
+            UkSolver::Dense => None,
+            _ if m == 0 => None,
+            UkSolver::Sparse => Some(Box::new(SparseUk::new(model))),
+            UkSolver::Auto => {
+                let sp = SparseUk::new(model);
+                if prefer_sparse(model, &sp) { Some(Box::new(sp)) } else { None }
+            }
         };
-        Data {
+        let hint = if sparse.is_some() { "raise memory_limit" } else { "use uk_solver='sparse' for a long chain or rope, or raise memory_limit" };
+        let base = 8 * (m as u64 * n as u64 + 6 * n as u64 + 8 * m as u64);
+        let dense = if sparse.is_none() { dense_uk_bytes(model) } else { 0 };
+        let sparse_bytes = if sparse.is_some() { SparseUk::bytes(model) } else { 0 };
+        Error::check_memory("the UK workspace (constraint Jacobian and factorization buffers)", base + dense + sparse_bytes, memory_limit, hint)?;
+        let bodies = model.bodies.iter().map(|b| b.new_data()).collect();
+        let mut data = Data {
             bodies,
             force: vec![0.0; n],
             phi: vec![0.0; m],
@@ -146,19 +222,63 @@ impl Data {
             qdd_free: vec![0.0; n],
             qdd: vec![0.0; n],
             lambda: vec![0.0; m],
-            bt: Mat::zeros(n, m),
-            svd_u: Mat::zeros(n, k),
-            svd_s: Diag::zeros(k),
-            svd_v: Mat::zeros(m, k),
+            bt: Mat::zeros(0, 0),
+            svd_u: Mat::zeros(0, 0),
+            svd_s: Diag::zeros(0),
+            svd_v: Mat::zeros(0, 0),
             residual: vec![0.0; m],
-            coeff: vec![0.0; k],
-            mem: MemBuffer::new(req),
-            qrj: if m > 0 && m <= n { Some(QrJacobi::new(n, m)) } else { None },
+            coeff: Vec::new(),
+            mem: MemBuffer::new(StackReq::EMPTY),
+            qrj: None,
             svd_backend: SvdBackend::default(),
             factored_with: Factored::None,
             tolerance: RankTolerance::default(),
             stabilization: Stabilization::None,
             rank_info: RankInfo::default(),
+            uk_solver: solver,
+            dense_ready: false,
+            sparse,
+            memory_limit,
+        };
+        if data.sparse.is_none() {
+            data.ensure_dense(model)?;
+        }
+        Ok(data)
+    }
+
+    /// Allocate the dense UK buffers if they are not there yet (once per workspace).
+    pub fn ensure_dense(&mut self, model: &Model) -> Result<()> {
+        if self.dense_ready {
+            return Ok(());
+        }
+        let (n, m) = (model.n, model.m);
+        if m > 0 && self.sparse.is_some() {
+            let hint = "the sparse UK path could not certify full rank here (redundant or nearly dependent constraints) and the dense rank-revealing fallback is this large; remove redundant constraints or raise memory_limit";
+            Error::check_memory("the dense UK fallback", dense_uk_bytes(model), self.memory_limit, hint)?;
+        }
+        let k = n.min(m);
+        let req = if m > 0 {
+            svd_scratch::<f64>(n, m, ComputeSvdVectors::Thin, ComputeSvdVectors::Thin, Par::Seq, Default::default())
+        } else {
+            StackReq::EMPTY
+        };
+        self.bt = Mat::zeros(n, m);
+        self.svd_u = Mat::zeros(n, k);
+        self.svd_s = Diag::zeros(k);
+        self.svd_v = Mat::zeros(m, k);
+        self.coeff = vec![0.0; k];
+        self.mem = MemBuffer::new(req);
+        self.qrj = if m > 0 && m <= n { Some(QrJacobi::new(n, m)) } else { None };
+        self.dense_ready = true;
+        Ok(())
+    }
+
+    /// Which UK path the last factorization took: "sparse" or "dense" (or "none").
+    pub fn uk_path(&self) -> &'static str {
+        match self.factored_with {
+            Factored::SparseGram => "sparse",
+            Factored::None => "none",
+            _ => "dense",
         }
     }
 }

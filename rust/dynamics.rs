@@ -59,10 +59,17 @@ pub fn apply_finv_sparse(model: &Model, bodies: &[BodyData], v: &mut [f64]) {
 /// Constraint terms: `A`, `Phi_t`, `gamma`, and `Phi` when `with_phi`.
 pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], with_phi: bool) {
     let n = model.n;
-    data.jac.fill(0.0);
     for c in &model.constraints {
         let rows = c.rows();
         let r0 = c.row;
+        // zero only the entries the rows can touch (their bodies' coordinates, see
+        // `Constraint::bodies`): O(nnz(A)), not O(m n); the rest of `jac` stays zero
+        for bi in c.bodies().into_iter().flatten() {
+            let b = &model.bodies[bi];
+            for r in r0..r0 + rows {
+                data.jac[r * n + b.offset..r * n + b.offset + b.n_coords].fill(0.0);
+            }
+        }
         let out = ConstraintOut {
             phi: if with_phi { Some(&mut data.phi[r0..r0 + rows]) } else { None },
             jac: &mut data.jac[r0 * n..(r0 + rows) * n],

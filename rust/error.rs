@@ -34,11 +34,22 @@ pub enum Error {
     /// A solver kernel could not produce a result (e.g. SVD did not converge).
     #[error("solver failure: {0}")]
     Solver(String),
+    /// An allocation would exceed the configured memory limit (refused before allocating).
+    #[error("{what} needs about {:.1} MiB, above the memory limit of {:.1} MiB; {hint}", *bytes as f64 / 1048576.0, *limit as f64 / 1048576.0)]
+    Memory { what: String, bytes: u64, limit: u64, hint: String },
 }
 
 impl Error {
     pub fn argument(what: impl Into<String>, message: impl Into<String>) -> Self {
         Error::Argument { what: what.into(), message: message.into() }
+    }
+
+    /// Refuse `bytes` above `limit` (checked before a large allocation).
+    pub fn check_memory(what: &str, bytes: u64, limit: u64, hint: &str) -> Result<()> {
+        if bytes > limit {
+            return Err(Error::Memory { what: what.to_string(), bytes, limit, hint: hint.to_string() });
+        }
+        Ok(())
     }
 
     pub fn invalid(item: impl Into<String>, message: impl Into<String>) -> Self {

@@ -25,11 +25,12 @@ pub mod linalg;
 pub mod model;
 pub mod sensors;
 pub mod small_svd;
+pub mod sparse_uk;
 pub mod uk;
 
 #[cfg(feature = "python")]
 mod bindings;
 
-pub use data::{Data, RankInfo, RankTolerance, SvdBackend};
+pub use data::{Data, RankInfo, RankTolerance, SvdBackend, UkSolver};
 pub use error::{Error, Result};
 pub use model::Model;

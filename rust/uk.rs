@@ -54,6 +54,20 @@ pub fn free_acceleration(model: &Model, data: &mut Data) {
 /// `B^T = F^-1 A^T` and its thin SVD with the rank decision (into `data.rank_info`).
 /// Needs `m > 0` and the mass factor of `dynamics::factor_mass`.
 pub fn factor_constraints(model: &Model, data: &mut Data) -> Result<()> {
+    if let Some(sp) = data.sparse.as_mut() {
+        if let Some(info) = sp.factor(model, &data.bodies, &data.jac, &data.tolerance) {
+            data.factored_with = Factored::SparseGram;
+            data.rank_info = info;
+            return Ok(());
+        }
+        // no full-rank certificate: the dense rank-revealing path decides (and reports) the rank
+        data.ensure_dense(model)?;
+    }
+    factor_dense(model, data)
+}
+
+/// The dense path of `factor_constraints`: `B^T` (n x m) and its certified QR / SVD.
+fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
     let (n, m) = (model.n, model.m);
     // B^T = F^-1 A^T, column by column
     for i in 0..m {
@@ -160,6 +174,12 @@ fn rank_from_singular_values(data: &Data, n: usize, m: usize, rcond: f64, atol: 
 /// the acceleration hot path -- and stores the exact `RankInfo` in `data.rank_info`. The
 /// current correction stays valid (it needs only the QR part).
 pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
+    if data.factored_with == Factored::SparseGram && !data.rank_info.exact {
+        // the singular values need the dense path (O(n m^2), on demand): factor the same `A`
+        // (still in `data.jac`) densely; the correction stays valid (same `q`)
+        data.ensure_dense(model)?;
+        factor_dense(model, data)?;
+    }
     if data.factored_with == Factored::FullRankQr && !data.rank_info.exact {
         let (n, m) = (model.n, model.m);
         let qrj = data.qrj.as_mut().expect("QR workspace");
@@ -189,6 +209,13 @@ pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
 /// The constraint correction with the current factorization: `r = b - A a`,
 /// `y += U S^+ V^T r`, `lambda = -V S^+ S^+ V^T r`, `qdd = F^-T y`.
 pub fn correct(model: &Model, data: &mut Data) {
+    if data.factored_with == Factored::SparseGram {
+        let sp = data.sparse.as_mut().expect("factored sparse");
+        sp.correct(&data.gamma, &mut data.residual, &mut data.y, &mut data.lambda);
+        data.qdd.copy_from_slice(&data.y);
+        apply_finvt(model, &data.bodies, &mut data.qdd);
+        return;
+    }
     let (n, m) = (model.n, model.m);
     let k = n.min(m);
     let rank = data.rank_info.rank;

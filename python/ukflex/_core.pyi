@@ -23,6 +23,7 @@ __all__ = [
     "NonFiniteError",
     "SolverError",
     "ExpressionError",
+    "MemoryLimitError",
 ]
 
 class UkflexError(Exception): ...
@@ -33,12 +34,19 @@ class NonFiniteError(UkflexError): ...
 class ExpressionError(InvalidSceneError):
     position: int
     expression: str
+class MemoryLimitError(UkflexError): ...
 
 @final
 class System:
     """Compiled model + workspace built from a JSON scene description (docs/scene-format.md)."""
 
-    def __new__(cls, description_json: str) -> "System": ...
+    def __new__(cls, description_json: str, uk_solver: str = "auto", memory_limit: Optional[float] = None) -> "System": ...
+    @property
+    def uk_solver(self) -> Tuple[str, str]:
+        """(asked at build: "auto" | "dense" | "sparse", taken by the last acceleration)."""
+    @property
+    def memory_limit(self) -> int:
+        """Bytes any lazily sized group of buffers may take (MemoryLimitError above)."""
     def M(self, q: _F64) -> _F64:
         """Mass matrix, shape (n, n)."""
     def Q(self, t: float, q: _F64, qd: _F64) -> _F64:
@@ -78,7 +86,7 @@ class System:
         """Columns x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
         the ends), psi of the axis point at xi; shape (5,) for q (n,), (nt, 5) for q (nt, n)."""
     def rank_info(self, t: Optional[float] = None, q: Optional[_F64] = None, qd: Optional[_F64] = None) -> Dict[str, Any]:
-        """rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the UK solve at (t, q, qd)
+        """uk_path, rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the UK solve at (t, q, qd)
         (one lock: thread-safe), or of the last solve of any thread without a state."""
     def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None:
         """Drop singular values of A F^-T at or below max(atol, rcond sigma_max)."""

@@ -25,6 +25,7 @@ __all__ = [
     "SingularMassError",
     "SolverError",
     "NonFiniteError",
+    "MemoryLimitError",
     "InconsistentInitialStateError",
     "ExpressionError",
     "MissingDependencyError",
@@ -36,6 +37,9 @@ SingularMassError = core.SingularMassError
 SolverError = core.SolverError
 ExpressionError = core.ExpressionError
 NonFiniteError = core.NonFiniteError
+#: An allocation would exceed the System's ``memory_limit`` (refused before allocating; the
+#: message names the buffers and a way out).
+MemoryLimitError = core.MemoryLimitError
 
 
 class InconsistentInitialStateError(UkflexError):  # type: ignore[misc, valid-type]

@@ -32,6 +32,8 @@ __all__ = [
     "cantilever",
     "pinned_beam",
     "every_joint",
+    "chain",
+    "rope",
     "gravity_vector",
     "scene_parameters",
     "SCENES",
@@ -496,6 +498,57 @@ def every_joint(gravity: Any = True) -> Scene:
     return s
 
 
+def _link_chain(s: Scene, angles: Any, link: float, mass: float, prefix: str = "link") -> list:
+    """Uniform rigid rods end to end from the origin, rod ``i`` at ``angles[i]`` (from +X), joined
+    by revolutes (``pivot`` to the ground, then ``joint{i}``); returns the bodies."""
+    bodies = []
+    x = y = 0.0
+    for i, a in enumerate(angles):
+        c, si = math.cos(a), math.sin(a)
+        b = s.rigid_body(f"{prefix}{i}", mass=mass, inertia=mass * link**2 / 12.0,
+                         position=(x + 0.5 * link * c, y + 0.5 * link * si), angle=a)
+        if i == 0:
+            s.revolute(s.ground.point(0.0, 0.0), b.point(-0.5 * link, 0.0), name="pivot")
+        else:
+            s.revolute(bodies[-1].point(0.5 * link, 0.0), b.point(-0.5 * link, 0.0), name=f"joint{i}")
+        bodies.append(b)
+        x, y = x + link * c, y + link * si
+    return bodies
+
+
+def chain(links: int = 16, length: float = 2.0, mass: float = 1.0, angle: float = 0.0, gravity: Any = True) -> Scene:
+    """Pendulum chain of rigid links under gravity.
+
+    ``links`` uniform rigid rods of total ``length`` and ``mass``, pinned end to end
+    (revolutes) and to the world origin, released from rest along ``angle`` (from +X; 0 is
+    horizontal).  ``n = 3 links`` coordinates, ``m = 2 links`` constraint rows: the scene of the
+    sparse UK path (docs/scale.md).  Conservative: ``T + V`` is constant."""
+    k = int(links)
+    if k < 1 or k != links:
+        raise ValueError(f"links must be a positive integer, got {links!r}")
+    s = Scene(gravity=gravity_vector(gravity))
+    _link_chain(s, [angle] * k, length / k, mass / k)
+    return s
+
+
+def rope(links: int = 64, length: float = 2.0, mass: float = 0.5, span: float = 1.6, gravity: Any = True) -> Scene:
+    """A rope of short rigid links hung between two pins (a closed loop through the ground).
+
+    ``links`` rods of total ``length`` and ``mass``, pins ``span`` apart: laid out as a symmetric
+    V (a consistent state), released from rest, it swings towards the catenary.  ``links`` even,
+    ``0 < span < length``."""
+    k = int(links)
+    if k < 2 or k != links or k % 2:
+        raise ValueError(f"links must be an even integer >= 2, got {links!r}")
+    if not 0.0 < span < length:
+        raise ValueError(f"span must be in (0, length), got span={span!r}, length={length!r}")
+    s = Scene(gravity=gravity_vector(gravity))
+    a = math.acos(span / length)
+    bodies = _link_chain(s, [-a] * (k // 2) + [a] * (k // 2), length / k, mass / k)
+    s.revolute(bodies[-1].point(0.5 * length / k, 0.0), s.ground.point(span, 0.0), name="anchor")
+    return s
+
+
 SCENES: Dict[str, Callable[..., Scene]] = {
     "slider_crank": slider_crank,
     "pendulum": pendulum,
@@ -504,6 +557,8 @@ SCENES: Dict[str, Callable[..., Scene]] = {
     "cantilever": cantilever,
     "pinned_beam": pinned_beam,
     "every_joint": every_joint,
+    "chain": chain,
+    "rope": rope,
 }
 
 

@@ -146,6 +146,15 @@ class System:
         Newton iteration limit.
     t0 : float
         Initial time (drivers are evaluated there).
+    uk_solver : {"auto", "dense", "sparse"}
+        How the UK correction is solved: ``"dense"`` (pseudoinverse of ``A F^-T``),
+        ``"sparse"`` (band Cholesky of ``A M^-1 A^T`` with a full-rank certificate, dense
+        rank-revealing fallback) or ``"auto"`` (sparse for long chains, ropes and tracks).
+        See docs/scale.md. ``core.uk_solver`` tells which path the last call took.
+    memory_limit : float, optional
+        Bytes any lazily sized group of buffers may take (default 2 GiB): the dense
+        ``n x n`` matrices of ``jac`` and of the implicit native integrators, the dense UK
+        fallback. Above it :class:`ukflex.MemoryLimitError` is raised before allocating.
 
     Attributes
     ----------
@@ -190,6 +199,8 @@ class System:
         velocity_tol: float = 1e-10,
         max_iterations: int = 50,
         t0: float = 0.0,
+        uk_solver: str = "auto",
+        memory_limit: Optional[float] = None,
     ):
         if isinstance(description, dict):
             _, self.description = normalize(description)
@@ -203,7 +214,8 @@ class System:
             "position_tol": position_tol, "velocity_tol": velocity_tol, "max_iterations": max_iterations, "t0": t0,
         }
         self._settings: Dict[str, tuple] = {}
-        self._bind(_core.System(json.dumps(self.description)))
+        self._core_options: Dict[str, Any] = {"uk_solver": uk_solver, "memory_limit": memory_limit}
+        self._bind(_core.System(json.dumps(self.description), **self._core_options))
         core = self.core
         self.t0 = float(t0)
         q_guess, qd_guess = core.initial_guess()
@@ -296,6 +308,7 @@ class System:
         return {
             "description": self.description,
             "build_options": self._build_options,
+            "core_options": self._core_options,
             "settings": self._settings,
             "t0": self.t0,
             "q_guess": self.q_guess,
@@ -309,7 +322,8 @@ class System:
         self.description = state["description"]
         self._build_options = dict(state["build_options"])
         self._settings = {}
-        self._bind(_core.System(json.dumps(self.description)))
+        self._core_options = dict(state.get("core_options", {}))
+        self._bind(_core.System(json.dumps(self.description), **self._core_options))
         for name, args in state["settings"].items():
             getattr(self, name)(*args)
         for key in ("t0", "q_guess", "qd_guess", "q0", "qd0", "initial_correction"):

@@ -26,6 +26,7 @@ create_exception!(ukflex, SingularMassError, UkflexError, "The mass matrix is no
 create_exception!(ukflex, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
 create_exception!(ukflex, SolverError, UkflexError, "A solver kernel failed.");
 create_exception!(ukflex, ExpressionError, InvalidSceneError, "A driver's motion expression does not parse; `position` is the 0-based character index.");
+create_exception!(ukflex, MemoryLimitError, UkflexError, "An allocation would exceed the System's memory limit (refused before allocating).");
 
 /// A 1-D float64 input. float64 vectors (what scipy passes) are read in place, strided or
 /// not; anything else array-like is converted once with `numpy.asarray(x, dtype=float64)`, and
@@ -106,6 +107,7 @@ pub(crate) fn to_py(e: Error) -> PyErr {
             let _ = v.setattr("expression", text);
             err
         }),
+        Error::Memory { .. } => MemoryLimitError::new_err(msg),
     }
 }
 
@@ -162,6 +164,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("NonFiniteError", py.get_type::<NonFiniteError>())?;
     m.add("SolverError", py.get_type::<SolverError>())?;
     m.add("ExpressionError", py.get_type::<ExpressionError>())?;
+    m.add("MemoryLimitError", py.get_type::<MemoryLimitError>())?;
     Ok(())
 }
 

@@ -13,7 +13,7 @@ use super::{check_time, finite_out, mat, read_into, to_py, SolverError, Vector};
 use crate::body::{ancf_cable, BodyKind};
 use crate::linalg::Banded;
 use crate::correct::{self, CorrectOptions};
-use crate::data::{Data, RankTolerance, Stabilization, SvdBackend};
+use crate::data::{Data, RankTolerance, Stabilization, SvdBackend, UkSolver};
 use crate::dynamics;
 use crate::error::Error;
 use crate::integrate::{integrate_uk, Method, Options};
@@ -27,10 +27,27 @@ struct Workspace {
     data: Data,
     q: Vec<f64>,
     qd: Vec<f64>,
-    /// Finite-difference Jacobian workspace and its two n x n blocks.
+    /// Finite-difference Jacobian workspace and its two n x n blocks (allocated on the first
+    /// `jac` call, not at build: most runs never need them).
     jws: JacobianWorkspace,
     jq: Vec<f64>,
     jv: Vec<f64>,
+}
+
+/// Default `memory_limit` of a System: 2 GiB per lazily sized group of buffers.
+pub const DEFAULT_MEMORY_LIMIT: u64 = 2 << 30;
+
+/// Bytes of the dense n x n buffers of the implicit paths: `System.jac` (`jq`, `jv`, the
+/// (2n)^2 result and the structured blocks) and the native RADAU5 / GENALPHA runs.
+fn implicit_bytes(model: &Model, what: &str) -> u64 {
+    let (n, m) = (model.n as u64, model.m as u64);
+    let saddle = (n + m) * (n + m) + 3 * n * n + m * n;
+    8 * match what {
+        "jac" => 6 * n * n + saddle,
+        "RADAU5" => 5 * n * n + saddle,
+        "GENALPHA" => 3 * n * n + saddle,
+        _ => 0,
+    }
 }
 
 /// A compiled scene: the immutable model and its workspace. Safe to share between threads
@@ -81,15 +98,48 @@ impl PySystem {
 #[pymethods]
 impl PySystem {
     /// Build the model from a JSON scene description (see docs/scene-format.md).
+    ///
+    /// uk_solver: "auto" (sparse for long chains, ropes, tracks; dense otherwise), "dense"
+    /// (the pseudoinverse of B^T) or "sparse" (band Cholesky of A M^-1 A^T with a full-rank
+    /// certificate, dense fallback); see docs/scale.md. memory_limit: bytes any lazily sized
+    /// group of buffers may take (None: 2 GiB); above it a MemoryLimitError is raised before
+    /// allocating.
     #[new]
-    fn new(description_json: &str) -> PyResult<Self> {
+    #[pyo3(signature = (description_json, uk_solver="auto", memory_limit=None))]
+    fn new(description_json: &str, uk_solver: &str, memory_limit: Option<f64>) -> PyResult<Self> {
+        let solver = UkSolver::parse(uk_solver).map_err(to_py)?;
+        let memory_limit = match memory_limit {
+            None => DEFAULT_MEMORY_LIMIT,
+            Some(b) if b > 0.0 && !b.is_nan() => if b.is_finite() { b as u64 } else { u64::MAX },
+            Some(b) => return Err(PyValueError::new_err(format!("memory_limit must be a positive number of bytes, got {b}"))),
+        };
         let model = catch_unwind(|| Model::from_json(description_json))
             .map_err(|_| SolverError::new_err("internal error while building the model"))?
             .map_err(to_py)?;
-        let data = Data::new(&model);
+        let data = Data::build(&model, solver, memory_limit).map_err(to_py)?;
         let n = model.n;
-        let ws = Workspace { data, q: vec![0.0; n], qd: vec![0.0; n], jws: JacobianWorkspace::new(&model), jq: vec![0.0; n * n], jv: vec![0.0; n * n] };
+        let ws = Workspace { data, q: vec![0.0; n], qd: vec![0.0; n], jws: JacobianWorkspace::new(&model), jq: Vec::new(), jv: Vec::new() };
         Ok(PySystem { model, ws: Mutex::new(ws) })
+    }
+
+    /// The UK path asked for at build ("auto", "dense", "sparse") and the one the last
+    /// acceleration took ("dense", "sparse" or "none").
+    #[getter]
+    fn uk_solver(&self) -> PyResult<(String, String)> {
+        self.with_ws(|_, ws| {
+            let asked = match ws.data.uk_solver {
+                UkSolver::Auto => "auto",
+                UkSolver::Dense => "dense",
+                UkSolver::Sparse => "sparse",
+            };
+            Ok((asked.to_string(), ws.data.uk_path().to_string()))
+        })
+    }
+
+    /// Memory limit in bytes (see the constructor).
+    #[getter]
+    fn memory_limit(&self) -> PyResult<u64> {
+        self.with_ws(|_, ws| Ok(ws.data.memory_limit))
     }
 
     /// Number of coordinates n.
@@ -311,11 +361,12 @@ impl PySystem {
         })
     }
 
-    /// Everything a pseudoinverse decided: rank, sigma_max, sigma_min_kept, sigma_max_dropped,
-    /// tolerance (exact singular values: when the acceleration took the certified full-rank path
-    /// they are computed here, on demand). With a state `(t, q, qd)` the UK solve at that state
-    /// and its rank report happen under one lock, so the answer belongs to that state even when
-    /// other threads use the System; without one it describes the last solve of any thread.
+    /// Everything a pseudoinverse decided: uk_path ("sparse" or "dense", the path the solve
+    /// took), rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance (exact singular
+    /// values: when the acceleration took a certified full-rank path they are computed here, on
+    /// demand, by the dense path). With a state `(t, q, qd)` the UK solve at that state and its
+    /// rank report happen under one lock, so the answer belongs to that state even when other
+    /// threads use the System; without one it describes the last solve of any thread.
     #[pyo3(signature = (t=None, q=None, qd=None))]
     fn rank_info<'py>(&self, py: Python<'py>, t: Option<f64>, q: Option<Vector<'py>>, qd: Option<Vector<'py>>) -> PyResult<Bound<'py, PyDict>> {
         let state = match (t, &q, &qd) {
@@ -323,15 +374,17 @@ impl PySystem {
             (None, None, None) => None,
             _ => return Err(PyValueError::new_err("rank_info: give all of t, q, qd (a state) or none of them (the last solve)")),
         };
-        let info = self.with_ws(|model, ws| {
+        let (info, path) = self.with_ws(|model, ws| {
             if let Some((t, q, qd)) = state {
                 check_time(t)?;
                 Self::load(ws, q, Some(qd))?;
                 uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
             }
-            uk::exact_rank_info(model, &mut ws.data)
+            let path = ws.data.uk_path();
+            Ok((uk::exact_rank_info(model, &mut ws.data)?, path))
         })?;
         let d = PyDict::new(py);
+        d.set_item("uk_path", path)?;
         d.set_item("rank", info.rank)?;
         d.set_item("sigma_max", info.sigma_max)?;
         d.set_item("sigma_min_kept", info.sigma_min_kept)?;
@@ -394,6 +447,12 @@ impl PySystem {
         let out = py.detach(|| {
             self.with_ws(|model, ws| {
                 ws.jws.scheme = scheme;
+                if ws.jq.len() != n * n {
+                    let hint = "the Jacobian of a system this large is dense n x n; use an explicit method (DOPRI5), or raise memory_limit";
+                    Error::check_memory("System.jac (dense (2n)^2 Jacobian)", implicit_bytes(model, "jac"), ws.data.memory_limit, hint)?;
+                    ws.jq = vec![0.0; n * n];
+                    ws.jv = vec![0.0; n * n];
+                }
                 let Workspace { data, jws, jq, jv, .. } = ws;
                 crate::jacobian::uk_jacobian(model, data, jws, t, &yv[..n], &yv[n..], jq, jv)?;
                 let mut out = vec![0.0; 4 * n * n];
@@ -473,11 +532,21 @@ impl PySystem {
         let opts = Options { rtol, atol, first_step, max_step, max_steps };
         opts.validate(2 * n).map_err(to_py)?;
         // a fresh workspace with this System's settings: the run does not hold the lock
-        let (tolerance, stabilization, backend) = self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.stabilization, ws.data.svd_backend)))?;
+        let (tolerance, stabilization, backend, solver, limit) =
+            self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.stabilization, ws.data.svd_backend, ws.data.uk_solver, ws.data.memory_limit)))?;
         let model = &self.model;
+        let implicit = match method {
+            Method::Dopri5 => 0,
+            Method::Radau5 => implicit_bytes(model, "RADAU5"),
+            Method::GenAlpha(_) => implicit_bytes(model, "GENALPHA"),
+        };
+        let hint = "implicit methods factor dense n x n matrices; use method='DOPRI5' for a system this large, or raise memory_limit";
+        Error::check_memory("the implicit integrator's n x n matrices", implicit, limit, hint).map_err(to_py)?;
+        // the run's own workspace (built before releasing the GIL so that a refusal is an error)
+        let data = Data::build(model, solver, limit).map_err(to_py)?;
         let result = py.detach(|| {
             catch_unwind(AssertUnwindSafe(|| {
-                let mut data = Data::new(model);
+                let mut data = data;
                 data.tolerance = tolerance;
                 data.stabilization = stabilization;
                 data.svd_backend = backend;

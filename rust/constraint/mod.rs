@@ -155,6 +155,21 @@ impl Constraint {
         Ok(Constraint { name, row: 0, kind })
     }
 
+    /// The bodies this constraint's rows can touch (the bodies of its markers; `None` for the
+    /// ground or an unused slot). Every Jacobian entry of its rows lies in these bodies'
+    /// coordinates: the sparsity pattern of `A` (`sparse_uk`, `dynamics::constraints`).
+    pub fn bodies(&self) -> [Option<usize>; 2] {
+        match &self.kind {
+            ConstraintKind::Revolute(c) => [c.a.body, c.b.body],
+            ConstraintKind::PointOnLine(c) => [c.point.body, c.line.body],
+            ConstraintKind::Prismatic(c) => [c.a.body, c.b.body],
+            ConstraintKind::Weld(c) => [c.a.body, c.b.body],
+            ConstraintKind::Distance(c) => [c.a.body, c.b.body],
+            ConstraintKind::AngleDriver(c) => [c.a.body, c.b.body],
+            ConstraintKind::CoordinateDriver(c) => [c.point.body, None],
+        }
+    }
+
     /// Name suffix of each row (`""` for single-row kinds).
     pub fn row_suffixes(&self) -> &'static [&'static str] {
         match &self.kind {
