@@ -70,8 +70,8 @@ class System:
     def tangent_stiffness(self, body: str, q: _F64) -> _F64:
         """-dQ_el/dq_b of beam ``body``'s elastic forces at q (n,), shape (n_b, n_b)."""
     def beam_point(self, body: str, xi: float, q: _F64) -> _F64:
-        """Columns x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
-        the ends), psi of the axis point at xi; shape (5,) for q (n,), (nt, 5) for q (nt, n)."""
+        """Rows x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
+        the ends), psi of the axis point at xi; shape (5,) for q (n,), (5, nt) for q (n, nt)."""
     def rank_info(self) -> Dict[str, Any]:
         """rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the last UK solve."""
     def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None:

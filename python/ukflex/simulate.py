@@ -122,7 +122,7 @@ def simulate(
     Returns
     -------
     SimulationResult
-        Histories ``t`` (nt,), ``q`` and ``qd`` (nt, n), constraint-residual norms (nt,) and
+        Histories ``t`` (nt,), ``q`` and ``qd`` (n, nt) (``y`` (2n, nt), as ``solve_ivp``), residual norms (nt,) and
         integrator statistics.
 
     Raises

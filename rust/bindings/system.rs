@@ -632,7 +632,8 @@ impl PySystem {
     }
 
     /// Axis point `xi` of beam `body` at the states `q`: an array (5,) for q of shape (n,), or
-    /// (nt, 5) for q of shape (nt, n), with columns x, y (world position), u, v (displacement
+    /// (5, nt) for q of shape (n, nt) (time along the last axis, as `SimulationResult.q`), with
+    /// rows x, y (world position), u, v (displacement
     /// in the beam frame from the undeformed (xi L, 0)) and psi (section rotation relative to
     /// that frame). The beam frame is an FFRF beam's floating frame (pinned-pinned: the chord
     /// of the ends) and an ANCF beam's chord frame of the ends, so the two compare one to one.
@@ -650,21 +651,25 @@ impl PySystem {
             .map_err(|_| PyValueError::new_err("q must be an array of floats"))?;
         let view = arr.readonly();
         let a = view.as_array();
-        let (rows, one) = match a.shape() {
+        let (cols, one) = match a.shape() {
             [m] if *m == n => (1, true),
-            [nt, m] if *m == n => (*nt, false),
-            other => return Err(PyValueError::new_err(format!("q must have shape (n,) or (nt, n) with n = {n}, got {other:?}"))),
+            [m, nt] if *m == n => (*nt, false),
+            other => return Err(PyValueError::new_err(format!("q must have shape (n,) or (n, nt) with n = {n}, got {other:?}"))),
         };
-        let flat: Vec<f64> = a.iter().copied().collect();
+        // one state per column: gather the transposed copy (state k contiguous)
+        let flat: Vec<f64> = if one { a.iter().copied().collect() } else { a.t().iter().copied().collect() };
         crate::error::check_finite("q", &flat).map_err(to_py)?;
-        let mut out = Vec::with_capacity(5 * rows);
-        for k in 0..rows {
-            out.extend_from_slice(&b.beam_point(xi, &flat[k * n..(k + 1) * n]).expect("checked: a beam"));
+        let mut out = vec![0.0; 5 * cols];
+        for k in 0..cols {
+            let p = b.beam_point(xi, &flat[k * n..(k + 1) * n]).expect("checked: a beam");
+            for (r, v) in p.iter().enumerate() {
+                out[r * cols + k] = *v;
+            }
         }
         if one {
             Ok(PyArray1::from_vec(py, out).into_any())
         } else {
-            Ok(mat(py, out, rows, 5)?.into_any())
+            Ok(mat(py, out, 5, cols)?.into_any())
         }
     }
 
