@@ -28,6 +28,10 @@ pub enum Error {
     /// A function argument (not the scene) is out of range: tolerances, times, options.
     #[error("{what}: {message}")]
     Argument { what: String, message: String },
+    /// A work budget of a run ran out (`what`: `max_steps`, `max_nfev`, `max_wall_time`,
+    /// `min_step`).
+    #[error("{message}")]
+    Budget { what: String, message: String },
     /// A solver kernel could not produce a result (e.g. SVD did not converge).
     #[error("solver failure: {0}")]
     Solver(String),

@@ -79,8 +79,8 @@ def test_native_argument_errors(system):
         ukflex.simulate(system, T_END, method="RADAU5", rtol=-1.0)
     with pytest.raises(ValueError):
         ukflex.simulate(system, T_END, method="DOPRI5", formulation="cp")
-    with pytest.raises(TypeError):
-        ukflex.simulate(system, T_END, method="DOPRI5", dense_output=True)
+    with pytest.raises(TypeError):  # an option the native methods do not take (dense_output now works)
+        ukflex.simulate(system, T_END, method="DOPRI5", max_stpe=1e-3)
 
 
 def test_rust_jacobian_matches_scipy_finite_differences(system):

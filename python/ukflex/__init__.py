@@ -15,11 +15,13 @@ Rust core (``ukflex._core``, private) + Python API:
 
 from .errors import (
     InconsistentInitialStateError,
+    InvalidArgumentError,
     InvalidSceneError,
     NonFiniteError,
     SingularMassError,
     SolverError,
     UkflexError,
+    UnknownOptionError,
 )
 from .scene import (
     BeamRef,
@@ -66,4 +68,6 @@ __all__ = [
     "SolverError",
     "NonFiniteError",
     "InconsistentInitialStateError",
+    "InvalidArgumentError",
+    "UnknownOptionError",
 ]

@@ -16,6 +16,7 @@ __all__ = [
     "SceneChecker",
     "item_name",
     "beam_elastic_dofs",
+    "dense_eval",
     "UkflexError",
     "InvalidSceneError",
     "SingularMassError",
@@ -98,8 +99,13 @@ class System:
         rho_inf: float = 0.9,
         step: Optional[float] = None,
         jacobian: str = "structured",
+        max_nfev: Optional[int] = None,
+        max_wall_time: Optional[float] = None,
+        min_step: float = 0.0,
+        dense: bool = False,
     ) -> Dict[str, Any]:
-        """Native integration; dict with t (nt,), y (2n, nt), status, message, statistics."""
+        """Native integration; dict with t (nt,), y (2n, nt), status, message, failure (None or
+        cause, t, stage, index), statistics, dense (None or meta (nseg, 3), data, part_len)."""
     def project(
         self, t: float, q: _F64, qd: _F64, tol: float = 1e-12, max_iter: int = 20
     ) -> Tuple[_F64, _F64, Dict[str, Any]]:
@@ -158,3 +164,6 @@ def item_name(section: str, kind: str, name: Optional[str], index: int) -> str:
 
 def beam_elastic_dofs(elements: int, frame: str) -> int:
     """Number of elastic coordinates of a beam."""
+
+def dense_eval(method: str, meta: _F64, data: _F64, part_len: List[int], t: _F64) -> _F64:
+    """Evaluate the dense output recorded by ``System.integrate(..., dense=True)`` at t (k,): (dim, k)."""

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import csv
 from dataclasses import dataclass, field
-from typing import Any, Dict, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = ["SimulationResult"]
 
@@ -31,7 +32,8 @@ class SimulationResult:
     wall_time : float
         Wall-clock time of the integration [s] (residual evaluation excluded).
     status : int
-        ``solve_ivp`` status (0: reached ``t_end``, -1: integration step failed, 1: event).
+        ``solve_ivp`` status (0: reached ``t_end``, -1: the run stopped early (failure, budget,
+        non-finite state; see ``stop``), 1: a terminal event).
     message : str
         Integrator message.
     system : ukflex.System
@@ -40,6 +42,17 @@ class SimulationResult:
         Integrator and formulation used.
     rtol, atol : float
         Tolerances used.
+    t_events, y_events : list of ndarray or None
+        With ``events``: per event, the times (k,) and states (k, 2n) of its roots, as
+        ``solve_ivp`` returns them.
+    sol : callable or None
+        With ``dense_output=True``: ``sol(t)`` -> (2n,) or (2n, k) (scipy's ``OdeSolution`` or
+        :class:`ukflex.simulate.DenseSolution`).
+    stop : dict or None
+        Why a run ended early (``status == -1``): ``cause`` (``"max_steps"``, ``"max_nfev"``,
+        ``"max_wall_time"``, ``"min_step"``, ``"non_finite"``, ``"solver"``), ``t`` (the last
+        accepted time, where the kept trajectory ends), for ``non_finite`` the ``coordinate``
+        and ``stage`` (``"q"``, ``"qd"`` or ``"qdd"``), and the ``message``.
     """
 
     t: np.ndarray
@@ -58,13 +71,17 @@ class SimulationResult:
     rtol: float = float("nan")
     atol: Any = float("nan")
     extra: Dict[str, Any] = field(default_factory=dict)
+    t_events: Optional[List[np.ndarray]] = None
+    y_events: Optional[List[np.ndarray]] = None
+    sol: Optional[Callable[..., np.ndarray]] = None
+    stop: Optional[Dict[str, Any]] = None
 
     @classmethod
     def from_trajectory(
         cls,
         system: Any,
-        t: Sequence[float],
-        y: Any,
+        t: ArrayLike,
+        y: ArrayLike,
         *,
         method: str = "",
         formulation: str = "uk",
@@ -106,20 +123,20 @@ class SimulationResult:
         ...                                        nfev=out["nfev"], status=out["status"])
         """
         n = system.n_coords
-        t = np.asarray(t, dtype=float)
-        y = np.asarray(y, dtype=float)
-        if t.ndim != 1 or y.shape != (2 * n, t.size):
+        tv = np.asarray(t, dtype=float)
+        yv = np.asarray(y, dtype=float)
+        if tv.ndim != 1 or yv.shape != (2 * n, tv.size):
             raise ValueError(f"from_trajectory: expected t of shape (nt,) and y of shape (2n, nt) = "
-                             f"({2 * n}, {t.size}), got {t.shape} and {y.shape}")
-        q = np.ascontiguousarray(y[:n])
-        qd = np.ascontiguousarray(y[n:])
-        return cls(t=t, q=q, qd=qd, residuals=_residual_norms(system, t, q, qd), nfev=int(nfev), njev=int(njev),
+                             f"({2 * n}, {tv.size}), got {tv.shape} and {yv.shape}")
+        q = np.ascontiguousarray(yv[:n])
+        qd = np.ascontiguousarray(yv[n:])
+        return cls(t=tv, q=q, qd=qd, residuals=_residual_norms(system, tv, q, qd), nfev=int(nfev), njev=int(njev),
                    nlu=int(nlu), wall_time=float(wall_time), status=int(status), message=str(message), system=system,
                    method=method, formulation=formulation, rtol=rtol, atol=atol, extra=dict(extra or {}))
 
     @property
     def success(self) -> bool:
-        """True if the integrator reached the end time."""
+        """True if the integrator reached the end time or stopped at a terminal event (status >= 0)."""
         return self.status >= 0
 
     @property

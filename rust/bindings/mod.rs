@@ -8,6 +8,7 @@ mod system;
 
 use numpy::ndarray::ArrayView1;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
+use pyo3::type_object::PyTypeInfo;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
@@ -38,13 +39,30 @@ impl<'py> std::ops::Deref for Vector<'py> {
 impl<'a, 'py> FromPyObject<'a, 'py> for Vector<'py> {
     type Error = PyErr;
     fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        if let Ok(a) = obj.extract::<PyReadonlyArray1<'py, f64>>() {
-            return Ok(Vector(a));
-        }
         let py = obj.py();
-        let converted = py
-            .import("numpy")?
-            .call_method1("asarray", (obj, "float64"))
+        if let Ok(a) = obj.extract::<PyReadonlyArray1<'py, f64>>() {
+            // a plain ndarray (the hot path); a subclass only if it is not masked
+            if obj.get_type().is(numpy::PyUntypedArray::type_object(py)) || !obj.hasattr("mask")? {
+                return Ok(Vector(a));
+            }
+            return Err(PyValueError::new_err("expected a 1-D array of floats, not a masked array (fill or compress the mask first)"));
+        }
+        // PyO3 attaches the argument's name to the error ("while processing 'q'")
+        if obj.is_none() {
+            return Err(PyValueError::new_err("expected a 1-D array of floats, got None"));
+        }
+        if obj.hasattr("mask")? {
+            return Err(PyValueError::new_err("expected a 1-D array of floats, not a masked array (fill or compress the mask first)"));
+        }
+        let np = py.import("numpy")?;
+        let raw = np.call_method1("asarray", (obj,)).map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?;
+        let kind: String = raw.getattr("dtype")?.getattr("kind")?.extract()?;
+        if matches!(kind.as_str(), "c" | "b" | "O") {
+            let dt = raw.getattr("dtype")?.str()?.to_string();
+            return Err(PyValueError::new_err(format!("expected a 1-D array of floats (real numbers), got dtype {dt}")));
+        }
+        let converted = np
+            .call_method1("asarray", (raw, "float64"))
             .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?;
         let arr = converted
             .cast_into::<numpy::PyArrayDyn<f64>>()
@@ -69,7 +87,7 @@ pub(crate) fn to_py(e: Error) -> PyErr {
         Error::Shape { .. } | Error::Argument { .. } => PyValueError::new_err(msg),
         Error::NonFinite { .. } => NonFiniteError::new_err(msg),
         Error::SingularMass { .. } => SingularMassError::new_err(msg),
-        Error::Solver(_) => SolverError::new_err(msg),
+        Error::Solver(_) | Error::Budget { .. } => SolverError::new_err(msg),
     }
 }
 
@@ -102,6 +120,37 @@ pub(crate) fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -
     PyArray1::from_vec(py, v).reshape([rows, cols])
 }
 
+/// Evaluate the dense output recorded by `System.integrate(..., dense=True)` of a run of
+/// `method` at the times `t` (k,): returns (dim, k). Each time uses the step whose interval
+/// holds it (outside the run: the first or last step's polynomial, extrapolated).
+#[pyfunction]
+fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<'py, f64>, data: numpy::PyReadonlyArray2<'py, f64>, part_len: Vec<usize>, t: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    use crate::integrate::{DenseRecord, Method};
+    let method = Method::from_name(method).ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}'")))?;
+    let (meta, data) = (meta.as_array(), data.as_array());
+    let width: usize = part_len.iter().sum();
+    if meta.ncols() != 3 || data.ncols() != width || meta.nrows() != data.nrows() || part_len.len() > 5 || meta.nrows() == 0 {
+        return Err(PyValueError::new_err("dense_eval: inconsistent dense record (meta (nseg, 3), data (nseg, sum(part_len)))"));
+    }
+    let dim = match method {
+        Method::GenAlpha(_) => part_len.last().copied().unwrap_or(0),
+        _ => part_len.first().copied().unwrap_or(0),
+    };
+    let rec = DenseRecord { meta: meta.iter().copied().collect(), data: data.iter().copied().collect(), part_len };
+    let ts: Vec<f64> = t.as_array().iter().copied().collect();
+    crate::error::check_finite("t", &ts).map_err(to_py)?;
+    let k = ts.len();
+    let mut out = vec![0.0; dim * k];
+    let mut buf = vec![0.0; dim];
+    for (j, tj) in ts.iter().enumerate() {
+        rec.eval(&method, *tj, &mut buf);
+        for i in 0..dim {
+            out[i * k + j] = buf[i];
+        }
+    }
+    mat(py, out, dim, k)
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -109,6 +158,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySceneChecker>()?;
     m.add_function(wrap_pyfunction!(item_name, m)?)?;
     m.add_function(wrap_pyfunction!(beam_elastic_dofs, m)?)?;
+    m.add_function(wrap_pyfunction!(dense_eval, m)?)?;
     m.add("UkflexError", py.get_type::<UkflexError>())?;
     m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
     m.add("SingularMassError", py.get_type::<SingularMassError>())?;
