@@ -413,14 +413,16 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
         nfev[0] += 1
         if nfev[0] > budget.max_nfev:
             raise _Stop("max_nfev")
-        bad = np.flatnonzero(~np.isfinite(y))
-        if bad.size:
+        try:
+            out = rhs(t, y)  # the core refuses a non-finite y
+        except NonFiniteError:
+            bad = np.flatnonzero(~np.isfinite(y))
+            if not bad.size:
+                raise
             i = int(bad[0])
-            raise _Stop("non_finite", "q" if i < n else "qd", i % n)
-        out = rhs(t, y)
-        bad = np.flatnonzero(~np.isfinite(out[n:]))
-        if bad.size:
-            raise _Stop("non_finite", "qdd", int(bad[0]))
+            raise _Stop("non_finite", "q" if i < n else "qd", i % n) from None
+        if not np.isfinite(out).all():
+            raise _Stop("non_finite", "qdd", int(np.flatnonzero(~np.isfinite(out[n:]))[0]))
         return out
 
     solver_cls = _SCIPY_SOLVERS[method] if isinstance(method, str) else method
@@ -475,7 +477,6 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
             sol = solver.dense_output() if dense else None
             if dense:
                 interpolants.append(sol)
-                ti.append(t)
             if events:
                 g_new = [ev(t, y) for ev in events]
                 active = find_active_events(g, g_new, event_dir)
@@ -493,6 +494,8 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
                         t = roots[-1]
                         y = sol(t)
                 g = g_new
+            if dense:
+                ti.append(t)  # the step end, or the terminal event's root (as solve_ivp)
             if t_eval is None:
                 ts.append(t)
                 ys.append(y)
