@@ -323,21 +323,22 @@ impl StepState {
     /// (`Error::Budget`) and the step-size floor.
     fn check_attempt(&mut self, method: &str, opts: &Options) -> Result<()> {
         self.steps += 1;
-        let t = fmt_t(self.t);
+        // formatted only on the way out: no allocation per attempt
+        let t = || fmt_t(self.t);
         if self.steps > opts.max_steps {
-            return Err(Error::Budget { what: "max_steps".into(), message: format!("{method}: more than max_steps = {} step attempts at t = {t}", opts.max_steps) });
+            return Err(Error::Budget { what: "max_steps".into(), message: format!("{method}: more than max_steps = {} step attempts at t = {}", opts.max_steps, t()) });
         }
         if self.stats.nfev > opts.max_nfev {
-            return Err(Error::Budget { what: "max_nfev".into(), message: format!("{method}: more than max_nfev = {} evaluations at t = {t}", opts.max_nfev) });
+            return Err(Error::Budget { what: "max_nfev".into(), message: format!("{method}: more than max_nfev = {} evaluations at t = {}", opts.max_nfev, t()) });
         }
         if opts.max_wall_time.is_finite() && self.started.is_some_and(|s| s.elapsed().as_secs_f64() > opts.max_wall_time) {
-            return Err(Error::Budget { what: "max_wall_time".into(), message: format!("{method}: wall time over max_wall_time = {} s at t = {t}", opts.max_wall_time) });
+            return Err(Error::Budget { what: "max_wall_time".into(), message: format!("{method}: wall time over max_wall_time = {} s at t = {}", opts.max_wall_time, t()) });
         }
         if 0.1 * self.h.abs() <= self.t.abs() * f64::EPSILON || !self.h.is_finite() || self.h < opts.min_step {
             if let Some((stage, index)) = self.nonfinite {
-                return Err(Error::NonFinite { what: format!("{stage} at t = {t} (trial steps down to h = {:.3e} all non-finite)", self.h), index });
+                return Err(Error::NonFinite { what: format!("{stage} at t = {} (trial steps down to h = {:.3e} all non-finite)", t(), self.h), index });
             }
-            return Err(Error::Budget { what: "min_step".into(), message: format!("{method}: step size too small (h = {:.3e}, min_step = {:.3e}) at t = {t}", self.h, opts.min_step) });
+            return Err(Error::Budget { what: "min_step".into(), message: format!("{method}: step size too small (h = {:.3e}, min_step = {:.3e}) at t = {}", self.h, opts.min_step, t()) });
         }
         Ok(())
     }
