@@ -35,7 +35,7 @@ fn run(model: &Model, method: Method, rtol: f64, atol: f64, te: &[f64]) -> Run {
     let y0: Vec<f64> = model.q0.iter().chain(&model.qd0).copied().collect();
     let opts = Options { rtol, atol: vec![atol], ..Default::default() };
     let tic = Instant::now();
-    let (sol, full, cheap) = integrate_uk(model, Data::new(model), method, opts, 0.0, &y0, 0.1, Some(te), None, ukflex::jacobian::Differences::Central).unwrap();
+    let (sol, full, cheap) = integrate_uk(model, Data::new(model), method, opts, 0.0, &y0, 0.1, Some(te), None, ukflex::jacobian::Differences::Central, false).unwrap();
     let secs = tic.elapsed().as_secs_f64();
     assert_eq!(sol.status, 0, "{}", sol.message);
     let v = (0..sol.t.len()).map(|k| midpoint_deflection(model, &sol.y[k * sol.dim..k * sol.dim + model.n])).collect();

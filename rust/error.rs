@@ -31,6 +31,10 @@ pub enum Error {
     /// A driver's motion expression does not parse (`position`: 0-based character index).
     #[error("{item}: cannot parse the motion expression {text:?} at position {position}: {message}")]
     Expression { item: String, text: String, message: String, position: usize },
+    /// A work budget of a run ran out (`what`: `max_steps`, `max_nfev`, `max_wall_time`,
+    /// `min_step`).
+    #[error("{message}")]
+    Budget { what: String, message: String },
     /// A solver kernel could not produce a result (e.g. SVD did not converge).
     #[error("solver failure: {0}")]
     Solver(String),

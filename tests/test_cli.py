@@ -98,7 +98,7 @@ def test_run_scene_file_end_to_end(tiny, tmp_path):
     v = o["v(beam, 0.5)/L"]
     assert v[0] == 0.0 and v.min() < -1e-6
     npz = np.load(out / "tiny.npz")
-    assert npz["q"].shape == (41, 3 + 6) and str(npz["method"]) == "DOP853"
+    assert npz["q"].shape == (3 + 6, 41) and str(npz["method"]) == "DOP853"
     from PIL import Image
 
     gif = Image.open(out / "tiny.gif")

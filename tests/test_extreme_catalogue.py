@@ -68,7 +68,7 @@ def test_axial_force_strain_vs_multipliers_and_buckling_load():
     """The strain-based axial force at the crank end equals the joint reaction along the coupler
     (from the multipliers) in a near-rigid coupler; P_cr = pi^2 E I / Lb^2."""
     r = S.run(X.stiff(100.0, elements=4), 0.006, "DOPRI5", rtol=1e-7, t_eval=np.linspace(0.002, 0.006, 41))
-    strain = -S.axial_force(r, "coupler")[:, 0]  # compression positive, element 1
+    strain = -S.axial_force(r, "coupler")[0]  # compression positive, element 1
     joint = S.joint_end_force(r, "crank_coupler", "coupler")
     scale = np.abs(joint).max()
     # element 1 (mean over its length) carries the end force minus part of the inertia of 1/4 of the coupler
@@ -136,7 +136,7 @@ def test_redundant_parallelogram_energy_branch_and_cp():
     te = np.linspace(0, 1.0, 101)
     r = S.run(system, 1.0, "DOPRI5", rtol=1e-9, t_eval=te, rank_tolerance=(1e-10, 0.0))
     E = r.energy()
-    T = np.array([system.kinetic_energy(q, qd) for q, qd in zip(r.q, r.qd)])
+    T = np.array([system.kinetic_energy(q, qd) for q, qd in zip(r.q.T, r.qd.T)])
     assert np.ptp(E) < 1e-7 * T.max()
     th = r.coordinate("crank.theta")
     for other in ("rocker.theta", "extra.theta"):
@@ -197,7 +197,7 @@ def test_mass_ratio_energy_and_cp(ratio):
     assert np.linalg.cond(system.M(system.q0)) > 1e7
     te = np.linspace(0, 1.0, 101)
     r = S.run(system, 1.0, "DOPRI5", rtol=1e-10, t_eval=te)
-    T = np.array([system.kinetic_energy(q, qd) for q, qd in zip(r.q, r.qd)])
+    T = np.array([system.kinetic_energy(q, qd) for q, qd in zip(r.q.T, r.qd.T)])
     assert np.ptp(r.energy()) < 1e-6 * T.max()
     cp = ukflex.simulate(system, 1.0, method="DOP853", rtol=1e-10, atol=1e-13, t_eval=te, formulation="cp")
     assert cp.status == 0 and np.abs(cp.q - r.q).max() < 1e-5

@@ -48,7 +48,7 @@ def test_energy_is_not_trivially_constant(drifts):
     """Kinetic and potential energy both vary by the full swing (the check above is not vacuous)."""
     _, res = drifts[1e-9]
     sys_ = res.system
-    T = np.array([sys_.kinetic_energy(q, qd) for q, qd in zip(res.q, res.qd)])
+    T = np.array([sys_.kinetic_energy(q, qd) for q, qd in zip(res.q.T, res.qd.T)])
     swing = M * G * (L / 2) * (1 - math.cos(PHI0))
     # sampled every 0.01 s, so the maximum is caught to about (omega dt)^2 ~ 1e-4
     assert T.max() == pytest.approx(swing, rel=1e-4)

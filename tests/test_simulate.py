@@ -45,7 +45,7 @@ def test_paper_scene_grid(beam, gravity, n, record_property):
     record_property("nfev", res.nfev)
     assert res.success, res.message
     assert res.t[-1] == pytest.approx(T_END)
-    assert res.q.shape == (1001, system.n_coords)
+    assert res.q.shape == (system.n_coords, 1001)
     # the driver is obeyed: crank angle = omega t (UK enforces it at acceleration level only)
     assert np.abs(res.coordinate("crank.theta") - OMEGA * res.t).max() < 1e-5
     # constraint drift without stabilization stays small over 0.1 s
@@ -121,8 +121,9 @@ def test_default_jacobian_and_bdf():
 def test_result_helpers(tmp_path):
     system = scenes.slider_crank(elements=2).build()
     res = simulate(system, 0.01, t_eval=np.linspace(0, 0.01, 11))
-    assert res.t.shape == (11,) and res.qd.shape == (11, system.n_coords)
-    assert res.y.shape == (11, 2 * system.n_coords)
+    assert res.t.shape == (11,) and res.qd.shape == (system.n_coords, 11)
+    assert res.y.shape == (2 * system.n_coords, 11)
+    np.testing.assert_array_equal(res.y, np.vstack([res.q, res.qd]))
     assert set(res.residuals) == {"position", "velocity", "acceleration"}
     assert all(r.shape == (11,) for r in res.residuals.values())
     assert res.nfev > 0 and res.njev > 0 and res.nlu > 0 and res.wall_time > 0
@@ -132,10 +133,10 @@ def test_result_helpers(tmp_path):
     _, v1 = res.beam_displacement("coupler", 1.0)
     assert np.allclose(v1, 0.0)
     u1, _ = res.beam_displacement("coupler", 1.0)
-    assert np.allclose(u1, res.q[:, system.elastic_slice("coupler")] @ system.beam_shape("coupler", 1.0)[0][0])
-    assert np.array_equal(res.coordinate("coupler.theta"), res.q[:, 5])
-    assert np.array_equal(res.velocity("crank.theta"), res.qd[:, 2])
-    assert res.multipliers().shape == (11, 6)
+    assert np.allclose(u1, system.beam_shape("coupler", 1.0)[0][0] @ res.q[system.elastic_slice("coupler")])
+    assert np.array_equal(res.coordinate("coupler.theta"), res.q[5])
+    assert np.array_equal(res.velocity("crank.theta"), res.qd[2])
+    assert res.multipliers().shape == (6, 11) and res.qdd().shape == (system.n_coords, 11)
     assert res.energy().shape == (11,)
     with pytest.raises(KeyError):
         res.coordinate("coupler.phi")
@@ -166,7 +167,7 @@ def test_simulate_accepts_scene_dict_and_methods():
 def test_simulate_initial_state_override():
     sys_ = scenes.pendulum().build()
     res = simulate(sys_, 0.05, q0=sys_.q0, qd0=np.zeros(3), t_eval=[0, 0.05])
-    assert np.array_equal(res.q[0], sys_.q0)
+    assert np.array_equal(res.q[:, 0], sys_.q0)
 
 
 def test_reference_formulations_are_wired():
@@ -184,7 +185,7 @@ def test_reference_formulations_are_wired():
         _, v_ref = ref.beam_displacement("coupler", 0.5)
         assert np.abs(v_ref).max() > 1e-4
         assert np.abs(v - v_ref).max() < 1e-6 * np.abs(v_ref).max()
-        assert np.allclose(res.q[:, :6], ref.q[:, :6], atol=1e-9)
+        assert np.allclose(res.q[:6], ref.q[:6], atol=1e-9)
 
 
 def test_cantilever_static_deflection():

@@ -28,7 +28,7 @@ def test_scaling_accuracy_on_a_fine_mesh():
     root M^-1/2 loses digits, and the diagonal scaling D = diag(M)^-1/2 recovers them."""
     system = X.stiff(1.0, elements=64).build()
     r = S.run(system, 0.002, "DOPRI5", rtol=1e-8, t_eval=[0.0, 0.002])
-    a = S.scaling_accuracy(system, r.t[-1], r.q[-1], r.qd[-1])
+    a = S.scaling_accuracy(system, r.t[-1], r.q[:, -1], r.qd[:, -1])
     assert a["cond_M"] > 5e7 and a["cond_M_scaled"] < 1e4
     assert a["rust_uk"] < 1e-13
     assert a["uk_symmetric"] > 1e-13

@@ -17,6 +17,7 @@ Rust core (``ukflex._core``, private) + Python API:
 from .errors import (
     ExpressionError,
     InconsistentInitialStateError,
+    InvalidArgumentError,
     InvalidSceneError,
     MissingDependencyError,
     MemoryLimitError,
@@ -24,6 +25,7 @@ from .errors import (
     SingularMassError,
     SolverError,
     UkflexError,
+    UnknownOptionError,
 )
 from .scene import (
     BeamRef,
@@ -94,4 +96,6 @@ __all__ = [
     "InconsistentInitialStateError",
     "ExpressionError",
     "MissingDependencyError",
+    "InvalidArgumentError",
+    "UnknownOptionError",
 ]

@@ -17,6 +17,7 @@ __all__ = [
     "item_name",
     "beam_elastic_dofs",
     "motion_values",
+    "dense_eval",
     "UkflexError",
     "InvalidSceneError",
     "SingularMassError",
@@ -83,8 +84,8 @@ class System:
     def tangent_stiffness(self, body: str, q: _F64) -> _F64:
         """-dQ_el/dq_b of beam or flexible body ``body``'s elastic forces at q (n,), shape (n_b, n_b)."""
     def beam_point(self, body: str, xi: float, q: _F64) -> _F64:
-        """Columns x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
-        the ends), psi of the axis point at xi; shape (5,) for q (n,), (nt, 5) for q (nt, n)."""
+        """Rows x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
+        the ends), psi of the axis point at xi; shape (5,) for q (n,), (5, nt) for q (n, nt)."""
     def rank_info(self, t: Optional[float] = None, q: Optional[_F64] = None, qd: Optional[_F64] = None) -> Dict[str, Any]:
         """uk_path, rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the UK solve at (t, q, qd)
         (one lock: thread-safe), or of the last solve of any thread without a state."""
@@ -112,8 +113,13 @@ class System:
         rho_inf: float = 0.9,
         step: Optional[float] = None,
         jacobian: str = "structured",
+        max_nfev: Optional[int] = None,
+        max_wall_time: Optional[float] = None,
+        min_step: float = 0.0,
+        dense: bool = False,
     ) -> Dict[str, Any]:
-        """Native integration; dict with t (nt,), y (2n, nt), status, message, statistics."""
+        """Native integration; dict with t (nt,), y (2n, nt), status, message, failure (None or
+        cause, t, stage, index), statistics, dense (None or meta (nseg, 3), data, part_len)."""
     def project(
         self, t: float, q: _F64, qd: _F64, tol: float = 1e-12, max_iter: int = 20
     ) -> Tuple[_F64, _F64, Dict[str, Any]]:
@@ -181,3 +187,6 @@ def motion_values(motion_json: str, t: _F64) -> _F64:
     ...
 def beam_elastic_dofs(elements: int, frame: str) -> int:
     """Number of elastic coordinates of a beam."""
+
+def dense_eval(method: str, meta: _F64, data: _F64, part_len: List[int], t: _F64) -> _F64:
+    """Evaluate the dense output recorded by ``System.integrate(..., dense=True)`` at t (k,): (dim, k)."""

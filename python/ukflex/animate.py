@@ -296,7 +296,7 @@ def animate(
     drawer = MechanismDrawer(res.system, deform_scale=deform_scale)
     fig = _new_figure(size, dpi)
     ax = fig.add_subplot(1, 1, 1)
-    sc = _Scene2D(ax, drawer, drawer.bounds([res.q[i] for i in idx]), _title(res, deform_scale, title))
+    sc = _Scene2D(ax, drawer, drawer.bounds([res.q[:, i] for i in idx]), _title(res, deform_scale, title))
     fig.tight_layout()
     # blitting: the static background (axes, ground, legend) is drawn once
     for a in sc.animated():
@@ -306,7 +306,7 @@ def animate(
     background = canvas.copy_from_bbox(fig.bbox)
     images = []
     for i in idx:
-        sc.update(res.q[i], float(res.t[i]))
+        sc.update(res.q[:, i], float(res.t[i]))
         canvas.restore_region(background)
         for a in sc.animated():
             ax.draw_artist(a)
@@ -335,14 +335,14 @@ def snapshots(
         idx = np.unique([int(np.argmin(np.abs(res.t - tt))) for tt in times])
     fig = _new_figure(size, dpi)
     ax = fig.add_subplot(1, 1, 1)
-    sc = _Scene2D(ax, drawer, drawer.bounds([res.q[i] for i in idx]), _title(res, deform_scale, title))
+    sc = _Scene2D(ax, drawer, drawer.bounds([res.q[:, i] for i in idx]), _title(res, deform_scale, title))
     for ln in sc.lines.values():
         ln.remove()
     sc.joints.remove()
     for k, i in enumerate(idx):
         alpha = 0.25 + 0.75 * (k + 1) / len(idx)
         for c, name in enumerate(drawer.bodies):
-            p = drawer.body_polyline(res.q[i], name)
+            p = drawer.body_polyline(res.q[:, i], name)
             ax.plot(p[:, 0], p[:, 1], "-", color=_Scene2D.COLORS[c % len(_Scene2D.COLORS)], alpha=alpha,
                     lw=2.0, label=name if k == len(idx) - 1 else None,
                     marker="o" if drawer.bodies[name] == "point_mass" else None, ms=7)

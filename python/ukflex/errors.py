@@ -29,6 +29,8 @@ __all__ = [
     "InconsistentInitialStateError",
     "ExpressionError",
     "MissingDependencyError",
+    "InvalidArgumentError",
+    "UnknownOptionError",
 ]
 
 UkflexError = core.UkflexError
@@ -63,3 +65,34 @@ class InconsistentInitialStateError(UkflexError):  # type: ignore[misc, valid-ty
 class MissingDependencyError(UkflexError, ImportError):  # type: ignore[misc, valid-type]
     """An optional dependency is not installed (matplotlib for plots, pandas/dask for sweeps);
     the message names the feature and the ``pip install 'ukflex[extra]'`` that provides it."""
+
+
+class InvalidArgumentError(UkflexError, ValueError, TypeError):  # type: ignore[misc, valid-type]
+    """A function argument of the Python API is invalid (wrong type, out of range, masked or
+    complex array, ...).  A ``ValueError`` and a ``TypeError`` too, so code written against
+    the built-in exceptions keeps working.
+
+    Attributes
+    ----------
+    argument : str
+        The argument's name (e.g. ``"t_end"``, ``"rtol"``, ``"q0"``).
+    """
+
+    def __init__(self, argument: str, message: str):
+        super().__init__(f"{argument}: {message}")
+        self.argument = argument
+
+
+class UnknownOptionError(InvalidArgumentError):
+    """An option that the function (or the chosen method) does not take, e.g. a misspelt
+    ``max_stpe``.
+
+    Attributes
+    ----------
+    valid : list of str
+        The options that are accepted.
+    """
+
+    def __init__(self, argument: str, message: str, valid: Sequence[str] = ()):
+        super().__init__(argument, message)
+        self.valid = list(valid)

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import csv
 from dataclasses import dataclass, field
-from typing import Any, Dict, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = ["SimulationResult"]
 
@@ -19,8 +20,10 @@ class SimulationResult:
     ----------
     t : ndarray, shape (nt,)
         Output times [s].
-    q, qd : ndarray, shape (nt, n)
-        Generalized coordinates and velocities at the output times.
+    q, qd : ndarray, shape (n, nt)
+        Generalized coordinates and velocities at the output times, time along the last axis
+        (``q[:, k]`` is the state at ``t[k]``); ``y`` stacks them as ``solve_ivp`` does,
+        shape (2n, nt).  Per coordinate: :meth:`coordinate`, :meth:`velocity` (1-D over time).
     residuals : dict of str -> ndarray, shape (nt,)
         Euclidean norms of the constraint residuals at each output time: ``"position"``
         (``Phi``), ``"velocity"`` (``A qd + Phi_t``), ``"acceleration"`` (``A qdd - b``).
@@ -29,7 +32,8 @@ class SimulationResult:
     wall_time : float
         Wall-clock time of the integration [s] (residual evaluation excluded).
     status : int
-        ``solve_ivp`` status (0: reached ``t_end``, -1: integration step failed, 1: event).
+        ``solve_ivp`` status (0: reached ``t_end``, -1: the run stopped early (failure, budget,
+        non-finite state; see ``stop``), 1: a terminal event).
     message : str
         Integrator message.
     system : ukflex.System
@@ -38,6 +42,17 @@ class SimulationResult:
         Integrator and formulation used.
     rtol, atol : float
         Tolerances used.
+    t_events, y_events : list of ndarray or None
+        With ``events``: per event, the times (k,) and states (k, 2n) of its roots, as
+        ``solve_ivp`` returns them.
+    sol : callable or None
+        With ``dense_output=True``: ``sol(t)`` -> (2n,) or (2n, k) (scipy's ``OdeSolution`` or
+        :class:`ukflex.simulate.DenseSolution`).
+    stop : dict or None
+        Why a run ended early (``status == -1``): ``cause`` (``"max_steps"``, ``"max_nfev"``,
+        ``"max_wall_time"``, ``"min_step"``, ``"non_finite"``, ``"solver"``), ``t`` (the last
+        accepted time, where the kept trajectory ends), for ``non_finite`` the ``coordinate``
+        and ``stage`` (``"q"``, ``"qd"`` or ``"qdd"``), and the ``message``.
     """
 
     t: np.ndarray
@@ -56,13 +71,17 @@ class SimulationResult:
     rtol: float = float("nan")
     atol: Any = float("nan")
     extra: Dict[str, Any] = field(default_factory=dict)
+    t_events: Optional[List[np.ndarray]] = None
+    y_events: Optional[List[np.ndarray]] = None
+    sol: Optional[Callable[..., np.ndarray]] = None
+    stop: Optional[Dict[str, Any]] = None
 
     @classmethod
     def from_trajectory(
         cls,
         system: Any,
-        t: Sequence[float],
-        y: Any,
+        t: ArrayLike,
+        y: ArrayLike,
         *,
         method: str = "",
         formulation: str = "uk",
@@ -104,26 +123,26 @@ class SimulationResult:
         ...                                        nfev=out["nfev"], status=out["status"])
         """
         n = system.n_coords
-        t = np.asarray(t, dtype=float)
-        y = np.asarray(y, dtype=float)
-        if t.ndim != 1 or y.shape != (2 * n, t.size):
+        tv = np.asarray(t, dtype=float)
+        yv = np.asarray(y, dtype=float)
+        if tv.ndim != 1 or yv.shape != (2 * n, tv.size):
             raise ValueError(f"from_trajectory: expected t of shape (nt,) and y of shape (2n, nt) = "
-                             f"({2 * n}, {t.size}), got {t.shape} and {y.shape}")
-        q = np.ascontiguousarray(y[:n].T)
-        qd = np.ascontiguousarray(y[n:].T)
-        return cls(t=t, q=q, qd=qd, residuals=_residual_norms(system, t, q, qd), nfev=int(nfev), njev=int(njev),
+                             f"({2 * n}, {tv.size}), got {tv.shape} and {yv.shape}")
+        q = np.ascontiguousarray(yv[:n])
+        qd = np.ascontiguousarray(yv[n:])
+        return cls(t=tv, q=q, qd=qd, residuals=_residual_norms(system, tv, q, qd), nfev=int(nfev), njev=int(njev),
                    nlu=int(nlu), wall_time=float(wall_time), status=int(status), message=str(message), system=system,
                    method=method, formulation=formulation, rtol=rtol, atol=atol, extra=dict(extra or {}))
 
     @property
     def success(self) -> bool:
-        """True if the integrator reached the end time."""
+        """True if the integrator reached the end time or stopped at a terminal event (status >= 0)."""
         return self.status >= 0
 
     @property
     def y(self) -> np.ndarray:
-        """``[q, qd]`` stacked, shape (nt, 2n)."""
-        return np.hstack([self.q, self.qd])
+        """``[q; qd]`` stacked, shape (2n, nt), exactly as ``solve_ivp``'s ``sol.y``."""
+        return np.vstack([self.q, self.qd])
 
     def __repr__(self) -> str:
         t_end = self.t[-1] if self.t.size else float("nan")
@@ -142,15 +161,15 @@ class SimulationResult:
     # ------------------------------------------------------------------------------ access
     def coordinate(self, name: str) -> np.ndarray:
         """History of coordinate ``name`` (e.g. ``"crank.theta"``), shape (nt,)."""
-        return self.q[:, self.system.coordinate_index(name)]
+        return self.q[self.system.coordinate_index(name)]
 
     def velocity(self, name: str) -> np.ndarray:
         """History of the rate of coordinate ``name``, shape (nt,)."""
-        return self.qd[:, self.system.coordinate_index(name)]
+        return self.qd[self.system.coordinate_index(name)]
 
     def _beam_point(self, body: str, xi: float) -> np.ndarray:
-        """The core's ``beam_point`` over the run: columns x, y, u, v, psi, shape (nt, 5)."""
-        return np.asarray(self.system.beam_point(body, float(xi), self.q)).reshape(-1, 5)
+        """The core's ``beam_point`` over the run: rows x, y, u, v, psi, shape (5, nt)."""
+        return np.asarray(self.system.beam_point(body, float(xi), self.q)).reshape(5, -1)
 
     def beam_displacement(self, body: str, xi: float) -> Tuple[np.ndarray, np.ndarray]:
         """Displacement of the axis point of beam ``body`` at ``x = xi * length``, in the beam frame.
@@ -167,32 +186,34 @@ class SimulationResult:
             paper's Fig. 4 plots ``v(xi = 0.5) / length``.
         """
         p = self._beam_point(body, xi)
-        return p[:, 2], p[:, 3]
+        return p[2], p[3]
 
     def beam_rotation(self, body: str, xi: float) -> np.ndarray:
         """Cross-section rotation ``psi`` of beam ``body`` at ``xi`` relative to its beam frame
         (FFRF: the elastic rotation; ANCF: the tangent's angle to the chord), shape (nt,)."""
-        return self._beam_point(body, xi)[:, 4]
+        return self._beam_point(body, xi)[4]
 
     def beam_position(self, body: str, xi: float) -> Tuple[np.ndarray, np.ndarray]:
         """World position ``(x, y)`` of the (deformed) axis point of beam ``body`` at ``xi``, each (nt,)."""
         p = self._beam_point(body, xi)
-        return p[:, 0], p[:, 1]
+        return p[0], p[1]
 
     def energy(self) -> np.ndarray:
         """Total mechanical energy ``T + V`` at each output time, shape (nt,)."""
         s = self.system
-        return np.array([s.kinetic_energy(q, qd) + s.potential_energy(q) for q, qd in zip(self.q, self.qd)])
+        return np.array([s.kinetic_energy(q, qd) + s.potential_energy(q) for q, qd in zip(self.q.T, self.qd.T)])
 
     def multipliers(self) -> np.ndarray:
-        """Lagrange multipliers (``M qdd + A^T lam = Q``) at each output time, shape (nt, m)."""
+        """Lagrange multipliers (``M qdd + A^T lam = Q``) at each output time, shape (m, nt)."""
         s = self.system
-        return np.array([s.multipliers(t, q, qd) for t, q, qd in zip(self.t, self.q, self.qd)])
+        lam = [s.multipliers(t, q, qd) for t, q, qd in zip(self.t, self.q.T, self.qd.T)]
+        return np.array(lam).reshape(self.t.size, -1).T
 
     def qdd(self) -> np.ndarray:
-        """Accelerations at each output time, shape (nt, n)."""
+        """Accelerations at each output time, shape (n, nt)."""
         s = self.system
-        return np.array([s.qdd(t, q, qd) for t, q, qd in zip(self.t, self.q, self.qd)])
+        acc = [s.qdd(t, q, qd) for t, q, qd in zip(self.t, self.q.T, self.qd.T)]
+        return np.array(acc).reshape(self.t.size, -1).T
 
     def max_residual(self, kind: str = "position") -> float:
         """Largest residual norm of ``kind`` over the run."""
@@ -231,7 +252,7 @@ class SimulationResult:
                 w.writerow([repr(float(x)) for x in row])
 
     def save_npz(self, path: str) -> None:
-        """Save ``t, q, qd``, the residual histories, statistics and names to ``path`` (NumPy .npz)."""
+        """Save ``t, q, qd`` (``q``, ``qd`` of shape (n, nt)), the residual histories, statistics and names to ``path`` (NumPy .npz)."""
         np.savez(
             path,
             t=self.t,
@@ -257,6 +278,6 @@ def _residual_norms(system: Any, t: np.ndarray, q: np.ndarray, qd: np.ndarray) -
     if system.n_constraints == 0:
         return out
     for i in range(t.size):
-        for key, r in zip(("position", "velocity", "acceleration"), system.residuals(t[i], q[i], qd[i])):
+        for key, r in zip(("position", "velocity", "acceleration"), system.residuals(t[i], q[:, i], qd[:, i])):
             out[key][i] = np.linalg.norm(r)
     return out

@@ -1,28 +1,42 @@
-"""Time integration with ``scipy.integrate.solve_ivp``."""
+"""Time integration: ``scipy.integrate`` solvers or the native Rust integrators, with
+``solve_ivp``'s interface (``t_span``, ``t_eval``, ``dense_output``, ``events``, ``args``),
+work budgets and partial results on every path (docs/solve-ivp.md)."""
 
 from __future__ import annotations
 
 import inspect
 import math
+import numbers
 import time
-from typing import Any, Callable, Dict, Optional, Sequence, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union, cast
 
 import numpy as np
-from scipy.integrate import OdeSolver, solve_ivp
+from numpy.typing import ArrayLike
+from scipy.integrate import OdeSolver
+from scipy.integrate._ivp.common import OdeSolution
+from scipy.integrate._ivp.ivp import METHODS as _SCIPY_SOLVERS, find_active_events, handle_events, prepare_events
 
-from .errors import NonFiniteError
+from . import _core
+from .errors import InvalidArgumentError, NonFiniteError, UnknownOptionError
 from .results import SimulationResult
 from .scene import Scene
 from .system import System
 
-__all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "time_acceleration"]
+__all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "time_acceleration", "DenseSolution"]
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 #: Integrators that run entirely in Rust with the GIL released (``System.integrate``):
 #: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
 NATIVE_METHODS = ("DOPRI5", "RADAU5", "GENALPHA")
-_NATIVE_OPTIONS = ("first_step", "max_step", "max_steps", "projection_tol", "rho_inf", "step", "jacobian")
+_NATIVE_OPTIONS = ("first_step", "max_step", "projection_tol", "rho_inf", "step", "jacobian")
+#: ``solve_ivp`` solver options passed through on the scipy paths.
+_SCIPY_OPTIONS = ("first_step", "max_step", "jac", "jac_sparsity", "lband", "uband")
 FORMULATIONS = ("uk", "uk-numpy", "cp")
+#: Every method name, looked up case-insensitively ("dopri5", "radau" and "Radau" work).
+_METHOD_BY_KEY = {m.upper(): m for m in METHODS + NATIVE_METHODS + ("auto",)}
+#: Default work budgets: step attempts and right-hand-side evaluations of one run.
+DEFAULT_MAX_STEPS = 1_000_000
+DEFAULT_MAX_NFEV = 20_000_000
 
 
 def as_system(scene_or_system: Union[Scene, System, Dict[str, Any]], **build_options: Any) -> System:
@@ -36,49 +50,134 @@ def as_system(scene_or_system: Union[Scene, System, Dict[str, Any]], **build_opt
     raise TypeError(f"expected a Scene, a description dict or a System, got {type(scene_or_system).__name__}")
 
 
-def _finite_array(name: str, value: Any, shape: Optional[tuple] = None) -> np.ndarray:
-    arr = np.asarray(value, dtype=float)
+# ------------------------------------------------------------------------------ argument checks
+def _real(name: str, value: Any) -> float:
+    """A real scalar: int or float (NumPy's too); bool, str, complex, None and arrays refused."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and not isinstance(value, np.ma.MaskedArray):
+        value = value[()]
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise InvalidArgumentError(name, f"must be a real number, got {type(value).__name__} {value!r}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise InvalidArgumentError(name, f"must be finite, got {value!r}")
+    return x
+
+
+def _positive(name: str, value: Any) -> float:
+    x = _real(name, value)
+    if x <= 0.0:
+        raise InvalidArgumentError(name, f"must be positive, got {value!r}")
+    return x
+
+
+def _count(name: str, value: Any) -> int:
+    """A positive integer (an integral float such as 1e6 too); 1.5, bools and strings refused."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise InvalidArgumentError(name, f"must be a positive integer, got {type(value).__name__} {value!r}")
+    x = float(value)
+    if not x.is_integer() or x < 1:
+        raise InvalidArgumentError(name, f"must be a positive integer, got {value!r}")
+    return int(x)
+
+
+def _real_array(name: str, value: Any, shape: Optional[tuple] = None) -> np.ndarray:
+    """A finite float array; None, strings, masked, complex, boolean and object arrays refused."""
+    if value is None:
+        raise InvalidArgumentError(name, "must be an array of real numbers, got None")
+    if isinstance(value, np.ma.MaskedArray):
+        raise InvalidArgumentError(name, "masked arrays are not accepted (fill or compress the mask first)")
+    if isinstance(value, (str, bytes)):
+        raise InvalidArgumentError(name, f"must be an array of real numbers, got a string {value!r}")
+    raw = np.asarray(value)
+    if raw.dtype.kind not in "iuf":
+        raise InvalidArgumentError(name, f"must hold real numbers, got dtype {raw.dtype}")
+    arr = raw.astype(float)
     if shape is not None and arr.shape != shape:
-        raise ValueError(f"{name}: expected shape {shape}, got {arr.shape}")
+        raise InvalidArgumentError(name, f"expected shape {shape}, got {arr.shape}")
     bad = np.flatnonzero(~np.isfinite(arr.ravel()))
     if bad.size:
         raise NonFiniteError(f"{name}: contains NaN or infinity at index {int(bad[0])}")
     return arr
 
 
-def _positive_scalar(name: str, value: Any) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(x) or x <= 0.0:
-        raise ValueError(f"{name} must be positive and finite, got {value!r}")
-    return x
+def _method_name(method: Any) -> Union[str, type]:
+    if isinstance(method, str):
+        key = method.upper()
+        if key not in _METHOD_BY_KEY:
+            raise InvalidArgumentError(
+                "method", f"unknown method {method!r}; expected 'auto', one of {METHODS}, a native method "
+                f"{NATIVE_METHODS} (any case) or an OdeSolver subclass")
+        return _METHOD_BY_KEY[key]
+    if inspect.isclass(method) and issubclass(method, OdeSolver):
+        return method
+    raise InvalidArgumentError("method", f"must be a method name or an OdeSolver subclass, got {method!r}")
+
+
+def _check_options(method: Any, formulation: str, options: Dict[str, Any]) -> None:
+    """Refuse options the chosen path does not take, naming the valid ones."""
+    if formulation != "uk":
+        return  # the NumPy references forward their options to their own solve_ivp call
+    if method == "auto":
+        valid = sorted(set(_NATIVE_OPTIONS) | set(_SCIPY_OPTIONS))
+    elif method in NATIVE_METHODS:
+        valid = sorted(_NATIVE_OPTIONS)
+    else:
+        valid = sorted(_SCIPY_OPTIONS)
+    unknown = sorted(set(options) - set(valid))
+    if unknown:
+        common = ["t_span", "t_eval", "rtol", "atol", "events", "dense_output", "args", "max_steps", "max_nfev",
+                  "max_wall_time", "min_step", "q0", "qd0", "progress"]
+        raise UnknownOptionError(
+            unknown[0], f"unknown option(s) {unknown} for method {method!r}; valid: {valid} and the keywords {common}",
+            valid)
+
+
+def _with_args(fn: Callable, args: Tuple) -> Callable:
+    """``fn(t, y, *args)`` as ``g(t, y)``, keeping ``terminal`` and ``direction``."""
+    def g(t: float, y: np.ndarray, _fn: Callable = fn) -> float:
+        return _fn(t, y, *args)
+
+    for attr in ("terminal", "direction"):
+        if hasattr(fn, attr):
+            setattr(g, attr, getattr(fn, attr))
+    return g
 
 
 def simulate(
     scene_or_system: Union[Scene, System, Dict[str, Any]],
-    t_end: float,
+    t_end: Optional[float] = None,
     method: Union[str, type] = "auto",
     rtol: float = 1e-6,
-    atol: Union[None, float, Sequence[float]] = None,
-    t_eval: Optional[Sequence[float]] = None,
+    atol: Union[None, float, ArrayLike] = None,
+    t_eval: Optional[ArrayLike] = None,
     formulation: str = "uk",
     *,
-    q0: Optional[Sequence[float]] = None,
-    qd0: Optional[Sequence[float]] = None,
+    t_span: Optional[Tuple[float, float]] = None,
+    q0: Optional[ArrayLike] = None,
+    qd0: Optional[ArrayLike] = None,
     partition: Any = None,
     progress: Optional[Callable[[float], None]] = None,
+    events: Union[None, Callable, Sequence[Callable]] = None,
+    dense_output: bool = False,
+    args: Optional[Sequence[Any]] = None,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    max_nfev: int = DEFAULT_MAX_NFEV,
+    max_wall_time: Optional[float] = None,
+    min_step: float = 0.0,
     **options: Any,
 ) -> SimulationResult:
     """Integrate the equations of motion from the system's consistent initial state to ``t_end``.
+
+    The interface follows ``scipy.integrate.solve_ivp`` (docs/solve-ivp.md has the feature
+    table): ``t_span``, ``t_eval``, ``dense_output``, ``events`` and ``args`` behave as there,
+    for the scipy methods and the native ones alike, and ``res.y`` is ``solve_ivp``'s (2n, nt).
 
     Parameters
     ----------
     scene_or_system : Scene, dict or System
         What to simulate; scenes and dicts are built with default options.
     t_end : float
-        End time [s], ``> t0`` (the system's initial time, normally 0).
+        End time [s], ``> t0`` (the system's initial time, normally 0).  Or give ``t_span``.
     method : str or scipy OdeSolver subclass
         ``"auto"`` (default): chosen from the constrained system's natural frequencies
         (:mod:`ukflex.choice`, docs/integrators.md): native ``"GENALPHA"`` with a fixed step
@@ -90,10 +189,10 @@ def simulate(
         dense output), ``"RADAU5"`` (Radau IIA order 5, Rust Jacobian) or ``"GENALPHA"``
         (generalized-alpha for stiff flexible systems: numerical dissipation ``rho_inf``
         (default 0.9), a structured Newton matrix, fixed ``step`` or error-controlled steps,
-        projection onto the constraints by default). Native methods take the options
-        ``first_step``, ``max_step``, ``max_steps`` and ``projection_tol`` (project onto the
-        constraints after every accepted step whose residuals exceed it; 0: off), GENALPHA also
-        ``rho_inf`` and ``step``; see docs/integrators.md.
+        projection onto the constraints by default).  Names are case-insensitive.  Native
+        methods take the options ``first_step``, ``max_step``, ``projection_tol`` (project onto
+        the constraints after every accepted step whose residuals exceed it; 0: off) and
+        ``jacobian``, GENALPHA also ``rho_inf`` and ``step``; see docs/integrators.md.
     rtol : float
         Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s).
     atol : float or array of shape (2n,), optional
@@ -102,113 +201,489 @@ def simulate(
         Output times in ``[t0, t_end]``; default: the integrator's own steps.
     formulation : {"uk", "uk-numpy", "cp"}
         ``"uk"``: Udwadia-Kalaba accelerations from the Rust core.  ``"uk-numpy"`` and ``"cp"``
-        (coordinate partitioning) come from the NumPy reference :mod:`ukflex.reference`.
+        (coordinate partitioning) come from the NumPy reference :mod:`ukflex.reference`
+        (their own ``solve_ivp`` call: no events, dense output, args or budgets there).
+    t_span : (t0, tf), optional
+        ``solve_ivp``'s form of the interval; ``t0`` must be the system's initial time unless
+        ``q0`` and ``qd0`` are given.
     q0, qd0 : array of shape (n,), optional
         Override the system's corrected initial state (not corrected again).
     partition : optional
         Passed to the ``"cp"`` reference integrator.
     progress : callable, optional
-        ``progress(t)`` is called at the start and after every accepted step of a scipy
-        integrator (formulations ``"uk"`` and ``"uk-numpy"``; the ``"cp"`` reference integrator
-        takes no step hook, so there it is called only at the end).  Keep it cheap (throttle
-        output yourself); used by the CLI's progress display.
+        ``progress(t)`` after every accepted step of a scipy method, once at the end of a native
+        run.  Keep it cheap; used by the CLI's progress display.
+    events : callable or list of callables, optional
+        ``event(t, y[, *args])`` with ``solve_ivp``'s attributes ``terminal`` (bool or a count)
+        and ``direction``; roots are located on the dense output of each step (scipy: by
+        ``solve_ivp``'s own routine; native: on the recorded dense output after the run, the
+        trajectory cut at a terminal event).  Results in ``res.t_events``, ``res.y_events``;
+        ``res.status == 1`` after a terminal event.
+    dense_output : bool
+        Keep a continuous solution ``res.sol(t)`` -> (2n,) or (2n, k): scipy's ``OdeSolution``,
+        or for native methods :class:`DenseSolution` (each method's own interpolant).
+    args : tuple, optional
+        Extra arguments passed to the event functions (the equations of motion come from the
+        scene, so there is no user ``fun``); a user ``jac`` gets them too.
+    max_steps, max_nfev : int
+        Work budgets of the run: step attempts and right-hand-side evaluations (defaults
+        1,000,000 and 20,000,000).
+    max_wall_time : float, optional
+        Wall-clock budget [s] (default: none).
+    min_step : float
+        Smallest step size [s] (default 0: the rounding limit); a ``max_step`` or GENALPHA
+        ``step`` that cannot reach ``t_end`` within ``max_steps`` is refused up front.
     **options
-        Further ``solve_ivp`` options (``max_step``, ``first_step``, ``jac``, ...).  For
-        ``"Radau"`` and ``"BDF"`` the default ``jac`` is the core's finite-difference Jacobian
-        ``System.jac``; pass ``jac=None`` for scipy's own ``num_jac``, which overflows on the
-        exactly-zero columns of these systems.
-        ``nfev`` counts only the integrator's ``rhs`` calls, not those inside Jacobians.
+        Solver options: ``first_step``, ``max_step``, ``jac``, ... (scipy); ``first_step``,
+        ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``jacobian`` (native).  An option
+        the chosen method does not take raises :class:`UnknownOptionError` listing the valid
+        ones.  For ``"Radau"`` and ``"BDF"`` the default ``jac`` is the core's finite-difference
+        Jacobian ``System.jac``; ``nfev`` counts only the integrator's ``rhs`` calls.
 
     Returns
     -------
     SimulationResult
-        Histories ``t`` (nt,), ``q`` and ``qd`` (nt, n), constraint-residual norms (nt,) and
-        integrator statistics.
+        ``t`` (nt,), ``y`` (2n, nt) = ``[q; qd]``, residual norms, statistics, ``t_events``,
+        ``y_events``, ``sol``.  A run that exceeds a budget or meets a non-finite state stops
+        with ``status = -1``, keeps the trajectory up to its last accepted step and says why
+        in ``res.message`` and ``res.stop`` (cause, time, coordinate).
 
     Raises
     ------
-    ValueError
-        Bad ``t_end``, tolerances, ``t_eval``, unknown method or formulation, wrong shapes.
+    InvalidArgumentError
+        Bad ``t_end``/``t_span``, tolerances, ``t_eval``, method, formulation, budgets, arrays
+        (a ``ValueError`` and ``TypeError`` too).
+    UnknownOptionError
+        An option the method does not take.
     NonFiniteError
         NaN or infinity in an input array.
     """
     if formulation not in FORMULATIONS:
-        raise ValueError(f"unknown formulation {formulation!r}; expected one of {FORMULATIONS}")
-    if isinstance(method, str):
-        if method != "auto" and method not in METHODS and method not in NATIVE_METHODS:
-            raise ValueError(
-                f"unknown method {method!r}; expected one of {METHODS}, a native method {NATIVE_METHODS} "
-                "or an OdeSolver subclass"
-            )
-        if method in NATIVE_METHODS and formulation != "uk":
-            raise ValueError(f"native method {method!r} integrates the Rust UK formulation only, not {formulation!r}")
-    elif not (inspect.isclass(method) and issubclass(method, OdeSolver)):
-        raise ValueError(f"method must be one of {METHODS} or an OdeSolver subclass, got {method!r}")
+        raise InvalidArgumentError("formulation", f"unknown formulation {formulation!r}; expected one of {FORMULATIONS}")
+    method = _method_name(method)
+    if method in NATIVE_METHODS and formulation != "uk":
+        raise InvalidArgumentError(
+            "method", f"native method {method!r} integrates the Rust UK formulation only, not {formulation!r}")
+    _check_options(method, formulation, options)
     system = as_system(scene_or_system)
     n = system.n_coords
-    t0 = system.t0
-    try:
-        t_end_f = float(t_end)
-    except (TypeError, ValueError):
-        raise TypeError(f"t_end must be a number, got {t_end!r}") from None
-    if not math.isfinite(t_end_f) or t_end_f <= t0:
-        raise ValueError(f"t_end must be finite and greater than t0 = {t0}, got {t_end!r}")
-    rtol = _positive_scalar("rtol", rtol)
+    if t_span is not None:
+        if t_end is not None:
+            raise InvalidArgumentError("t_span", "give t_end or t_span, not both")
+        if isinstance(t_span, (str, bytes)) or np.ndim(t_span) != 1 or len(t_span) != 2:
+            raise InvalidArgumentError("t_span", f"must be a pair (t0, tf), got {t_span!r}")
+        t0 = _real("t_span[0]", t_span[0])
+        t_end = t_span[1]
+        if t0 != system.t0 and (q0 is None or qd0 is None):
+            raise InvalidArgumentError(
+                "t_span", f"t0 = {t0} differs from the system's initial time {system.t0}: give q0 and qd0 for it")
+    else:
+        t0 = system.t0
+    if t_end is None:
+        raise InvalidArgumentError("t_end", "missing: give t_end or t_span=(t0, tf)")
+    t_end_f = _real("t_end", t_end)
+    if t_end_f <= t0:
+        raise InvalidArgumentError("t_end", f"must be greater than t0 = {t0}, got {t_end!r}")
+    rtol = _positive("rtol", rtol)
     if atol is None:
         atol_v: Any = 1e-3 * rtol
-    elif np.ndim(atol) == 0:
-        atol_v = _positive_scalar("atol", atol)
+    elif np.ndim(atol) == 0 and not isinstance(atol, np.ma.MaskedArray):
+        atol_v = _positive("atol", atol)
     else:
-        atol_v = _finite_array("atol", atol, (2 * n,))
+        atol_v = _real_array("atol", atol, (2 * n,))
         if np.any(atol_v <= 0):
-            raise ValueError("atol entries must be positive")
+            raise InvalidArgumentError("atol", "entries must be positive")
+    t_eval_v: Optional[np.ndarray] = None
     if t_eval is not None:
-        t_eval = _finite_array("t_eval", t_eval)
-        if t_eval.ndim != 1 or t_eval.size == 0:
-            raise ValueError(f"t_eval must be a non-empty 1-D array, got shape {t_eval.shape}")
-        if np.any(np.diff(t_eval) <= 0):
-            raise ValueError("t_eval must be strictly increasing")
-        if t_eval[0] < t0 or t_eval[-1] > t_end_f:
-            raise ValueError(f"t_eval must lie within [t0, t_end] = [{t0}, {t_end_f}]")
-    q_init = system.q0 if q0 is None else _finite_array("q0", q0, (n,))
-    qd_init = system.qd0 if qd0 is None else _finite_array("qd0", qd0, (n,))
+        t_eval_v = _real_array("t_eval", t_eval)
+        if t_eval_v.ndim != 1 or t_eval_v.size == 0:
+            raise InvalidArgumentError("t_eval", f"must be a non-empty 1-D array, got shape {t_eval_v.shape}")
+        if np.any(np.diff(t_eval_v) <= 0):
+            raise InvalidArgumentError("t_eval", "must be strictly increasing")
+        if t_eval_v[0] < t0 or t_eval_v[-1] > t_end_f:
+            raise InvalidArgumentError("t_eval", f"must lie within [t0, t_end] = [{t0}, {t_end_f}]")
+    q_init = system.q0 if q0 is None else _real_array("q0", q0, (n,))
+    qd_init = system.qd0 if qd0 is None else _real_array("qd0", qd0, (n,))
+    budget = _Budget(_count("max_steps", max_steps), _count("max_nfev", max_nfev),
+                     None if max_wall_time is None else _positive("max_wall_time", max_wall_time),
+                     0.0 if min_step == 0 else _positive("min_step", min_step))
+    for key in ("max_step", "step"):  # a step size that cannot reach t_end within the step budget
+        if options.get(key) is not None:
+            h = _positive(key, options[key])
+            if (t_end_f - t0) / h > budget.max_steps:
+                raise InvalidArgumentError(
+                    key, f"{key} = {h:g} needs {(t_end_f - t0) / h:.3g} steps to reach t_end, more than max_steps = "
+                    f"{budget.max_steps}")
+            if h < budget.min_step:
+                raise InvalidArgumentError(key, f"{key} = {h:g} is below min_step = {budget.min_step:g}")
+    if not isinstance(dense_output, (bool, np.bool_)):
+        raise InvalidArgumentError("dense_output", f"must be True or False, got {dense_output!r}")
+    if args is not None:
+        if isinstance(args, (str, bytes)) or not isinstance(args, (tuple, list)):
+            args = (args,)  # solve_ivp: "If the function has a single argument, wrap it in a tuple"
+        args = tuple(args)
+    ev_list: List[Callable] = []
+    if events is not None:
+        ev_list = list(events) if isinstance(events, (list, tuple)) else [cast(Callable, events)]
+        for k, ev in enumerate(ev_list):
+            if not callable(ev):
+                raise InvalidArgumentError("events", f"entry {k} is not callable: {ev!r}")
+        if args is not None:
+            ev_list = [_with_args(ev, args) for ev in ev_list]
+    if args is not None and callable(options.get("jac")):
+        options = dict(options, jac=_with_args(options["jac"], args))
+    if formulation != "uk" and (ev_list or dense_output or args is not None):
+        raise InvalidArgumentError(
+            "formulation", f"events, dense_output and args need formulation='uk' (the NumPy reference {formulation!r} "
+            "runs its own solve_ivp call)")
     if method == "auto":
         start = time.perf_counter()
         method, options, choice = _resolve_auto(system, formulation, t0, t_end_f, rtol, q_init, qd_init, options)
         choice_time = time.perf_counter() - start
         run_rtol = choice.rtol if choice is not None and choice.rtol is not None else rtol
-        res = simulate(system, t_end_f, method, run_rtol, atol, t_eval, formulation, q0=q0, qd0=qd0,
-                       partition=partition, progress=progress, **options)
+        res = simulate(system, None, method, run_rtol, atol, t_eval_v, formulation, t_span=(t0, t_end_f), q0=q_init,
+                       qd0=qd_init, partition=partition, progress=progress, events=ev_list or None,
+                       dense_output=dense_output, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
+                       max_wall_time=budget.max_wall_time, min_step=budget.min_step, **options)
         if choice is not None:
             res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
         return res
-    if isinstance(method, str) and method in NATIVE_METHODS:
-        res = _simulate_native(system, method, t0, t_end_f, np.concatenate([q_init, qd_init]), rtol, atol_v, t_eval,
-                               options)
+    y0 = np.concatenate([q_init, qd_init])
+    if method in NATIVE_METHODS:
+        res = _simulate_native(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
+                               dense_output)
         if progress is not None and res.t.size:
             progress(float(res.t[-1]))
         return res
-    if progress is not None and formulation != "cp":
-        options = _with_progress_event(options, progress)
-
     if formulation != "uk":
         res = _simulate_reference(
-            system, formulation, t_end_f, method, rtol, atol_v, t_eval, q_init, qd_init, partition, options
+            system, formulation, t_end_f, method, rtol, atol_v, t_eval_v, q_init, qd_init, partition, options
         )
-        if progress is not None and formulation == "cp" and res.t.size:
+        if progress is not None and res.t.size:
             progress(float(res.t[-1]))
         return res
-
-    y0 = np.concatenate([q_init, qd_init])
     if method in ("Radau", "BDF") and "jac" not in options:
         options["jac"] = system.jac  # Rust finite differences, GIL released
+    return _simulate_scipy(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
+                           dense_output, progress)
+
+
+class _Budget:
+    def __init__(self, max_steps: int, max_nfev: int, max_wall_time: Optional[float], min_step: float):
+        self.max_steps, self.max_nfev, self.max_wall_time, self.min_step = max_steps, max_nfev, max_wall_time, min_step
+
+
+class _Stop(Exception):
+    """Ends a scipy run from inside the right-hand side (a budget or a non-finite value)."""
+
+    def __init__(self, cause: str, stage: str = "", index: Optional[int] = None):
+        super().__init__(cause)
+        self.cause, self.stage, self.index = cause, stage, index
+
+
+def _stop_info(system: System, cause: str, t: float, stage: str = "", index: Optional[int] = None,
+               detail: str = "") -> Tuple[Dict[str, Any], str]:
+    """``res.stop`` and the message for a run that ended early."""
+    info: Dict[str, Any] = {"cause": cause, "t": float(t)}
+    if cause == "non_finite" and index is not None:
+        names = system.coordinate_names
+        what = {"q": "coordinate", "qd": "velocity", "qdd": "acceleration"}.get(stage, stage)
+        info.update(stage=stage, coordinate=names[index] if index < len(names) else str(index))
+        msg = f"non-finite {what} of '{info['coordinate']}' at t = {t:.9g} s; the result holds the run up to there"
+    elif cause == "non_finite":
+        msg = f"non-finite state at t = {t:.9g} s ({detail}); the result holds the run up to there"
+    elif cause in ("max_steps", "max_nfev", "max_wall_time"):
+        msg = f"work budget {cause} exhausted at t = {t:.9g} s ({detail}); the result holds the run up to there"
+    elif cause == "min_step":
+        msg = f"step size below the minimum at t = {t:.9g} s ({detail}); the result holds the run up to there"
+    else:
+        msg = f"integration failed at t = {t:.9g} s: {detail}"
+    info["message"] = msg
+    return info, msg
+
+
+def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, budget, events, dense, progress):
+    """``solve_ivp``'s loop over a scipy ``OdeSolver``, with work budgets, a non-finite check
+    with its cause, and the trajectory kept when the run stops early."""
+    n = system.n_coords
+    rhs = system.rhs
+    nfev = [0]
+
+    def fun(t: float, y: np.ndarray) -> np.ndarray:
+        nfev[0] += 1
+        if nfev[0] > budget.max_nfev:
+            raise _Stop("max_nfev")
+        try:
+            out = rhs(t, y)  # the core refuses a non-finite y
+        except NonFiniteError:
+            bad = np.flatnonzero(~np.isfinite(y))
+            if not bad.size:
+                raise
+            i = int(bad[0])
+            raise _Stop("non_finite", "q" if i < n else "qd", i % n) from None
+        if not np.isfinite(out).all():
+            raise _Stop("non_finite", "qdd", int(np.flatnonzero(~np.isfinite(out[n:]))[0]))
+        return out
+
+    solver_cls = _SCIPY_SOLVERS[method] if isinstance(method, str) else method
+    name = method if isinstance(method, str) else method.__name__
     start = time.perf_counter()
-    sol = solve_ivp(system.rhs, (t0, t_end_f), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol_v, **options)
+    ts: List[Any] = [] if t_eval is not None else [t0]
+    ys: List[Any] = [] if t_eval is not None else [y0]
+    ti = [t0]
+    interpolants: List[Any] = []
+    t_events: Optional[List[List[float]]] = None
+    y_events: Optional[List[List[np.ndarray]]] = None
+    stop = None
+    status: Optional[int] = None
+    message = ""
+    t_eval_i = 0
+    steps = 0
+    solver = None
+    try:
+        solver = solver_cls(fun, t0, y0, tf, rtol=rtol, atol=atol, **options)
+        if events:
+            events, max_events, event_dir = prepare_events(events)
+            event_count = np.zeros(len(events))
+            g = [ev(t0, y0) for ev in events]
+            t_events, y_events = [[] for _ in events], [[] for _ in events]
+        if t_eval is not None and t_eval[0] == t0:
+            ts.append(t_eval[:1])
+            ys.append(y0[:, None])
+            t_eval_i = 1
+        if progress is not None:
+            progress(float(t0))
+        while status is None:
+            if steps >= budget.max_steps:
+                raise _Stop("max_steps")
+            if budget.max_wall_time is not None and time.perf_counter() - start > budget.max_wall_time:
+                raise _Stop("max_wall_time")
+            try:
+                message = solver.step()
+            except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # e.g. lu_factor on infinities
+                text = str(exc)
+                cause = "non_finite" if ("inf" in text or "NaN" in text) else "solver"
+                stop, message = _stop_info(system, cause, solver.t, detail=text)
+                status = -1
+                break
+            steps += 1
+            if solver.status == "finished":
+                status = 0
+            elif solver.status == "failed":
+                stop, message = _stop_info(system, "solver", solver.t, detail=str(message))
+                status = -1
+                break
+            t_old, t, y = solver.t_old, solver.t, solver.y
+            sol = solver.dense_output() if dense else None
+            if dense:
+                interpolants.append(sol)
+            if events:
+                g_new = [ev(t, y) for ev in events]
+                active = find_active_events(g, g_new, event_dir)
+                if active.size > 0:
+                    if sol is None:
+                        sol = solver.dense_output()
+                    event_count[active] += 1
+                    root_indices, roots, terminate = handle_events(sol, events, active, event_count, max_events,
+                                                                   t_old, t)
+                    for e, te in zip(root_indices, roots):
+                        t_events[e].append(te)
+                        y_events[e].append(sol(te))
+                    if terminate:
+                        status = 1
+                        t = roots[-1]
+                        y = sol(t)
+                g = g_new
+            if dense:
+                ti.append(t)  # the step end, or the terminal event's root (as solve_ivp)
+            if t_eval is None:
+                ts.append(t)
+                ys.append(y)
+            else:
+                i_new = np.searchsorted(t_eval, t, side="right")
+                if i_new > t_eval_i:
+                    if sol is None:
+                        sol = solver.dense_output()
+                    ts.append(t_eval[t_eval_i:i_new])
+                    ys.append(sol(t_eval[t_eval_i:i_new]))
+                    t_eval_i = i_new
+            if progress is not None:
+                progress(float(t))
+            if status is None and budget.min_step > 0 and solver.step_size is not None \
+                    and solver.step_size < budget.min_step and solver.t < tf:
+                raise _Stop("min_step")
+    except _Stop as s:
+        t_last = float(solver.t) if solver is not None else t0
+        if solver is not None and s.cause == "non_finite":
+            t_last = float(solver.t)  # the last accepted step: the non-finite value came from a stage beyond it
+        detail = {"max_steps": f"{steps} steps", "max_nfev": f"{nfev[0] - 1} evaluations",
+                  "max_wall_time": f"{budget.max_wall_time} s",
+                  "min_step": f"h = {getattr(solver, 'step_size', 0.0):.3g} s < min_step = {budget.min_step:g} s"}
+        stop, message = _stop_info(system, s.cause, t_last, s.stage, s.index, detail.get(s.cause, ""))
+        status = -1
     wall = time.perf_counter() - start
+    if status == 0:
+        message = "The solver successfully reached the end of the integration interval."
+    elif status == 1:
+        message = "A termination event occurred."
+    if t_eval is None:
+        t_arr, y_arr = np.array(ts, dtype=float), np.vstack(ys).T
+    elif ts:
+        t_arr, y_arr = np.hstack(ts), np.hstack(ys)
+    else:
+        t_arr, y_arr = np.zeros(0), np.zeros((2 * n, 0))
+    sol_obj = None
+    if dense and interpolants:
+        sol_obj = OdeSolution(ti, interpolants, alt_segment=method in ("BDF", "LSODA"))
+    return _result(system, t_arr, y_arr, name, rtol, atol, nfev=solver.nfev if solver is not None else nfev[0],
+                   njev=getattr(solver, "njev", 0), nlu=getattr(solver, "nlu", 0), wall=wall, status=status,
+                   message=message, stop=stop, t_events=t_events, y_events=y_events, sol=sol_obj, extra={"steps": steps})
+
+
+def _result(system, t, y, method, rtol, atol, *, nfev, njev, nlu, wall, status, message, stop, t_events, y_events,
+            sol, extra) -> SimulationResult:
+    res = SimulationResult.from_trajectory(
+        system, t, y, method=method, formulation="uk", rtol=rtol, atol=atol, nfev=nfev, njev=njev, nlu=nlu,
+        wall_time=wall, status=status, message=message, extra=extra)
+    res.stop = stop
+    res.sol = sol
+    if t_events is not None:
+        res.t_events = [np.asarray(te, dtype=float) for te in t_events]
+        res.y_events = [np.asarray(ye, dtype=float).reshape(-1, 2 * system.n_coords) for ye in y_events]
+    return res
+
+
+class DenseSolution:
+    """The continuous solution of a native run (``res.sol`` with ``dense_output=True``), like
+    scipy's ``OdeSolution``: ``sol(t)`` -> (2n,) for a scalar, (2n, k) for k times.
+
+    Each accepted step keeps its method's own interpolant, recorded in Rust during the run and
+    evaluated in Rust: DOPRI5 its 4th-order continuous extension (Hairer's CONTD5), RADAU5 the
+    step's collocation polynomial (CONTR5), GENALPHA a cubic Hermite polynomial in ``q`` from
+    ``q`` and ``qd`` at the step's ends (``qd`` from its derivative).  Outside ``[t_min, t_max]``
+    the first or last step's polynomial is extrapolated (as ``OdeSolution`` does).
+
+    Attributes
+    ----------
+    ts : ndarray, shape (nseg + 1,)
+        Step boundaries.
+    t_min, t_max : float
+    """
+
+    def __init__(self, method: str, meta: np.ndarray, data: np.ndarray, part_len: Sequence[int]):
+        self.method = method
+        self.meta = np.ascontiguousarray(meta, dtype=float)
+        self.data = np.ascontiguousarray(data, dtype=float)
+        self.part_len = [int(k) for k in part_len]
+        self.ts = np.concatenate([self.meta[:1, 0], self.meta[:, 1]]) if len(self.meta) else np.zeros(0)
+        self.t_min = float(self.ts[0]) if self.ts.size else float("nan")
+        self.t_max = float(self.ts[-1]) if self.ts.size else float("nan")
+
+    def __call__(self, t: ArrayLike) -> np.ndarray:
+        tt = np.asarray(t, dtype=float)
+        out = _core.dense_eval(self.method, self.meta, self.data, self.part_len, np.atleast_1d(tt).ravel())
+        return out[:, 0] if tt.ndim == 0 else out
+
+    def truncated(self, t_stop: float) -> "DenseSolution":
+        """The steps up to the one that holds ``t_stop``."""
+        k = int(np.searchsorted(self.meta[:, 1], t_stop, side="left")) + 1
+        return DenseSolution(self.method, self.meta[:k], self.data[:k], self.part_len)
+
+
+def _native_events(sol: DenseSolution, events: List[Callable], t0: float, y0: np.ndarray):
+    """solve_ivp's event search over the recorded steps of a native run: the sign of each event
+    at the step ends, roots by ``handle_events`` on the step's interpolant.  Returns t_events,
+    y_events and the terminal time (None if no terminal event)."""
+    events, max_events, event_dir = prepare_events(events)
+    event_count = np.zeros(len(events))
+    t_events: List[List[float]] = [[] for _ in events]
+    y_events: List[List[np.ndarray]] = [[] for _ in events]
+    g = [ev(t0, y0) for ev in events]
+    ends = sol.meta[:, 1]
+    y_ends = sol(ends) if ends.size else np.zeros((y0.size, 0))
+    for k in range(ends.size):
+        t_old, t = float(sol.meta[k, 0]), float(ends[k])
+        y = y_ends[:, k]
+        g_new = [ev(t, y) for ev in events]
+        active = find_active_events(g, g_new, event_dir)
+        if active.size > 0:
+            event_count[active] += 1
+            root_indices, roots, terminate = handle_events(sol, events, active, event_count, max_events, t_old, t)
+            for e, te in zip(root_indices, roots):
+                t_events[e].append(te)
+                y_events[e].append(sol(te))
+            if terminate:
+                return t_events, y_events, float(roots[-1])
+        g = g_new
+    return t_events, y_events, None
+
+
+def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options, budget, events, dense):
+    """Run a native Rust integrator (``System.integrate``: all steps in Rust, GIL released).
+
+    Dense output is recorded in Rust during the run; events are located on it afterwards and a
+    terminal event cuts the trajectory there (one-step methods: the states up to the event do
+    not depend on what follows, so the cut run equals a run stopped at the event)."""
+    kwargs: Dict[str, Any] = {}
+    for key in ("first_step", "max_step", "step"):
+        if options.get(key) is not None:
+            kwargs[key] = _positive(key, options[key])
+    for key in ("projection_tol", "rho_inf"):  # 0 is meaningful (projection off, full dissipation)
+        if options.get(key) is not None:
+            kwargs[key] = _real(key, options[key])
+    if options.get("jacobian") is not None:
+        kwargs["jacobian"] = str(options["jacobian"])
+    atol_arr = np.atleast_1d(np.asarray(atol, dtype=float))
+    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
+    out = system.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),
+                           atol_arr, te, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
+                           max_wall_time=budget.max_wall_time, min_step=budget.min_step,
+                           dense=bool(dense or events), **kwargs)
+    t, y, status, message = np.asarray(out["t"]), np.asarray(out["y"]), int(out["status"]), str(out["message"])
+    stop = None
+    if out["failure"] is not None:
+        f = out["failure"]
+        stop, msg = _stop_info(system, f["cause"], f["t"], f["stage"], f["index"], message)
+        message = msg if f["cause"] != "solver" else message + f" (the result holds the run up to t = {f['t']:.9g} s)"
+        stop["message"] = message
+    sol = None
+    if out["dense"] is not None and len(out["dense"]["meta"]):
+        d = out["dense"]
+        sol = DenseSolution(method, d["meta"], d["data"], d["part_len"])
+    t_events = y_events = None
+    if events and sol is not None:
+        t_events, y_events, t_term = _native_events(sol, events, t0, y0)
+        if t_term is not None:
+            keep = t <= t_term
+            t, y = t[keep], y[:, keep]
+            if t_eval is None and (t.size == 0 or t[-1] < t_term):
+                t = np.append(t, t_term)
+                y = np.column_stack([y, sol(t_term)])
+            sol = sol.truncated(t_term)
+            status, message, stop = 1, "A termination event occurred.", None
+    elif events:
+        t_events, y_events = [[] for _ in events], [[] for _ in events]
+    extra = {k: out[k] for k in ("naccept", "nreject", "newton_iterations", "jac_evals")}
+    return _result(system, t, y, method, rtol, atol, nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"],
+                   wall=out["wall_time"], status=status, message=message, stop=stop, t_events=t_events,
+                   y_events=y_events, sol=sol if dense else None, extra=extra)
+
+
+def _simulate_reference(system, formulation, t_end, method, rtol, atol, t_eval, q0, qd0, partition, options):
+    """Run the NumPy reference (uk-numpy or coordinate partitioning) on the same description."""
+    from . import reference
+
+    fn = reference.simulate_uk_numpy if formulation == "uk-numpy" else reference.simulate_cp
+    kwargs: Dict[str, Any] = dict(method=method, rtol=rtol, atol=atol, t_eval=t_eval, q0=q0, qd0=qd0)
+    if formulation == "cp" and partition is not None:
+        kwargs["partition"] = partition
+    kwargs.update(options)
+    out = fn(system.description, t_end, **kwargs)
+    extra = dict(out.extra, accel_time=out.accel_time, repartitions=out.repartitions)
     return SimulationResult.from_trajectory(
-        system, sol.t, sol.y, method=method if isinstance(method, str) else method.__name__, formulation="uk",
-        rtol=rtol, atol=atol_v, nfev=sol.nfev, njev=sol.njev, nlu=sol.nlu, wall_time=wall, status=sol.status,
-        message=sol.message)
+        system, out.t, out.y, method=method if isinstance(method, str) else method.__name__, formulation=formulation,
+        rtol=rtol, atol=atol, nfev=out.nfev, njev=out.extra.get("njev", 0), nlu=out.extra.get("nlu", 0),
+        wall_time=out.wall_time, status=out.status, message=out.message, extra=extra)
 
 
 def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
@@ -233,61 +708,6 @@ def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
     merged = dict(choice.options)
     merged.update(options)  # the user's own settings win (e.g. step=...)
     return choice.method, merged, choice
-
-
-def _with_progress_event(options: Dict[str, Any], progress: Callable[[float], None]) -> Dict[str, Any]:
-    """Add a never-triggering, non-terminal solve_ivp event that reports the step end time."""
-
-    def _progress_event(t: float, y: np.ndarray) -> float:
-        progress(float(t))
-        return 1.0  # constant sign: solve_ivp never searches for a root
-
-    user = options.get("events")
-    events = [] if user is None else (list(user) if isinstance(user, (list, tuple)) else [user])
-    return dict(options, events=events + [_progress_event])
-
-
-def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options) -> SimulationResult:
-    """Run a native Rust integrator (``System.integrate``: all steps in Rust, GIL released)."""
-    unknown = sorted(set(options) - set(_NATIVE_OPTIONS))
-    if unknown:
-        raise TypeError(f"native method {method!r} does not take option(s) {unknown}; it accepts {_NATIVE_OPTIONS}")
-    kwargs: Dict[str, Any] = {}
-    for key in ("first_step", "max_step", "step"):
-        if options.get(key) is not None:
-            kwargs[key] = _positive_scalar(key, options[key])
-    for key in ("projection_tol", "rho_inf"):  # 0 is meaningful (projection off, full dissipation)
-        if options.get(key) is not None:
-            kwargs[key] = float(options[key])
-    if options.get("max_steps") is not None:
-        kwargs["max_steps"] = int(options["max_steps"])
-    if options.get("jacobian") is not None:
-        kwargs["jacobian"] = str(options["jacobian"])
-    atol_arr = np.atleast_1d(np.asarray(atol, dtype=float))
-    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
-    out = system.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),
-                           atol_arr, te, **kwargs)
-    return SimulationResult.from_trajectory(
-        system, out["t"], out["y"], method=method, formulation="uk", rtol=rtol, atol=atol, nfev=out["nfev"],
-        njev=out["njev"], nlu=out["nlu"], wall_time=out["wall_time"], status=out["status"], message=out["message"],
-        extra={k: out[k] for k in ("naccept", "nreject", "newton_iterations", "jac_evals")})
-
-
-def _simulate_reference(system, formulation, t_end, method, rtol, atol, t_eval, q0, qd0, partition, options):
-    """Run the NumPy reference (uk-numpy or coordinate partitioning) on the same description."""
-    from . import reference
-
-    fn = reference.simulate_uk_numpy if formulation == "uk-numpy" else reference.simulate_cp
-    kwargs: Dict[str, Any] = dict(method=method, rtol=rtol, atol=atol, t_eval=t_eval, q0=q0, qd0=qd0)
-    if formulation == "cp" and partition is not None:
-        kwargs["partition"] = partition
-    kwargs.update(options)
-    out = fn(system.description, t_end, **kwargs)
-    extra = dict(out.extra, accel_time=out.accel_time, repartitions=out.repartitions)
-    return SimulationResult.from_trajectory(
-        system, out.t, out.y, method=method if isinstance(method, str) else method.__name__, formulation=formulation,
-        rtol=rtol, atol=atol, nfev=out.nfev, njev=out.extra.get("njev", 0), nlu=out.extra.get("nlu", 0),
-        wall_time=out.wall_time, status=out.status, message=out.message, extra=extra)
 
 
 def time_acceleration(system: System, t: float, q: Sequence[float], qd: Sequence[float], reps: int = 1000,

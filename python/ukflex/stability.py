@@ -355,7 +355,7 @@ def rank_history(result: SimulationResult, rcond: Optional[float] = None, atol: 
     prev = None
     closeness = np.zeros(nt)
     for k in range(nt):
-        info = s.rank_info(result.t[k], result.q[k], result.qd[k])
+        info = s.rank_info(result.t[k], result.q[:, k], result.qd[:, k])
         rank[k] = int(info["rank"])
         ratio[k] = info["sigma_min_kept"] / info["sigma_max"] if info["sigma_max"] > 0 else 0.0
         dropped[k] = info["sigma_max_dropped"]
@@ -412,14 +412,14 @@ def buckling_load(system: System, body: str) -> float:
 
 
 def axial_force(result: SimulationResult, body: str) -> np.ndarray:
-    """Axial force of each element of beam ``body`` from its elastic strain, shape (nt, N).
+    """Axial force of each element of beam ``body`` from its elastic strain, shape (N, nt).
 
     ``N_k = E a eps_k`` with the element's axial strain as the model defines it (the core's
     ``System.axial_forces``): ``(u(x_{k+1}) - u(x_k)) / l`` for linear strain, plus the averaged
     ``v'^2 / 2`` for nonlinear strain; tension positive.
     """
     s: System = result.system
-    return np.array([np.asarray(s.axial_forces(body, q)) for q in result.q])
+    return np.array([np.asarray(s.axial_forces(body, q)) for q in result.q.T]).reshape(result.t.size, -1).T
 
 
 def joint_end_force(result: SimulationResult, joint: str, body: str) -> np.ndarray:
@@ -433,8 +433,8 @@ def joint_end_force(result: SimulationResult, joint: str, body: str) -> np.ndarr
     jd = next(j for j in s.description["joints"] if j.get("name") == joint)
     sign = 1.0 if jd["b"]["body"] == body else -1.0  # Phi = r_a - r_b
     lam = result.multipliers()
-    th = result.q[:, s.coordinate_index(f"{body}.theta")]
-    F = sign * lam[:, [ix, iy]]  # force on the beam end
+    th = result.coordinate(f"{body}.theta")
+    F = sign * lam[[ix, iy]].T  # force on the beam end
     ex = np.column_stack([np.cos(th), np.sin(th)])  # the beam frame's axis
     return np.sum(F * ex, axis=1)
 
@@ -447,7 +447,7 @@ def buckling_ratio(result: SimulationResult, body: str) -> Dict[str, float]:
     """
     s = result.system
     P = axial_force(result, body)
-    comp = -P.min(axis=1)
+    comp = -P.min(axis=0)
     k = int(np.argmax(comp))
     Pcr = buckling_load(s, body)
     return {"P_cr": Pcr, "max_compression": float(comp[k]), "ratio": float(comp[k] / Pcr), "t": float(result.t[k])}
@@ -461,7 +461,7 @@ def ffrf_validity(result: SimulationResult, body: str, points: int = 21) -> Dict
     """
     s = result.system
     L = beam_properties(s, body)["length"]
-    qf = result.q[:, s.elastic_slice(body)]
+    qf = result.q[s.elastic_slice(body)].T
     vmax = umax = pmax = 0.0
     for xi in np.linspace(0.0, 1.0, points):
         S, npsi = s.beam_shape(body, float(xi))

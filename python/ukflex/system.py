@@ -174,9 +174,9 @@ class System:
     ``phi_t(t)`` (m,); ``b(t, q, qd)`` (m,); ``qdd(t, q, qd)`` (n,); ``rhs(t, y)`` (2n,);
     ``multipliers(t, q, qd)`` (m,) with ``M qdd + A^T lam = Q``; ``residuals(t, q, qd)`` ->
     (position, velocity, acceleration), each (m,); ``rank()``; ``beam_shape(body, xi)``;
-    ``beam_point(body, xi, q)`` -> columns x, y (world), u, v (displacement in the beam frame:
-    an FFRF beam's floating frame, an ANCF beam's chord frame of the ends), psi, for q (n,) or
-    (nt, n); ``tangent_stiffness(body, q)`` (n_b, n_b); ``kinetic_energy(q, qd)``;
+    ``beam_point(body, xi, q)`` -> x, y (world), u, v (displacement in the beam frame:
+    an FFRF beam's floating frame, an ANCF beam's chord frame of the ends), psi: shape (5,) for
+    q (n,), (5, nt) for q (n, nt) (time along the last axis); ``tangent_stiffness(body, q)`` (n_b, n_b); ``kinetic_energy(q, qd)``;
     ``potential_energy(q)``.
 
     Raises

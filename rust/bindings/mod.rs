@@ -9,6 +9,7 @@ mod system;
 
 use numpy::ndarray::ArrayView1;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
+use pyo3::type_object::PyTypeInfo;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
@@ -98,7 +99,7 @@ pub(crate) fn to_py(e: Error) -> PyErr {
         Error::Shape { .. } | Error::Argument { .. } => PyValueError::new_err(msg),
         Error::NonFinite { .. } => NonFiniteError::new_err(msg),
         Error::SingularMass { .. } => SingularMassError::new_err(msg),
-        Error::Solver(_) => SolverError::new_err(msg),
+        Error::Solver(_) | Error::Budget { .. } => SolverError::new_err(msg),
         Error::Expression { text, position, .. } => Python::attach(|py| {
             let err = ExpressionError::new_err(msg);
             let v = err.value(py);
@@ -150,6 +151,37 @@ pub(crate) fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -
     PyArray1::from_vec(py, v).reshape([rows, cols])
 }
 
+/// Evaluate the dense output recorded by `System.integrate(..., dense=True)` of a run of
+/// `method` at the times `t` (k,): returns (dim, k). Each time uses the step whose interval
+/// holds it (outside the run: the first or last step's polynomial, extrapolated).
+#[pyfunction]
+fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<'py, f64>, data: numpy::PyReadonlyArray2<'py, f64>, part_len: Vec<usize>, t: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    use crate::integrate::{DenseRecord, Method};
+    let method = Method::from_name(method).ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}'")))?;
+    let (meta, data) = (meta.as_array(), data.as_array());
+    let width: usize = part_len.iter().sum();
+    if meta.ncols() != 3 || data.ncols() != width || meta.nrows() != data.nrows() || part_len.len() > 5 || meta.nrows() == 0 {
+        return Err(PyValueError::new_err("dense_eval: inconsistent dense record (meta (nseg, 3), data (nseg, sum(part_len)))"));
+    }
+    let dim = match method {
+        Method::GenAlpha(_) => part_len.last().copied().unwrap_or(0),
+        _ => part_len.first().copied().unwrap_or(0),
+    };
+    let rec = DenseRecord { meta: meta.iter().copied().collect(), data: data.iter().copied().collect(), part_len };
+    let ts: Vec<f64> = t.as_array().iter().copied().collect();
+    crate::error::check_finite("t", &ts).map_err(to_py)?;
+    let k = ts.len();
+    let mut out = vec![0.0; dim * k];
+    let mut buf = vec![0.0; dim];
+    for (j, tj) in ts.iter().enumerate() {
+        rec.eval(&method, *tj, &mut buf);
+        for i in 0..dim {
+            out[i * k + j] = buf[i];
+        }
+    }
+    mat(py, out, dim, k)
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -158,6 +190,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(item_name, m)?)?;
     m.add_function(wrap_pyfunction!(beam_elastic_dofs, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::motion_values, m)?)?;
+    m.add_function(wrap_pyfunction!(dense_eval, m)?)?;
     m.add("UkflexError", py.get_type::<UkflexError>())?;
     m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
     m.add("SingularMassError", py.get_type::<SingularMassError>())?;

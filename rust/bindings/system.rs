@@ -476,9 +476,17 @@ impl PySystem {
     /// tolerance, stabilization and backend), so several threads can integrate the same System
     /// concurrently.
     ///
-    /// Returns a dict: t (nt,), y (2n, nt), status (0 ok, -1 failed), message, nfev, njev, nlu,
-    /// naccept, nreject, jac_evals (UK calls inside Jacobians), wall_time [s].
-    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=0.9, step=None, jacobian="structured"))]
+    /// Work budgets: max_steps (step attempts), max_nfev (right-hand-side evaluations),
+    /// max_wall_time [s], min_step (smallest step size [s]); a run that exceeds one, or whose
+    /// state or acceleration turns non-finite, ends with status -1 and the trajectory up to its
+    /// last accepted step. dense: record every step's dense output (evaluate with
+    /// `ukflex._core.dense_eval`).
+    ///
+    /// Returns a dict: t (nt,), y (2n, nt), status (0 ok, -1 failed), message, failure (None,
+    /// or a dict cause, t, stage, index), nfev, njev, nlu, naccept, nreject, jac_evals (UK calls
+    /// inside Jacobians), wall_time [s], dense (None, or a dict meta (nseg, 3), data
+    /// (nseg, width), part_len).
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=0.9, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false))]
     #[allow(clippy::too_many_arguments)]
     fn integrate<'py>(
         &self,
@@ -497,6 +505,10 @@ impl PySystem {
         rho_inf: f64,
         step: Option<f64>,
         jacobian: &str,
+        max_nfev: Option<usize>,
+        max_wall_time: Option<f64>,
+        min_step: f64,
+        dense: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let jacobian = match jacobian {
             "central" => Differences::Central,
@@ -529,7 +541,16 @@ impl PySystem {
             Some(p) if p > 0.0 && p.is_finite() => Some(crate::correct::ProjectionTolerance { position_tol: p, velocity_tol: p, max_iter: 20 }),
             Some(p) => return Err(PyValueError::new_err(format!("projection_tol must be >= 0 and finite, got {p}"))),
         };
-        let opts = Options { rtol, atol, first_step, max_step, max_steps };
+        let opts = Options {
+            rtol,
+            atol,
+            first_step,
+            max_step,
+            max_steps,
+            max_nfev: max_nfev.unwrap_or(usize::MAX),
+            max_wall_time: max_wall_time.unwrap_or(f64::INFINITY),
+            min_step,
+        };
         opts.validate(2 * n).map_err(to_py)?;
         // a fresh workspace with this System's settings: the run does not hold the lock
         let (tolerance, stabilization, backend, solver, limit) =
@@ -551,7 +572,7 @@ impl PySystem {
                 data.stabilization = stabilization;
                 data.svd_backend = backend;
                 let tic = std::time::Instant::now();
-                let r = integrate_uk(model, data, method, opts, t0, &y, t_end, t_eval.as_deref(), projection, jacobian);
+                let r = integrate_uk(model, data, method, opts, t0, &y, t_end, t_eval.as_deref(), projection, jacobian, dense);
                 r.map(|(sol, full, cheap)| (sol, full + cheap, tic.elapsed().as_secs_f64()))
             }))
         });
@@ -572,6 +593,28 @@ impl PySystem {
         d.set_item("y", mat(py, yt, dim, nt)?)?;
         d.set_item("status", sol.status)?;
         d.set_item("message", sol.message)?;
+        match &sol.failure {
+            None => d.set_item("failure", py.None())?,
+            Some(f) => {
+                let fd = PyDict::new(py);
+                fd.set_item("cause", &f.cause)?;
+                fd.set_item("t", f.t)?;
+                fd.set_item("stage", &f.stage)?;
+                fd.set_item("index", f.index)?;
+                d.set_item("failure", fd)?;
+            }
+        }
+        match sol.dense {
+            None => d.set_item("dense", py.None())?,
+            Some(rec) => {
+                let (nseg, w) = (rec.meta.len() / 3, rec.width());
+                let dd = PyDict::new(py);
+                dd.set_item("part_len", rec.part_len.clone())?;
+                dd.set_item("meta", mat(py, rec.meta, nseg, 3)?)?;
+                dd.set_item("data", mat(py, rec.data, nseg, w)?)?;
+                d.set_item("dense", dd)?;
+            }
+        }
         d.set_item("nfev", sol.stats.nfev)?;
         d.set_item("njev", sol.stats.njev)?;
         d.set_item("nlu", sol.stats.nlu)?;
@@ -736,7 +779,8 @@ impl PySystem {
     }
 
     /// Axis point `xi` of beam `body` at the states `q`: an array (5,) for q of shape (n,), or
-    /// (nt, 5) for q of shape (nt, n), with columns x, y (world position), u, v (displacement
+    /// (5, nt) for q of shape (n, nt) (time along the last axis, as `SimulationResult.q`), with
+    /// rows x, y (world position), u, v (displacement
     /// in the beam frame from the undeformed (xi L, 0)) and psi (section rotation relative to
     /// that frame). The beam frame is an FFRF beam's floating frame (pinned-pinned: the chord
     /// of the ends) and an ANCF beam's chord frame of the ends, so the two compare one to one.
@@ -754,21 +798,25 @@ impl PySystem {
             .map_err(|_| PyValueError::new_err("q must be an array of floats"))?;
         let view = arr.readonly();
         let a = view.as_array();
-        let (rows, one) = match a.shape() {
+        let (cols, one) = match a.shape() {
             [m] if *m == n => (1, true),
-            [nt, m] if *m == n => (*nt, false),
-            other => return Err(PyValueError::new_err(format!("q must have shape (n,) or (nt, n) with n = {n}, got {other:?}"))),
+            [m, nt] if *m == n => (*nt, false),
+            other => return Err(PyValueError::new_err(format!("q must have shape (n,) or (n, nt) with n = {n}, got {other:?}"))),
         };
-        let flat: Vec<f64> = a.iter().copied().collect();
+        // one state per column: gather the transposed copy (state k contiguous)
+        let flat: Vec<f64> = if one { a.iter().copied().collect() } else { a.t().iter().copied().collect() };
         crate::error::check_finite("q", &flat).map_err(to_py)?;
-        let mut out = Vec::with_capacity(5 * rows);
-        for k in 0..rows {
-            out.extend_from_slice(&b.beam_point(xi, &flat[k * n..(k + 1) * n]).expect("checked: a beam"));
+        let mut out = vec![0.0; 5 * cols];
+        for k in 0..cols {
+            let p = b.beam_point(xi, &flat[k * n..(k + 1) * n]).expect("checked: a beam");
+            for (r, v) in p.iter().enumerate() {
+                out[r * cols + k] = *v;
+            }
         }
         if one {
             Ok(PyArray1::from_vec(py, out).into_any())
         } else {
-            Ok(mat(py, out, rows, 5)?.into_any())
+            Ok(mat(py, out, 5, cols)?.into_any())
         }
     }
 

@@ -1,7 +1,7 @@
 //! Dormand-Prince 5(4) with Hairer's step-size control (PI, beta = 0.04) and his 4th-order
 //! dense output (`DOPRI5`, Hairer, Norsett & Wanner, Solving ODEs I, II.5).
 
-use super::{initial_step, rhs, Options, SecondOrderSystem, StepState, Stepper};
+use super::{initial_step, rhs, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::error::Result;
 
 mod dp {
@@ -107,7 +107,7 @@ impl Stepper for Dopri5 {
         let dim = self.st.y.len();
         let hmax = self.opts.max_step;
         loop {
-            self.st.check_attempt("DOPRI5", self.opts.max_steps)?;
+            self.st.check_attempt("DOPRI5", &self.opts)?;
             if self.st.t + 1.01 * self.st.h >= t_end {
                 self.st.h = t_end - self.st.t;
             }
@@ -192,15 +192,18 @@ impl Stepper for Dopri5 {
         }
     }
 
-    fn dense(&self, t: f64, out: &mut [f64]) {
-        let h = self.st.t - self.st.t_old;
-        if h == 0.0 {
-            out.copy_from_slice(&self.st.y);
-            return;
-        }
-        let theta = (t - self.st.t_old) / h;
-        let theta1 = 1.0 - theta;
+    fn dense_parts(&self) -> DenseParts<'_> {
         let [r0, r1, r2, r3, r4] = &self.rcont;
+        DenseParts { meta: [self.st.t_old, self.st.t, 0.0], parts: [r0, r1, r2, r3, r4], count: 5 }
+    }
+    /// Hairer's 4th-order continuous extension (CONTD5):
+    /// `y(t_old + theta h) = r0 + theta (r1 + (1 - theta) (r2 + theta (r3 + (1 - theta) r4)))`.
+    fn dense_eval(meta: [f64; 3], parts: &[&[f64]], t: f64, out: &mut [f64]) {
+        let [t_old, t_new, _] = meta;
+        let h = t_new - t_old;
+        let theta = if h == 0.0 { 1.0 } else { (t - t_old) / h };
+        let theta1 = 1.0 - theta;
+        let [r0, r1, r2, r3, r4] = [parts[0], parts[1], parts[2], parts[3], parts[4]];
         for i in 0..out.len() {
             out[i] = r0[i] + theta * (r1[i] + theta1 * (r2[i] + theta * (r3[i] + theta1 * r4[i])));
         }

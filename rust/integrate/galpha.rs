@@ -41,7 +41,7 @@
 //! `atol + rtol |q|`. Dense output: the cubic Hermite interpolant of `(q, qd)` at both ends.
 
 use super::lu::{lu_cm, lu_cm_solve};
-use super::{initial_step, Options, SecondOrderSystem, StepState, Stepper};
+use super::{initial_step, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::correct::ProjectionTolerance;
 use crate::error::{Error, Result};
 
@@ -356,6 +356,12 @@ impl GenAlpha {
             }
             let d = self.newton_norm(&self.g);
             if !d.is_finite() {
+                // remembered: if the step size then shrinks to nothing, the run ends naming it
+                let (q, qd, qdd) = (&self.q_new, &self.qd_new, &self.x);
+                self.st.nonfinite = [("q", q), ("qd", qd), ("qdd", qdd)]
+                    .iter()
+                    .find_map(|(w, v)| v.iter().position(|x| !x.is_finite()).map(|i| (*w, i)))
+                    .or(Some(("qdd", 0)));
                 return Ok(None);
             }
             let converged = if d <= 1e-3 * tol {
@@ -440,7 +446,7 @@ impl Stepper for GenAlpha {
         self.lam_prev.copy_from_slice(&self.lam);
         let mut fresh = false;
         loop {
-            self.st.check_attempt("GENALPHA", self.opts.max_steps)?;
+            self.st.check_attempt("GENALPHA", &self.opts)?;
             let mut h = self.st.h;
             let last = self.st.t + 1.01 * h >= t_end;
             if last {
@@ -508,6 +514,7 @@ impl Stepper for GenAlpha {
             self.err_prev = err;
             self.reject = false;
             self.st.stats.naccept += 1;
+            self.st.nonfinite = None;
             self.st.t_old = self.st.t;
             self.st.t = if last { t_end } else { self.st.t + h };
             self.st.y[..n].copy_from_slice(&self.q_new);
@@ -528,21 +535,27 @@ impl Stepper for GenAlpha {
         }
     }
 
-    fn dense(&self, t: f64, out: &mut [f64]) {
-        let n = self.n;
-        let (t0, t1) = (self.st.t_old, self.st.t);
+    fn dense_parts(&self) -> DenseParts<'_> {
+        DenseParts { meta: [self.st.t_old, self.st.t, 0.0], parts: [&self.q0, &self.qd0, &self.st.y, &[], &[]], count: 3 }
+    }
+    /// Cubic Hermite interpolation of `q` from `q`, `qd` at both ends of the step (error
+    /// O(h^4) in `q`, O(h^3) in `qd`: above the method's own order 2), `qd` from its derivative.
+    fn dense_eval(meta: [f64; 3], parts: &[&[f64]], t: f64, out: &mut [f64]) {
+        let n = out.len() / 2;
+        let [t0, t1, _] = meta;
+        let (q0, qd0, y) = (parts[0], parts[1], parts[2]);
         let h = t1 - t0;
         if h == 0.0 {
-            out.copy_from_slice(&self.st.y);
+            out.copy_from_slice(y);
             return;
         }
         let s = (t - t0) / h;
         // cubic Hermite of q with slopes qd; qd from its derivative
         let (h00, h10, h01, h11) = (2.0 * s * s * s - 3.0 * s * s + 1.0, s * s * s - 2.0 * s * s + s, -2.0 * s * s * s + 3.0 * s * s, s * s * s - s * s);
         let (d00, d10, d01, d11) = (6.0 * s * s - 6.0 * s, 3.0 * s * s - 4.0 * s + 1.0, -6.0 * s * s + 6.0 * s, 3.0 * s * s - 2.0 * s);
-        let (q1, qd1) = self.st.y.split_at(n);
+        let (q1, qd1) = y.split_at(n);
         for i in 0..n {
-            let (p0, v0, p1, v1) = (self.q0[i], self.qd0[i], q1[i], qd1[i]);
+            let (p0, v0, p1, v1) = (q0[i], qd0[i], q1[i], qd1[i]);
             out[i] = h00 * p0 + h10 * h * v0 + h01 * p1 + h11 * h * v1;
             out[n + i] = (d00 * p0 + d01 * p1) / h + d10 * v0 + d11 * v1;
         }

@@ -88,6 +88,17 @@ pub trait SecondOrderSystem {
     }
 }
 
+/// A non-finite state or acceleration ends a run: `Error::NonFinite` with `what` naming the
+/// stage (`"q"`, `"qd"`, `"qdd"`) and the time, `index` the coordinate (the bindings add names).
+fn check_state_finite(t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<()> {
+    for (what, v) in [("q", q), ("qd", qd), ("qdd", qdd)] {
+        if let Some(index) = v.iter().position(|x| !x.is_finite()) {
+            return Err(Error::NonFinite { what: format!("{what} at t = {}", fmt_t(t)), index });
+        }
+    }
+    Ok(())
+}
+
 /// `dy = f(t, y) = [qd, g(t, q, qd)]`.
 #[inline]
 fn rhs<S: SecondOrderSystem + ?Sized>(sys: &mut S, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()> {
@@ -126,7 +137,7 @@ impl SecondOrderSystem for UkSystem<'_> {
     fn acc(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &mut [f64]) -> Result<()> {
         uk::acceleration(self.model, &mut self.data, t, q, qd)?;
         qdd.copy_from_slice(&self.data.qdd);
-        Ok(())
+        check_state_finite(t, q, qd, qdd)
     }
     fn jac(&mut self, t: f64, q: &[f64], qd: &[f64], jq: &mut [f64], jv: &mut [f64]) -> Result<()> {
         uk_jacobian(self.model, &mut self.data, &mut self.jws, t, q, qd, jq, jv)?;
@@ -205,11 +216,18 @@ pub struct Options {
     pub max_step: f64,
     /// Maximum number of step attempts.
     pub max_steps: usize,
+    /// Maximum number of right-hand-side evaluations (`Stats::nfev`).
+    pub max_nfev: usize,
+    /// Wall-clock budget of the run [s] (checked before every step attempt).
+    pub max_wall_time: f64,
+    /// Smallest step size allowed [s]: a step below it ends the run (0: only the rounding
+    /// limit `|t| eps`).
+    pub min_step: f64,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { rtol: 1e-6, atol: vec![1e-9], first_step: None, max_step: f64::INFINITY, max_steps: 1_000_000 }
+        Options { rtol: 1e-6, atol: vec![1e-9], first_step: None, max_step: f64::INFINITY, max_steps: 1_000_000, max_nfev: usize::MAX, max_wall_time: f64::INFINITY, min_step: 0.0 }
     }
 }
 
@@ -233,6 +251,15 @@ impl Options {
         }
         if !(self.max_step > 0.0) {
             return bad(format!("max_step must be positive, got {}", self.max_step));
+        }
+        if !(self.min_step >= 0.0) || !self.min_step.is_finite() {
+            return bad(format!("min_step must be >= 0 and finite, got {}", self.min_step));
+        }
+        if self.max_step < self.min_step || self.first_step.is_some_and(|h| h < self.min_step) {
+            return bad(format!("max_step and first_step must be >= min_step = {:e}", self.min_step));
+        }
+        if !(self.max_wall_time > 0.0) {
+            return bad(format!("max_wall_time must be positive, got {}", self.max_wall_time));
         }
         Ok(v)
     }
@@ -265,6 +292,16 @@ pub struct StepState {
     pub stats: Stats,
     /// Step attempts so far (bounded by `Options::max_steps`).
     pub steps: usize,
+    /// Start of the run (for `Options::max_wall_time`).
+    pub started: Option<std::time::Instant>,
+    /// The last attempt was rejected for a non-finite trial value (stage, coordinate): named
+    /// if the step size then shrinks to nothing.
+    pub nonfinite: Option<(&'static str, usize)>,
+}
+
+/// A time for a message: plain below 1e6 s, in exponent notation above (no 90-digit times).
+pub(crate) fn fmt_t(t: f64) -> String {
+    if t != 0.0 && (t.abs() >= 1e6 || t.abs() < 1e-4) { format!("{t:.9e}") } else { format!("{t}") }
 }
 
 impl StepState {
@@ -278,16 +315,30 @@ impl StepState {
         self.y.copy_from_slice(y0);
         self.stats = Stats::default();
         self.steps = 0;
+        self.started = Some(std::time::Instant::now());
+        self.nonfinite = None;
     }
 
-    /// The checks every method makes before a step attempt.
-    fn check_attempt(&mut self, method: &str, max_steps: usize) -> Result<()> {
+    /// The checks every method makes before a step attempt: the work budgets
+    /// (`Error::Budget`) and the step-size floor.
+    fn check_attempt(&mut self, method: &str, opts: &Options) -> Result<()> {
         self.steps += 1;
-        if self.steps > max_steps {
-            return Err(Error::Solver(format!("{method}: more than {max_steps} steps at t = {}", self.t)));
+        // formatted only on the way out: no allocation per attempt
+        let t = || fmt_t(self.t);
+        if self.steps > opts.max_steps {
+            return Err(Error::Budget { what: "max_steps".into(), message: format!("{method}: more than max_steps = {} step attempts at t = {}", opts.max_steps, t()) });
         }
-        if 0.1 * self.h.abs() <= self.t.abs() * f64::EPSILON || !self.h.is_finite() {
-            return Err(Error::Solver(format!("{method}: step size too small (h = {:e}) at t = {}", self.h, self.t)));
+        if self.stats.nfev > opts.max_nfev {
+            return Err(Error::Budget { what: "max_nfev".into(), message: format!("{method}: more than max_nfev = {} evaluations at t = {}", opts.max_nfev, t()) });
+        }
+        if opts.max_wall_time.is_finite() && self.started.is_some_and(|s| s.elapsed().as_secs_f64() > opts.max_wall_time) {
+            return Err(Error::Budget { what: "max_wall_time".into(), message: format!("{method}: wall time over max_wall_time = {} s at t = {}", opts.max_wall_time, t()) });
+        }
+        if 0.1 * self.h.abs() <= self.t.abs() * f64::EPSILON || !self.h.is_finite() || self.h < opts.min_step {
+            if let Some((stage, index)) = self.nonfinite {
+                return Err(Error::NonFinite { what: format!("{stage} at t = {} (trial steps down to h = {:.3e} all non-finite)", t(), self.h), index });
+            }
+            return Err(Error::Budget { what: "min_step".into(), message: format!("{method}: step size too small (h = {:.3e}, min_step = {:.3e}) at t = {}", self.h, opts.min_step, t()) });
         }
         Ok(())
     }
@@ -299,8 +350,16 @@ pub trait Stepper {
     fn init<S: SecondOrderSystem>(&mut self, sys: &mut S, t0: f64, y0: &[f64], t_end: f64) -> Result<()>;
     /// One accepted step (rejected attempts are retried inside), never beyond `t_end`.
     fn step<S: SecondOrderSystem>(&mut self, sys: &mut S, t_end: f64) -> Result<()>;
+    /// The data of the last step's dense output: `meta = [t_old, t, aux]` and up to five
+    /// vectors (`count` of them); `dense_eval` evaluates them.
+    fn dense_parts(&self) -> DenseParts<'_>;
+    /// The dense output defined by `meta` and `parts` (as `dense_parts` gives them) at `t`.
+    fn dense_eval(meta: [f64; 3], parts: &[&[f64]], t: f64, out: &mut [f64]);
     /// State at `t` in `[t_old, t]` from the dense output of the last step.
-    fn dense(&self, t: f64, out: &mut [f64]);
+    fn dense(&self, t: f64, out: &mut [f64]) {
+        let d = self.dense_parts();
+        Self::dense_eval(d.meta, &d.parts[..d.count], t, out);
+    }
     /// `y` was changed (post-step hook): re-evaluate what depends on it.
     fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()>;
     fn state(&self) -> &StepState;
@@ -355,6 +414,90 @@ fn initial_step<S: SecondOrderSystem>(sys: &mut S, t0: f64, y0: &[f64], f0: &[f6
 }
 
 
+/// What defines one step's dense output (`Stepper::dense_parts`).
+pub struct DenseParts<'a> {
+    /// `[t_old, t, aux]` (`aux`: a method's extra scalar, e.g. RADAU5's step size).
+    pub meta: [f64; 3],
+    pub parts: [&'a [f64]; 5],
+    pub count: usize,
+}
+
+/// The dense output of a whole run, one segment per accepted step (`integrate` with
+/// `dense = true`): `meta` (3 per segment, `[t_old, t, aux]`) and the parts' data, concatenated
+/// (`width` values per segment, split by `part_len`). Grown by amortized doubling, no per-step
+/// allocation in the steady state.
+#[derive(Debug, Clone, Default)]
+pub struct DenseRecord {
+    pub meta: Vec<f64>,
+    pub data: Vec<f64>,
+    pub part_len: Vec<usize>,
+}
+
+impl DenseRecord {
+    fn push(&mut self, d: &DenseParts<'_>) {
+        if self.part_len.is_empty() {
+            self.part_len = d.parts[..d.count].iter().map(|p| p.len()).collect();
+        }
+        self.meta.extend_from_slice(&d.meta);
+        for p in &d.parts[..d.count] {
+            self.data.extend_from_slice(p);
+        }
+    }
+
+    /// Values per segment.
+    pub fn width(&self) -> usize {
+        self.part_len.iter().sum()
+    }
+
+    /// Evaluate the record of a run of `method` at `t` (the segment whose interval holds `t`;
+    /// before the first or after the last segment: that segment's polynomial extrapolated).
+    pub fn eval(&self, method: &Method, t: f64, out: &mut [f64]) {
+        let nseg = self.meta.len() / 3;
+        if nseg == 0 {
+            out.fill(f64::NAN);
+            return;
+        }
+        // first segment whose end is >= t
+        let (mut lo, mut hi) = (0usize, nseg - 1);
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if self.meta[3 * mid + 1] < t {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        let w = self.width();
+        let seg = &self.data[lo * w..(lo + 1) * w];
+        let mut parts: [&[f64]; 5] = [&[]; 5];
+        let mut at = 0;
+        for (k, len) in self.part_len.iter().enumerate() {
+            parts[k] = &seg[at..at + len];
+            at += len;
+        }
+        let meta = [self.meta[3 * lo], self.meta[3 * lo + 1], self.meta[3 * lo + 2]];
+        let parts = &parts[..self.part_len.len()];
+        match method {
+            Method::Dopri5 => Dopri5::dense_eval(meta, parts, t, out),
+            Method::Radau5 => Radau5::dense_eval(meta, parts, t, out),
+            Method::GenAlpha(_) => GenAlpha::dense_eval(meta, parts, t, out),
+        }
+    }
+}
+
+/// Why a run ended early (`Solution::failure`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Failure {
+    /// `"max_steps"`, `"max_nfev"`, `"max_wall_time"`, `"min_step"`, `"non_finite"` or
+    /// `"solver"` (Newton failure, singular matrix, ...).
+    pub cause: String,
+    /// Time of the last accepted state.
+    pub t: f64,
+    /// `non_finite`: the stage (`"q"`, `"qd"` or `"qdd"`) and the coordinate index.
+    pub stage: String,
+    pub index: Option<usize>,
+}
+
 /// Trajectory of a run: `t` (nt) and `y` (nt x dim, row-major).
 #[derive(Debug, Clone, Default)]
 pub struct Solution {
@@ -362,9 +505,12 @@ pub struct Solution {
     pub y: Vec<f64>,
     pub dim: usize,
     pub stats: Stats,
-    /// 0: reached `t_end`; -1: failed (see `message`).
+    /// 0: reached `t_end`; -1: failed (see `message` and `failure`).
     pub status: i32,
     pub message: String,
+    pub failure: Option<Failure>,
+    /// The dense output of every accepted step (when asked for).
+    pub dense: Option<DenseRecord>,
 }
 
 /// Integrate from `(t0, y0)` to `t_end`. Outputs at `t_eval` (strictly increasing, within
@@ -372,6 +518,13 @@ pub struct Solution {
 /// A failure inside the run ends it with `status = -1` and the trajectory up to there; only
 /// invalid arguments are returned as `Err`.
 pub fn integrate<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut S, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>) -> Result<Solution> {
+    integrate_dense(stepper, sys, t0, y0, t_end, t_eval, false)
+}
+
+/// `integrate`, and with `dense = true` the dense output of every accepted step in
+/// `Solution::dense` (recorded after the post-step hook, so that it reproduces the `t_eval`
+/// outputs exactly).
+pub fn integrate_dense<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut S, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, dense: bool) -> Result<Solution> {
     let dim = y0.len();
     if dim != 2 * sys.n() {
         return Err(Error::Shape { what: "y0".into(), expected: 2 * sys.n(), got: dim });
@@ -390,6 +543,9 @@ pub fn integrate<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut 
     sol.y.reserve(cap * dim);
     let mut next = 0usize;
     let mut buf = vec![0.0; dim];
+    let mut record = if dense { Some(DenseRecord::default()) } else { None };
+    // the last accepted (finite) state's time: where a failed run's trajectory ends
+    let mut t_good = t0;
     // the run; a failure ends it with the trajectory up to there
     let mut run = |sol: &mut Solution| -> Result<()> {
         stepper.init(sys, t0, y0, t_end)?;
@@ -411,8 +567,18 @@ pub fn integrate<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut 
             sol.stats = stepper.stats();
             step?;
             let t = stepper.t();
+            // an accepted step must be finite (an implicit method's converged iterate can
+            // overflow in the positions): the run ends before it
+            let n = dim / 2;
+            if let Some(i) = stepper.y().iter().position(|x| !x.is_finite()) {
+                let stage = if i < n { "q" } else { "qd" };
+                return Err(Error::NonFinite { what: format!("{stage} at t = {}", fmt_t(t)), index: i % n });
+            }
             if sys.post_step(t, stepper.y_mut())? {
                 stepper.restart_at(sys)?;
+            }
+            if let Some(rec) = record.as_mut() {
+                rec.push(&stepper.dense_parts());
             }
             match t_eval {
                 None => {
@@ -432,6 +598,7 @@ pub fn integrate<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut 
                     }
                 }
             }
+            t_good = t;
         }
         Ok(())
     };
@@ -440,9 +607,19 @@ pub fn integrate<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut 
         Err(e) => {
             sol.status = -1;
             sol.message = e.to_string();
+            let t = t_good;
+            sol.failure = Some(match e {
+                Error::Budget { what, .. } => Failure { cause: what, t, ..Default::default() },
+                Error::NonFinite { what, index } => {
+                    let stage = what.split(' ').next().unwrap_or("").to_string();
+                    Failure { cause: "non_finite".into(), t, stage, index: Some(index) }
+                }
+                _ => Failure { cause: "solver".into(), t, ..Default::default() },
+            });
         }
     }
     sol.stats = stepper.stats();
+    sol.dense = record;
     Ok(sol)
 }
 
@@ -479,24 +656,25 @@ impl Method {
 }
 
 /// Convenience: run `method` on the UK system of `model` with a workspace `data`.
-pub fn integrate_uk(model: &Model, data: Data, method: Method, opts: Options, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, projection: Option<ProjectionTolerance>, jacobian: Differences) -> Result<(Solution, usize, usize)> {
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_uk(model: &Model, data: Data, method: Method, opts: Options, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, projection: Option<ProjectionTolerance>, jacobian: Differences, dense: bool) -> Result<(Solution, usize, usize)> {
     let mut sys = UkSystem::new(model, data);
     sys.projection = projection;
     sys.jws.scheme = jacobian;
     let sol = match method {
         Method::Dopri5 => {
             let mut st = Dopri5::new(2 * model.n, opts)?;
-            integrate(&mut st, &mut sys, t0, y0, t_end, t_eval)?
+            integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
         }
         Method::Radau5 => {
             let mut st = Radau5::new(model.n, opts)?;
-            integrate(&mut st, &mut sys, t0, y0, t_end, t_eval)?
+            integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
         }
         Method::GenAlpha(mut go) => {
             // the method projects with the factorization of its own last kernel call
             go.projection = sys.projection.take();
             let mut st = GenAlpha::new(model.n, model.m, opts, go)?;
-            integrate(&mut st, &mut sys, t0, y0, t_end, t_eval)?
+            integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
         }
     };
     Ok((sol, sys.jac_full_evals, sys.jac_cheap_evals))

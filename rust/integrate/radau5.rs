@@ -5,7 +5,7 @@
 //! of `integrate`).
 
 use super::lu::{lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
-use super::{initial_step, rhs, rms_norm, Options, SecondOrderSystem, StepState, Stepper};
+use super::{initial_step, rhs, rms_norm, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::error::{Error, Result};
 
 mod rc {
@@ -343,7 +343,7 @@ impl Stepper for Radau5 {
                     continue;
                 }
             }
-            self.st.check_attempt("RADAU5", self.opts.max_steps)?;
+            self.st.check_attempt("RADAU5", &self.opts)?;
             let (t, h) = (self.st.t, self.st.h);
             let xph = t + h;
             // starting values for Newton
@@ -545,14 +545,23 @@ impl Stepper for Radau5 {
         }
     }
 
-    fn dense(&self, t: f64, out: &mut [f64]) {
+    fn dense_parts(&self) -> DenseParts<'_> {
+        let [c0, c1, c2, c3] = &self.cont;
+        let h = if self.st.t == self.st.t_old { 0.0 } else { self.h_old };
+        DenseParts { meta: [self.st.t_old, self.st.t, h], parts: [c0, c1, c2, c3, &[]], count: 4 }
+    }
+    /// The collocation polynomial of the step (Hairer's CONTR5, order 3 in between the nodes,
+    /// the step's order 5 at its end): `s = (t - t_new) / h`,
+    /// `y = c0 + s (c1 + (s - c2 + 1) (c2' + (s - c1 + 1) c3))`.
+    fn dense_eval(meta: [f64; 3], parts: &[&[f64]], t: f64, out: &mut [f64]) {
         use rc::*;
-        if self.st.t == self.st.t_old {
-            out.copy_from_slice(&self.st.y);
+        let [_, t_new, h] = meta;
+        let [c0, c1, c2, c3] = [parts[0], parts[1], parts[2], parts[3]];
+        if h == 0.0 {
+            out.copy_from_slice(c0);
             return;
         }
-        let s = (t - self.st.t) / self.h_old;
-        let [c0, c1, c2, c3] = &self.cont;
+        let s = (t - t_new) / h;
         for i in 0..out.len() {
             out[i] = c0[i] + s * (c1[i] + (s - C2M1) * (c2[i] + (s - C1M1) * c3[i]));
         }

@@ -418,7 +418,7 @@ def run_one(model: str, elements: int, case: Case = PAPER_CASE, integrator: Inte
         return r
     _, v = res.beam_displacement("coupler", 0.5)
     r.v = np.asarray(v, float) / LB
-    finite = np.all(np.isfinite(res.q), axis=1)
+    finite = np.all(np.isfinite(res.q), axis=0)
     if not np.all(finite):
         r.success = False
         r.message = (r.message + "; " if r.message else "") + f"non-finite state at t = {r.t[np.argmin(finite)]:.6g} s"
@@ -430,7 +430,7 @@ def run_one(model: str, elements: int, case: Case = PAPER_CASE, integrator: Inte
     res_pos = np.asarray(res.residuals["position"], float)
     r.max_residual = float(np.nanmax(res_pos)) if res_pos.size else float("nan")
     if axial:
-        P = axial_forces(system, np.asarray(res.q)[finite]) / r.euler_load
+        P = axial_forces(system, np.asarray(res.q).T[finite]) / r.euler_load
         comp = np.full(r.t.size, np.nan)
         mean = np.full(r.t.size, np.nan)
         comp[finite] = np.maximum(-P.min(axis=1), 0.0)

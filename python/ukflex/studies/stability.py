@@ -45,7 +45,7 @@ def _observable(result: SimulationResult) -> Tuple[str, np.ndarray]:
 
 def _closed_form_error(c: extreme.Case, quick: bool, result: SimulationResult) -> Optional[Tuple[str, float]]:
     s = result.system
-    q = result.q
+    q = result.q.T  # (nt, n): columns per coordinate
     name = c.name
     if name == "singular_slider_crank":  # slider branch: coupler angle = -omega t
         w = c.parameters(quick)["omega"]
@@ -65,7 +65,7 @@ def _energy_drift(result: SimulationResult) -> float:
     largest kinetic energy reached)."""
     s = result.system
     E = result.energy()
-    T = np.array([s.kinetic_energy(q, qd) for q, qd in zip(result.q, result.qd)])
+    T = np.array([s.kinetic_energy(q, qd) for q, qd in zip(result.q.T, result.qd.T)])
     return float(np.ptp(E) / max(T.max(), 1e-300))
 
 
@@ -156,7 +156,7 @@ def _case_runs(c, quick: bool, log) -> Dict[str, Any]:
             if not entry["ok"]:
                 entry["error_message"] = r.message
             elif ref is not None:
-                entry["error"] = float(np.abs(_observable(r)[1] - ref_obs[: te.size]).max())
+                entry["error"] = float(np.abs(_observable(r)[1] - ref_obs[..., : te.size]).max())
         except Exception as exc:  # the reference CP raises plain NumPy / Python errors
             entry.update(ok=False, wall=time.perf_counter() - tic, error_message=f"{type(exc).__name__}: {exc}")
         log(f"  {c.name}: CP {'ok' if entry['ok'] else 'FAILED'} {entry['wall']:.1f}s")
@@ -202,7 +202,7 @@ def _scaling_study(quick: bool) -> List[Dict[str, Any]]:
     for label, sc in cases:
         system = System(sc)
         r = run(system, 0.01, "DOPRI5", rtol=1e-8, t_eval=[0.0, 0.01])
-        a = scaling_accuracy(system, r.t[-1], r.q[-1], r.qd[-1])
+        a = scaling_accuracy(system, r.t[-1], r.q[:, -1], r.qd[:, -1])
         a["case"] = label
         rows.append(a)
     return rows

@@ -187,7 +187,7 @@ def run_one(system, formulation: str, method: str, rtol: float, t_end: float, t_
             if not res.success or res.t.size != t_eval.size:
                 row.update(status="failed", message=res.message)
             else:
-                Y = res.q.T
+                Y = res.q
                 row["drift_end"] = float(res.residuals["position"][-1])
     except BudgetExceeded:
         row.update(status="over_budget", wall_time=time.perf_counter() - tic,
