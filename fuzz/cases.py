@@ -114,7 +114,7 @@ def _max_abs(a: Any) -> float:
 _TEMPLATES: Dict[str, Dict[str, st.SearchStrategy]] = {
     "rigid_pendulum": dict(mass=scaled(0.1, 10.0), inertia=scaled(1e-3, 1.0), length=scaled(0.1, 2.0),
                            angle=st.floats(-3.0, 3.0), angular_velocity=st.floats(-5.0, 5.0),
-                           gravity=scaled(1.0, 20.0), position=st.floats(-1.0, 1.0), pivot_x=st.floats(-10.0, 10.0)),
+                           gravity=scaled(1.0, 20.0), position=st.floats(-1.0, 1.0), pivot_x=st.one_of(st.floats(-10.0, 10.0), st.sampled_from([1e5, -1e8, 1e12, 1e17]))),
     "point_pendulum": dict(mass=scaled(0.1, 10.0), length=scaled(0.1, 2.0), angle=st.floats(-3.0, 3.0),
                            gravity=scaled(1.0, 20.0), position=st.floats(-1.0, 1.0),
                            velocity=st.floats(-2.0, 2.0)),
@@ -206,6 +206,14 @@ def _check_scene(case: Dict[str, Any]) -> List[Finding]:
         phi = _max_abs(system.phi(system.t0, system.q0))
         if phi > 1e-9 * L:
             findings.append(("wrong", f"build: max|Phi(q0)| = {phi:.3g} > 1e-9 L (L = {L:g})"))
+        # the state must resolve the mechanism: a motion of 1e-6 L shows up in Phi as A d does
+        # (at 1e17 m from the origin positions move in steps of 16 m and Phi reads 0 whatever)
+        d = 1e-6 * L * np.cos(np.arange(system.n_coords) + 1.0)
+        expected = system.A(system.q0) @ d
+        actual = system.phi(system.t0, system.q0 + d) - system.phi(system.t0, system.q0)
+        if _max_abs(actual - expected) > 1e-3 * _max_abs(expected) + 1e-15 * L:
+            findings.append(("wrong", f"build: the state does not resolve a 1e-6 L motion (dPhi {_max_abs(actual):.3g} "
+                                      f"vs A d {_max_abs(expected):.3g}): positions too far from the origin"))
         try:
             res = uk.simulate(system, system.t0 + 0.02, method="DOPRI5", rtol=1e-8, max_steps=20000)
         except Exception as exc:  # noqa: BLE001

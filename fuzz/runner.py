@@ -122,6 +122,8 @@ def run(cases: Dict[str, int], *, workers: int = 2, timeout: float = 10.0, seed:
 
     ``wall_limit`` (s) stops handing out batches after that time (the report says how many cases ran).
     """
+    # the same cases on every run: hash-based ordering inside the workers must not vary
+    os.environ["PYTHONHASHSEED"] = "0"
     ctx = mp.get_context("spawn")
     tasks = ctx.Queue()
     results = ctx.Queue()

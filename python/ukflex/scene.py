@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from .description import Checker, normalize
-from .errors import InvalidSceneError, core
+from .errors import InvalidArgumentError, InvalidSceneError, core
 from .system import System
 
 __all__ = [
@@ -73,7 +73,7 @@ class Circular:
     diameter: float
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"shape": "circular", "diameter": float(self.diameter)}
+        return {"shape": "circular", "diameter": _num("diameter", self.diameter)}
 
 
 @dataclass(frozen=True)
@@ -84,7 +84,7 @@ class Rectangular:
     height: float
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"shape": "rectangular", "width": float(self.width), "height": float(self.height)}
+        return {"shape": "rectangular", "width": _num("width", self.width), "height": _num("height", self.height)}
 
 
 @dataclass(frozen=True)
@@ -95,7 +95,7 @@ class CustomSection:
     second_moment: float
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"shape": "custom", "area": float(self.area), "second_moment": float(self.second_moment)}
+        return {"shape": "custom", "area": _num("area", self.area), "second_moment": _num("second_moment", self.second_moment)}
 
 
 @dataclass(frozen=True)
@@ -106,7 +106,7 @@ class ConstantSpeed:
     initial: float = 0.0
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"kind": "constant_speed", "initial": float(self.initial), "speed": float(self.speed)}
+        return {"kind": "constant_speed", "initial": _num("initial", self.initial), "speed": _num("speed", self.speed)}
 
 
 @dataclass(frozen=True)
@@ -116,7 +116,7 @@ class Polynomial:
     coefficients: Sequence[float]
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"kind": "polynomial", "coefficients": [float(c) for c in self.coefficients]}
+        return {"kind": "polynomial", "coefficients": [_num("coefficients", c) for c in self.coefficients]}
 
 
 @dataclass(frozen=True)
@@ -131,10 +131,10 @@ class Harmonic:
     def to_dict(self) -> Dict[str, Any]:
         return {
             "kind": "harmonic",
-            "offset": float(self.offset),
-            "amplitude": float(self.amplitude),
-            "frequency": float(self.frequency),
-            "phase": float(self.phase),
+            "offset": _num("offset", self.offset),
+            "amplitude": _num("amplitude", self.amplitude),
+            "frequency": _num("frequency", self.frequency),
+            "phase": _num("phase", self.phase),
         }
 
 
@@ -166,10 +166,10 @@ class Spline:
     slopes: Optional[Sequence[float]] = None
 
     def to_dict(self) -> Dict[str, Any]:
-        d: Dict[str, Any] = {"kind": "spline", "times": [float(x) for x in self.times],
-                             "values": [float(x) for x in self.values]}
+        d: Dict[str, Any] = {"kind": "spline", "times": [_num("times", x) for x in self.times],
+                             "values": [_num("values", x) for x in self.values]}
         if self.slopes is not None:
-            d["slopes"] = [float(x) for x in self.slopes]
+            d["slopes"] = [_num("slopes", x) for x in self.slopes]
         return d
 
 
@@ -201,19 +201,36 @@ class Marker:
     def to_dict(self) -> Dict[str, Any]:
         d: Dict[str, Any] = {"body": self.body}
         if self.point is not None:
-            d["point"] = [float(self.point[0]), float(self.point[1])]
+            d["point"] = [_num("point", self.point[0]), _num("point", self.point[1])]
         if self.xi is not None:
-            d["xi"] = float(self.xi)
-        d["angle"] = float(self.angle)
+            d["xi"] = _num("xi", self.xi)
+        d["angle"] = _num("angle", self.angle)
         return d
+
+
+def _num(name: str, value: Any) -> float:
+    """``float(value)`` for a builder argument, with errors that name it (a 400-digit integer,
+    a string, a boolean, None or a complex number are refused, not converted or overflowed)."""
+    if isinstance(value, (bool, str, bytes)) or value is None or isinstance(value, complex):
+        raise InvalidArgumentError(name, f"expected a real number, got {value!r}")
+    try:
+        v = float(value)
+    except OverflowError:
+        raise InvalidArgumentError(name, f"{value!r:.40} is beyond the double-precision range") from None
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(name, f"expected a real number, got {value!r}") from None
+    return v
 
 
 def _point_args(x: Any, y: Any) -> Vec2:
     if y is None:
-        px, py = x
+        try:
+            px, py = x
+        except (TypeError, ValueError):
+            raise InvalidArgumentError("x", f"expected a point (x, y) or two numbers, got {x!r}") from None
     else:
         px, py = x, y
-    return (float(px), float(py))
+    return (_num("x", px), _num("y", py))
 
 
 class BodyRef:
@@ -246,16 +263,16 @@ class _PointBody(BodyRef):
 
     def point(self, x: Any, y: Any = None, angle: float = 0.0) -> Marker:
         """Marker at body-frame point ``(x, y)`` (also accepts ``point((x, y))``)."""
-        return Marker(self.name, point=_point_args(x, y), angle=float(angle))
+        return Marker(self.name, point=_point_args(x, y), angle=_num("angle", angle))
 
     def frame(self, angle: float = 0.0) -> Marker:
         """Marker at the body-frame origin; its world angle is ``theta + angle``."""
-        return Marker(self.name, point=(0.0, 0.0), angle=float(angle))
+        return Marker(self.name, point=(0.0, 0.0), angle=_num("angle", angle))
 
     def line(self, origin: Any = (0.0, 0.0), angle: float = 0.0) -> Marker:
         """Marker describing a line through ``origin`` with direction ``(cos angle, sin angle)``
         in the body frame (for :meth:`Scene.point_on_line` and :meth:`Scene.prismatic`)."""
-        return Marker(self.name, point=_point_args(origin, None), angle=float(angle))
+        return Marker(self.name, point=_point_args(origin, None), angle=_num("angle", angle))
 
 
 class GroundRef(_PointBody):
@@ -285,7 +302,7 @@ class PointMassRef(BodyRef):
 
     def point(self, angle: float = 0.0) -> Marker:
         """The marker on the particle; ``angle`` fixes the direction of a line through it."""
-        return Marker(self.name, angle=float(angle))
+        return Marker(self.name, angle=_num("angle", angle))
 
     def line(self, angle: float = 0.0) -> Marker:
         """The line through the particle with the constant direction ``angle``."""
@@ -304,7 +321,7 @@ class BeamRef(BodyRef):
         beam ``angle`` plus the direction of the tangent ``r'(x)``, measured continuously from the
         beam's initial ``angle`` (valid while the tangent stays within +-pi of it).
         """
-        return Marker(self.name, xi=float(xi), angle=float(angle))
+        return Marker(self.name, xi=_num("xi", xi), angle=_num("angle", angle))
 
     def line(self, xi: float = 0.0, angle: float = 0.0) -> Marker:
         """Same as :meth:`at`: the line through the axis point with direction ``angle``."""
@@ -327,7 +344,7 @@ class FlexibleBodyRef(BodyRef):
         (``psi`` its elastic rotation, if the body gives one)."""
         for m in self._scene._body(self.name)["markers"]:
             if m["name"] == name:
-                return Marker(self.name, point=(float(m["point"][0]), float(m["point"][1])), angle=float(angle))
+                return Marker(self.name, point=(float(m["point"][0]), float(m["point"][1])), angle=_num("angle", angle))
         names = [m["name"] for m in self._scene._body(self.name)["markers"]]
         raise InvalidSceneError(f"flexible body {self.name!r} has no interface point {name!r}; its points are {names}")
 
