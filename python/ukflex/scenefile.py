@@ -249,8 +249,8 @@ def _number(path: str, where: str, key: str, value: Any, *, positive: bool = Fal
     ok = isinstance(value, (int, float)) and not isinstance(value, bool)
     if integer:
         ok = ok and isinstance(value, int)
-    if ok and not math.isfinite(float(value)):
-        ok = False
+    if ok and not (isinstance(value, int) and abs(value) <= 2 ** 53 or isinstance(value, float) and math.isfinite(value)):
+        ok = False  # non-finite, or an integer beyond what a double holds exactly (no OverflowError)
     if ok and positive and value <= 0:
         ok = False
     if ok and minimum is not None and value < minimum:

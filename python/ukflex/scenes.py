@@ -77,8 +77,12 @@ def _checked(fn: Callable[..., Scene]) -> Callable[..., Scene]:
                 raise TypeError(f"{fn.__name__}: {name} must be an integer, got {value!r}")
             if not isinstance(value, numbers.Real):
                 raise TypeError(f"{fn.__name__}: {name} must be a real number, got {value!r}")
-            if isinstance(default, float) and not math.isfinite(float(value)):
-                raise ValueError(f"{fn.__name__}: {name} must be finite, got {value!r}")
+            try:
+                finite = math.isfinite(float(value))
+            except OverflowError:
+                finite = False
+            if isinstance(default, float) and not finite:
+                raise ValueError(f"{fn.__name__}: {name} must be finite, got {value!r:.40}")
         try:
             return fn(*args, **kwargs)
         except (ZeroDivisionError, OverflowError) as exc:

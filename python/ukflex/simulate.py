@@ -57,7 +57,10 @@ def _real(name: str, value: Any) -> float:
         value = value[()]
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise InvalidArgumentError(name, f"must be a real number, got {type(value).__name__} {value!r}")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:
+        raise InvalidArgumentError(name, f"{value!r:.40} is beyond the double-precision range") from None
     if not math.isfinite(x):
         raise InvalidArgumentError(name, f"must be finite, got {value!r}")
     return x
@@ -74,6 +77,10 @@ def _count(name: str, value: Any) -> int:
     """A positive integer (an integral float such as 1e6 too); 1.5, bools and strings refused."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise InvalidArgumentError(name, f"must be a positive integer, got {type(value).__name__} {value!r}")
+    if isinstance(value, numbers.Integral):
+        if value < 1:
+            raise InvalidArgumentError(name, f"must be a positive integer, got {value!r}")
+        return int(value)
     x = float(value)
     if not x.is_integer() or x < 1:
         raise InvalidArgumentError(name, f"must be a positive integer, got {value!r}")
