@@ -112,3 +112,8 @@ def test_type_errors_in_the_description_speak_the_users_words(field, value, matc
     with pytest.raises(InvalidSceneError, match=match):
         s.beam("b", **kwargs)
         s.build()
+
+
+def test_an_angle_double_precision_cannot_resolve_fails_loudly():
+    with pytest.raises(InvalidSceneError, match="rod.theta = 1e\\+200 rad"):
+        ukflex.System(scenes.pendulum(angle=1e200))

@@ -607,6 +607,16 @@ class System:
         resolve the mechanism: at 1e17 m a coordinate moves in steps of 16 m, the constraints
         read zero whatever the motion, and a run would "succeed" with garbage."""
         scale = length_scale(self.description)
+        eps = np.finfo(float).eps
+        angles = [i for i, c in enumerate(self.coordinate_names) if c.endswith(".theta")]
+        if angles:
+            k = int(angles[int(np.argmax(np.abs(q[angles])))])
+            if abs(float(q[k])) * eps > self.RESOLUTION:
+                raise InvalidSceneError(
+                    f"{self.coordinate_names[k]} = {q[k]:.3g} rad: double precision resolves angles there only to "
+                    f"{np.spacing(abs(float(q[k]))):.2g} rad (resolving {self.RESOLUTION:g} rad needs |angle| <= "
+                    f"{self.RESOLUTION / eps:.3g} rad); give the angle modulo 2 pi"
+                )
         idx = [i for i, c in enumerate(self.coordinate_names) if c.endswith((".x", ".y"))]
         if not idx:
             return
