@@ -30,7 +30,7 @@ from scipy.integrate import solve_ivp
 
 from .errors import SolverError
 from .results import SimulationResult
-from .simulate import NATIVE_METHODS, as_system, simulate
+from .simulate import DEFAULT_MAX_STEPS, NATIVE_METHODS, as_system, simulate
 from .system import System
 
 __all__ = [
@@ -158,7 +158,7 @@ def run(
     rank_tolerance: Any = None,
     pseudoinverse: Optional[str] = None,
     max_step: Optional[float] = None,
-    max_steps: int = 10_000_000,
+    max_steps: int = DEFAULT_MAX_STEPS,
     max_nfev: Optional[int] = None,
     raise_on_failure: bool = True,
 ) -> SimulationResult:
@@ -194,7 +194,8 @@ def run(
     pseudoinverse : {"auto", "qr-jacobi", "faer"}, optional
         Pseudoinverse backend of the core.
     max_steps : int
-        Native methods: step limit.
+        Native methods: step limit (default: :func:`ukflex.simulate`'s, one million; it was ten
+        million, which ran 144 s on a 1e4 s pendulum before stopping).
     max_nfev : int, optional
         scipy methods: stop with a failure after this many right-hand-side calls (a step-size
         collapse -- e.g. a rank decision flipping at every call -- otherwise runs for ever).
