@@ -86,6 +86,8 @@ class System:
     def beam_point(self, body: str, xi: float, q: _F64) -> _F64:
         """Rows x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
         the ends), psi of the axis point at xi; shape (5,) for q (n,), (5, nt) for q (n, nt)."""
+    def residual_norms(self, t: _F64, q: _F64, qd: _F64) -> _F64:
+        """Norms of the position, velocity and acceleration residuals along a trajectory, (3, nt)."""
     def rank_info(self, t: Optional[float] = None, q: Optional[_F64] = None, qd: Optional[_F64] = None) -> Dict[str, Any]:
         """uk_path, rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the UK solve at (t, q, qd)
         (one lock: thread-safe), or of the last solve of any thread without a state."""

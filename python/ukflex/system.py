@@ -244,6 +244,14 @@ class System:
                 0, rp, rp, rv, rv, np.zeros(self.n_coords), np.zeros(self.n_coords), [], self.coordinate_names
             )
         self._check_resolution(self.q0)
+        try:  # energies are outputs of every run: they must be representable at the start
+            core.kinetic_energy(self.q0, self.qd0)
+            core.potential_energy(self.q0)
+        except NonFiniteError as exc:
+            raise InvalidSceneError(
+                f"the scene's energy at the initial state is out of the double-precision range ({exc}); "
+                "check lengths, masses, gravity and their units"
+            ) from exc
 
     def _bind(self, core: Any) -> None:
         """Attach the compiled object and its bound per-step methods (no Python layer per call)."""

@@ -3,7 +3,7 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
-use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -333,6 +333,46 @@ impl PySystem {
             Ok(ws.data.lambda.clone())
         })?;
         Ok(PyArray1::from_vec(py, v))
+    }
+
+    /// Euclidean norms of the position, velocity and acceleration residuals along a trajectory:
+    /// t (nt,), q and qd (n, nt) -> (3, nt), in one call with the GIL released (a result's
+    /// residual histories; a state with NaN or infinity gets NaN norms).
+    fn residual_norms<'py>(&self, py: Python<'py>, t: Vector<'py>, q: PyReadonlyArray2<'py, f64>, qd: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (n, m) = (self.model.n, self.model.m);
+        let tv: Vec<f64> = t.as_array().to_vec();
+        let nt = tv.len();
+        let (qa, qda) = (q.as_array().to_owned(), qd.as_array().to_owned());
+        if qa.shape() != [n, nt] || qda.shape() != [n, nt] {
+            return Err(PyValueError::new_err(format!(
+                "residual_norms: expected q and qd of shape ({n}, {nt}), got {:?} and {:?}", qa.shape(), qda.shape())));
+        }
+        let out = py.detach(|| {
+            self.with_ws(|model, ws| {
+                let mut out = vec![0.0; 3 * nt];
+                let (mut p, mut v, mut a) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+                let (mut qc, mut qdc) = (vec![0.0; n], vec![0.0; n]);
+                let norm = |x: &[f64]| x.iter().map(|e| e * e).sum::<f64>().sqrt();
+                for k in 0..nt {
+                    for i in 0..n {
+                        qc[i] = qa[[i, k]];
+                        qdc[i] = qda[[i, k]];
+                    }
+                    if !tv[k].is_finite() || qc.iter().chain(qdc.iter()).any(|x| !x.is_finite()) {
+                        out[k] = f64::NAN;
+                        out[nt + k] = f64::NAN;
+                        out[2 * nt + k] = f64::NAN;
+                        continue;
+                    }
+                    uk::residuals(model, &mut ws.data, tv[k], &qc, &qdc, &mut p, &mut v, &mut a)?;
+                    out[k] = norm(&p);
+                    out[nt + k] = norm(&v);
+                    out[2 * nt + k] = norm(&a);
+                }
+                Ok(out)
+            })
+        })?;
+        mat(py, out, 3, nt)
     }
 
     /// (position Phi, velocity A qd + Phi_t, acceleration A qdd - b), each shape (m,).
