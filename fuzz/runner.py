@@ -81,8 +81,14 @@ def _worker(wid, tasks, results, started, current, reprs, counts, regression):  
 
     if regression:
         regressions.apply(regression)
+    parent = os.getppid()
     while True:
-        task = tasks.get()
+        try:
+            task = tasks.get(timeout=1.0)
+        except queue.Empty:
+            if os.getppid() != parent:  # the runner died (killed): do not run on as an orphan
+                return
+            continue
         if task is None:
             return
         task_id, cat, s, n = task
