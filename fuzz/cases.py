@@ -191,7 +191,9 @@ def _check_scene(case: Dict[str, Any]) -> List[Finding]:
     names = [field] + _ALIASES.get(field, [])
     text_field = field in ("formulation", "strain")  # fields whose plausible values are strings
     no_gravity = field == "gravity" and p[field] is None  # Scene(gravity=None): a scene without gravity
-    no_gravity = no_gravity or (name == "point_pendulum" and field == "length" and p[field] is None)  # distance at the guess
+    # None means "the distance at the initial guess" for a distance constraint and a spring's rest length
+    no_gravity = no_gravity or (field in ("length", "rest_length") and name in ("point_pendulum", "spring")
+                                and p[field] is None)
     hostile_input = not text_field and not no_gravity and (_is_bad_input(p[field]) if not isinstance(p[field], (list, tuple)) else True)
     with _quiet():
         try:

@@ -117,3 +117,10 @@ def test_type_errors_in_the_description_speak_the_users_words(field, value, matc
 def test_an_angle_double_precision_cannot_resolve_fails_loudly():
     with pytest.raises(InvalidSceneError, match="rod.theta = 1e\\+200 rad"):
         ukflex.System(scenes.pendulum(angle=1e200))
+
+
+def test_a_budget_stop_before_the_first_step_still_has_a_message():
+    # the stop message used to format the step size of a solver that had none yet (TypeError)
+    res = ukflex.simulate(scenes.pendulum(), 1e200, method="BDF", rtol=1e-300, t_eval=np.array([0.0, 5e8, 1e9]),
+                          max_wall_time=5.0, atol=[0.43, 1.0, 0.68, 0.68, 1.45e-226, 2.6e-124])
+    assert res.status in (-1, 0) and res.message

@@ -525,7 +525,7 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
             t_last = float(solver.t)  # the last accepted step: the non-finite value came from a stage beyond it
         detail = {"max_steps": f"{steps} steps", "max_nfev": f"{nfev[0] - 1} evaluations",
                   "max_wall_time": f"{budget.max_wall_time} s",
-                  "min_step": f"h = {getattr(solver, 'step_size', 0.0):.3g} s < min_step = {budget.min_step:g} s"}
+                  "min_step": f"h = {getattr(solver, 'step_size', None) or 0.0:.3g} s < min_step = {budget.min_step:g} s"}
         stop, message = _stop_info(system, s.cause, t_last, s.stage, s.index, detail.get(s.cause, ""))
         status = -1
     wall = time.perf_counter() - start
