@@ -1,4 +1,4 @@
-"""Every hostile example of issue 15, run as a user would (each in its own process, with a time
+"""Every hostile input of the robustness review, run as a user would (each in its own process, with a time
 limit), printed as a Markdown table: what happens now, the message quoted, the exit status.
 
 ``python -m fuzz.examples`` from the repository root (about two minutes); docs/robustness.md

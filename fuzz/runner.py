@@ -79,6 +79,8 @@ def _worker(wid, tasks, results, started, current, reprs, counts, regression):  
     from . import regressions
     from .cases import CATEGORIES
 
+    import ukflex  # noqa: F401 - imported before the first case, so the watchdog never times an import
+
     if regression:
         regressions.apply(regression)
     parent = os.getppid()
