@@ -28,7 +28,7 @@ from typing import List, Tuple
 
 import numpy as np
 
-from .sensors import SENSOR_HELP, Sensors
+from .sensors import SENSOR_HELP, Sensors, parse_xi
 
 __all__ = ["evaluate", "validate", "default_outputs", "beam_names", "OUTPUT_HELP", "BEAM_KINDS"]
 
@@ -63,12 +63,7 @@ def _parse(system, expr: str):
         beams = beam_names(system)
         if body not in beams:
             raise ValueError(f"output {expr!r}: {body!r} is not a beam; beams are {beams}")
-        try:
-            xi = float(xi_text)
-        except ValueError:
-            raise ValueError(f"output {expr!r}: XI must be a number in [0, 1], got {xi_text!r}") from None
-        if not 0.0 <= xi <= 1.0:
-            raise ValueError(f"output {expr!r}: XI must lie in [0, 1], got {xi}")
+        xi = parse_xi(expr, xi_text)
         if per_length and what not in ("u", "v"):
             raise ValueError(f"output {expr!r}: /L applies to u(...) and v(...) only")
         return ("beam", what, body, xi, bool(per_length))

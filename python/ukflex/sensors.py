@@ -32,6 +32,18 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+
+def parse_xi(expr: str, xi_text: str) -> float:
+    """The axis coordinate XI of an output expression such as ``v(coupler, 0.5)``: a number in [0, 1]."""
+    try:
+        xi = float(xi_text)
+    except ValueError:
+        raise ValueError(f"output {expr!r}: XI must be a number in [0, 1], got {xi_text!r}") from None
+    if not 0.0 <= xi <= 1.0:
+        raise ValueError(f"output {expr!r}: XI must lie in [0, 1], got {xi}")
+    return xi
+
+
 __all__ = ["Sensors", "cumulative_integral", "energy_line", "SENSOR_HELP"]
 
 #: Columns of a reaction (``System.sensors``).
@@ -262,13 +274,7 @@ class Sensors:
             what, body, xi_text = m.groups()
             if body not in system.body_names or system.body_kind(body) not in ("beam", "ancf_beam"):
                 raise ValueError(f"output {expr!r}: {body!r} is not a beam")
-            try:
-                xi = float(xi_text)
-            except ValueError:
-                raise ValueError(f"output {expr!r}: XI must be a number in [0, 1], got {xi_text!r}") from None
-            if not 0.0 <= xi <= 1.0:
-                raise ValueError(f"output {expr!r}: XI must lie in [0, 1], got {xi}")
-            return ("internal", what, body, xi)
+            return ("internal", what, body, parse_xi(expr, xi_text))
         return None
 
     def evaluate(self, p: Tuple[Any, ...]) -> Tuple[str, np.ndarray]:
