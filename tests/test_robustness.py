@@ -124,3 +124,44 @@ def test_a_budget_stop_before_the_first_step_still_has_a_message():
     res = ukflex.simulate(scenes.pendulum(), 1e200, method="BDF", rtol=1e-300, t_eval=np.array([0.0, 5e8, 1e9]),
                           max_wall_time=5.0, atol=[0.43, 1.0, 0.68, 0.68, 1.45e-226, 2.6e-124])
     assert res.status in (-1, 0) and res.message
+
+
+@pytest.mark.parametrize("crank_length", [1e-30, 1e-12])
+def test_masses_too_disparate_for_the_uk_solve_fail_loudly(crank_length):
+    # a 1e-12 m crank (1e-37 kg m^2 next to a 0.08 kg coupler) used to build and then run with the
+    # UK solve dropping 3 of 6 independent constraints as "redundant": max |Phi| 2e-3 m, status 0
+    with pytest.raises(InvalidSceneError, match=r"masses span too many orders.*independent \(rank 6 of A"):
+        ukflex.System(scenes.slider_crank(crank_length=crank_length, coupler_length=0.381))
+
+
+def test_a_small_but_resolvable_crank_still_builds_and_runs():
+    system = ukflex.System(scenes.slider_crank(crank_length=1e-6, coupler_length=0.381))
+    res = ukflex.simulate(system, 0.02, method="DOPRI5", rtol=1e-8)
+    assert res.status == 0
+    assert max(np.abs(system.phi(t, q)).max() for t, q in zip(res.t, res.q.T)) < 1e-9
+
+
+def test_redundant_constraints_of_the_scene_itself_are_not_mistaken_for_conditioning():
+    # a parallelogram four-bar with a redundant coupler-parallel link: rank deficient by design
+    s = ukflex.Scene()
+    bars = [s.rigid_body(f"b{i}", mass=1.0, inertia=0.1, position=(x, 0.5), angle=np.pi / 2) for i, x in enumerate((0.0, 1.0, 2.0))]
+    top = s.rigid_body("top", mass=1.0, inertia=0.5, position=(1.0, 1.0))
+    for i, b in enumerate(bars):
+        s.revolute(s.ground.point(float(i), 0.0), b.point(-0.5, 0.0))
+        s.revolute(b.point(0.5, 0.0), top.point(float(i) - 1.0, 0.0))
+    system = s.build()
+    assert system.rank_info(system.t0, system.q0, system.qd0)["rank"] < system.n_constraints
+
+
+@pytest.mark.parametrize("length", [5e-324, 1e-300, 1e-30])
+def test_a_distance_below_the_scenes_resolution_fails_loudly(length):
+    # a point pendulum of 1e-30 m used to be "corrected" onto its pivot (the absolute position
+    # tolerance 1e-12 m accepted it) and then fell freely: status 0
+    s = ukflex.Scene(gravity=(0.0, -9.81))
+    bob = s.point_mass("bob", mass=1.0, position=(0.0, -0.5), velocity=(0.285, 0.0))
+    s.distance(s.ground.point(0.0, 0.0), bob.point(), length=length)
+    with pytest.raises(ukflex.UkflexError, match="degenerate|cannot be corrected"):
+        ukflex.System(s)
+    s.rigid_body("plate", mass=1.0, inertia=0.1, com=(0.5, 0.0))
+    with pytest.raises(InvalidSceneError, match="below what the scene resolves"):
+        ukflex.System(s)

@@ -88,7 +88,7 @@ class System:
         the ends), psi of the axis point at xi; shape (5,) for q (n,), (5, nt) for q (n, nt)."""
     def residual_norms(self, t: _F64, q: _F64, qd: _F64) -> _F64:
         """Norms of the position, velocity and acceleration residuals along a trajectory, (3, nt)."""
-    def rank_info(self, t: Optional[float] = None, q: Optional[_F64] = None, qd: Optional[_F64] = None) -> Dict[str, Any]:
+    def rank_info(self, t: Optional[float] = None, q: Optional[_F64] = None, qd: Optional[_F64] = None, exact: bool = True) -> Dict[str, Any]:
         """uk_path, rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the UK solve at (t, q, qd)
         (one lock: thread-safe), or of the last solve of any thread without a state."""
     def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None:

@@ -139,7 +139,9 @@ class System:
         none, or give coordinate names such as ``"crank.theta"``; ``"elastic"`` may be combined
         with names in a list.
     position_tol : float
-        Newton stops when ``max |Phi| <= position_tol`` (absolute, m and rad).
+        Newton stops when ``max |Phi| <= position_tol`` (absolute, m and rad); a scene smaller
+        than a millimetre is corrected to ``1e-9`` of its length scale instead when that is
+        tighter (:data:`System.RESOLUTION`).
     velocity_tol : float
         Accepted ``max |A qd + Phi_t|`` after the velocity projection (absolute).
     max_iterations : int
@@ -232,9 +234,16 @@ class System:
                 "stiffnesses, initial velocities and their units"
             ) from exc
 
+        scale = length_scale(self.description)
+        self._check_lengths(scale)
         if correct:
+            # a tolerance in metres must not be coarser than the scene itself (a 1e-30 m rod
+            # would be "corrected" onto the pivot): 1e-9 of the length scale when that is tighter
+            tol = max(min(float(position_tol), self.RESOLUTION * scale), np.finfo(float).tiny)
+            self._tol_note = (f" = {self.RESOLUTION:g} of the scene's length scale {scale:.3g} m"
+                              if tol < float(position_tol) else "")
             self.q0, self.qd0, self.initial_correction = self._correct(
-                self.q_guess, self.qd_guess, hold, position_tol, velocity_tol, max_iterations
+                self.q_guess, self.qd_guess, hold, tol, velocity_tol, max_iterations
             )
         else:
             self.q0, self.qd0 = self.q_guess.copy(), self.qd_guess.copy()
@@ -244,6 +253,7 @@ class System:
                 0, rp, rp, rv, rv, np.zeros(self.n_coords), np.zeros(self.n_coords), [], self.coordinate_names
             )
         self._check_resolution(self.q0)
+        self._check_conditioning(scale)
         try:  # energies are outputs of every run: they must be representable at the start
             core.kinetic_energy(self.q0, self.qd0)
             core.potential_energy(self.q0)
@@ -638,6 +648,59 @@ class System:
                 f"{self.RESOLUTION * scale / np.finfo(float).eps:.3g} m); place the origin near the mechanism"
             )
 
+    def _check_lengths(self, scale: float) -> None:
+        """Refuse a distance constraint shorter than the scene resolves: its direction (the row of
+        ``A``) is rounding noise and the correction would put the two points on top of each other."""
+        for j in self.description.get("joints", []):
+            length = j.get("length")
+            if j.get("kind") == "distance" and isinstance(length, (int, float)) and 0.0 < length < self.RESOLUTION * scale:
+                raise InvalidSceneError(
+                    f"joint '{j.get('name', 'distance')}': length = {length:.3g} m is below what the scene resolves "
+                    f"({self.RESOLUTION:g} of its length scale {scale:.3g} m = {self.RESOLUTION * scale:.3g} m): the "
+                    "rod's direction is undefined there; use a revolute joint for coincident points"
+                )
+
+    #: largest problem (m * n * min(m, n)) for which a rank-deficient start is cross-checked
+    #: against the unweighted Jacobian at build (a dense SVD: ~1 s at this size)
+    CONDITIONING_CHECK_WORK = 2e9
+
+    def _check_conditioning(self, scale: float) -> None:
+        """Refuse masses so disparate that the UK solve cannot tell independent constraints from
+        redundant ones: the rank of ``A M^-1/2`` at the start must equal the rank of ``A`` (columns
+        equilibrated, so units do not matter). Only a rank-deficient solve needs the check."""
+        m, n = self.n_constraints, self.n_coords
+        if m == 0:
+            return
+        info = self.core.rank_info(self.t0, self.q0, self.qd0, exact=False)
+        if info["rank"] >= m or m * n * min(m, n) > self.CONDITIONING_CHECK_WORK:
+            return
+        A = np.asarray(self.core.A(self.q0), dtype=float)
+        dead = [self.constraint_names[i] for i in np.flatnonzero(~np.any(A != 0.0, axis=1))]
+        if dead:
+            raise InvalidSceneError(
+                f"constraint row(s) {', '.join(dead)} are degenerate at the start: their gradient vanishes (e.g. a "
+                "distance between coincident points, whose direction is undefined); use a revolute joint for "
+                "coincident points, or check the lengths and their units"
+            )
+        norms = np.linalg.norm(A, axis=0)
+        norms[norms == 0.0] = 1.0
+        sv = np.linalg.svd(A / norms, compute_uv=False)
+        rank_a = int(np.sum(sv > max(m, n) * np.finfo(float).eps * sv[0])) if sv.size and sv[0] > 0 else 0
+        if rank_a <= info["rank"]:
+            return  # the redundancy is the constraints' own
+        d = np.diag(np.asarray(self.core.M(self.q0), dtype=float)).copy()
+        rot = np.array([c.endswith(".theta") for c in self.coordinate_names])
+        d[rot] /= scale ** 2  # rotational inertia as a mass at the length scale
+        lo, hi = int(np.argmin(d)), int(np.argmax(d))
+        raise InvalidSceneError(
+            f"the masses span too many orders of magnitude for double precision: the {m} constraints are "
+            f"independent (rank {rank_a} of A at the start) but the mass-weighted UK solve resolves only rank "
+            f"{info['rank']}; the mass matrix ranges from {d[lo]:.3g} kg ({self.coordinate_names[lo]}"
+            + (f", inertia / {scale:.3g} m^2" if rot[lo] else "") + f") to {d[hi]:.3g} kg ({self.coordinate_names[hi]}"
+            + (f", inertia / {scale:.3g} m^2" if rot[hi] else "") + "); check tiny bodies (lengths, masses, inertias) "
+            "and their units"
+        )
+
     def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations):
         held = self._held_mask(hold)
         c = self.core.correct(self.t0, q_guess, qd_guess, [bool(h) for h in held], position_tol=position_tol,
@@ -646,7 +709,7 @@ class System:
             phi = np.asarray(c["phi"])
             raise InconsistentInitialStateError(
                 f"initial positions cannot be corrected onto the constraints Phi(q, t0) = 0: after {c['iterations']} "
-                f"Newton iteration(s) max |Phi| = {c['position_residual_after']:.3e} (tolerance {position_tol:.1e}); "
+                f"Newton iteration(s) max |Phi| = {c['position_residual_after']:.3e} (tolerance {position_tol:.1e}{getattr(self, '_tol_note', '')}); "
                 f"largest residual rows: {self._detail(phi)}" + (" (held coordinates: elastic)" if np.any(held) else ""),
                 rows=self._worst_rows(phi),
                 residuals=phi,

@@ -407,8 +407,10 @@ impl PySystem {
     /// demand, by the dense path). With a state `(t, q, qd)` the UK solve at that state and its
     /// rank report happen under one lock, so the answer belongs to that state even when other
     /// threads use the System; without one it describes the last solve of any thread.
-    #[pyo3(signature = (t=None, q=None, qd=None))]
-    fn rank_info<'py>(&self, py: Python<'py>, t: Option<f64>, q: Option<Vector<'py>>, qd: Option<Vector<'py>>) -> PyResult<Bound<'py, PyDict>> {
+    /// `exact=False` skips the on-demand singular values: after a certified full-rank solve the
+    /// report then holds the certificate's bounds (`exact` says which), at no extra cost.
+    #[pyo3(signature = (t=None, q=None, qd=None, exact=true))]
+    fn rank_info<'py>(&self, py: Python<'py>, t: Option<f64>, q: Option<Vector<'py>>, qd: Option<Vector<'py>>, exact: bool) -> PyResult<Bound<'py, PyDict>> {
         let state = match (t, &q, &qd) {
             (Some(t), Some(q), Some(qd)) => Some((t, q, qd)),
             (None, None, None) => None,
@@ -421,7 +423,8 @@ impl PySystem {
                 uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
             }
             let path = ws.data.uk_path();
-            Ok((uk::exact_rank_info(model, &mut ws.data)?, path))
+            let info = if exact { uk::exact_rank_info(model, &mut ws.data)? } else { ws.data.rank_info };
+            Ok((info, path))
         })?;
         let d = PyDict::new(py);
         d.set_item("uk_path", path)?;
@@ -430,6 +433,7 @@ impl PySystem {
         d.set_item("sigma_min_kept", info.sigma_min_kept)?;
         d.set_item("sigma_max_dropped", info.sigma_max_dropped)?;
         d.set_item("tolerance", info.tolerance)?;
+        d.set_item("exact", info.exact)?;
         Ok(d)
     }
 
