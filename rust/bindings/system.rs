@@ -581,7 +581,7 @@ impl PySystem {
         let max_step = max_step.unwrap_or(f64::INFINITY);
         let projection = match projection_tol {
             None => method.default_projection(),
-            Some(p) if p == 0.0 => None,
+            Some(0.0) => None,
             Some(p) if p > 0.0 && p.is_finite() => Some(crate::correct::ProjectionTolerance { position_tol: p, velocity_tol: p, max_iter: 20 }),
             Some(p) => return Err(PyValueError::new_err(format!("projection_tol must be >= 0 and finite, got {p}"))),
         };
