@@ -32,11 +32,16 @@ class Report:
     workers: int = 0
     regression: Optional[str] = None
 
+    #: every finding's detail (up to 1,000), for the JSON report; the text shows 5 per kind
+    details: List[Tuple[str, str, str]] = field(default_factory=list)
+
     def add(self, category: str, kind: str, detail: str, keep: int = 5) -> None:
         self.findings[category][kind] += 1
         s = self.samples[(category, kind)]
         if len(s) < keep:
             s.append(detail)
+        if len(self.details) < 1000:
+            self.details.append((category, kind, detail))
 
     @property
     def total_findings(self) -> int:
@@ -66,6 +71,7 @@ class Report:
     def to_json(self) -> str:
         return json.dumps(dict(cases=dict(self.cases), findings={c: dict(k) for c, k in self.findings.items()},
                                samples={f"{c}/{k}": v for (c, k), v in self.samples.items()},
+                               all_findings=[dict(category=c, kind=k, detail=d) for c, k, d in self.details],
                                wall_time=self.wall_time, workers=self.workers, regression=self.regression),
                           indent=1)
 

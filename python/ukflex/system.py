@@ -103,8 +103,9 @@ class Equilibrium:
 
 def length_scale(description: Dict[str, Any]) -> float:
     """The scene's length scale [m]: the largest body dimension -- beam lengths, centre-of-mass
-    and marker offsets on bodies (not on the ground: those place the mechanism), distance and
-    rest lengths; 1 m for a scene without any."""
+    and marker offsets on bodies (not on the ground: those place the mechanism) and distance
+    lengths; 1 m for a scene without any. A spring's rest length is a force parameter, not a
+    size (0 is usual), so it does not count."""
     sizes: List[float] = []
     for b in description.get("bodies", []):
         for key in ("length",):
@@ -115,7 +116,7 @@ def length_scale(description: Dict[str, Any]) -> float:
     for section in ("joints", "drivers", "forces"):
         for item in description.get(section, []):
             for key, v in item.items():
-                if key in ("length", "rest_length") and isinstance(v, (int, float)):
+                if key == "length" and isinstance(v, (int, float)):
                     sizes.append(abs(float(v)))
                 elif isinstance(v, dict) and v.get("body", "ground") != "ground":
                     sizes.extend(abs(float(x)) for x in (v.get("point") or []) if isinstance(x, (int, float)))
