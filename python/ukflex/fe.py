@@ -31,6 +31,7 @@ from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 import scipy.linalg as sla
 
+from .errors import InvalidArgumentError
 from .flexible import FlexibleData, InterfacePoint
 
 __all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices", "reduce"]
@@ -44,7 +45,7 @@ def _interface_rows(nodes: np.ndarray, spec: Interface) -> Tuple[Tuple[float, fl
     ndof = 2 * nodes.shape[0]
     idx = np.atleast_1d(np.asarray(spec, dtype=int))
     if idx.size == 0 or idx.min() < 0 or idx.max() >= nodes.shape[0]:
-        raise ValueError(f"interface nodes {idx.tolist()} are not nodes of the mesh (0..{nodes.shape[0] - 1})")
+        raise InvalidArgumentError("interfaces", f"interface nodes {idx.tolist()} are not nodes of the mesh (0..{nodes.shape[0] - 1})")
     c = nodes[idx].mean(axis=0)
     d = np.zeros((2, ndof))
     for i in idx:
@@ -65,7 +66,7 @@ def _scalar_mass(mm: np.ndarray) -> np.ndarray:
     m = mm[0::2, 0::2]
     scale = np.max(np.abs(mm))
     if (np.max(np.abs(mm[1::2, 1::2] - m)) > 1e-10 * scale or np.max(np.abs(mm[0::2, 1::2])) > 1e-10 * scale):
-        raise ValueError("the mass matrix must act alike on x and y (m (x) I_2, dof order x_1, y_1, x_2, ...): "
+        raise InvalidArgumentError("mass_matrix", "the mass matrix must act alike on x and y (m (x) I_2, dof order x_1, y_1, x_2, ...): "
                          "give a consistent or lumped mass of a planar continuum")
     return m
 
@@ -92,28 +93,41 @@ def from_nodal(
     kk = np.asarray(stiffness_matrix, dtype=float)
     n = 2 * x.shape[0]
     if x.ndim != 2 or x.shape[1] != 2 or mm.shape != (n, n) or kk.shape != (n, n):
-        raise ValueError(f"nodes must be (N, 2) and the matrices (2N, 2N); got {x.shape}, {mm.shape}, {kk.shape}")
+        raise InvalidArgumentError("nodes", f"nodes must be (N, 2) and the matrices (2N, 2N); got {x.shape}, {mm.shape}, {kk.shape}")
+    for name, a in (("mass_matrix", mm), ("stiffness_matrix", kk)):
+        if not np.all(np.isfinite(a)):
+            raise InvalidArgumentError(name, "has entries that are not finite")
+        if np.max(np.abs(a - a.T)) > 1e-10 * max(np.max(np.abs(a)), 1e-300):
+            raise InvalidArgumentError(name, "must be symmetric")
+    try:
+        sla.cholesky(mm, lower=True)
+    except np.linalg.LinAlgError:
+        raise InvalidArgumentError("mass_matrix", "is not positive definite (a negative or zero nodal mass, or a node "
+                                   "without mass)") from None
     m_scalar = _scalar_mass(mm)
     iface = {name: _interface_rows(x, spec) for name, spec in interfaces.items()}
     if frame == "mean-axis":
         lam, vec = sla.eigh(kk, mm)
         if modes + 3 > n:
-            raise ValueError(f"{modes} modes do not fit a model with {n} dofs")
+            raise InvalidArgumentError("modes", f"{modes} modes do not fit a model with {n} dofs")
         lam_rigid = lam[:3]
         if np.max(np.abs(lam_rigid)) > 1e-6 * abs(lam[3]):
-            raise ValueError("the stiffness matrix does not have the three rigid-body modes of a free planar part "
+            raise InvalidArgumentError("stiffness_matrix", "the stiffness matrix does not have the three rigid-body modes of a free planar part "
                              f"(lowest eigenvalues {lam[:4]}): is the part supported or disconnected?")
         phi = vec[:, 3:3 + modes]
         freq = np.sqrt(np.maximum(lam[3:3 + modes], 0.0))
     elif frame in ("fixed", "craig-bampton"):
         if fixed is None or len(fixed) != 3:
-            raise ValueError("frame 'fixed' and 'craig-bampton' need fixed = three (interface, 'x'|'y') reference conditions")
+            raise InvalidArgumentError("fixed", "frame 'fixed' and 'craig-bampton' need fixed = three (interface, 'x'|'y') reference conditions")
         ref = []
         for name, ax in fixed:
             if name not in iface or ax not in ("x", "y"):
-                raise ValueError(f"fixed entry ({name!r}, {ax!r}): expected an interface name {list(iface)} and 'x' or 'y'")
+                raise InvalidArgumentError("fixed", f"fixed entry ({name!r}, {ax!r}): expected an interface name {list(iface)} and 'x' or 'y'")
             ref.append(iface[name][1][0 if ax == "x" else 1])
         c = np.array(ref)  # (3, n) constraint rows c u = 0
+        if np.linalg.matrix_rank(c) < 3:
+            raise InvalidArgumentError("fixed", f"the reference conditions {list(fixed)} are not independent (they do "
+                                       "not fix the three rigid-body motions of the frame)")
         if frame == "craig-bampton":
             rows = [iface[nm][1][k] for nm in iface for k in range(2)]
             rows = [r for r in rows if np.linalg.matrix_rank(np.vstack([c, r])) > np.linalg.matrix_rank(c)]
@@ -123,9 +137,13 @@ def from_nodal(
         phi = _constrained_basis(kk, mm, c, b, modes)
         kr, mr = phi.T @ kk @ phi, phi.T @ mm @ phi
         lam = sla.eigh(kr, mr, eigvals_only=True)
+        if lam[0] <= 1e-9 * abs(lam[-1]):
+            raise InvalidArgumentError("stiffness_matrix", f"the stiffness with the reference conditions {list(fixed)} is "
+                                       f"not positive definite (lowest eigenvalue {lam[0]:.3e}): rigid-body motions left "
+                                       "free, a mechanism or a disconnected part, or an indefinite stiffness")
         freq = np.sqrt(np.maximum(lam, 0.0))
     else:
-        raise ValueError(f"unknown frame {frame!r}; expected 'mean-axis', 'fixed' or 'craig-bampton'")
+        raise InvalidArgumentError("frame", f"unknown frame {frame!r}; expected 'mean-axis', 'fixed' or 'craig-bampton'")
     inv = _invariants(x, mm, m_scalar, phi)
     k_ff = phi.T @ kk @ phi
     k_ff = 0.5 * (k_ff + k_ff.T)
@@ -151,7 +169,7 @@ def _constrained_basis(kk: np.ndarray, mm: np.ndarray, c: np.ndarray, b: np.ndar
     z = sla.null_space(cb)
     kz, mz = z.T @ kk @ z, z.T @ mm @ z
     if modes > kz.shape[0]:
-        raise ValueError(f"{modes} modes do not fit: only {kz.shape[0]} interior dofs")
+        raise InvalidArgumentError("modes", f"{modes} modes do not fit: only {kz.shape[0]} interior dofs")
     lam, v = sla.eigh(kz, mz, subset_by_index=[0, modes - 1])
     normal = z @ v
     if not nb:
@@ -180,29 +198,39 @@ def _invariants(x: np.ndarray, mm: np.ndarray, m_scalar: np.ndarray, phi: np.nda
     m_ff = phi.T @ mm @ phi
     return dict(mass=mass, inertia=j0 - mass * float(com @ com), com=(float(com[0]), float(com[1])),
                 s_bar=np.vstack([ex @ mm @ phi, ey @ mm @ phi]), s_u0=phi.T @ mm @ u0, s_ju0=phi.T @ mm @ ju0,
-                s_tilde=phi.T @ tilde @ phi, m_ff=0.5 * (m_ff + m_ff.T))
+                s_tilde=_antisym(phi.T @ tilde @ phi), m_ff=0.5 * (m_ff + m_ff.T))
 
 
 def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickness: float, density: float,
-                               youngs_modulus: float, poisson_ratio: float) -> Tuple[np.ndarray, np.ndarray]:
+                               youngs_modulus: float, poisson_ratio: float,
+                               order: int = 1) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Consistent mass and stiffness matrices (2N, 2N; dof order ``x_1, y_1, ...``) of a planar
     mesh of triangles (``cells`` (E, 3)) or quadrilaterals ((E, 4)), plane stress, assembled by
-    scikit-fem with P1/Q1 elements."""
+    scikit-fem, and the coordinates (N, 2) of the N nodes.
+
+    ``order=1``: linear triangles / bilinear quads (P1/Q1; the nodes are the mesh points; stiff in
+    bending: shear locking).  ``order=2``: quadratic triangles (P2, 6 nodes) / biquadratic quads
+    (Q2, 9 nodes), which represent pure bending exactly; the nodes are the mesh points followed by
+    the edge midpoints (and, for Q2, the cell centres)."""
     try:
         import skfem
         from skfem.models.elasticity import lame_parameters, linear_elasticity
         from skfem.helpers import dot
     except ImportError as e:  # pragma: no cover - optional extra
         raise ImportError("from_mesh needs scikit-fem (the optional 'fe' extra: pip install scikit-fem meshio)") from e
+    if order not in (1, 2):
+        raise InvalidArgumentError("order", f"order must be 1 (P1/Q1) or 2 (P2/Q2), got {order!r}")
     p = np.asarray(points, dtype=float)[:, :2].T
     t = np.asarray(cells, dtype=int).T
     if t.shape[0] == 3:
-        mesh, elem = skfem.MeshTri(p, t), skfem.ElementVector(skfem.ElementTriP1())
+        mesh = skfem.MeshTri(p, t)
+        scalar = skfem.ElementTriP1() if order == 1 else skfem.ElementTriP2()
     elif t.shape[0] == 4:
-        mesh, elem = skfem.MeshQuad(p, t), skfem.ElementVector(skfem.ElementQuad1())
+        mesh = skfem.MeshQuad(p, t)
+        scalar = skfem.ElementQuad1() if order == 1 else skfem.ElementQuad2()
     else:
-        raise ValueError("cells must be triangles (E, 3) or quadrilaterals (E, 4)")
-    basis = skfem.Basis(mesh, elem)
+        raise InvalidArgumentError("cells", "cells must be triangles (E, 3) or quadrilaterals (E, 4)")
+    basis = skfem.Basis(mesh, skfem.ElementVector(scalar))
     # plane stress: lambda* = 2 lambda mu / (lambda + 2 mu)
     lam, mu = lame_parameters(youngs_modulus, poisson_ratio)
     lam_ps = 2.0 * lam * mu / (lam + 2.0 * mu)
@@ -213,20 +241,33 @@ def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickne
         return density * thickness * dot(u, v)
 
     mm = skfem.asm(mass, basis).toarray()
-    # scikit-fem orders vector dofs node-wise (x_1, y_1, ...) for ElementVector of nodal elements
-    order = basis.nodal_dofs.T.ravel()
-    return mm[np.ix_(order, order)], kk[np.ix_(order, order)]
+    # vector dofs by location: row 0 the x component, row 1 the y component (vertices, then edge
+    # midpoints, then cell interiors)
+    groups = [basis.nodal_dofs]
+    if order == 2:
+        groups.append(basis.facet_dofs)
+        if getattr(basis, "interior_dofs", None) is not None and basis.interior_dofs.size:
+            groups.append(basis.interior_dofs)
+    per_node = np.hstack(groups)  # (2, N)
+    order_ = per_node.T.ravel()
+    nodes = basis.doflocs[:, per_node[0]].T
+    return mm[np.ix_(order_, order_)], kk[np.ix_(order_, order_)], np.ascontiguousarray(nodes)
 
 
 def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: float, poisson_ratio: float,
               interfaces: Mapping[str, Interface], modes: int = 4, frame: str = "mean-axis",
               fixed: Optional[Sequence[Tuple[str, str]]] = None, damping_ratio: float = 0.0,
-              cells: Optional[np.ndarray] = None) -> FlexibleData:
+              cells: Optional[np.ndarray] = None, order: int = 1) -> FlexibleData:
     """A :class:`FlexibleData` of a planar part meshed with triangles or quads.
 
     ``mesh``: a path of any meshio-readable file, a ``meshio.Mesh``, or a points array (N, 2|3)
-    with ``cells``.  The part is plane stress of ``thickness``; see :func:`from_nodal` for the
-    rest.  ``info["points"]`` and ``info["cells"]`` keep the mesh (for drawing).
+    with ``cells``.  The part is plane stress of ``thickness``; ``order`` 1 (P1/Q1) or 2 (P2/Q2,
+    free of the bending locking of linear elements; see :func:`plane_stress_mesh_matrices`).
+    An interface is a node index, a list of them, or a callable taking the (N, 2) node
+    coordinates (with ``order=2`` the mid-edge nodes too) and returning a boolean mask or indices
+    (e.g. ``lambda p: np.isclose(p[:, 0], 0.0)``: every node of the left edge).  See
+    :func:`from_nodal` for the rest.  ``info["points"]``, ``info["cells"]`` keep the mesh and
+    ``info["nodes"]`` all nodes (for drawing).
     """
     if cells is None:
         if isinstance(mesh, str):
@@ -235,29 +276,79 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             mesh = meshio.read(mesh)
         blocks = [c for c in mesh.cells if c.type in ("triangle", "quad")]
         if not blocks:
-            raise ValueError("the mesh has no triangle or quad cells")
+            raise InvalidArgumentError("mesh", "the mesh has no triangle or quad cells")
         points, cells = np.asarray(mesh.points)[:, :2], blocks[0].data
     else:
         points = np.asarray(mesh, dtype=float)[:, :2]
-    mm, kk = plane_stress_mesh_matrices(points, cells, thickness=thickness, density=density,
-                                        youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio)
-    data = from_nodal(points, mm, kk, interfaces=interfaces, modes=modes, frame=frame, fixed=fixed,
+    mm, kk, nodes = plane_stress_mesh_matrices(points, cells, thickness=thickness, density=density,
+                                               youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, order=order)
+    resolved = {}
+    for name, spec in interfaces.items():
+        if callable(spec):
+            sel = np.asarray(spec(nodes))
+            idx = np.flatnonzero(sel) if sel.dtype == bool else sel.astype(int).ravel()
+            if idx.size == 0:
+                raise InvalidArgumentError("interfaces", f"interface {name!r}: the selection matches no node of the mesh")
+            resolved[name] = idx
+        else:
+            resolved[name] = spec
+    data = from_nodal(nodes, mm, kk, interfaces=resolved, modes=modes, frame=frame, fixed=fixed,
                       damping_ratio=damping_ratio)
-    data.info.update(points=points, cells=np.asarray(cells))
+    data.info.update(points=points, cells=np.asarray(cells), nodes=nodes)
     return data
 
 
-def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0) -> FlexibleData:
+def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_derivatives: Union[bool, int] = False,
+           static_modes: bool = False, tol: float = 1e-9) -> FlexibleData:
     """Reduce a flexible body (e.g. nodal, with its frame fixed by reference conditions) to its
-    ``modes`` lowest eigenmodes of ``(K_ff, M_ff)``: every invariant is projected on the modal
-    basis (``k3``/``k4`` too).  ``info["frequencies"]`` holds the kept frequencies (rad/s)."""
+    ``modes`` lowest eigenmodes of ``(K_ff, M_ff)``: every invariant is projected on the basis
+    (``k3``/``k4`` too).  ``info["frequencies"]`` holds the frequencies (rad/s) of the reduced
+    model, ``info["modes"]`` the basis (n_f of ``data``, n_f of the result).
+
+    Enrichments of the basis (vectors added to the ``modes`` normal modes, then the whole basis
+    mass-orthonormalized with ``tol``, vectors it already spans dropped, and diagonalized):
+
+    * ``modal_derivatives`` (needs ``k3``, i.e. nonlinear strain data): the static modal
+      derivatives ``K^-1 k3(phi_i, phi_j)``, ``i <= j``, of the kept modes (``True``) or of the
+      ``m`` lowest ones (an int ``m``: ``m (m + 1) / 2`` vectors instead of ``k (k + 1) / 2``).  For beams and
+      slender parts they carry the axial shortening a bending mode needs: without them a
+      reduced basis of bending modes cannot shorten and the quartic membrane energy locks it
+      (docs/flexible-bodies.md: 21 % too stiff on the paper's coupler);
+    * ``static_modes``: the static responses ``K^-1 f`` to the body's inertia load patterns
+      (``s_bar`` rows: translational acceleration; ``s_u0``: centrifugal; ``s_ju0``: angular
+      acceleration) and to unit forces and moments at every marker (static correction modes):
+      they carry the quasi-static axial force whose geometric stiffness the nonlinear strain
+      adds.
+    """
     k, m = np.asarray(data.k_ff, dtype=float), np.asarray(data.m_ff, dtype=float)
     if not 1 <= modes <= k.shape[0]:
-        raise ValueError(f"modes must be in 1..{k.shape[0]}, got {modes}")
+        raise InvalidArgumentError("modes", f"modes must be in 1..{k.shape[0]}, got {modes}")
     lam, p = sla.eigh(k, m, subset_by_index=[0, modes - 1])
+    if modal_derivatives or static_modes:
+        extra = []
+        if static_modes:
+            extra += [np.asarray(data.s_bar, dtype=float)[0], np.asarray(data.s_bar, dtype=float)[1],
+                      np.asarray(data.s_u0, dtype=float), np.asarray(data.s_ju0, dtype=float)]
+            for pt in data.markers.values():
+                extra += list(np.asarray(pt.displacement, dtype=float).reshape(2, -1))
+                if pt.rotation is not None:
+                    extra.append(np.asarray(pt.rotation, dtype=float).ravel())
+        if modal_derivatives:
+            if data.k3 is None:
+                raise InvalidArgumentError("modal_derivatives", "modal_derivatives need the third-order stiffness k3 (nonlinear strain data)")
+            nd = modes if modal_derivatives is True else int(modal_derivatives)
+            if not 1 <= nd <= modes:
+                raise InvalidArgumentError("modal_derivatives", f"modal_derivatives: the number of modes differentiated must be in 1..{modes}, got {nd}")
+            k3p = np.einsum("ijk,jb,kc->ibc", np.asarray(data.k3, dtype=float), p[:, :nd], p[:, :nd])
+            extra += [k3p[:, a, b] for a in range(nd) for b in range(a, nd)]
+        loads = np.array(extra).T  # (n, n_extra)
+        p = _enrich(p, sla.cho_solve(sla.cho_factor(k), loads), m, tol)
+        lam, v = sla.eigh(p.T @ k @ p, p.T @ m @ p)
+        p = p @ v
+    n_r = p.shape[1]
     proj = lambda a: None if a is None else p.T @ np.asarray(a, dtype=float) @ p  # noqa: E731
-    k3 = None if data.k3 is None else np.einsum("ijk,ia,jb,kc->abc", np.asarray(data.k3), p, p, p)
-    k4 = None if data.k4 is None else np.einsum("ijkl,ia,jb,kc,ld->abcd", np.asarray(data.k4), p, p, p, p)
+    k3 = None if data.k3 is None else _project_tensor(np.asarray(data.k3, dtype=float), p)
+    k4 = None if data.k4 is None else _project_tensor(np.asarray(data.k4, dtype=float), p)
     w = np.sqrt(np.maximum(lam, 0.0))
     d_ff = proj(data.d_ff)
     if damping_ratio > 0.0:
@@ -265,6 +356,39 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0) -> Flexib
     markers = {name: InterfacePoint(pt.point, np.asarray(pt.displacement) @ p, None if pt.rotation is None else np.asarray(pt.rotation) @ p)
                for name, pt in data.markers.items()}
     return FlexibleData(mass=data.mass, inertia=data.inertia, com=data.com, s_bar=np.asarray(data.s_bar) @ p,
-                        s_u0=p.T @ np.asarray(data.s_u0), s_ju0=p.T @ np.asarray(data.s_ju0), s_tilde=proj(data.s_tilde),
-                        m_ff=np.eye(modes), k_ff=np.diag(lam), d_ff=d_ff, m_ff_tr=proj(data.m_ff_tr), k3=k3, k4=k4,
+                        s_u0=p.T @ np.asarray(data.s_u0), s_ju0=p.T @ np.asarray(data.s_ju0), s_tilde=_antisym(proj(data.s_tilde)),
+                        m_ff=np.eye(n_r), k_ff=np.diag(lam), d_ff=d_ff, m_ff_tr=proj(data.m_ff_tr), k3=k3, k4=k4,
                         markers=markers, info={"frequencies": w, "modes": p})
+
+
+def _antisym(a: np.ndarray) -> np.ndarray:
+    """The antisymmetric part (a projected ``s_tilde`` is antisymmetric up to rounding)."""
+    return 0.5 * (a - a.T)
+
+
+def _project_tensor(t: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``t`` (n, ..., n) with every index projected on the columns of ``p`` (n, r), one index at
+    a time (n^d r work instead of n^d r^d)."""
+    for _ in range(t.ndim):
+        # contract the first index and move the new one last: after ndim steps the order is back
+        t = np.moveaxis(np.tensordot(p, t, axes=([0], [0])), 0, -1)
+    return np.ascontiguousarray(t)
+
+
+def _enrich(p: np.ndarray, extra: np.ndarray, m: np.ndarray, tol: float) -> np.ndarray:
+    """``p`` (mass-orthonormal columns) extended by the columns of ``extra`` that it does not
+    span: Gram-Schmidt in the mass inner product, twice, dropping a vector whose remainder is
+    below ``tol`` times its mass norm."""
+    cols = [c for c in p.T]
+    for v in extra.T:
+        n0 = float(np.sqrt(v @ m @ v))
+        if n0 == 0.0:
+            continue
+        r = v.copy()
+        for _ in range(2):
+            for c in cols:
+                r -= (c @ m @ r) * c
+        nr = float(np.sqrt(max(r @ m @ r, 0.0)))
+        if nr > tol * n0:
+            cols.append(r / nr)
+    return np.array(cols).T
