@@ -144,6 +144,14 @@ def from_nodal(
         freq = np.sqrt(np.maximum(lam, 0.0))
     else:
         raise InvalidArgumentError("frame", f"unknown frame {frame!r}; expected 'mean-axis', 'fixed' or 'craig-bampton'")
+    data = _data_from_basis(x, mm, kk, m_scalar, iface, phi, damping_ratio)
+    data.info["frequencies"] = freq
+    return data
+
+
+def _data_from_basis(x: np.ndarray, mm: np.ndarray, kk: np.ndarray, m_scalar: np.ndarray, iface: Dict[str, Any],
+                     phi: np.ndarray, damping_ratio: float) -> FlexibleData:
+    """The flexible body of the nodal model on the basis ``phi`` (2N, n_f)."""
     inv = _invariants(x, mm, m_scalar, phi)
     k_ff = phi.T @ kk @ phi
     k_ff = 0.5 * (k_ff + k_ff.T)
@@ -155,7 +163,7 @@ def from_nodal(
         mv = m_ff @ v
         d_ff = mv @ np.diag(2.0 * damping_ratio * w) @ mv.T
     markers = {name: InterfacePoint(p, d @ phi, None if r is None else r @ phi) for name, (p, d, r) in iface.items()}
-    return FlexibleData(k_ff=k_ff, d_ff=d_ff, markers=markers, info={"frequencies": freq, "modes": phi}, **inv)
+    return FlexibleData(k_ff=k_ff, d_ff=d_ff, markers=markers, info={"modes": phi}, **inv)
 
 
 def _constrained_basis(kk: np.ndarray, mm: np.ndarray, c: np.ndarray, b: np.ndarray, modes: int) -> np.ndarray:
@@ -201,21 +209,11 @@ def _invariants(x: np.ndarray, mm: np.ndarray, m_scalar: np.ndarray, phi: np.nda
                 s_tilde=_antisym(phi.T @ tilde @ phi), m_ff=0.5 * (m_ff + m_ff.T))
 
 
-def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickness: float, density: float,
-                               youngs_modulus: float, poisson_ratio: float,
-                               order: int = 1) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Consistent mass and stiffness matrices (2N, 2N; dof order ``x_1, y_1, ...``) of a planar
-    mesh of triangles (``cells`` (E, 3)) or quadrilaterals ((E, 4)), plane stress, assembled by
-    scikit-fem, and the coordinates (N, 2) of the N nodes.
-
-    ``order=1``: linear triangles / bilinear quads (P1/Q1; the nodes are the mesh points; stiff in
-    bending: shear locking).  ``order=2``: quadratic triangles (P2, 6 nodes) / biquadratic quads
-    (Q2, 9 nodes), which represent pure bending exactly; the nodes are the mesh points followed by
-    the edge midpoints (and, for Q2, the cell centres)."""
+def _mesh_basis(points: np.ndarray, cells: np.ndarray, order: int) -> Tuple[Any, np.ndarray, np.ndarray]:
+    """scikit-fem vector basis of the mesh, the permutation ``perm`` (node dof ``j`` = scikit-fem
+    dof ``perm[j]``; node dofs ``x_1, y_1, x_2, ...``) and the node coordinates (N, 2)."""
     try:
         import skfem
-        from skfem.models.elasticity import lame_parameters, linear_elasticity
-        from skfem.helpers import dot
     except ImportError as e:  # pragma: no cover - optional extra
         raise ImportError("from_mesh needs scikit-fem (the optional 'fe' extra: pip install scikit-fem meshio)") from e
     if order not in (1, 2):
@@ -231,16 +229,6 @@ def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickne
     else:
         raise InvalidArgumentError("cells", "cells must be triangles (E, 3) or quadrilaterals (E, 4)")
     basis = skfem.Basis(mesh, skfem.ElementVector(scalar))
-    # plane stress: lambda* = 2 lambda mu / (lambda + 2 mu)
-    lam, mu = lame_parameters(youngs_modulus, poisson_ratio)
-    lam_ps = 2.0 * lam * mu / (lam + 2.0 * mu)
-    kk = (thickness * skfem.asm(linear_elasticity(lam_ps, mu), basis)).toarray()
-
-    @skfem.BilinearForm
-    def mass(u, v, w):
-        return density * thickness * dot(u, v)
-
-    mm = skfem.asm(mass, basis).toarray()
     # vector dofs by location: row 0 the x component, row 1 the y component (vertices, then edge
     # midpoints, then cell interiors)
     groups = [basis.nodal_dofs]
@@ -249,15 +237,49 @@ def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickne
         if getattr(basis, "interior_dofs", None) is not None and basis.interior_dofs.size:
             groups.append(basis.interior_dofs)
     per_node = np.hstack(groups)  # (2, N)
-    order_ = per_node.T.ravel()
-    nodes = basis.doflocs[:, per_node[0]].T
-    return mm[np.ix_(order_, order_)], kk[np.ix_(order_, order_)], np.ascontiguousarray(nodes)
+    nodes = np.ascontiguousarray(basis.doflocs[:, per_node[0]].T)
+    return basis, per_node.T.ravel(), nodes
+
+
+def _plane_stress_lame(youngs_modulus: float, poisson_ratio: float) -> Tuple[float, float]:
+    """Plane-stress Lame parameters ``(lambda*, mu)``, ``lambda* = 2 lambda mu / (lambda + 2 mu)``."""
+    mu = youngs_modulus / (2.0 * (1.0 + poisson_ratio))
+    lam = youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio))
+    return 2.0 * lam * mu / (lam + 2.0 * mu), mu
+
+
+def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickness: float, density: float,
+                               youngs_modulus: float, poisson_ratio: float,
+                               order: int = 1) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Consistent mass and stiffness matrices (2N, 2N; dof order ``x_1, y_1, ...``) of a planar
+    mesh of triangles (``cells`` (E, 3)) or quadrilaterals ((E, 4)), plane stress, assembled by
+    scikit-fem, and the coordinates (N, 2) of the N nodes.
+
+    ``order=1``: linear triangles / bilinear quads (P1/Q1; the nodes are the mesh points; stiff in
+    bending: shear locking).  ``order=2``: quadratic triangles (P2, 6 nodes) / biquadratic quads
+    (Q2, 9 nodes), which represent pure bending exactly; the nodes are the mesh points followed by
+    the edge midpoints (and, for Q2, the cell centres)."""
+    import skfem
+    from skfem.helpers import dot
+    from skfem.models.elasticity import linear_elasticity
+
+    basis, perm, nodes = _mesh_basis(points, cells, order)
+    lam_ps, mu = _plane_stress_lame(youngs_modulus, poisson_ratio)
+    kk = (thickness * skfem.asm(linear_elasticity(lam_ps, mu), basis)).toarray()
+
+    @skfem.BilinearForm
+    def mass(u, v, w):
+        return density * thickness * dot(u, v)
+
+    mm = skfem.asm(mass, basis).toarray()
+    return mm[np.ix_(perm, perm)], kk[np.ix_(perm, perm)], nodes
 
 
 def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: float, poisson_ratio: float,
               interfaces: Mapping[str, Interface], modes: int = 4, frame: str = "mean-axis",
               fixed: Optional[Sequence[Tuple[str, str]]] = None, damping_ratio: float = 0.0,
-              cells: Optional[np.ndarray] = None, order: int = 1) -> FlexibleData:
+              cells: Optional[np.ndarray] = None, order: int = 1, strain: str = "linear",
+              modal_derivatives: Union[bool, int] = False) -> FlexibleData:
     """A :class:`FlexibleData` of a planar part meshed with triangles or quads.
 
     ``mesh``: a path of any meshio-readable file, a ``meshio.Mesh``, or a points array (N, 2|3)
@@ -268,7 +290,23 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
     (e.g. ``lambda p: np.isclose(p[:, 0], 0.0)``: every node of the left edge).  See
     :func:`from_nodal` for the rest.  ``info["points"]``, ``info["cells"]`` keep the mesh and
     ``info["nodes"]`` all nodes (for drawing).
+
+    ``strain="nonlinear"``: the body also gets ``k3``, ``k4``, the plane-stress Green-Lagrange
+    strain energy ``int t E:C:E / 2 dA`` (``E = (grad u + grad u^T + grad u^T grad u) / 2``)
+    restricted to the basis, integrated over the elements (use it with
+    ``Scene.flexible_body(..., strain="nonlinear")``).  ``modal_derivatives`` (``True`` or the
+    number ``m`` of lowest modes differentiated; needs a frame fixed by reference conditions)
+    adds the static modal derivatives of the Green-Lagrange energy, ``K^-1 k3(phi_i, phi_j)``,
+    to the basis: without them the bending modes of a slender part cannot shorten and the
+    reduced part locks (docs/flexible-bodies.md).
     """
+    if strain not in ("linear", "nonlinear"):
+        raise InvalidArgumentError("strain", f"expected 'linear' or 'nonlinear', got {strain!r}")
+    if modal_derivatives is not False and strain != "nonlinear":
+        raise InvalidArgumentError("modal_derivatives", "modal derivatives need strain='nonlinear'")
+    if modal_derivatives is not False and frame == "mean-axis":
+        raise InvalidArgumentError("modal_derivatives", "modal derivatives need a frame fixed by reference conditions "
+                                   "(frame='fixed' or 'craig-bampton'): the free-free static problem is singular")
     if cells is None:
         if isinstance(mesh, str):
             import meshio
@@ -294,53 +332,126 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             resolved[name] = spec
     data = from_nodal(nodes, mm, kk, interfaces=resolved, modes=modes, frame=frame, fixed=fixed,
                       damping_ratio=damping_ratio)
+    if strain == "nonlinear":
+        basis, perm, _ = _mesh_basis(points, cells, order)
+        lam_ps, mu = _plane_stress_lame(youngs_modulus, poisson_ratio)
+        phi = data.info["modes"]
+        if modal_derivatives is not False:
+            nd = modes if modal_derivatives is True else int(modal_derivatives)
+            if not 1 <= nd <= phi.shape[1]:
+                raise InvalidArgumentError("modal_derivatives", f"the number of modes differentiated must be in "
+                                           f"1..{phi.shape[1]}, got {nd}")
+            # the lowest nd normal modes (Craig-Bampton: its reduced model's modes)
+            lam_r, v = sla.eigh(phi.T @ kk @ phi, phi.T @ mm @ phi)
+            low = phi @ v[:, :nd]
+            loads = _green_lagrange_md_loads(basis, perm, low, thickness, lam_ps, mu)
+            iface = {name: _interface_rows(nodes, spec) for name, spec in resolved.items()}
+            c = np.array([iface[name][1][0 if ax == "x" else 1] for name, ax in fixed])  # type: ignore[union-attr]
+            kkt = np.block([[kk, c.T], [c, np.zeros((3, 3))]])
+            theta = np.linalg.solve(kkt, np.vstack([loads, np.zeros((3, loads.shape[1]))]))[:kk.shape[0]]
+            p = _enrich(np.zeros((kk.shape[0], 0)), np.hstack([phi, theta]), mm, 1e-9)
+            lam_e, v = sla.eigh(p.T @ kk @ p, p.T @ mm @ p)
+            phi = p @ v
+            freq = np.sqrt(np.maximum(lam_e, 0.0))
+            data = _data_from_basis(nodes, mm, kk, _scalar_mass(mm), iface, phi, damping_ratio)
+            data.info["frequencies"] = freq
+        data.k3, data.k4 = _green_lagrange_tensors(basis, perm, phi, thickness, lam_ps, mu)
     data.info.update(points=points, cells=np.asarray(cells), nodes=nodes)
     return data
 
 
+def _mode_gradients(basis: Any, perm: np.ndarray, phi: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """Displacement gradients ``G[a, i, j, e, g] = d u_i / d x_j`` of the columns of ``phi``
+    (node dofs) at the quadrature points, and the quadrature weights ``dx[e, g]``."""
+    out = []
+    for a in range(phi.shape[1]):
+        u = np.zeros(basis.N)
+        u[perm] = phi[:, a]
+        out.append(np.asarray(basis.interpolate(u).grad))
+    return np.array(out), np.asarray(basis.dx)
+
+
+def _stress(e: np.ndarray, lam: float, mu: float) -> np.ndarray:
+    """Plane-stress ``C : E`` of symmetric tensors ``e[..., 2, 2, e, g]`` (first two of the last
+    four axes the tensor's)."""
+    tr = e[..., 0, 0, :, :] + e[..., 1, 1, :, :]
+    s = 2.0 * mu * e
+    s[..., 0, 0, :, :] += lam * tr
+    s[..., 1, 1, :, :] += lam * tr
+    return s
+
+
+def _green_lagrange_tensors(basis: Any, perm: np.ndarray, phi: np.ndarray, thickness: float, lam: float,
+                            mu: float) -> Tuple[np.ndarray, np.ndarray]:
+    """``k3``, ``k4`` of the plane-stress Green-Lagrange strain energy on the basis ``phi``:
+    ``U = int t (E_l + E_n) : C : (E_l + E_n) / 2``, ``E_l = sym G q``, ``E_n = (G q)^T (G q) / 2``;
+    the cubic part ``int t E_l : C : E_n`` and the quartic ``int t E_n : C : E_n / 2``."""
+    g, dx = _mode_gradients(basis, perm, phi)
+    w = thickness * dx
+    sig = _stress(0.5 * (g + np.swapaxes(g, 1, 2)), lam, mu)  # (r, 2, 2, E, Q)
+    h = np.einsum("bkieq,ckjeq->bcijeq", g, g)  # G_b^T G_c
+    hs = 0.5 * (h + np.swapaxes(h, 2, 3))
+    t3 = 0.5 * np.einsum("aijeq,bcijeq,eq->abc", sig, hs, w)  # symmetric in (b, c)
+    k3 = 2.0 * (t3 + np.transpose(t3, (1, 2, 0)) + np.transpose(t3, (2, 0, 1)))
+    chs = _stress(hs, lam, mu)
+    t4 = 0.125 * np.einsum("abijeq,cdijeq,eq->abcd", hs, chs, w)
+    k4 = 8.0 * (t4 + np.transpose(t4, (0, 2, 1, 3)) + np.transpose(t4, (0, 2, 3, 1)))
+    return k3, k4
+
+
+def _green_lagrange_md_loads(basis: Any, perm: np.ndarray, phi: np.ndarray, thickness: float, lam: float,
+                             mu: float) -> np.ndarray:
+    """Node loads ``k3(., phi_a, phi_b)`` (2N, m (m + 1) / 2), ``a <= b``, of the Green-Lagrange
+    energy: ``int t grad N_i : (C:sym(G_a^T G_b) + G_b sigma_a + G_a sigma_b)``."""
+    import skfem
+    from skfem.helpers import ddot, grad
+
+    g, _ = _mode_gradients(basis, perm, phi)
+    sig = _stress(0.5 * (g + np.swapaxes(g, 1, 2)), lam, mu)
+
+    @skfem.LinearForm
+    def load(v, w):
+        return thickness * ddot(grad(v), w["s"])
+
+    cols = []
+    m = phi.shape[1]
+    for a in range(m):
+        for b in range(a, m):
+            hab = np.einsum("kieq,kjeq->ijeq", g[a], g[b])
+            s = _stress(0.5 * (hab + np.swapaxes(hab, 0, 1)), lam, mu)
+            s = s + np.einsum("ikeq,kjeq->ijeq", g[b], sig[a]) + np.einsum("ikeq,kjeq->ijeq", g[a], sig[b])
+            cols.append(skfem.asm(load, basis, s=s)[perm])
+    return np.array(cols).T
+
+
 def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_derivatives: Union[bool, int] = False,
-           static_modes: bool = False, tol: float = 1e-9) -> FlexibleData:
+           tol: float = 1e-9) -> FlexibleData:
     """Reduce a flexible body (e.g. nodal, with its frame fixed by reference conditions) to its
     ``modes`` lowest eigenmodes of ``(K_ff, M_ff)``: every invariant is projected on the basis
     (``k3``/``k4`` too).  ``info["frequencies"]`` holds the frequencies (rad/s) of the reduced
     model, ``info["modes"]`` the basis (n_f of ``data``, n_f of the result).
 
-    Enrichments of the basis (vectors added to the ``modes`` normal modes, then the whole basis
-    mass-orthonormalized with ``tol``, vectors it already spans dropped, and diagonalized):
-
-    * ``modal_derivatives`` (needs ``k3``, i.e. nonlinear strain data): the static modal
-      derivatives ``K^-1 k3(phi_i, phi_j)``, ``i <= j``, of the kept modes (``True``) or of the
-      ``m`` lowest ones (an int ``m``: ``m (m + 1) / 2`` vectors instead of ``k (k + 1) / 2``).  For beams and
-      slender parts they carry the axial shortening a bending mode needs: without them a
-      reduced basis of bending modes cannot shorten and the quartic membrane energy locks it
-      (docs/flexible-bodies.md: 21 % too stiff on the paper's coupler);
-    * ``static_modes``: the static responses ``K^-1 f`` to the body's inertia load patterns
-      (``s_bar`` rows: translational acceleration; ``s_u0``: centrifugal; ``s_ju0``: angular
-      acceleration) and to unit forces and moments at every marker (static correction modes):
-      they carry the quasi-static axial force whose geometric stiffness the nonlinear strain
-      adds.
+    ``modal_derivatives`` (needs ``k3``, i.e. nonlinear strain data) adds the static modal
+    derivatives ``K^-1 k3(phi_i, phi_j)``, ``i <= j``, of the kept modes (``True``) or of the
+    ``m`` lowest ones (an int ``m``: ``m (m + 1) / 2`` vectors instead of ``k (k + 1) / 2``); the
+    basis is then mass-orthonormalized (vectors it already spans, to ``tol``, dropped) and
+    diagonalized.  For beams and slender parts the derivatives carry the axial shortening a
+    bending mode needs: without them a basis of bending modes cannot shorten and the quartic
+    membrane energy locks it (docs/flexible-bodies.md: 21 % too stiff on the paper's coupler).
     """
     k, m = np.asarray(data.k_ff, dtype=float), np.asarray(data.m_ff, dtype=float)
     if not 1 <= modes <= k.shape[0]:
         raise InvalidArgumentError("modes", f"modes must be in 1..{k.shape[0]}, got {modes}")
     lam, p = sla.eigh(k, m, subset_by_index=[0, modes - 1])
-    if modal_derivatives or static_modes:
-        extra = []
-        if static_modes:
-            extra += [np.asarray(data.s_bar, dtype=float)[0], np.asarray(data.s_bar, dtype=float)[1],
-                      np.asarray(data.s_u0, dtype=float), np.asarray(data.s_ju0, dtype=float)]
-            for pt in data.markers.values():
-                extra += list(np.asarray(pt.displacement, dtype=float).reshape(2, -1))
-                if pt.rotation is not None:
-                    extra.append(np.asarray(pt.rotation, dtype=float).ravel())
-        if modal_derivatives:
-            if data.k3 is None:
-                raise InvalidArgumentError("modal_derivatives", "modal_derivatives need the third-order stiffness k3 (nonlinear strain data)")
-            nd = modes if modal_derivatives is True else int(modal_derivatives)
-            if not 1 <= nd <= modes:
-                raise InvalidArgumentError("modal_derivatives", f"modal_derivatives: the number of modes differentiated must be in 1..{modes}, got {nd}")
-            k3p = np.einsum("ijk,jb,kc->ibc", np.asarray(data.k3, dtype=float), p[:, :nd], p[:, :nd])
-            extra += [k3p[:, a, b] for a in range(nd) for b in range(a, nd)]
+    if modal_derivatives is not False:
+        if data.k3 is None:
+            raise InvalidArgumentError("modal_derivatives", "modal derivatives need the third-order stiffness k3 "
+                                       "(nonlinear strain data)")
+        nd = modes if modal_derivatives is True else int(modal_derivatives)
+        if not 1 <= nd <= modes:
+            raise InvalidArgumentError("modal_derivatives", f"the number of modes differentiated must be in 1..{modes}, got {nd}")
+        k3p = np.einsum("ijk,jb,kc->ibc", np.asarray(data.k3, dtype=float), p[:, :nd], p[:, :nd])
+        extra = [k3p[:, a, b] for a in range(nd) for b in range(a, nd)]
         loads = np.array(extra).T  # (n, n_extra)
         p = _enrich(p, sla.cho_solve(sla.cho_factor(k), loads), m, tol)
         lam, v = sla.eigh(p.T @ k @ p, p.T @ m @ p)

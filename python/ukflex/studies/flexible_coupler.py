@@ -53,13 +53,15 @@ def _section():
     return h, area / h
 
 
-def mesh_coupler_data(nx: int, ny: int, order: int = 2, modes: int = 4, cells: str = "quad") -> FlexibleData:
+def mesh_coupler_data(nx: int, ny: int, order: int = 2, modes: int = 4, cells: str = "quad", strain: str = "linear",
+                      modal_derivatives: Any = False) -> FlexibleData:
     """The paper's coupler as a plane-stress rectangle (same length, area, second moment, mass
     per length and rotary inertia as the rod: height ``d sqrt(3)/2``, thickness ``A / height``)
     meshed with ``nx`` x ``ny`` quads (``cells="quad"``, Q1/Q2 by ``order``) or twice as many
     triangles (``"tri"``, P1/P2), assembled by :func:`ukflex.fe.from_mesh`, pinned-pinned frame
     through the centres of the end edges, ``modes`` normal modes.  Markers ``"A"``, ``"M"``,
-    ``"B"``: rigid averages of the nodes of the left, middle (``nx`` even) and right sections."""
+    ``"B"``: rigid averages of the nodes of the left, middle (``nx`` even) and right sections.
+    ``strain``, ``modal_derivatives``: see :func:`ukflex.fe.from_mesh` (Green-Lagrange strain)."""
     if nx % 2:
         raise ValueError("nx must be even (a section of nodes at the midpoint)")
     lb = P["coupler_length"]
@@ -73,7 +75,8 @@ def mesh_coupler_data(nx: int, ny: int, order: int = 2, modes: int = 4, cells: s
     ifs = {name: (lambda p, x0=x0: np.abs(p[:, 0] - x0) < tol) for name, x0 in (("A", 0.0), ("M", lb / 2), ("B", lb))}
     return fe.from_mesh(pts, cells=cellarr, thickness=t, density=P["density"], youngs_modulus=P["youngs_modulus"],
                         poisson_ratio=P["poisson_ratio"], interfaces=ifs, modes=modes, frame="fixed",
-                        fixed=[("A", "x"), ("A", "y"), ("B", "y")], order=order)
+                        fixed=[("A", "x"), ("A", "y"), ("B", "y")], order=order, strain=strain,
+                        modal_derivatives=modal_derivatives)
 
 
 def beam_frequencies(elements: int = 32, shear_factor: Optional[float] = None, count: int = 8) -> np.ndarray:
