@@ -6,6 +6,17 @@ frame, its invariants integrated in NumPy (:mod:`ukflex.reference.fe_invariants`
 ``k`` lowest modes (:func:`ukflex.fe.reduce`) and built with :meth:`ukflex.Scene.flexible_body`.
 The measure is the paper's: peak ``|v(0.5)| / Lb`` over ``0 <= t <= 0.07`` s (``v`` the midpoint
 deflection in the chord frame), compared with the built-in beam of the same elements.
+With nonlinear strain the basis takes the modes' modal derivatives (``modal_derivatives``).
+
+The same coupler as a plane-stress rectangle meshed with quadratic quads
+(:func:`mesh_coupler_data`, :func:`mesh_study`) converges to the beam under mesh refinement.
+
+Commands (docs/flexible-bodies.md has the figures and times)::
+
+    python -m ukflex.studies.flexible_coupler                                    # beam FE, linear
+    python -m ukflex.studies.flexible_coupler --nonlinear --modal-derivatives=2  # beam FE, nonlinear
+    python -m ukflex.studies.flexible_coupler --mesh                             # Q2 meshes, linear
+    python -m ukflex.studies.flexible_coupler --mesh --nonlinear --modal-derivatives=2
 """
 
 from __future__ import annotations
@@ -160,12 +171,21 @@ MESHES = ((8, 1), (16, 1), (32, 2), (64, 4))
 
 
 def mesh_study(meshes=MESHES, ks=(2, 4, 8), order: int = 2, cells: str = "quad", beam_elements: int = 16,
-               rtol: float = 1e-8) -> Dict[str, Any]:
+               rtol: float = 1e-8, strain: str = "linear", modal_derivatives: Any = False) -> Dict[str, Any]:
     """The coupler from a plane-stress mesh (:func:`mesh_coupler_data`), reduced to ``k`` modes,
     against the built-in beam of ``beam_elements`` elements (linear strain): for every mesh the
     four lowest frequencies and, for every ``k``, the peak ``|v(0.5)|/Lb``, its error and the
-    wall time of the run."""
-    ref = run_beam(beam_elements, "linear", rtol)
+    wall time of the run; ``error_k`` is the error against the same ``k`` modes of the 32-element
+    Timoshenko beam (the modelling difference alone, without the modal truncation; linear only).
+
+    ``strain="nonlinear"``: Green-Lagrange strain for the mesh (:func:`ukflex.fe.from_mesh`, with
+    ``modal_derivatives``), the built-in beam's nonlinear strain for the reference; each ``k``
+    builds its own basis (the derivatives depend on the modes kept)."""
+    ref = run_beam(beam_elements, strain, rtol)
+    beam_k: Dict[int, float] = {}
+    if strain == "linear":
+        beam32 = coupler_data(32)
+        beam_k = {k: run_flexible(fe.reduce(beam32, k), "linear", rtol)["peak"] for k in ks}
     rows = []
     for nx, ny in meshes:
         t0 = time.perf_counter()
@@ -174,36 +194,47 @@ def mesh_study(meshes=MESHES, ks=(2, 4, 8), order: int = 2, cells: str = "quad",
         row: Dict[str, Any] = dict(mesh=(nx, ny), dofs=int(data.info["modes"].shape[0]), build=build,
                                    frequencies=data.info["frequencies"][:4] / (2 * math.pi), runs=[])
         for k in ks:
-            r = run_flexible(fe.reduce(data, k), "linear", rtol)
-            row["runs"].append(dict(k=k, peak=r["peak"], error=abs(r["peak"] - ref["peak"]) / ref["peak"], wall=r["wall"]))
+            if strain == "linear":
+                dk = fe.reduce(data, k)
+            else:
+                dk = mesh_coupler_data(nx, ny, order, k, cells, "nonlinear", modal_derivatives)
+            r = run_flexible(dk, strain, rtol)
+            row["runs"].append(dict(k=k, n_f=dk.n_f, peak=r["peak"], error=abs(r["peak"] - ref["peak"]) / ref["peak"],
+                                    error_k=abs(r["peak"] - beam_k[k]) / beam_k[k] if beam_k else None, wall=r["wall"]))
         rows.append(row)
-    return dict(beam=ref, beam_elements=beam_elements, rows=rows)
+    return dict(beam=ref, beam_elements=beam_elements, beam_k=beam_k, rows=rows)
 
 
 def _print_mesh_study(out: Dict[str, Any]) -> None:
     fb = beam_frequencies(32)
     print(f"built-in beam N={out['beam_elements']}: peak |v(0.5)|/Lb {out['beam']['peak']:.6e}  {out['beam']['wall']:.1f} s")
+    if out["beam_k"]:
+        print("Timoshenko beam N=32 reduced to k modes: " + "  ".join(f"k={k}: {v:.6e}" for k, v in out["beam_k"].items()))
     print("Timoshenko beam N=32 frequencies (Hz): k=0.8 " + " ".join(f"{f:.2f}" for f in fb[:4])
           + ";  Cowper rectangle k=" + f"{10 * (1 + P['poisson_ratio']) / (12 + 11 * P['poisson_ratio']):.3f} "
           + " ".join(f"{f:.2f}" for f in beam_frequencies(32, 10 * (1 + P["poisson_ratio"]) / (12 + 11 * P["poisson_ratio"]))[:4]))
     for row in out["rows"]:
-        fr = " ".join(f"{f:.2f}" for f in row["frequencies"])
+        fr = " ".join(f"{f:.2f}" for f in row["frequencies"])  # of the linear model
         print(f"mesh {row['mesh'][0]}x{row['mesh'][1]} ({row['dofs']} dofs, built in {row['build']:.1f} s): f {fr} Hz")
         for r in row["runs"]:
-            print(f"    k={r['k']}: peak {r['peak']:.6e}  rel. error {r['error']:.2e}  {r['wall']:.2f} s")
+            ek = "" if r["error_k"] is None else f" (vs beam N=32, k modes: {r['error_k']:.2e})"
+            print(f"    k={r['k']} (n_f {r['n_f']}): peak {r['peak']:.6e}  rel. error {r['error']:.2e}{ek}  {r['wall']:.2f} s")
 
 
 if __name__ == "__main__":  # pragma: no cover
     import sys
 
-    if "--mesh" in sys.argv:
-        _print_mesh_study(mesh_study())
-        raise SystemExit(0)
     strain = "nonlinear" if "--nonlinear" in sys.argv else "linear"
     md: Any = False
     for a in sys.argv:
         if a.startswith("--modal-derivatives"):
             md = True if a == "--modal-derivatives" else int(a.split("=")[1])
+    if "--mesh" in sys.argv:
+        if strain == "linear":
+            _print_mesh_study(mesh_study())
+        else:
+            _print_mesh_study(mesh_study(meshes=((32, 2),), strain="nonlinear", modal_derivatives=md))
+        raise SystemExit(0)
     for row in study(strain=strain, modal_derivatives=md, nodal=strain == "linear"):
         fmax = "" if row["f_max"] is None else f"  f_max {row['f_max']:.0f} Hz"
         nf = "" if row["n_f"] is None else f"  n_f {row['n_f']}"
