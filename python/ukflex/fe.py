@@ -45,7 +45,8 @@ def _interface_rows(nodes: np.ndarray, spec: Interface) -> Tuple[Tuple[float, fl
     ndof = 2 * nodes.shape[0]
     idx = np.atleast_1d(np.asarray(spec, dtype=int))
     if idx.size == 0 or idx.min() < 0 or idx.max() >= nodes.shape[0]:
-        raise InvalidArgumentError("interfaces", f"interface nodes {idx.tolist()} are not nodes of the mesh (0..{nodes.shape[0] - 1})")
+        raise InvalidArgumentError("interfaces",
+                                   f"interface nodes {idx.tolist()} are not nodes of the mesh (0..{nodes.shape[0] - 1})")
     c = nodes[idx].mean(axis=0)
     d = np.zeros((2, ndof))
     for i in idx:
@@ -93,7 +94,8 @@ def from_nodal(
     kk = np.asarray(stiffness_matrix, dtype=float)
     n = 2 * x.shape[0]
     if x.ndim != 2 or x.shape[1] != 2 or mm.shape != (n, n) or kk.shape != (n, n):
-        raise InvalidArgumentError("nodes", f"nodes must be (N, 2) and the matrices (2N, 2N); got {x.shape}, {mm.shape}, {kk.shape}")
+        raise InvalidArgumentError("nodes",
+                                   f"nodes must be (N, 2) and the matrices (2N, 2N); got {x.shape}, {mm.shape}, {kk.shape}")
     for name, a in (("mass_matrix", mm), ("stiffness_matrix", kk)):
         if not np.all(np.isfinite(a)):
             raise InvalidArgumentError(name, "has entries that are not finite")
@@ -118,11 +120,13 @@ def from_nodal(
         freq = np.sqrt(np.maximum(lam[3:3 + modes], 0.0))
     elif frame in ("fixed", "craig-bampton"):
         if fixed is None or len(fixed) != 3:
-            raise InvalidArgumentError("fixed", "frame 'fixed' and 'craig-bampton' need fixed = three (interface, 'x'|'y') reference conditions")
+            raise InvalidArgumentError("fixed",
+                                       "frame 'fixed' and 'craig-bampton' need fixed = three (interface, 'x'|'y') reference conditions")
         ref = []
         for name, ax in fixed:
             if name not in iface or ax not in ("x", "y"):
-                raise InvalidArgumentError("fixed", f"fixed entry ({name!r}, {ax!r}): expected an interface name {list(iface)} and 'x' or 'y'")
+                raise InvalidArgumentError("fixed",
+                                           f"fixed entry ({name!r}, {ax!r}): expected an interface name {list(iface)} and 'x' or 'y'")
             ref.append(iface[name][1][0 if ax == "x" else 1])
         c = np.array(ref)  # (3, n) constraint rows c u = 0
         if np.linalg.matrix_rank(c) < 3:
@@ -143,7 +147,8 @@ def from_nodal(
                                        "free, a mechanism or a disconnected part, or an indefinite stiffness")
         freq = np.sqrt(np.maximum(lam, 0.0))
     else:
-        raise InvalidArgumentError("frame", f"unknown frame {frame!r}; expected 'mean-axis', 'fixed' or 'craig-bampton'")
+        raise InvalidArgumentError("frame",
+                                   f"unknown frame {frame!r}; expected 'mean-axis', 'fixed' or 'craig-bampton'")
     data = _data_from_basis(x, mm, kk, m_scalar, iface, phi, damping_ratio)
     data.info["frequencies"] = freq
     return data
@@ -326,7 +331,8 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             sel = np.asarray(spec(nodes))
             idx = np.flatnonzero(sel) if sel.dtype == bool else sel.astype(int).ravel()
             if idx.size == 0:
-                raise InvalidArgumentError("interfaces", f"interface {name!r}: the selection matches no node of the mesh")
+                raise InvalidArgumentError("interfaces",
+                                           f"interface {name!r}: the selection matches no node of the mesh")
             resolved[name] = idx
         else:
             resolved[name] = spec
@@ -449,7 +455,8 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_
                                        "(nonlinear strain data)")
         nd = modes if modal_derivatives is True else int(modal_derivatives)
         if not 1 <= nd <= modes:
-            raise InvalidArgumentError("modal_derivatives", f"the number of modes differentiated must be in 1..{modes}, got {nd}")
+            raise InvalidArgumentError("modal_derivatives",
+                                       f"the number of modes differentiated must be in 1..{modes}, got {nd}")
         k3p = np.einsum("ijk,jb,kc->ibc", np.asarray(data.k3, dtype=float), p[:, :nd], p[:, :nd])
         extra = [k3p[:, a, b] for a in range(nd) for b in range(a, nd)]
         loads = np.array(extra).T  # (n, n_extra)
