@@ -217,10 +217,9 @@ def _invariants(x: np.ndarray, mm: np.ndarray, m_scalar: np.ndarray, phi: np.nda
 def _mesh_basis(points: np.ndarray, cells: np.ndarray, order: int) -> Tuple[Any, np.ndarray, np.ndarray]:
     """scikit-fem vector basis of the mesh, the permutation ``perm`` (node dof ``j`` = scikit-fem
     dof ``perm[j]``; node dofs ``x_1, y_1, x_2, ...``) and the node coordinates (N, 2)."""
-    try:
-        import skfem
-    except ImportError as e:  # pragma: no cover - optional extra
-        raise ImportError("from_mesh needs scikit-fem (the optional 'fe' extra: pip install scikit-fem meshio)") from e
+    from .plotting import require
+
+    skfem = require("skfem", "ukflex.fe.from_mesh", extra="fe")
     if order not in (1, 2):
         raise InvalidArgumentError("order", f"order must be 1 (P1/Q1) or 2 (P2/Q2), got {order!r}")
     p = np.asarray(points, dtype=float)[:, :2].T

@@ -17,6 +17,7 @@ Commands (docs/flexible-bodies.md has the figures and times)::
     python -m ukflex.studies.flexible_coupler --nonlinear --modal-derivatives=2  # beam FE, nonlinear
     python -m ukflex.studies.flexible_coupler --mesh                             # Q2 meshes, linear
     python -m ukflex.studies.flexible_coupler --mesh --nonlinear --modal-derivatives=2
+    python -m ukflex.studies.flexible_coupler --figure coupler_nonlinear.png
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from ..reference import fe_invariants as fi
 from ..scene import ConstantSpeed, Scene
 from ..simulate import simulate
 
-__all__ = ["coupler_data", "mesh_coupler_data", "scene", "peak", "study", "mesh_study", "beam_frequencies"]
+__all__ = ["coupler_data", "mesh_coupler_data", "scene", "peak", "study", "mesh_study", "beam_frequencies", "figure"]
 
 P = scenes.PAPER
 WINDOW = 0.07
@@ -132,7 +133,8 @@ def run_flexible(data: FlexibleData, strain: str = "linear", rtol: float = 1e-8)
     wall = time.perf_counter() - t0
     qf = np.array([res.coordinate(f"coupler.qf{i}") for i in range(data.n_f)])
     v = np.asarray(data.markers["M"].displacement)[1] @ qf
-    return dict(peak=peak(res.t, v / P["coupler_length"]), wall=wall, nfev=int(getattr(res, "nfev", -1)))
+    return dict(peak=peak(res.t, v / P["coupler_length"]), wall=wall, nfev=int(getattr(res, "nfev", -1)),
+                t=np.asarray(res.t), v=v / P["coupler_length"])
 
 
 def run_beam(elements: int, strain: str = "linear", rtol: float = 1e-8) -> Dict[str, Any]:
@@ -141,7 +143,7 @@ def run_beam(elements: int, strain: str = "linear", rtol: float = 1e-8) -> Dict[
     res = simulate(system, WINDOW, method="DOPRI5", rtol=rtol, atol=1e-3 * rtol)
     wall = time.perf_counter() - t0
     _, v = res.beam_displacement("coupler", 0.5)
-    return dict(peak=peak(res.t, v / P["coupler_length"]), wall=wall)
+    return dict(peak=peak(res.t, v / P["coupler_length"]), wall=wall, t=np.asarray(res.t), v=v / P["coupler_length"])
 
 
 def study(elements: int = 8, ks=(2, 4, 8), strain: str = "linear", rtol: float = 1e-8,
@@ -205,6 +207,31 @@ def mesh_study(meshes=MESHES, ks=(2, 4, 8), order: int = 2, cells: str = "quad",
     return dict(beam=ref, beam_elements=beam_elements, beam_k=beam_k, rows=rows)
 
 
+def figure(path: str, k: int = 4, modal_derivatives: Any = 2, rtol: float = 1e-8) -> None:
+    """Midpoint deflection over 0-0.07 s: the built-in beam N = 8 (linear and nonlinear strain)
+    and the k-mode coupler with nonlinear strain, without and with modal derivatives."""
+    from ..plotting import figure as new_figure
+
+    nodal = coupler_data(8, None, "nonlinear")
+    curves = [("built-in beam N=8, linear strain", run_beam(8, "linear", rtol), dict(color="0.6", lw=2.5)),
+              ("built-in beam N=8, nonlinear strain", run_beam(8, "nonlinear", rtol), dict(color="k", lw=2.5)),
+              (f"{k} modes, nonlinear strain", run_flexible(fe.reduce(nodal, k), "nonlinear", rtol), dict(color="C3")),
+              (f"{k} modes + modal derivatives, nonlinear strain",
+               run_flexible(fe.reduce(nodal, k, modal_derivatives=modal_derivatives), "nonlinear", rtol),
+               dict(color="C0", ls="--"))]
+    fig = new_figure((7.0, 3.8), "the flexible coupler figure")
+    ax = fig.add_subplot(1, 1, 1)
+    for label, r, style in curves:
+        ax.plot(1e3 * r["t"], r["v"], label=label, **style)
+    ax.set_xlabel("t [ms]")
+    ax.set_ylabel("v(0.5) / Lb")
+    ax.set_xlim(0.0, 1e3 * WINDOW)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="lower left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 def _print_mesh_study(out: Dict[str, Any]) -> None:
     fb = beam_frequencies(32)
     print(f"built-in beam N={out['beam_elements']}: peak |v(0.5)|/Lb {out['beam']['peak']:.6e}  {out['beam']['wall']:.1f} s")
@@ -224,6 +251,9 @@ def _print_mesh_study(out: Dict[str, Any]) -> None:
 if __name__ == "__main__":  # pragma: no cover
     import sys
 
+    if "--figure" in sys.argv:
+        figure(sys.argv[sys.argv.index("--figure") + 1])
+        raise SystemExit(0)
     strain = "nonlinear" if "--nonlinear" in sys.argv else "linear"
     md: Any = False
     for a in sys.argv:
