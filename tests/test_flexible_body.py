@@ -221,3 +221,218 @@ def test_holed_link_example_loads_runs_and_draws(tmp_path):
     outline = drawer.body_polyline(q, "link")
     assert outline.shape == (7, 2)  # six interface points, closed
     assert np.allclose(drawer.joint_positions(q)[1], outline[0])  # crank pin at interface A
+
+
+# -------------------------------------------------------------------------------- modal derivatives
+def _static_midpoint_deflection(data, force):
+    """Nonlinear static equilibrium ``K q + k3 q q / 2 + k4 q q q / 6 = f`` (Newton) under a
+    transverse force at marker "M"; returns its deflection."""
+    k3, k4 = np.asarray(data.k3), np.asarray(data.k4)
+    row = np.asarray(data.markers["M"].displacement)[1]
+    q = np.zeros(data.n_f)
+    for _ in range(60):
+        r = data.k_ff @ q + np.einsum("ijk,j,k->i", k3, q, q) / 2 + np.einsum("ijkl,j,k,l->i", k4, q, q, q) / 6 - force * row
+        kt = data.k_ff + np.einsum("ijk,k->ij", k3, q) + np.einsum("ijkl,k,l->ij", k4, q, q) / 2
+        dq = np.linalg.solve(kt, -r)
+        q += dq
+        if np.linalg.norm(dq) <= 1e-14 * np.linalg.norm(q):
+            break
+    linear = force * row @ np.linalg.solve(data.k_ff, row)
+    return row @ q, linear
+
+
+def test_modal_derivatives_let_the_reduced_coupler_shorten():
+    """The paper's coupler (pinned-pinned, free axial end) under a transverse midpoint load of a
+    deflection of 1 % of its length: the nodal model with nonlinear strain relaxes its membrane
+    strain by axial shortening (nonlinear = linear deflection); two bending modes alone cannot
+    shorten and lock (> 30 % stiffer); with their modal derivatives they shorten exactly."""
+    from ukflex import fe
+    from ukflex.studies import flexible_coupler as fc
+
+    nodal = fc.coupler_data(8, None, "nonlinear")
+    v, lin = _static_midpoint_deflection(nodal, 85.0)
+    assert abs(v - lin) <= 1e-9 * abs(lin)
+    locked, lin2 = _static_midpoint_deflection(fe.reduce(nodal, 2), 85.0)
+    assert locked < 0.7 * lin2
+    enriched = fe.reduce(nodal, 2, modal_derivatives=True)
+    assert enriched.n_f == 5  # two bending modes and the three (axial) derivatives
+    v_md, lin_md = _static_midpoint_deflection(enriched, 85.0)
+    assert abs(v_md - lin_md) <= 1e-8 * abs(lin_md)
+    # the enriched basis's linear answer is the two modes' (the derivatives are axial)
+    assert abs(lin_md - lin2) <= 1e-10 * abs(lin2)
+    with pytest.raises(ukflex.InvalidArgumentError, match="k3"):
+        fe.reduce(fc.coupler_data(8, None, "linear"), 2, modal_derivatives=True)
+    with pytest.raises(ValueError, match="number of modes differentiated"):
+        fe.reduce(nodal, 2, modal_derivatives=3)
+
+
+def test_reduced_tensors_are_the_projection_of_the_nodal_ones():
+    from ukflex import fe
+    from ukflex.studies import flexible_coupler as fc
+
+    nodal = fc.coupler_data(4, None, "nonlinear")
+    red = fe.reduce(nodal, 3, modal_derivatives=2)
+    p = red.info["modes"]
+    assert np.allclose(p.T @ nodal.m_ff @ p, np.eye(red.n_f), atol=1e-10)
+    k4 = np.einsum("ijkl,ia,jb,kc,ld->abcd", nodal.k4, p, p, p, p)
+    k3 = np.einsum("ijk,ia,jb,kc->abc", nodal.k3, p, p, p)
+    assert np.max(np.abs(red.k4 - k4)) <= 1e-12 * np.max(np.abs(k4))
+    assert np.max(np.abs(red.k3 - k3)) <= 1e-12 * np.max(np.abs(k3))
+    # and the body builds with its nonlinear strain
+    Scene().flexible_body("c", red, strain="nonlinear")
+
+
+# -------------------------------------------------------------------------------- quadratic meshes
+def test_quadratic_mesh_of_the_coupler_converges_to_the_timoshenko_beam():
+    """Q2 quads do not lock: the coupler's plane-stress rectangle approaches the Timoshenko beam
+    (shear factor of the rectangle, Cowper) under refinement; Q1 quads of the same mesh are far
+    off (locking)."""
+    pytest.importorskip("skfem")
+    from ukflex.studies import flexible_coupler as fc
+
+    nu = fc.P["poisson_ratio"]
+    beam = fc.beam_frequencies(32, 10 * (1 + nu) / (12 + 11 * nu), count=4)
+    errs = []
+    for nx in (8, 16):
+        f = fc.mesh_coupler_data(nx, 1, order=2, modes=4).info["frequencies"] / (2 * np.pi)
+        errs.append(np.abs(f[[0, 1, 2, 3]] - beam) / beam)
+    assert np.all(errs[1] < errs[0] / 3)  # quadratic elements: error ~ h^2 or faster
+    assert errs[1][0] < 1e-3 and errs[1][1] < 5e-3
+    q1 = fc.mesh_coupler_data(16, 1, order=1, modes=1).info["frequencies"][0] / (2 * np.pi)
+    assert q1 > 1.5 * beam[0]
+
+
+def test_quadratic_mesh_invariants_of_a_rectangle():
+    """P2 triangles: mass, centre of mass and inertia of the rectangle exactly; the chord-frame
+    reference conditions hold; interfaces by a node predicate take the mid-edge nodes too."""
+    fe = pytest.importorskip("ukflex.fe")
+    pytest.importorskip("skfem")
+    pts, tris = _plate_mesh(nx=6, ny=2)
+    length, height, t, rho = 0.3, 0.02, 0.01, 7800.0
+    ifs = {"A": lambda p: np.isclose(p[:, 0], 0.0), "B": lambda p: np.isclose(p[:, 0], length)}
+    data = fe.from_mesh(pts, cells=tris, thickness=t, density=rho, youngs_modulus=2e11, poisson_ratio=0.3,
+                        interfaces=ifs, modes=3, frame="fixed", fixed=[("A", "x"), ("A", "y"), ("B", "y")], order=2)
+    m = rho * t * length * height
+    assert abs(data.mass - m) <= 1e-12 * m
+    assert np.allclose(data.com, (length / 2, 0.0), atol=1e-15)
+    inertia = m * (length**2 + height**2) / 12
+    assert abs(data.inertia - inertia) <= 1e-12 * inertia
+    nodes = data.info["nodes"]
+    assert nodes.shape[0] == 7 * 3 + (6 * 2 * 3 + 6 + 2)  # vertices + edges
+    assert np.max(np.abs(data.markers["A"].displacement)) < 1e-12
+    assert np.max(np.abs(data.markers["B"].displacement[1])) < 1e-12
+    with pytest.raises(ukflex.InvalidArgumentError, match="matches no node"):
+        fe.from_mesh(pts, cells=tris, thickness=t, density=rho, youngs_modulus=2e11, poisson_ratio=0.3,
+                     interfaces={"A": lambda p: p[:, 0] < -1.0}, order=2)
+    with pytest.raises(ukflex.InvalidArgumentError, match="order"):
+        fe.from_mesh(pts, cells=tris, thickness=t, density=rho, youngs_modulus=2e11, poisson_ratio=0.3,
+                     interfaces=ifs, order=3)
+
+
+# -------------------------------------------------------------------------------- bad FE input
+def _nodal_plate():
+    fe = pytest.importorskip("ukflex.fe")
+    pytest.importorskip("skfem")
+    pts, tris = _plate_mesh(nx=4, ny=1)
+    mm, kk, nodes = fe.plane_stress_mesh_matrices(pts, tris, thickness=0.01, density=7800.0, youngs_modulus=2e11,
+                                                  poisson_ratio=0.3)
+    left = [i for i, p in enumerate(nodes) if p[0] == 0.0]
+    right = [i for i, p in enumerate(nodes) if abs(p[0] - 0.3) < 1e-12]
+    return fe, nodes, mm, kk, {"A": left, "B": right}
+
+
+@pytest.mark.parametrize("case, match", [
+    ("mass unsymmetric", "mass_matrix: must be symmetric"),
+    ("mass indefinite", "mass_matrix: is not positive definite"),
+    ("stiffness unsymmetric", "stiffness_matrix: must be symmetric"),
+    ("stiffness supported", "three rigid-body modes"),
+    ("fixed frame leaves a rigid motion", "not independent"),
+    ("fixed frame on a disconnected stiffness", "not positive definite"),
+    ("marker outside the mesh", "not nodes of the mesh"),
+    ("too many modes", "do not fit"),
+])
+def test_bad_fe_input_raises_named_errors(case, match):
+    fe, nodes, mm, kk, ifs = _nodal_plate()
+    kw = dict(interfaces=ifs, modes=3, frame="mean-axis")
+    n = mm.shape[0]
+    if case == "mass unsymmetric":
+        mm = mm.copy()
+        mm[0, 2] += 0.1 * mm[0, 0]
+    elif case == "mass indefinite":
+        mm = mm.copy()
+        mm[0, 0] = mm[1, 1] = -mm[0, 0]
+    elif case == "stiffness unsymmetric":
+        kk = kk.copy()
+        kk[0, 3] += 0.1 * kk[0, 0]
+    elif case == "stiffness supported":
+        kk = kk + np.diag(np.r_[1e-3 * kk[0, 0], 1e-3 * kk[0, 0], np.zeros(n - 2)])
+    elif case == "fixed frame leaves a rigid motion":
+        kw.update(frame="fixed", fixed=[("A", "x"), ("A", "x"), ("B", "y")])
+    elif case == "fixed frame on a disconnected stiffness":
+        kk = kk.copy()
+        kk[:, :2] = kk[:2, :] = 0.0  # node 0 connected to nothing
+        kk = kk + np.diag(np.r_[0.0, 0.0, np.zeros(n - 2)])
+        kw.update(frame="fixed", fixed=[("B", "x"), ("B", "y"), ("M", "y")],
+                  interfaces={"B": ifs["B"], "M": [2]})
+    elif case == "marker outside the mesh":
+        kw.update(interfaces={"A": [0], "B": [len(nodes) + 3]})
+    elif case == "too many modes":
+        kw.update(modes=n)
+    with pytest.raises(ukflex.InvalidArgumentError, match=match):
+        fe.from_nodal(nodes, mm, kk, **kw)
+
+
+# -------------------------------------------------------------------------------- Green-Lagrange
+def test_green_lagrange_tensors_of_a_mesh_match_direct_quadrature():
+    """k3/k4 of a P2 mesh on a (random) basis are the cubic and quartic parts of the plane-stress
+    Green-Lagrange energy integrated directly; the modal-derivative loads are k3's contraction."""
+    fe = pytest.importorskip("ukflex.fe")
+    pytest.importorskip("skfem")
+    pts, tris = _plate_mesh(nx=4, ny=1)
+    basis, perm, nodes = fe._mesh_basis(pts, tris, 2)
+    lam, mu = fe._plane_stress_lame(2e11, 0.3)
+    rng = np.random.default_rng(7)
+    phi = 1e-3 * rng.normal(size=(2 * nodes.shape[0], 3))
+    k3, k4 = fe._green_lagrange_tensors(basis, perm, phi, 0.01, lam, mu)
+    g, dx = fe._mode_gradients(basis, perm, phi)
+    w = 0.01 * dx
+    for _ in range(3):
+        q = rng.normal(size=3)
+        gq = np.einsum("aijeq,a->ijeq", g, q)
+        e_l = 0.5 * (gq + np.swapaxes(gq, 0, 1))
+        e_n = 0.5 * np.einsum("kieq,kjeq->ijeq", gq, gq)
+        u3 = np.einsum("ijeq,ijeq,eq->", fe._stress(e_l, lam, mu), e_n, w)
+        u4 = 0.5 * np.einsum("ijeq,ijeq,eq->", fe._stress(e_n, lam, mu), e_n, w)
+        assert abs(np.einsum("abc,a,b,c->", k3, q, q, q) / 6 - u3) <= 1e-12 * abs(u3)
+        assert abs(np.einsum("abcd,a,b,c,d->", k4, q, q, q, q) / 24 - u4) <= 1e-12 * abs(u4)
+    import itertools
+
+    for perm3 in itertools.permutations(range(3)):
+        assert np.allclose(k3, np.transpose(k3, perm3), rtol=0, atol=1e-12 * np.max(np.abs(k3)))
+    for perm4 in itertools.permutations(range(4)):
+        assert np.allclose(k4, np.transpose(k4, perm4), rtol=0, atol=1e-12 * np.max(np.abs(k4)))
+    loads = fe._green_lagrange_md_loads(basis, perm, phi[:, :2], 0.01, lam, mu)
+    for j, (a, b) in enumerate([(0, 0), (0, 1), (1, 1)]):
+        assert np.allclose(phi.T @ loads[:, j], k3[:, a, b], rtol=1e-10, atol=1e-12 * np.max(np.abs(k3)))
+
+
+def test_mesh_coupler_with_modal_derivatives_does_not_lock():
+    """The coupler meshed with Q2 quads, Green-Lagrange strain, two modes: under a transverse
+    midpoint load (deflection 1 % of the length) the two bending modes alone are far too stiff;
+    with their modal derivatives the nonlinear deflection is within 0.5 % of the linear one
+    (a pinned-sliding beam shortens freely)."""
+    pytest.importorskip("skfem")
+    from ukflex.studies import flexible_coupler as fc
+
+    locked = fc.mesh_coupler_data(16, 1, 2, 2, strain="nonlinear")
+    v, lin = _static_midpoint_deflection(locked, 85.0)
+    assert v < 0.7 * lin
+    md = fc.mesh_coupler_data(16, 1, 2, 2, strain="nonlinear", modal_derivatives=True)
+    assert md.n_f == 5
+    v, lin = _static_midpoint_deflection(md, 85.0)
+    assert abs(v - lin) <= 5e-3 * abs(lin)
+    with pytest.raises(ukflex.InvalidArgumentError, match="reference conditions"):
+        fe = pytest.importorskip("ukflex.fe")
+        pts, tris = _plate_mesh(nx=4, ny=1)
+        fe.from_mesh(pts, cells=tris, thickness=0.01, density=7800.0, youngs_modulus=2e11, poisson_ratio=0.3,
+                     interfaces={"A": [0]}, modes=2, strain="nonlinear", modal_derivatives=True)

@@ -31,6 +31,7 @@ from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 import scipy.linalg as sla
 
+from .errors import InvalidArgumentError
 from .flexible import FlexibleData, InterfacePoint
 
 __all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices", "reduce"]
@@ -44,7 +45,8 @@ def _interface_rows(nodes: np.ndarray, spec: Interface) -> Tuple[Tuple[float, fl
     ndof = 2 * nodes.shape[0]
     idx = np.atleast_1d(np.asarray(spec, dtype=int))
     if idx.size == 0 or idx.min() < 0 or idx.max() >= nodes.shape[0]:
-        raise ValueError(f"interface nodes {idx.tolist()} are not nodes of the mesh (0..{nodes.shape[0] - 1})")
+        raise InvalidArgumentError("interfaces",
+                                   f"interface nodes {idx.tolist()} are not nodes of the mesh (0..{nodes.shape[0] - 1})")
     c = nodes[idx].mean(axis=0)
     d = np.zeros((2, ndof))
     for i in idx:
@@ -65,7 +67,7 @@ def _scalar_mass(mm: np.ndarray) -> np.ndarray:
     m = mm[0::2, 0::2]
     scale = np.max(np.abs(mm))
     if (np.max(np.abs(mm[1::2, 1::2] - m)) > 1e-10 * scale or np.max(np.abs(mm[0::2, 1::2])) > 1e-10 * scale):
-        raise ValueError("the mass matrix must act alike on x and y (m (x) I_2, dof order x_1, y_1, x_2, ...): "
+        raise InvalidArgumentError("mass_matrix", "the mass matrix must act alike on x and y (m (x) I_2, dof order x_1, y_1, x_2, ...): "
                          "give a consistent or lumped mass of a planar continuum")
     return m
 
@@ -92,28 +94,44 @@ def from_nodal(
     kk = np.asarray(stiffness_matrix, dtype=float)
     n = 2 * x.shape[0]
     if x.ndim != 2 or x.shape[1] != 2 or mm.shape != (n, n) or kk.shape != (n, n):
-        raise ValueError(f"nodes must be (N, 2) and the matrices (2N, 2N); got {x.shape}, {mm.shape}, {kk.shape}")
+        raise InvalidArgumentError("nodes",
+                                   f"nodes must be (N, 2) and the matrices (2N, 2N); got {x.shape}, {mm.shape}, {kk.shape}")
+    for name, a in (("mass_matrix", mm), ("stiffness_matrix", kk)):
+        if not np.all(np.isfinite(a)):
+            raise InvalidArgumentError(name, "has entries that are not finite")
+        if np.max(np.abs(a - a.T)) > 1e-10 * max(np.max(np.abs(a)), 1e-300):
+            raise InvalidArgumentError(name, "must be symmetric")
+    try:
+        sla.cholesky(mm, lower=True)
+    except np.linalg.LinAlgError:
+        raise InvalidArgumentError("mass_matrix", "is not positive definite (a negative or zero nodal mass, or a node "
+                                   "without mass)") from None
     m_scalar = _scalar_mass(mm)
     iface = {name: _interface_rows(x, spec) for name, spec in interfaces.items()}
     if frame == "mean-axis":
         lam, vec = sla.eigh(kk, mm)
         if modes + 3 > n:
-            raise ValueError(f"{modes} modes do not fit a model with {n} dofs")
+            raise InvalidArgumentError("modes", f"{modes} modes do not fit a model with {n} dofs")
         lam_rigid = lam[:3]
         if np.max(np.abs(lam_rigid)) > 1e-6 * abs(lam[3]):
-            raise ValueError("the stiffness matrix does not have the three rigid-body modes of a free planar part "
+            raise InvalidArgumentError("stiffness_matrix", "the stiffness matrix does not have the three rigid-body modes of a free planar part "
                              f"(lowest eigenvalues {lam[:4]}): is the part supported or disconnected?")
         phi = vec[:, 3:3 + modes]
         freq = np.sqrt(np.maximum(lam[3:3 + modes], 0.0))
     elif frame in ("fixed", "craig-bampton"):
         if fixed is None or len(fixed) != 3:
-            raise ValueError("frame 'fixed' and 'craig-bampton' need fixed = three (interface, 'x'|'y') reference conditions")
+            raise InvalidArgumentError("fixed",
+                                       "frame 'fixed' and 'craig-bampton' need fixed = three (interface, 'x'|'y') reference conditions")
         ref = []
         for name, ax in fixed:
             if name not in iface or ax not in ("x", "y"):
-                raise ValueError(f"fixed entry ({name!r}, {ax!r}): expected an interface name {list(iface)} and 'x' or 'y'")
+                raise InvalidArgumentError("fixed",
+                                           f"fixed entry ({name!r}, {ax!r}): expected an interface name {list(iface)} and 'x' or 'y'")
             ref.append(iface[name][1][0 if ax == "x" else 1])
         c = np.array(ref)  # (3, n) constraint rows c u = 0
+        if np.linalg.matrix_rank(c) < 3:
+            raise InvalidArgumentError("fixed", f"the reference conditions {list(fixed)} are not independent (they do "
+                                       "not fix the three rigid-body motions of the frame)")
         if frame == "craig-bampton":
             rows = [iface[nm][1][k] for nm in iface for k in range(2)]
             rows = [r for r in rows if np.linalg.matrix_rank(np.vstack([c, r])) > np.linalg.matrix_rank(c)]
@@ -123,9 +141,22 @@ def from_nodal(
         phi = _constrained_basis(kk, mm, c, b, modes)
         kr, mr = phi.T @ kk @ phi, phi.T @ mm @ phi
         lam = sla.eigh(kr, mr, eigvals_only=True)
+        if lam[0] <= 1e-9 * abs(lam[-1]):
+            raise InvalidArgumentError("stiffness_matrix", f"the stiffness with the reference conditions {list(fixed)} is "
+                                       f"not positive definite (lowest eigenvalue {lam[0]:.3e}): rigid-body motions left "
+                                       "free, a mechanism or a disconnected part, or an indefinite stiffness")
         freq = np.sqrt(np.maximum(lam, 0.0))
     else:
-        raise ValueError(f"unknown frame {frame!r}; expected 'mean-axis', 'fixed' or 'craig-bampton'")
+        raise InvalidArgumentError("frame",
+                                   f"unknown frame {frame!r}; expected 'mean-axis', 'fixed' or 'craig-bampton'")
+    data = _data_from_basis(x, mm, kk, m_scalar, iface, phi, damping_ratio)
+    data.info["frequencies"] = freq
+    return data
+
+
+def _data_from_basis(x: np.ndarray, mm: np.ndarray, kk: np.ndarray, m_scalar: np.ndarray, iface: Dict[str, Any],
+                     phi: np.ndarray, damping_ratio: float) -> FlexibleData:
+    """The flexible body of the nodal model on the basis ``phi`` (2N, n_f)."""
     inv = _invariants(x, mm, m_scalar, phi)
     k_ff = phi.T @ kk @ phi
     k_ff = 0.5 * (k_ff + k_ff.T)
@@ -137,7 +168,7 @@ def from_nodal(
         mv = m_ff @ v
         d_ff = mv @ np.diag(2.0 * damping_ratio * w) @ mv.T
     markers = {name: InterfacePoint(p, d @ phi, None if r is None else r @ phi) for name, (p, d, r) in iface.items()}
-    return FlexibleData(k_ff=k_ff, d_ff=d_ff, markers=markers, info={"frequencies": freq, "modes": phi}, **inv)
+    return FlexibleData(k_ff=k_ff, d_ff=d_ff, markers=markers, info={"modes": phi}, **inv)
 
 
 def _constrained_basis(kk: np.ndarray, mm: np.ndarray, c: np.ndarray, b: np.ndarray, modes: int) -> np.ndarray:
@@ -151,7 +182,7 @@ def _constrained_basis(kk: np.ndarray, mm: np.ndarray, c: np.ndarray, b: np.ndar
     z = sla.null_space(cb)
     kz, mz = z.T @ kk @ z, z.T @ mm @ z
     if modes > kz.shape[0]:
-        raise ValueError(f"{modes} modes do not fit: only {kz.shape[0]} interior dofs")
+        raise InvalidArgumentError("modes", f"{modes} modes do not fit: only {kz.shape[0]} interior dofs")
     lam, v = sla.eigh(kz, mz, subset_by_index=[0, modes - 1])
     normal = z @ v
     if not nb:
@@ -180,32 +211,64 @@ def _invariants(x: np.ndarray, mm: np.ndarray, m_scalar: np.ndarray, phi: np.nda
     m_ff = phi.T @ mm @ phi
     return dict(mass=mass, inertia=j0 - mass * float(com @ com), com=(float(com[0]), float(com[1])),
                 s_bar=np.vstack([ex @ mm @ phi, ey @ mm @ phi]), s_u0=phi.T @ mm @ u0, s_ju0=phi.T @ mm @ ju0,
-                s_tilde=phi.T @ tilde @ phi, m_ff=0.5 * (m_ff + m_ff.T))
+                s_tilde=_antisym(phi.T @ tilde @ phi), m_ff=0.5 * (m_ff + m_ff.T))
 
 
-def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickness: float, density: float,
-                               youngs_modulus: float, poisson_ratio: float) -> Tuple[np.ndarray, np.ndarray]:
-    """Consistent mass and stiffness matrices (2N, 2N; dof order ``x_1, y_1, ...``) of a planar
-    mesh of triangles (``cells`` (E, 3)) or quadrilaterals ((E, 4)), plane stress, assembled by
-    scikit-fem with P1/Q1 elements."""
-    try:
-        import skfem
-        from skfem.models.elasticity import lame_parameters, linear_elasticity
-        from skfem.helpers import dot
-    except ImportError as e:  # pragma: no cover - optional extra
-        raise ImportError("from_mesh needs scikit-fem (the optional 'fe' extra: pip install scikit-fem meshio)") from e
+def _mesh_basis(points: np.ndarray, cells: np.ndarray, order: int) -> Tuple[Any, np.ndarray, np.ndarray]:
+    """scikit-fem vector basis of the mesh, the permutation ``perm`` (node dof ``j`` = scikit-fem
+    dof ``perm[j]``; node dofs ``x_1, y_1, x_2, ...``) and the node coordinates (N, 2)."""
+    from .plotting import require
+
+    skfem = require("skfem", "ukflex.fe.from_mesh", extra="fe")
+    if order not in (1, 2):
+        raise InvalidArgumentError("order", f"order must be 1 (P1/Q1) or 2 (P2/Q2), got {order!r}")
     p = np.asarray(points, dtype=float)[:, :2].T
     t = np.asarray(cells, dtype=int).T
     if t.shape[0] == 3:
-        mesh, elem = skfem.MeshTri(p, t), skfem.ElementVector(skfem.ElementTriP1())
+        mesh = skfem.MeshTri(p, t)
+        scalar = skfem.ElementTriP1() if order == 1 else skfem.ElementTriP2()
     elif t.shape[0] == 4:
-        mesh, elem = skfem.MeshQuad(p, t), skfem.ElementVector(skfem.ElementQuad1())
+        mesh = skfem.MeshQuad(p, t)
+        scalar = skfem.ElementQuad1() if order == 1 else skfem.ElementQuad2()
     else:
-        raise ValueError("cells must be triangles (E, 3) or quadrilaterals (E, 4)")
-    basis = skfem.Basis(mesh, elem)
-    # plane stress: lambda* = 2 lambda mu / (lambda + 2 mu)
-    lam, mu = lame_parameters(youngs_modulus, poisson_ratio)
-    lam_ps = 2.0 * lam * mu / (lam + 2.0 * mu)
+        raise InvalidArgumentError("cells", "cells must be triangles (E, 3) or quadrilaterals (E, 4)")
+    basis = skfem.Basis(mesh, skfem.ElementVector(scalar))
+    # vector dofs by location: row 0 the x component, row 1 the y component (vertices, then edge
+    # midpoints, then cell interiors)
+    groups = [basis.nodal_dofs]
+    if order == 2:
+        groups.append(basis.facet_dofs)
+        if getattr(basis, "interior_dofs", None) is not None and basis.interior_dofs.size:
+            groups.append(basis.interior_dofs)
+    per_node = np.hstack(groups)  # (2, N)
+    nodes = np.ascontiguousarray(basis.doflocs[:, per_node[0]].T)
+    return basis, per_node.T.ravel(), nodes
+
+
+def _plane_stress_lame(youngs_modulus: float, poisson_ratio: float) -> Tuple[float, float]:
+    """Plane-stress Lame parameters ``(lambda*, mu)``, ``lambda* = 2 lambda mu / (lambda + 2 mu)``."""
+    mu = youngs_modulus / (2.0 * (1.0 + poisson_ratio))
+    lam = youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio))
+    return 2.0 * lam * mu / (lam + 2.0 * mu), mu
+
+
+def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickness: float, density: float,
+                               youngs_modulus: float, poisson_ratio: float,
+                               order: int = 1) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Consistent mass and stiffness matrices (2N, 2N; dof order ``x_1, y_1, ...``) of a planar
+    mesh of triangles (``cells`` (E, 3)) or quadrilaterals ((E, 4)), plane stress, assembled by
+    scikit-fem, and the coordinates (N, 2) of the N nodes.
+
+    ``order=1``: linear triangles / bilinear quads (P1/Q1; the nodes are the mesh points; stiff in
+    bending: shear locking).  ``order=2``: quadratic triangles (P2, 6 nodes) / biquadratic quads
+    (Q2, 9 nodes), which represent pure bending exactly; the nodes are the mesh points followed by
+    the edge midpoints (and, for Q2, the cell centres)."""
+    import skfem
+    from skfem.helpers import dot
+    from skfem.models.elasticity import linear_elasticity
+
+    basis, perm, nodes = _mesh_basis(points, cells, order)
+    lam_ps, mu = _plane_stress_lame(youngs_modulus, poisson_ratio)
     kk = (thickness * skfem.asm(linear_elasticity(lam_ps, mu), basis)).toarray()
 
     @skfem.BilinearForm
@@ -213,21 +276,41 @@ def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickne
         return density * thickness * dot(u, v)
 
     mm = skfem.asm(mass, basis).toarray()
-    # scikit-fem orders vector dofs node-wise (x_1, y_1, ...) for ElementVector of nodal elements
-    order = basis.nodal_dofs.T.ravel()
-    return mm[np.ix_(order, order)], kk[np.ix_(order, order)]
+    return mm[np.ix_(perm, perm)], kk[np.ix_(perm, perm)], nodes
 
 
 def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: float, poisson_ratio: float,
               interfaces: Mapping[str, Interface], modes: int = 4, frame: str = "mean-axis",
               fixed: Optional[Sequence[Tuple[str, str]]] = None, damping_ratio: float = 0.0,
-              cells: Optional[np.ndarray] = None) -> FlexibleData:
+              cells: Optional[np.ndarray] = None, order: int = 1, strain: str = "linear",
+              modal_derivatives: Union[bool, int] = False) -> FlexibleData:
     """A :class:`FlexibleData` of a planar part meshed with triangles or quads.
 
     ``mesh``: a path of any meshio-readable file, a ``meshio.Mesh``, or a points array (N, 2|3)
-    with ``cells``.  The part is plane stress of ``thickness``; see :func:`from_nodal` for the
-    rest.  ``info["points"]`` and ``info["cells"]`` keep the mesh (for drawing).
+    with ``cells``.  The part is plane stress of ``thickness``; ``order`` 1 (P1/Q1) or 2 (P2/Q2,
+    free of the bending locking of linear elements; see :func:`plane_stress_mesh_matrices`).
+    An interface is a node index, a list of them, or a callable taking the (N, 2) node
+    coordinates (with ``order=2`` the mid-edge nodes too) and returning a boolean mask or indices
+    (e.g. ``lambda p: np.isclose(p[:, 0], 0.0)``: every node of the left edge).  See
+    :func:`from_nodal` for the rest.  ``info["points"]``, ``info["cells"]`` keep the mesh and
+    ``info["nodes"]`` all nodes (for drawing).
+
+    ``strain="nonlinear"``: the body also gets ``k3``, ``k4``, the plane-stress Green-Lagrange
+    strain energy ``int t E:C:E / 2 dA`` (``E = (grad u + grad u^T + grad u^T grad u) / 2``)
+    restricted to the basis, integrated over the elements (use it with
+    ``Scene.flexible_body(..., strain="nonlinear")``).  ``modal_derivatives`` (``True`` or the
+    number ``m`` of lowest modes differentiated; needs a frame fixed by reference conditions)
+    adds the static modal derivatives of the Green-Lagrange energy, ``K^-1 k3(phi_i, phi_j)``,
+    to the basis: without them the bending modes of a slender part cannot shorten and the
+    reduced part locks (docs/flexible-bodies.md).
     """
+    if strain not in ("linear", "nonlinear"):
+        raise InvalidArgumentError("strain", f"expected 'linear' or 'nonlinear', got {strain!r}")
+    if modal_derivatives is not False and strain != "nonlinear":
+        raise InvalidArgumentError("modal_derivatives", "modal derivatives need strain='nonlinear'")
+    if modal_derivatives is not False and frame == "mean-axis":
+        raise InvalidArgumentError("modal_derivatives", "modal derivatives need a frame fixed by reference conditions "
+                                   "(frame='fixed' or 'craig-bampton'): the free-free static problem is singular")
     if cells is None:
         if isinstance(mesh, str):
             import meshio
@@ -235,29 +318,154 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             mesh = meshio.read(mesh)
         blocks = [c for c in mesh.cells if c.type in ("triangle", "quad")]
         if not blocks:
-            raise ValueError("the mesh has no triangle or quad cells")
+            raise InvalidArgumentError("mesh", "the mesh has no triangle or quad cells")
         points, cells = np.asarray(mesh.points)[:, :2], blocks[0].data
     else:
         points = np.asarray(mesh, dtype=float)[:, :2]
-    mm, kk = plane_stress_mesh_matrices(points, cells, thickness=thickness, density=density,
-                                        youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio)
-    data = from_nodal(points, mm, kk, interfaces=interfaces, modes=modes, frame=frame, fixed=fixed,
+    mm, kk, nodes = plane_stress_mesh_matrices(points, cells, thickness=thickness, density=density,
+                                               youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, order=order)
+    resolved = {}
+    for name, spec in interfaces.items():
+        if callable(spec):
+            sel = np.asarray(spec(nodes))
+            idx = np.flatnonzero(sel) if sel.dtype == bool else sel.astype(int).ravel()
+            if idx.size == 0:
+                raise InvalidArgumentError("interfaces",
+                                           f"interface {name!r}: the selection matches no node of the mesh")
+            resolved[name] = idx
+        else:
+            resolved[name] = spec
+    data = from_nodal(nodes, mm, kk, interfaces=resolved, modes=modes, frame=frame, fixed=fixed,
                       damping_ratio=damping_ratio)
-    data.info.update(points=points, cells=np.asarray(cells))
+    if strain == "nonlinear":
+        basis, perm, _ = _mesh_basis(points, cells, order)
+        lam_ps, mu = _plane_stress_lame(youngs_modulus, poisson_ratio)
+        phi = data.info["modes"]
+        if modal_derivatives is not False:
+            nd = modes if modal_derivatives is True else int(modal_derivatives)
+            if not 1 <= nd <= phi.shape[1]:
+                raise InvalidArgumentError("modal_derivatives", f"the number of modes differentiated must be in "
+                                           f"1..{phi.shape[1]}, got {nd}")
+            # the lowest nd normal modes (Craig-Bampton: its reduced model's modes)
+            lam_r, v = sla.eigh(phi.T @ kk @ phi, phi.T @ mm @ phi)
+            low = phi @ v[:, :nd]
+            loads = _green_lagrange_md_loads(basis, perm, low, thickness, lam_ps, mu)
+            iface = {name: _interface_rows(nodes, spec) for name, spec in resolved.items()}
+            c = np.array([iface[name][1][0 if ax == "x" else 1] for name, ax in fixed])  # type: ignore[union-attr]
+            kkt = np.block([[kk, c.T], [c, np.zeros((3, 3))]])
+            theta = np.linalg.solve(kkt, np.vstack([loads, np.zeros((3, loads.shape[1]))]))[:kk.shape[0]]
+            p = _enrich(np.zeros((kk.shape[0], 0)), np.hstack([phi, theta]), mm, 1e-9)
+            lam_e, v = sla.eigh(p.T @ kk @ p, p.T @ mm @ p)
+            phi = p @ v
+            freq = np.sqrt(np.maximum(lam_e, 0.0))
+            data = _data_from_basis(nodes, mm, kk, _scalar_mass(mm), iface, phi, damping_ratio)
+            data.info["frequencies"] = freq
+        data.k3, data.k4 = _green_lagrange_tensors(basis, perm, phi, thickness, lam_ps, mu)
+    data.info.update(points=points, cells=np.asarray(cells), nodes=nodes)
     return data
 
 
-def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0) -> FlexibleData:
+def _mode_gradients(basis: Any, perm: np.ndarray, phi: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """Displacement gradients ``G[a, i, j, e, g] = d u_i / d x_j`` of the columns of ``phi``
+    (node dofs) at the quadrature points, and the quadrature weights ``dx[e, g]``."""
+    out = []
+    for a in range(phi.shape[1]):
+        u = np.zeros(basis.N)
+        u[perm] = phi[:, a]
+        out.append(np.asarray(basis.interpolate(u).grad))
+    return np.array(out), np.asarray(basis.dx)
+
+
+def _stress(e: np.ndarray, lam: float, mu: float) -> np.ndarray:
+    """Plane-stress ``C : E`` of symmetric tensors ``e[..., 2, 2, e, g]`` (first two of the last
+    four axes the tensor's)."""
+    tr = e[..., 0, 0, :, :] + e[..., 1, 1, :, :]
+    s = 2.0 * mu * e
+    s[..., 0, 0, :, :] += lam * tr
+    s[..., 1, 1, :, :] += lam * tr
+    return s
+
+
+def _green_lagrange_tensors(basis: Any, perm: np.ndarray, phi: np.ndarray, thickness: float, lam: float,
+                            mu: float) -> Tuple[np.ndarray, np.ndarray]:
+    """``k3``, ``k4`` of the plane-stress Green-Lagrange strain energy on the basis ``phi``:
+    ``U = int t (E_l + E_n) : C : (E_l + E_n) / 2``, ``E_l = sym G q``, ``E_n = (G q)^T (G q) / 2``;
+    the cubic part ``int t E_l : C : E_n`` and the quartic ``int t E_n : C : E_n / 2``."""
+    g, dx = _mode_gradients(basis, perm, phi)
+    w = thickness * dx
+    sig = _stress(0.5 * (g + np.swapaxes(g, 1, 2)), lam, mu)  # (r, 2, 2, E, Q)
+    h = np.einsum("bkieq,ckjeq->bcijeq", g, g)  # G_b^T G_c
+    hs = 0.5 * (h + np.swapaxes(h, 2, 3))
+    t3 = 0.5 * np.einsum("aijeq,bcijeq,eq->abc", sig, hs, w)  # symmetric in (b, c)
+    k3 = 2.0 * (t3 + np.transpose(t3, (1, 2, 0)) + np.transpose(t3, (2, 0, 1)))
+    chs = _stress(hs, lam, mu)
+    t4 = 0.125 * np.einsum("abijeq,cdijeq,eq->abcd", hs, chs, w)
+    k4 = 8.0 * (t4 + np.transpose(t4, (0, 2, 1, 3)) + np.transpose(t4, (0, 2, 3, 1)))
+    return k3, k4
+
+
+def _green_lagrange_md_loads(basis: Any, perm: np.ndarray, phi: np.ndarray, thickness: float, lam: float,
+                             mu: float) -> np.ndarray:
+    """Node loads ``k3(., phi_a, phi_b)`` (2N, m (m + 1) / 2), ``a <= b``, of the Green-Lagrange
+    energy: ``int t grad N_i : (C:sym(G_a^T G_b) + G_b sigma_a + G_a sigma_b)``."""
+    import skfem
+    from skfem.helpers import ddot, grad
+
+    g, _ = _mode_gradients(basis, perm, phi)
+    sig = _stress(0.5 * (g + np.swapaxes(g, 1, 2)), lam, mu)
+
+    @skfem.LinearForm
+    def load(v, w):
+        return thickness * ddot(grad(v), w["s"])
+
+    cols = []
+    m = phi.shape[1]
+    for a in range(m):
+        for b in range(a, m):
+            hab = np.einsum("kieq,kjeq->ijeq", g[a], g[b])
+            s = _stress(0.5 * (hab + np.swapaxes(hab, 0, 1)), lam, mu)
+            s = s + np.einsum("ikeq,kjeq->ijeq", g[b], sig[a]) + np.einsum("ikeq,kjeq->ijeq", g[a], sig[b])
+            cols.append(skfem.asm(load, basis, s=s)[perm])
+    return np.array(cols).T
+
+
+def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_derivatives: Union[bool, int] = False,
+           tol: float = 1e-9) -> FlexibleData:
     """Reduce a flexible body (e.g. nodal, with its frame fixed by reference conditions) to its
-    ``modes`` lowest eigenmodes of ``(K_ff, M_ff)``: every invariant is projected on the modal
-    basis (``k3``/``k4`` too).  ``info["frequencies"]`` holds the kept frequencies (rad/s)."""
+    ``modes`` lowest eigenmodes of ``(K_ff, M_ff)``: every invariant is projected on the basis
+    (``k3``/``k4`` too).  ``info["frequencies"]`` holds the frequencies (rad/s) of the reduced
+    model, ``info["modes"]`` the basis (n_f of ``data``, n_f of the result).
+
+    ``modal_derivatives`` (needs ``k3``, i.e. nonlinear strain data) adds the static modal
+    derivatives ``K^-1 k3(phi_i, phi_j)``, ``i <= j``, of the kept modes (``True``) or of the
+    ``m`` lowest ones (an int ``m``: ``m (m + 1) / 2`` vectors instead of ``k (k + 1) / 2``); the
+    basis is then mass-orthonormalized (vectors it already spans, to ``tol``, dropped) and
+    diagonalized.  For beams and slender parts the derivatives carry the axial shortening a
+    bending mode needs: without them a basis of bending modes cannot shorten and the quartic
+    membrane energy locks it (docs/flexible-bodies.md: 21 % too stiff on the paper's coupler).
+    """
     k, m = np.asarray(data.k_ff, dtype=float), np.asarray(data.m_ff, dtype=float)
     if not 1 <= modes <= k.shape[0]:
-        raise ValueError(f"modes must be in 1..{k.shape[0]}, got {modes}")
+        raise InvalidArgumentError("modes", f"modes must be in 1..{k.shape[0]}, got {modes}")
     lam, p = sla.eigh(k, m, subset_by_index=[0, modes - 1])
+    if modal_derivatives is not False:
+        if data.k3 is None:
+            raise InvalidArgumentError("modal_derivatives", "modal derivatives need the third-order stiffness k3 "
+                                       "(nonlinear strain data)")
+        nd = modes if modal_derivatives is True else int(modal_derivatives)
+        if not 1 <= nd <= modes:
+            raise InvalidArgumentError("modal_derivatives",
+                                       f"the number of modes differentiated must be in 1..{modes}, got {nd}")
+        k3p = np.einsum("ijk,jb,kc->ibc", np.asarray(data.k3, dtype=float), p[:, :nd], p[:, :nd])
+        extra = [k3p[:, a, b] for a in range(nd) for b in range(a, nd)]
+        loads = np.array(extra).T  # (n, n_extra)
+        p = _enrich(p, sla.cho_solve(sla.cho_factor(k), loads), m, tol)
+        lam, v = sla.eigh(p.T @ k @ p, p.T @ m @ p)
+        p = p @ v
+    n_r = p.shape[1]
     proj = lambda a: None if a is None else p.T @ np.asarray(a, dtype=float) @ p  # noqa: E731
-    k3 = None if data.k3 is None else np.einsum("ijk,ia,jb,kc->abc", np.asarray(data.k3), p, p, p)
-    k4 = None if data.k4 is None else np.einsum("ijkl,ia,jb,kc,ld->abcd", np.asarray(data.k4), p, p, p, p)
+    k3 = None if data.k3 is None else _project_tensor(np.asarray(data.k3, dtype=float), p)
+    k4 = None if data.k4 is None else _project_tensor(np.asarray(data.k4, dtype=float), p)
     w = np.sqrt(np.maximum(lam, 0.0))
     d_ff = proj(data.d_ff)
     if damping_ratio > 0.0:
@@ -265,6 +473,39 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0) -> Flexib
     markers = {name: InterfacePoint(pt.point, np.asarray(pt.displacement) @ p, None if pt.rotation is None else np.asarray(pt.rotation) @ p)
                for name, pt in data.markers.items()}
     return FlexibleData(mass=data.mass, inertia=data.inertia, com=data.com, s_bar=np.asarray(data.s_bar) @ p,
-                        s_u0=p.T @ np.asarray(data.s_u0), s_ju0=p.T @ np.asarray(data.s_ju0), s_tilde=proj(data.s_tilde),
-                        m_ff=np.eye(modes), k_ff=np.diag(lam), d_ff=d_ff, m_ff_tr=proj(data.m_ff_tr), k3=k3, k4=k4,
+                        s_u0=p.T @ np.asarray(data.s_u0), s_ju0=p.T @ np.asarray(data.s_ju0), s_tilde=_antisym(proj(data.s_tilde)),
+                        m_ff=np.eye(n_r), k_ff=np.diag(lam), d_ff=d_ff, m_ff_tr=proj(data.m_ff_tr), k3=k3, k4=k4,
                         markers=markers, info={"frequencies": w, "modes": p})
+
+
+def _antisym(a: np.ndarray) -> np.ndarray:
+    """The antisymmetric part (a projected ``s_tilde`` is antisymmetric up to rounding)."""
+    return 0.5 * (a - a.T)
+
+
+def _project_tensor(t: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``t`` (n, ..., n) with every index projected on the columns of ``p`` (n, r), one index at
+    a time (n^d r work instead of n^d r^d)."""
+    for _ in range(t.ndim):
+        # contract the first index and move the new one last: after ndim steps the order is back
+        t = np.moveaxis(np.tensordot(p, t, axes=([0], [0])), 0, -1)
+    return np.ascontiguousarray(t)
+
+
+def _enrich(p: np.ndarray, extra: np.ndarray, m: np.ndarray, tol: float) -> np.ndarray:
+    """``p`` (mass-orthonormal columns) extended by the columns of ``extra`` that it does not
+    span: Gram-Schmidt in the mass inner product, twice, dropping a vector whose remainder is
+    below ``tol`` times its mass norm."""
+    cols = [c for c in p.T]
+    for v in extra.T:
+        n0 = float(np.sqrt(v @ m @ v))
+        if n0 == 0.0:
+            continue
+        r = v.copy()
+        for _ in range(2):
+            for c in cols:
+                r -= (c @ m @ r) * c
+        nr = float(np.sqrt(max(r @ m @ r, 0.0)))
+        if nr > tol * n0:
+            cols.append(r / nr)
+    return np.array(cols).T
