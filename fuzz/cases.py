@@ -238,6 +238,9 @@ def _check_scene(case: Dict[str, Any]) -> List[Finding]:
             if not str(res.message).strip():
                 findings.append(("wrong", "simulate failed without a message"))
             return findings
+        if "drift" in res.extra:  # the run said it lost the constraints (DriftWarning): not silent
+            return findings if str(res.extra["drift"].get("message", "")).strip() else \
+                findings + [("wrong", "simulate: a drift report without a message")]
         q = np.array([res.coordinate(c) for c in system.coordinate_names])
         qd = np.array([res.velocity(c) for c in system.coordinate_names])
         if not _finite(q, qd):
@@ -536,6 +539,9 @@ def _check_options(case: Dict[str, Any]) -> List[Finding]:
         findings.append(("wrong", "simulate accepted the misspelt option max_stpe"))
     t = np.asarray(res.t)
     if res.status >= 0:
+        if "drift" in res.extra:  # the run said it lost the constraints (DriftWarning): not silent
+            return findings if str(res.extra["drift"].get("message", "")).strip() else \
+                findings + [("wrong", "simulate: a drift report without a message")]
         q = np.array([res.coordinate(c) for c in system.coordinate_names])
         if not _finite(t, q):
             findings.append(("silent-nonfinite", "status >= 0 with non-finite states"))

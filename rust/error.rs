@@ -79,6 +79,12 @@ pub fn positive(item: &str, what: &str, v: f64) -> Result<f64> {
     if !v.is_finite() || v <= 0.0 {
         return Err(Error::invalid(item, format!("{what} must be positive and finite, got {v}")));
     }
+    if v < f64::MIN_POSITIVE {
+        return Err(Error::invalid(item, format!(
+            "{what} = {v:e} is a subnormal number (below {:e}): it has almost no significant digits; check the units",
+            f64::MIN_POSITIVE
+        )));
+    }
     Ok(v)
 }
 

@@ -7,6 +7,7 @@ import pytest
 
 import ukflex
 from ukflex import InvalidSceneError, NonFiniteError, scenes
+from ukflex.stability import DriftWarning
 
 
 @pytest.mark.parametrize("kwargs, match", [
@@ -153,7 +154,14 @@ def test_redundant_constraints_of_the_scene_itself_are_not_mistaken_for_conditio
     assert system.rank_info(system.t0, system.q0, system.qd0)["rank"] < system.n_constraints
 
 
-@pytest.mark.parametrize("length", [5e-324, 1e-300, 1e-30])
+def test_subnormal_properties_are_refused_by_name():
+    s = ukflex.Scene()
+    bob = s.point_mass("bob", mass=1.0, position=(0.0, -0.5))
+    with pytest.raises(InvalidSceneError, match=r"length .*= 5e-324 is a subnormal number"):
+        s.distance(s.ground.point(0.0, 0.0), bob.point(), length=5e-324)
+
+
+@pytest.mark.parametrize("length", [1e-300, 1e-30])
 def test_a_distance_below_the_scenes_resolution_fails_loudly(length):
     # a point pendulum of 1e-30 m used to be "corrected" onto its pivot (the absolute position
     # tolerance 1e-12 m accepted it) and then fell freely: status 0
@@ -165,3 +173,29 @@ def test_a_distance_below_the_scenes_resolution_fails_loudly(length):
     s.rigid_body("plate", mass=1.0, inertia=0.1, com=(0.5, 0.0))
     with pytest.raises(InvalidSceneError, match="below what the scene resolves"):
         ukflex.System(s)
+
+
+def test_a_run_that_loses_its_constraints_says_so():
+    # gravity 1e30 m/s^2 on a 1 m pendulum: the UK correction cancels 1e30 to its rounding (1e14
+    # m/s^2) and the bob flies off by 3e10 m; the run used to end with status 0 and nothing said
+    s = ukflex.Scene(gravity=(0.0, -1e30))
+    bob = s.point_mass("bob", mass=2.8524188109448385, position=(2.8216492434996586e-298, -0.5),
+                       velocity=(-1.3678032781104694e-269, 0.0))
+    s.distance(s.ground.point(0.0, 0.0), bob.point(), length=1.0)
+    with pytest.warns(DriftWarning, match="the run did not deliver the requested accuracy"):
+        res = ukflex.simulate(s.build(), 0.02, method="DOPRI5", rtol=1e-8, max_steps=20000)
+    assert res.extra["drift"]["max_position_residual"] > 1.0
+
+
+def test_an_ordinary_run_does_not_warn_about_drift():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DriftWarning)
+        res = ukflex.simulate(scenes.slider_crank(), 0.05, method="DOPRI5", rtol=1e-6)
+    assert "drift" not in res.extra
+
+
+def test_a_run_that_cannot_finish_within_its_budget_stops_early():
+    # scipy paths cost ~0.1 ms per step: 1e9 s of pendulum used to grind 2 min towards the budget
+    res = ukflex.simulate(scenes.pendulum(), 1e9, method="RK45")
+    assert res.status == -1 and res.stop["cause"] == "max_steps"
+    assert "cannot suffice" in res.message and res.t.size > 100 and res.t[-1] < 1e9

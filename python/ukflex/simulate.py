@@ -8,6 +8,7 @@ import inspect
 import math
 import numbers
 import time
+import warnings
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union, cast
 
 import numpy as np
@@ -20,7 +21,7 @@ from . import _core
 from .errors import InvalidArgumentError, NonFiniteError, UnknownOptionError
 from .results import SimulationResult
 from .scene import Scene
-from .system import System
+from .system import System, length_scale
 
 __all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "time_acceleration", "DenseSolution"]
 
@@ -363,18 +364,49 @@ def simulate(
                                dense_output)
         if progress is not None and res.t.size:
             progress(float(res.t[-1]))
-        return res
-    if formulation != "uk":
+    elif formulation != "uk":
         res = _simulate_reference(
             system, formulation, t_end_f, method, rtol, atol_v, t_eval_v, q_init, qd_init, partition, options
         )
         if progress is not None and res.t.size:
             progress(float(res.t[-1]))
-        return res
-    if method in ("Radau", "BDF") and "jac" not in options:
-        options["jac"] = system.jac  # Rust finite differences, GIL released
-    return _simulate_scipy(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
-                           dense_output, progress)
+    else:
+        if method in ("Radau", "BDF") and "jac" not in options:
+            options["jac"] = system.jac  # Rust finite differences, GIL released
+        res = _simulate_scipy(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
+                              dense_output, progress)
+    _check_drift(system, res, rtol, atol_v)
+    return res
+
+
+#: a run whose constraint residual passes this many times (rtol x length scale + atol) did not
+#: deliver the accuracy it was asked for: it says so (DriftWarning, res.extra["drift"]) ...
+DRIFT_FACTOR = 1000.0
+#: ... as does a run whose constraints drifted by more than this fraction of the scene's length
+#: scale, whatever the tolerances (an absolute atol of 1e-11 m cannot resolve a 1e-16 m pendulum)
+DRIFT_OF_SCALE = 1e-2
+
+
+def _check_drift(system: System, res: SimulationResult, rtol: float, atol: Any) -> None:
+    """Warn when the positions left the constraints far beyond the requested tolerance (e.g.
+    accelerations of 1e30 m/s^2 cancelled by the UK correction to their rounding, 1e14 m/s^2):
+    a result is never wrong silently. The residuals are already part of every result."""
+    pos = np.asarray(res.residuals.get("position", ()), dtype=float)
+    if pos.size == 0:
+        return
+    scale = length_scale(system.description)
+    limit = min(DRIFT_FACTOR * (rtol * scale + float(np.min(atol))), DRIFT_OF_SCALE * scale)
+    worst = int(np.argmax(pos))
+    if not pos[worst] > limit:
+        return
+    from .stability import DriftWarning  # the warning family of stability reports
+    text = (f"the constraints drifted to ||Phi|| = {pos[worst]:.3g} m at t = {res.t[worst]:.6g} s, more than "
+            f"min({DRIFT_FACTOR:g} x (rtol x length scale {scale:.3g} m + atol), {DRIFT_OF_SCALE:g} x length scale) = "
+            f"{limit:.3g} m: the run did not deliver "
+            "the requested accuracy (check the scene's units and scales, tighten rtol, or use a method with "
+            "projection such as GENALPHA)")
+    res.extra["drift"] = dict(max_position_residual=float(pos[worst]), t=float(res.t[worst]), limit=limit, message=text)
+    warnings.warn(text, DriftWarning, stacklevel=3)
 
 
 #: scipy paths (about 0.1 ms of Python per step): after this many steps, and at each doubling,
