@@ -43,10 +43,9 @@ fn mass_norm(model: &Model, data: &Data, v: &[f64]) -> f64 {
 
 /// `A qd + Phi_t` from the terms in `data`.
 fn velocity_residual(model: &Model, data: &Data, qd: &[f64], out: &mut [f64]) {
-    let n = model.n;
+    debug_assert_eq!(out.len(), model.m);
     for (i, o) in out.iter_mut().enumerate() {
-        let row = &data.jac[i * n..(i + 1) * n];
-        *o = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i];
+        *o = data.ajac.row_dot(i, qd) + data.phi_t[i];
     }
 }
 
@@ -245,8 +244,19 @@ pub struct Correction {
 /// Minimum-norm solution of `A[:, free] dx = r` in the metric `M[free, free]` (the UK/Gauss
 /// projection restricted to the free coordinates): `dx_free = F^-T (A_f F^-T)^+ r` with
 /// `M_ff = F F^T`. Needs the mass blocks and `A` at the current `q` in `data`.
-fn metric_step(model: &Model, data: &Data, free: &[bool], r: &[f64]) -> Result<Vec<f64>> {
+///
+/// When no coordinate is held and the workspace has the sparse UK path, this is the UK solve
+/// itself with `Q = 0`, `b = r` (O(n), the sparse path's rank certificate or its dense
+/// fallback); otherwise the dense SVD of `A_f F^-T` below (O(n m^2)).
+fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Result<Vec<f64>> {
     let (n, m) = (model.n, model.m);
+    if m > 0 && data.sparse.is_some() && free.iter().all(|f| *f) {
+        crate::dynamics::factor_mass(model, data)?;
+        data.force.fill(0.0);
+        data.gamma.copy_from_slice(r);
+        solve(model, data)?;
+        return Ok(data.qdd.clone());
+    }
     let mut dx = vec![0.0; n];
     let idx: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
     let k = idx.len();
@@ -288,8 +298,15 @@ fn metric_step(model: &Model, data: &Data, free: &[bool], r: &[f64]) -> Result<V
     let mut bt = Mat::<f64>::zeros(k, m);
     let mut col = vec![0.0; k];
     for i in 0..m {
-        for (p, &g) in idx.iter().enumerate() {
-            col[p] = data.jac[i * n + g];
+        // row i of A on the free coordinates, from the segment form (O(nnz) per row)
+        col.fill(0.0);
+        for sg in data.ajac.row_segs(i) {
+            for (j, &a) in data.ajac.vals[sg.val..sg.val + sg.len].iter().enumerate() {
+                let p = pos[sg.col + j];
+                if p != usize::MAX {
+                    col[p] = a;
+                }
+            }
         }
         for (&(first, kb), &off) in blocks.iter().zip(&offsets) {
             lower_solve(&mf[off..off + kb * kb], kb, &mut col[first..first + kb]);

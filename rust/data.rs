@@ -7,6 +7,7 @@ use faer::diag::Diag;
 use faer::{Mat, Par};
 
 use crate::body::BodyData;
+use crate::constraint::jac::SegJac;
 use crate::model::Model;
 use crate::error::{Error, Result};
 use crate::small_svd::QrJacobi;
@@ -58,7 +59,8 @@ pub fn dense_uk_bytes(model: &Model) -> u64 {
     }
     let k = n.min(m);
     let req = svd_scratch::<f64>(model.n, model.m, ComputeSvdVectors::Thin, ComputeSvdVectors::Thin, Par::Seq, Default::default());
-    8 * (n * m + n * k + m * k + k + if m <= n { n * m + 3 * m * m + n } else { 0 }) + req.size_bytes() as u64
+    // the dense A (m x n), B^T (n x m), U, V, S and the QR + Jacobi buffers
+    8 * (2 * n * m + n * k + m * k + k + if m <= n { n * m + 3 * m * m + n } else { 0 }) + req.size_bytes() as u64
 }
 
 /// How the UK pseudoinverse `(A F^-T)^+` is computed. Every choice is allocation free per
@@ -144,8 +146,12 @@ pub struct Data {
     pub force: Vec<f64>,
     /// `Phi` (m).
     pub phi: Vec<f64>,
-    /// `A = Phi_q`, m x n row-major.
+    /// `A = Phi_q` in per-row segment form (always current after `dynamics::constraints`).
+    pub ajac: SegJac,
+    /// `A = Phi_q`, m x n row-major: empty until `ensure_dense_jac` (the dense UK path, the
+    /// implicit integrators, `System.A`); once allocated, `dynamics::constraints` keeps it current.
     pub jac: Vec<f64>,
+    pub dense_jac: bool,
     /// `Phi_t` (m).
     pub phi_t: Vec<f64>,
     /// `b = gamma` (m).
@@ -206,7 +212,7 @@ impl Data {
             }
         };
         let hint = if sparse.is_some() { "raise memory_limit" } else { "use uk_solver='sparse' for a long chain or rope, or raise memory_limit" };
-        let base = 8 * (m as u64 * n as u64 + 6 * n as u64 + 8 * m as u64);
+        let base = SegJac::bytes(model) + 8 * (6 * n as u64 + 8 * m as u64);
         let dense = if sparse.is_none() { dense_uk_bytes(model) } else { 0 };
         let sparse_bytes = if sparse.is_some() { SparseUk::bytes(model) } else { 0 };
         Error::check_memory("the UK workspace (constraint Jacobian and factorization buffers)", base + dense + sparse_bytes, memory_limit, hint)?;
@@ -215,7 +221,9 @@ impl Data {
             bodies,
             force: vec![0.0; n],
             phi: vec![0.0; m],
-            jac: vec![0.0; m * n],
+            ajac: SegJac::new(model),
+            jac: Vec::new(),
+            dense_jac: false,
             phi_t: vec![0.0; m],
             gamma: vec![0.0; m],
             y: vec![0.0; n],
@@ -256,6 +264,7 @@ impl Data {
             let hint = "the sparse UK path could not certify full rank here (redundant or nearly dependent constraints) and the dense rank-revealing fallback is this large; remove redundant constraints or raise memory_limit";
             Error::check_memory("the dense UK fallback", dense_uk_bytes(model), self.memory_limit, hint)?;
         }
+        self.ensure_dense_jac()?;
         let k = n.min(m);
         let req = if m > 0 {
             svd_scratch::<f64>(n, m, ComputeSvdVectors::Thin, ComputeSvdVectors::Thin, Par::Seq, Default::default())
@@ -270,6 +279,22 @@ impl Data {
         self.mem = MemBuffer::new(req);
         self.qrj = if m > 0 && m <= n { Some(QrJacobi::new(n, m)) } else { None };
         self.dense_ready = true;
+        Ok(())
+    }
+
+    /// Allocate the dense `m x n` copy of `A` (`jac`) if it is not there yet, filled from the
+    /// segment form; from then on `dynamics::constraints` keeps it current. Refused (before
+    /// allocating) above `memory_limit`.
+    pub fn ensure_dense_jac(&mut self) -> Result<()> {
+        if self.dense_jac {
+            return Ok(());
+        }
+        let (m, n) = (self.ajac.m, self.ajac.n);
+        let hint = "the dense m x n constraint Jacobian is this large; use DOPRI5 with uk_solver='sparse' for a long chain or rope, or raise memory_limit";
+        Error::check_memory("the dense constraint Jacobian A (m x n)", 8 * m as u64 * n as u64, self.memory_limit, hint)?;
+        self.jac = vec![0.0; m * n];
+        self.ajac.scatter(&mut self.jac);
+        self.dense_jac = true;
         Ok(())
     }
 

@@ -56,27 +56,26 @@ pub fn apply_finv_sparse(model: &Model, bodies: &[BodyData], v: &mut [f64]) {
     }
 }
 
-/// Constraint terms: `A`, `Phi_t`, `gamma`, and `Phi` when `with_phi`.
+/// Constraint terms: `A` (in segment form, `data.ajac`; also the dense `data.jac` when that
+/// exists), `Phi_t`, `gamma`, and `Phi` when `with_phi`. O(nnz(A)): no pass over `m x n`.
 pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], with_phi: bool) {
-    let n = model.n;
-    for c in &model.constraints {
+    for (k, c) in model.constraints.iter().enumerate() {
         let rows = c.rows();
         let r0 = c.row;
-        // zero only the entries the rows can touch (their bodies' coordinates, see
-        // `Constraint::bodies`): O(nnz(A)), not O(m n); the rest of `jac` stays zero
-        for bi in c.bodies().into_iter().flatten() {
-            let b = &model.bodies[bi];
-            for r in r0..r0 + rows {
-                data.jac[r * n + b.offset..r * n + b.offset + b.n_coords].fill(0.0);
-            }
-        }
+        let (vals, layout, width) = data.ajac.constraint_block(k, r0, rows);
+        vals.fill(0.0);
         let out = ConstraintOut {
             phi: if with_phi { Some(&mut data.phi[r0..r0 + rows]) } else { None },
-            jac: &mut data.jac[r0 * n..(r0 + rows) * n],
+            jac: vals,
+            layout,
             phi_t: &mut data.phi_t[r0..r0 + rows],
             gamma: &mut data.gamma[r0..r0 + rows],
         };
-        c.eval(&model.bodies, t, q, qd, n, out);
+        c.eval(&model.bodies, t, q, qd, width, out);
+    }
+    if data.dense_jac {
+        // entries outside the pattern were zeroed at allocation and are never written
+        data.ajac.scatter(&mut data.jac);
     }
 }
 

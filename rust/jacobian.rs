@@ -220,6 +220,7 @@ impl StructuredJacobian {
         dynamics::mass_and_forces(model, data, q, qd);
         dynamics::dense_mass_into(model, data, &mut self.m_dense);
         dynamics::stiffness_into(model, data, q, qd, &mut self.k);
+        data.ensure_dense_jac()?;
         dynamics::constraints(model, data, t, q, qd, false);
         self.assemble_saddle(&data.jac, n, m, 0.0);
         if !lu_cm(&mut self.saddle, &mut self.piv, nm) {

@@ -23,7 +23,6 @@ pub const ENERGY_COLUMNS: [&str; 3] = ["kinetic", "strain", "gravity"];
 /// acceleration at `(t, q, qd)` for the multipliers.
 pub fn reactions_into(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> Result<()> {
     uk::acceleration(model, data, t, q, qd)?;
-    let n = model.n;
     for (k, c) in model.constraints.iter().enumerate() {
         let rows = c.row..c.row + c.rows();
         let lam = &data.lambda[rows.clone()];
@@ -31,8 +30,7 @@ pub fn reactions_into(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
         // -lambda^T A qd (exact at any state, also off the velocity manifold)
         let mut power = 0.0;
         for row in rows {
-            let a = &data.jac[row * n..(row + 1) * n];
-            power -= data.lambda[row] * a.iter().zip(qd).map(|(x, y)| x * y).sum::<f64>();
+            power -= data.lambda[row] * data.ajac.row_dot(row, qd);
         }
         let (s, co) = r.frame.sin_cos();
         let o = &mut out[6 * k..6 * k + 6];

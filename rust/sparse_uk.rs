@@ -41,6 +41,7 @@
 use std::collections::VecDeque;
 
 use crate::body::BodyData;
+use crate::constraint::jac::SegJac;
 use crate::data::{RankInfo, RankTolerance};
 use crate::model::Model;
 
@@ -179,16 +180,15 @@ impl SparseUk {
 
     /// `B^T`, `S`, its band Cholesky factor and the full-rank certificate. `Some(info)` when
     /// rank = m is certified (the factorization is then ready for `correct`), `None` otherwise.
-    pub fn factor(&mut self, model: &Model, bodies: &[BodyData], jac: &[f64], tol: &RankTolerance) -> Option<RankInfo> {
+    pub fn factor(&mut self, model: &Model, bodies: &[BodyData], ajac: &SegJac, tol: &RankTolerance) -> Option<RankInfo> {
         let (n, m, hb) = (self.n, self.m, self.hb);
         let w = hb + 1;
-        // B^T segments: rows of A restricted to their bodies, then F_b^-1
-        for i in 0..m {
-            for s in &self.segs[self.seg_ptr[i]..self.seg_ptr[i + 1]] {
-                let v = &mut self.vals[s.val..s.val + s.len];
-                v.copy_from_slice(&jac[i * n + s.col..i * n + s.col + s.len]);
-                model.bodies[s.body].finv(&bodies[s.body], v);
-            }
+        // B^T segments: the segment form of A has the same layout (rows in order, each row's
+        // bodies in increasing order, one after the other); then F_b^-1 on each segment
+        debug_assert_eq!(self.vals.len(), ajac.vals.len());
+        self.vals.copy_from_slice(&ajac.vals);
+        for s in &self.segs {
+            model.bodies[s.body].finv(&bodies[s.body], &mut self.vals[s.val..s.val + s.len]);
         }
         // S = B B^T in band storage
         self.band.fill(0.0);

@@ -55,7 +55,7 @@ pub fn free_acceleration(model: &Model, data: &mut Data) {
 /// Needs `m > 0` and the mass factor of `dynamics::factor_mass`.
 pub fn factor_constraints(model: &Model, data: &mut Data) -> Result<()> {
     if let Some(sp) = data.sparse.as_mut() {
-        if let Some(info) = sp.factor(model, &data.bodies, &data.jac, &data.tolerance) {
+        if let Some(info) = sp.factor(model, &data.bodies, &data.ajac, &data.tolerance) {
             data.factored_with = Factored::SparseGram;
             data.rank_info = info;
             return Ok(());
@@ -109,6 +109,11 @@ fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
     data.rank_info = rank_from_singular_values(data, n, m, rcond, atol)?;
     Ok(())
 }
+
+/// Above this many constraint rows `exact_rank_info` keeps the sparse path's certified bounds
+/// instead of running the dense SVD (at m = 256, n ~ 400 that SVD takes ~10 ms; at m = 2048 it
+/// takes seconds and 100 MB).
+pub const EXACT_RANK_MAX_ROWS: usize = 256;
 
 /// Above this many constraint rows the `Auto` fallback (no full-rank certificate) uses faer's
 /// bidiagonal SVD instead of Jacobi: measured crossover between m = 6 (Jacobi 1.6x faster) and
@@ -173,10 +178,19 @@ fn rank_from_singular_values(data: &Data, n: usize, m: usize, rcond: f64, atol: 
 /// this runs the Jacobi SVD of the stored R (the singular values of `B`) -- O(m^3), not part of
 /// the acceleration hot path -- and stores the exact `RankInfo` in `data.rank_info`. The
 /// current correction stays valid (it needs only the QR part).
+///
+/// After the sparse path (certified full rank, `exact == false`) the exact values need the
+/// dense SVD, O(n m^2) time and O(n m) memory: done here only for `m <= EXACT_RANK_MAX_ROWS`;
+/// above, the certified report stays (rank = m exactly, `sigma_max` the upper bound
+/// `sqrt(trace(A M^-1 A^T))`, `sigma_min_kept` the lower bound
+/// `sqrt(1/(2 trace((A M^-1 A^T)^-1)) - delta)`, `exact == false`).
 pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
     if data.factored_with == Factored::SparseGram && !data.rank_info.exact {
+        if model.m > EXACT_RANK_MAX_ROWS {
+            return Ok(data.rank_info);
+        }
         // the singular values need the dense path (O(n m^2), on demand): factor the same `A`
-        // (still in `data.jac`) densely; the correction stays valid (same `q`)
+        // (the segment form is current) densely; the correction stays valid (same `q`)
         data.ensure_dense(model)?;
         factor_dense(model, data)?;
     }
@@ -220,9 +234,7 @@ pub fn correct(model: &Model, data: &mut Data) {
     let k = n.min(m);
     let rank = data.rank_info.rank;
     for i in 0..m {
-        let row = &data.jac[i * n..(i + 1) * n];
-        let aa: f64 = row.iter().zip(&data.qdd_free).map(|(x, y)| x * y).sum();
-        data.residual[i] = data.gamma[i] - aa;
+        data.residual[i] = data.gamma[i] - data.ajac.row_dot(i, &data.qdd_free);
     }
     if data.factored_with == Factored::FullRankQr {
         let qrj = data.qrj.as_mut().expect("factored with QR");
@@ -323,10 +335,8 @@ pub fn acceleration_same_q(model: &Model, data: &mut Data, t: f64, q: &[f64], qd
 /// Baumgarte: `b <- gamma - 2 alpha (A qd + Phi_t) - beta^2 Phi` (needs `Phi`).
 fn stabilize_rhs(model: &Model, data: &mut Data, qd: &[f64]) {
     if let Stabilization::Baumgarte { alpha, beta } = data.stabilization {
-        let n = model.n;
         for i in 0..model.m {
-            let row = &data.jac[i * n..(i + 1) * n];
-            let vel = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i];
+            let vel = data.ajac.row_dot(i, qd) + data.phi_t[i];
             data.gamma[i] -= 2.0 * alpha * vel + beta * beta * data.phi[i];
         }
     }
@@ -337,12 +347,10 @@ fn stabilize_rhs(model: &Model, data: &mut Data, qd: &[f64]) {
 pub fn residuals(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], pos: &mut [f64], vel: &mut [f64], acc: &mut [f64]) -> Result<()> {
     evaluate(model, data, t, q, qd, true)?;
     solve(model, data)?;
-    let n = model.n;
     for i in 0..model.m {
-        let row = &data.jac[i * n..(i + 1) * n];
         pos[i] = data.phi[i];
-        vel[i] = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + data.phi_t[i];
-        acc[i] = row.iter().zip(&data.qdd).map(|(a, b)| a * b).sum::<f64>() - data.gamma[i];
+        vel[i] = data.ajac.row_dot(i, qd) + data.phi_t[i];
+        acc[i] = data.ajac.row_dot(i, &data.qdd) - data.gamma[i];
     }
     Ok(())
 }

@@ -106,6 +106,7 @@ fn quadratic_velocity_vector_matches_eq_40() {
 fn jacobian_matches_differences_of_phi_and_gamma_second_differences() {
     for (name, json) in scenes() {
         let (model, mut data) = build(&json);
+        data.ensure_dense_jac().unwrap(); // the dense m x n copy of A (the sparse path keeps none)
         let (n, m) = (model.n, model.m);
         let mut rng = Lcg(3);
         for _ in 0..4 {
@@ -147,6 +148,7 @@ fn jacobian_matches_differences_of_phi_and_gamma_second_differences() {
 fn uk_satisfies_constraints_and_equals_augmented_solution() {
     for (name, json) in scenes() {
         let (model, mut data) = build(&json);
+        data.ensure_dense_jac().unwrap(); // the dense m x n copy of A (the sparse path keeps none)
         let (n, m) = (model.n, model.m);
         let mut rng = Lcg(5);
         for _ in 0..5 {
@@ -224,6 +226,7 @@ fn projection_restores_consistency_and_leaves_consistent_states_alone() {
 #[test]
 fn baumgarte_modifies_the_acceleration_right_hand_side() {
     let (model, mut data) = build(&paper_scene("euler-bernoulli", 2, true));
+    data.ensure_dense_jac().unwrap(); // the dense m x n copy of A (the sparse path keeps none)
     let n = model.n;
     let mut rng = Lcg(21);
     let (q, qd) = random_state(&model, &mut rng);

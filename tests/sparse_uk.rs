@@ -141,3 +141,64 @@ fn memory_limit_refuses_before_allocating() {
     assert!(matches!(err, ukflex::Error::Memory { .. }), "{err}");
     assert!(Data::build(&model, UkSolver::Sparse, 16 << 20).is_ok());
 }
+
+#[test]
+fn sparse_workspace_keeps_no_dense_jacobian_and_reports_the_certificate() {
+    // K = 1024: n = 3072, m = 2048; the dense A alone would be 50 MB
+    let model = Model::from_json(&chain_scene(1024)).unwrap();
+    let mut sp = data(&model, UkSolver::Sparse);
+    let mut rng = Lcg(5);
+    let (q, qd) = chain_state(&model, &mut rng);
+    uk::acceleration(&model, &mut sp, 0.0, &q, &qd).unwrap();
+    assert_eq!(sp.factored_with, Factored::SparseGram);
+    assert!(sp.jac.is_empty() && !sp.dense_jac && !sp.dense_ready, "no m x n buffer on the sparse path");
+    assert_eq!(sp.ajac.nnz(), 2 * 1024 * 6 - 2 * 3, "two rigid bodies per row, one at the pivot");
+    // the residual A qdd - b of the solve, from the segment form
+    let (mut p, mut v, mut a) = (vec![0.0; model.m], vec![0.0; model.m], vec![0.0; model.m]);
+    uk::residuals(&model, &mut sp, 0.0, &q, &qd, &mut p, &mut v, &mut a).unwrap();
+    let scale = max_abs(&sp.gamma).max(1.0);
+    assert!(max_abs(&a) <= 1e-10 * scale, "A qdd - b = {:e}", max_abs(&a));
+    assert!(max_abs(&p) <= 1e-12 && max_abs(&v) <= 1e-12, "a consistent state");
+    // above EXACT_RANK_MAX_ROWS: the certified report, no dense SVD
+    let info = uk::exact_rank_info(&model, &mut sp).unwrap();
+    assert!(!info.exact && info.rank == model.m && info.sigma_min_kept > info.tolerance);
+    assert!(!sp.dense_ready && sp.jac.is_empty());
+    // at or below it: the exact values (the dense SVD on demand), which the bounds enclose
+    let small = Model::from_json(&chain_scene(64)).unwrap();
+    let mut s2 = data(&small, UkSolver::Sparse);
+    let (q, qd) = chain_state(&small, &mut rng);
+    uk::acceleration(&small, &mut s2, 0.0, &q, &qd).unwrap();
+    let bounds = s2.rank_info;
+    let exact = uk::exact_rank_info(&small, &mut s2).unwrap();
+    assert!(exact.exact && !bounds.exact && exact.rank == small.m);
+    assert!(bounds.sigma_min_kept <= exact.sigma_min_kept && bounds.sigma_max >= exact.sigma_max);
+}
+
+#[test]
+fn baumgarte_and_state_correction_agree_on_both_paths() {
+    let model = Model::from_json(&chain_scene(48)).unwrap();
+    let (mut sp, mut de) = (data(&model, UkSolver::Sparse), data(&model, UkSolver::Dense));
+    let mut rng = Lcg(9);
+    let (mut q, qd) = chain_state(&model, &mut rng);
+    // off the manifold: Baumgarte's Phi and A qd terms matter
+    for x in q.iter_mut() {
+        *x += 1e-3 * (rng.next() - 0.5);
+    }
+    for d in [&mut sp, &mut de] {
+        d.stabilization = ukflex::data::Stabilization::Baumgarte { alpha: 5.0, beta: 7.0 };
+    }
+    uk::acceleration(&model, &mut sp, 0.0, &q, &qd).unwrap();
+    uk::acceleration(&model, &mut de, 0.0, &q, &qd).unwrap();
+    assert_eq!(sp.factored_with, Factored::SparseGram);
+    let (cond, _) = cond_b(&model, &mut de);
+    let dq = rel_diff(&sp.qdd, &de.qdd);
+    assert!(dq <= 20.0 * cond * f64::EPSILON, "Baumgarte: {dq:e}");
+    // the initial-state correction (nothing held): the sparse UK step vs the dense SVD step
+    let opts = ukflex::correct::CorrectOptions { hold: vec![false; model.n], position_tol: 1e-12, velocity_tol: 1e-12, max_iterations: 20 };
+    let (cs, cd) = (ukflex::correct::correct(&model, &mut sp, 0.0, &q, &qd, &opts).unwrap(), ukflex::correct::correct(&model, &mut de, 0.0, &q, &qd, &opts).unwrap());
+    assert!(cs.positions_ok && cs.velocities_ok && cd.positions_ok && cd.velocities_ok);
+    assert!(cs.position_residual_after <= 1e-12 && cs.velocity_residual_after <= 1e-12);
+    assert!(rel_diff(&cs.q, &cd.q) <= 1e-9, "corrected q differ by {:e}", rel_diff(&cs.q, &cd.q));
+    assert!(rel_diff(&cs.qd, &cd.qd) <= 1e-9, "corrected qd differ by {:e}", rel_diff(&cs.qd, &cd.qd));
+    assert!(!sp.dense_ready && sp.jac.is_empty(), "the correction stayed on the sparse path");
+}

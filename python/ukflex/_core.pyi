@@ -89,8 +89,10 @@ class System:
     def residual_norms(self, t: _F64, q: _F64, qd: _F64) -> _F64:
         """Norms of the position, velocity and acceleration residuals along a trajectory, (3, nt)."""
     def rank_info(self, t: Optional[float] = None, q: Optional[_F64] = None, qd: Optional[_F64] = None, exact: bool = True) -> Dict[str, Any]:
-        """uk_path, rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance of the UK solve at (t, q, qd)
-        (one lock: thread-safe), or of the last solve of any thread without a state."""
+        """uk_path, rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance, exact of the UK solve at
+        (t, q, qd) (one lock: thread-safe), or of the last solve of any thread without a state; exact is
+        False after the sparse path with m > 256 (the certified bounds, no dense SVD), and after any
+        certified full-rank solve with exact=False (no on-demand singular values)."""
     def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None:
         """Drop singular values of A F^-T at or below max(atol, rcond sigma_max)."""
     def set_pseudoinverse(self, kind: str = "auto") -> None:

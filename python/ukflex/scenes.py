@@ -34,6 +34,7 @@ __all__ = [
     "every_joint",
     "chain",
     "rope",
+    "lattice",
     "gravity_vector",
     "scene_parameters",
     "SCENES",
@@ -553,6 +554,67 @@ def rope(links: int = 64, length: float = 2.0, mass: float = 0.5, span: float = 
     return s
 
 
+@_checked
+def lattice(columns: int = 4, rows: int = 4, cell: float = 0.25, mass: float = 0.1, shear: float = 0.3,
+            beams: str = "links", gravity: Any = True) -> Scene:
+    """A shear lattice: ``rows`` levels of ``columns`` square cells of pinned rigid bars, hung
+    from ``columns + 1`` ground pins (every cell a closed four-bar loop).
+
+    Level ``r`` has ``columns + 1`` hangers (bars of length ``cell`` pinned at both ends) below
+    the level above, their lower ends joined by horizontal bars: with ``beams="links"`` one bar
+    per cell (pinned at every node, the constraints independent: ``m = rows (6 columns + 2)``,
+    one degree of freedom per level), with ``beams="continuous"`` one bar per level through all
+    the nodes (a parallel-crank linkage: ``columns - 1`` redundant rows per level, rank
+    ``m - rows (columns - 1)``). Each bar has mass ``mass``; released from rest with every hanger
+    tilted by ``shear`` (rad, alternating in sign from level to level), under gravity. A
+    consistent state; conservative: ``T + V`` is constant."""
+    w, h = int(columns), int(rows)
+    if w < 1 or w != columns or h < 1 or h != rows:
+        raise ValueError(f"columns and rows must be positive integers, got columns={columns!r}, rows={rows!r}")
+    if not cell > 0.0 or not mass > 0.0:
+        raise ValueError(f"cell and mass must be positive, got cell={cell!r}, mass={mass!r}")
+    if beams not in ("links", "continuous"):
+        raise ValueError(f"beams must be 'links' or 'continuous', got {beams!r}")
+    if not abs(shear) < 0.5 * math.pi:
+        raise ValueError(f"shear must be in (-pi/2, pi/2), got {shear!r}")
+    s = Scene(gravity=gravity_vector(gravity))
+    inertia = mass * cell**2 / 12.0
+    span = w * cell
+    x0 = 0.0  # the level's left node
+    top = [s.ground.point(i * cell, 0.0) for i in range(w + 1)]
+    for r in range(h):
+        a = shear if r % 2 == 0 else -shear
+        # hanger direction: straight down turned by a
+        dx, dy = cell * math.sin(a), -cell * math.cos(a)
+        y_top = -r * cell * math.cos(shear)
+        x_top = x0
+        bottom = []
+        for i in range(w + 1):
+            xt = x_top + i * cell
+            hb = s.rigid_body(f"hanger{r}_{i}", mass=mass, inertia=inertia,
+                              position=(xt + 0.5 * dx, y_top + 0.5 * dy), angle=math.atan2(dy, dx))
+            s.revolute(top[i], hb.point(-0.5 * cell, 0.0), name=f"hang{r}_{i}")
+            bottom.append(hb.point(0.5 * cell, 0.0))
+        x0 = x_top + dx
+        yb = y_top + dy
+        if beams == "links":
+            nodes = []
+            for i in range(w):
+                b = s.rigid_body(f"bar{r}_{i}", mass=mass, inertia=inertia, position=(x0 + (i + 0.5) * cell, yb))
+                s.revolute(bottom[i], b.point(-0.5 * cell, 0.0), name=f"left{r}_{i}")
+                s.revolute(bottom[i + 1], b.point(0.5 * cell, 0.0), name=f"right{r}_{i}")
+                nodes.append(b.point(-0.5 * cell, 0.0))
+            nodes.append(b.point(0.5 * cell, 0.0))
+        else:
+            b = s.rigid_body(f"beam{r}", mass=mass * w, inertia=mass * w * span**2 / 12.0, position=(x0 + 0.5 * span, yb))
+            nodes = []
+            for i in range(w + 1):
+                s.revolute(bottom[i], b.point((i - 0.5 * w) * cell, 0.0), name=f"node{r}_{i}")
+                nodes.append(b.point((i - 0.5 * w) * cell, 0.0))
+        top = nodes
+    return s
+
+
 SCENES: Dict[str, Callable[..., Scene]] = {
     "slider_crank": slider_crank,
     "pendulum": pendulum,
@@ -563,6 +625,7 @@ SCENES: Dict[str, Callable[..., Scene]] = {
     "every_joint": every_joint,
     "chain": chain,
     "rope": rope,
+    "lattice": lattice,
 }
 
 

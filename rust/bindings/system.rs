@@ -219,8 +219,12 @@ impl PySystem {
         let v = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
             dynamics::constraints(model, &mut ws.data, 0.0, &ws.q, &ws.qd, false);
-            finite_out("A(q)", &ws.data.jac)?;
-            Ok(ws.data.jac.clone())
+            // a fresh dense copy from the segment form (the workspace keeps no dense A for this)
+            Error::check_memory("System.A (dense m x n)", 8 * m as u64 * n as u64, ws.data.memory_limit, "A is m x n dense; raise memory_limit")?;
+            let mut a = vec![0.0; m * n];
+            ws.data.ajac.scatter(&mut a);
+            finite_out("A(q)", &a)?;
+            Ok(a)
         })?;
         mat(py, v, m, n)
     }
@@ -402,9 +406,12 @@ impl PySystem {
     }
 
     /// Everything a pseudoinverse decided: uk_path ("sparse" or "dense", the path the solve
-    /// took), rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance (exact singular
-    /// values: when the acceleration took a certified full-rank path they are computed here, on
-    /// demand, by the dense path). With a state `(t, q, qd)` the UK solve at that state and its
+    /// took), rank, sigma_max, sigma_min_kept, sigma_max_dropped, tolerance, exact. The
+    /// singular values are exact (`exact` True) except after the sparse path with more than
+    /// 256 constraint rows: there the rank is the certified m and sigma_max / sigma_min_kept
+    /// are the certificate's upper / lower bounds (`exact` False; no dense SVD is run). After a
+    /// certified full-rank path of a smaller system the exact values are computed here, on
+    /// demand, by the dense path. With a state `(t, q, qd)` the UK solve at that state and its
     /// rank report happen under one lock, so the answer belongs to that state even when other
     /// threads use the System; without one it describes the last solve of any thread.
     /// `exact=False` skips the on-demand singular values: after a certified full-rank solve the

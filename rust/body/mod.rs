@@ -445,9 +445,15 @@ impl Marker {
     /// `row += w . d r / d q` (row spans all of `q`).
     #[inline]
     pub fn add_point_jacobian(&self, bodies: &[Body], ms: &MarkerState, w: [f64; 2], row: &mut [f64]) {
+        self.add_point_jacobian_in(bodies, ms, w, row, None);
+    }
+
+    /// `add_point_jacobian` into a row of layout `layout`: `None` spans all of `q`,
+    /// `Some(l)` is a constraint's compressed row (`l` lists `(body, start)`, `constraint::jac`).
+    #[inline]
+    pub fn add_point_jacobian_in(&self, bodies: &[Body], ms: &MarkerState, w: [f64; 2], row: &mut [f64], layout: Option<&[(usize, usize)]>) {
         let Some(bi) = self.body else { return };
-        let body = &bodies[bi];
-        let rb = &mut row[body.offset..body.offset + body.n_coords];
+        let rb = body_slice(bodies, bi, row, layout);
         match &self.shape {
             MarkerShape::Rigid(_) => rigid::add_point_jacobian(ms, w, rb),
             MarkerShape::Beam(ps) => ffrf_beam::add_point_jacobian(ps, ms, w, rb),
@@ -460,9 +466,14 @@ impl Marker {
     /// `row += w . d phi / d q` (`ms`: this marker's state at the same `q`).
     #[inline]
     pub fn add_angle_jacobian(&self, bodies: &[Body], ms: &MarkerState, w: f64, row: &mut [f64]) {
+        self.add_angle_jacobian_in(bodies, ms, w, row, None);
+    }
+
+    /// `add_angle_jacobian` into a row of layout `layout` (see `add_point_jacobian_in`).
+    #[inline]
+    pub fn add_angle_jacobian_in(&self, bodies: &[Body], ms: &MarkerState, w: f64, row: &mut [f64], layout: Option<&[(usize, usize)]>) {
         let Some(bi) = self.body else { return };
-        let body = &bodies[bi];
-        let rb = &mut row[body.offset..body.offset + body.n_coords];
+        let rb = body_slice(bodies, bi, row, layout);
         match &self.shape {
             MarkerShape::Rigid(_) => rigid::add_angle_jacobian(w, rb),
             MarkerShape::Beam(ps) => ffrf_beam::add_angle_jacobian(ps, w, rb),
@@ -470,6 +481,18 @@ impl Marker {
             MarkerShape::Particle | MarkerShape::Ground(_) => {}
         }
     }
+}
+
+/// Body `bi`'s coordinates in a row: at the body's offset in a full row (`layout = None`), at
+/// its start in a constraint's compressed row otherwise.
+#[inline]
+fn body_slice<'r>(bodies: &[Body], bi: usize, row: &'r mut [f64], layout: Option<&[(usize, usize)]>) -> &'r mut [f64] {
+    let body = &bodies[bi];
+    let start = match layout {
+        None => body.offset,
+        Some(l) => l.iter().find(|e| e.0 == bi).expect("the marker's body is in the constraint's layout").1,
+    };
+    &mut row[start..start + body.n_coords]
 }
 
 /// The planar kinematics shared by the kinds with a floating frame `(x, y, theta)` (rigid

@@ -47,9 +47,10 @@ impl Distance {
             return;
         }
         let e = [d[0] / l, d[1] / l];
+        let layout = Some(out.layout);
         let row = &mut out.jac[0..n];
-        self.a.add_point_jacobian(bodies, &sa, e, row);
-        self.b.add_point_jacobian(bodies, &sb, [-e[0], -e[1]], row);
+        self.a.add_point_jacobian_in(bodies, &sa, e, row, layout);
+        self.b.add_point_jacobian_in(bodies, &sb, [-e[0], -e[1]], row, layout);
         let edd = e[0] * dd[0] + e[1] * dd[1];
         let hd = [sa.h[0] - sb.h[0], sa.h[1] - sb.h[1]];
         out.gamma[0] = -(e[0] * hd[0] + e[1] * hd[1]) - (dd[0] * dd[0] + dd[1] * dd[1] - edd * edd) / l;

@@ -74,7 +74,7 @@ impl CoordinateDriver {
         }
         let mut w = [0.0; 2];
         w[k] = 1.0;
-        self.point.add_point_jacobian(bodies, &sp, w, &mut out.jac[0..n]);
+        self.point.add_point_jacobian_in(bodies, &sp, w, &mut out.jac[0..n], Some(out.layout));
         out.phi_t[0] = -f.1;
         out.gamma[0] = -sp.h[k] + f.2;
     }

@@ -10,6 +10,7 @@
 pub mod distance;
 pub mod driver;
 pub mod expr;
+pub mod jac;
 pub mod motion;
 pub mod point_on_line;
 pub mod prismatic;
@@ -66,8 +67,11 @@ pub struct Reaction {
 pub struct ConstraintOut<'a> {
     /// `Phi` rows (written only when `Some`).
     pub phi: Option<&'a mut [f64]>,
-    /// Jacobian rows, each `n` long (row-major), already zeroed by the caller.
+    /// Jacobian rows in the constraint's compressed layout (`jac::SegJac`): each row is the
+    /// coordinates of its bodies one after the other (`layout`: `(body, start)`), `width` long
+    /// (the `n` passed to `eval`), row-major, already zeroed by the caller.
     pub jac: &'a mut [f64],
+    pub layout: &'a [(usize, usize)],
     /// `Phi_t` rows.
     pub phi_t: &'a mut [f64],
     /// `gamma` rows.
@@ -219,7 +223,8 @@ impl Constraint {
         }
     }
 
-    /// Evaluate this constraint's rows at `(t, q, qd)`.
+    /// Evaluate this constraint's rows at `(t, q, qd)`; `n` is the width of a Jacobian row in
+    /// `out.jac` (the compressed layout).
     #[inline]
     pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, mut out: ConstraintOut) {
         let out = &mut out;

@@ -13,9 +13,10 @@ pub fn coincidence(bodies: &[Body], a: &Marker, b: &Marker, sa: &MarkerState, sb
         }
         let mut w = [0.0; 2];
         w[c] = 1.0;
+        let layout = Some(out.layout);
         let row = &mut out.jac[(k + c) * n_cols..(k + c + 1) * n_cols];
-        a.add_point_jacobian(bodies, sa, w, row);
-        b.add_point_jacobian(bodies, sb, [-w[0], -w[1]], row);
+        a.add_point_jacobian_in(bodies, sa, w, row, layout);
+        b.add_point_jacobian_in(bodies, sb, [-w[0], -w[1]], row, layout);
         out.phi_t[k + c] = 0.0;
         out.gamma[k + c] = -(sa.h[c] - sb.h[c]);
     }
@@ -34,10 +35,11 @@ pub fn point_on_line(bodies: &[Body], p: &Marker, l: &Marker, sp: &MarkerState, 
     if let Some(phi) = out.phi.as_deref_mut() {
         phi[k] = nv[0] * d[0] + nv[1] * d[1];
     }
+    let layout = Some(out.layout);
     let row = &mut out.jac[k * n_cols..(k + 1) * n_cols];
-    p.add_point_jacobian(bodies, sp, nv, row);
-    l.add_point_jacobian(bodies, sl, [-nv[0], -nv[1]], row);
-    l.add_angle_jacobian(bodies, sl, jnd, row);
+    p.add_point_jacobian_in(bodies, sp, nv, row, layout);
+    l.add_point_jacobian_in(bodies, sl, [-nv[0], -nv[1]], row, layout);
+    l.add_angle_jacobian_in(bodies, sl, jnd, row, layout);
     out.phi_t[k] = 0.0;
     let hd = [sp.h[0] - sl.h[0], sp.h[1] - sl.h[1]];
     out.gamma[k] = -(nv[0] * hd[0] + nv[1] * hd[1] + 2.0 * sl.omega * (jn[0] * dd[0] + jn[1] * dd[1]) + sl.h_phi * jnd
@@ -50,9 +52,10 @@ pub fn angle(bodies: &[Body], a: &Marker, b: &Marker, sa: &MarkerState, sb: &Mar
     if let Some(phi) = out.phi.as_deref_mut() {
         phi[k] = sa.phi - sb.phi - f.0;
     }
+    let layout = Some(out.layout);
     let row = &mut out.jac[k * n_cols..(k + 1) * n_cols];
-    a.add_angle_jacobian(bodies, sa, 1.0, row);
-    b.add_angle_jacobian(bodies, sb, -1.0, row);
+    a.add_angle_jacobian_in(bodies, sa, 1.0, row, layout);
+    b.add_angle_jacobian_in(bodies, sb, -1.0, row, layout);
     out.phi_t[k] = -f.1;
     out.gamma[k] = -(sa.h_phi - sb.h_phi) + f.2; // -Phi_tt = f''
 }

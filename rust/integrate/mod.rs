@@ -163,14 +163,9 @@ impl SecondOrderSystem for UkSystem<'_> {
         for i in 0..n {
             r1[i] -= data.force[i];
         }
-        for (r, l) in lambda.iter().enumerate() {
-            let row = &data.jac[r * n..(r + 1) * n];
-            let mut ax = 0.0;
-            for i in 0..n {
-                r1[i] += row[i] * l;
-                ax += row[i] * qdd[i];
-            }
-            r2[r] = ax - data.gamma[r];
+        for (r, &l) in lambda.iter().enumerate() {
+            data.ajac.add_row(r, l, r1);
+            r2[r] = data.ajac.row_dot(r, qdd) - data.gamma[r];
         }
         Ok(true)
     }
@@ -187,7 +182,8 @@ impl SecondOrderSystem for UkSystem<'_> {
     }
     fn stiff_structure(&mut self, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], a: &mut [f64]) -> Result<bool> {
         // `uk::acceleration` / `augmented_residual` left the body blocks and A of (q, qd) in `data`
-        let (model, data) = (self.model, &self.data);
+        let (model, data) = (self.model, &mut self.data);
+        data.ensure_dense_jac()?;
         dynamics::dense_mass_into(model, data, m);
         dynamics::stiffness_into(model, data, q, qd, k);
         a.copy_from_slice(&data.jac);
@@ -195,6 +191,7 @@ impl SecondOrderSystem for UkSystem<'_> {
     }
     fn structure(&mut self, t: f64, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], c: &mut [f64], a: &mut [f64], bv: &mut [f64]) -> Result<bool> {
         let (model, data) = (self.model, &mut self.data);
+        data.ensure_dense_jac()?;
         dynamics::mass_and_forces(model, data, q, qd);
         dynamics::dense_mass_into(model, data, m);
         dynamics::tangent_into(model, data, q, qd, k, c);
