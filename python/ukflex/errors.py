@@ -31,6 +31,11 @@ __all__ = [
     "MissingDependencyError",
     "InvalidArgumentError",
     "UnknownOptionError",
+    "StabilityWarning",
+    "RankDeficiencyWarning",
+    "DriftWarning",
+    "BucklingWarning",
+    "ModelValidityWarning",
 ]
 
 UkflexError = core.UkflexError
@@ -96,3 +101,24 @@ class UnknownOptionError(InvalidArgumentError):
     def __init__(self, argument: str, message: str, valid: Sequence[str] = ()):
         super().__init__(argument, message)
         self.valid = list(valid)
+
+
+# ------------------------------------------------------------------------------------ warnings
+class StabilityWarning(UserWarning):
+    """Base class of the numerical-stability warnings of ukflex (reports: ``ukflex.stability``)."""
+
+
+class RankDeficiencyWarning(StabilityWarning):
+    """The constraint Jacobian lost rank (in the mass metric) during the run."""
+
+
+class DriftWarning(StabilityWarning):
+    """The constraint residual (drift) passed the threshold."""
+
+
+class BucklingWarning(StabilityWarning):
+    """A beam's compressive axial force approaches (or exceeds) its Euler buckling load."""
+
+
+class ModelValidityWarning(StabilityWarning):
+    """The linear-elastic FFRF model (small deformations) is outside its range of validity."""

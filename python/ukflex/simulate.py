@@ -18,7 +18,7 @@ from scipy.integrate._ivp.common import OdeSolution
 from scipy.integrate._ivp.ivp import METHODS as _SCIPY_SOLVERS, find_active_events, handle_events, prepare_events
 
 from . import _core
-from .errors import InvalidArgumentError, NonFiniteError, UnknownOptionError
+from .errors import DriftWarning, InvalidArgumentError, NonFiniteError, UnknownOptionError
 from .results import SimulationResult
 from .scene import Scene
 from .system import System, length_scale
@@ -399,7 +399,6 @@ def _check_drift(system: System, res: SimulationResult, rtol: float, atol: Any) 
     worst = int(np.argmax(pos))
     if not pos[worst] > limit:
         return
-    from .stability import DriftWarning  # the warning family of stability reports
     text = (f"the constraints drifted to ||Phi|| = {pos[worst]:.3g} m at t = {res.t[worst]:.6g} s, more than "
             f"min({DRIFT_FACTOR:g} x (rtol x length scale {scale:.3g} m + atol), {DRIFT_OF_SCALE:g} x length scale) = "
             f"{limit:.3g} m: the run did not deliver "

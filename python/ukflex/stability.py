@@ -58,24 +58,14 @@ __all__ = [
 
 
 # ------------------------------------------------------------------------------------ warnings
-class StabilityWarning(UserWarning):
-    """Base class of the numerical-stability warnings of ukflex."""
-
-
-class RankDeficiencyWarning(StabilityWarning):
-    """The constraint Jacobian lost rank (in the mass metric) during the run."""
-
-
-class DriftWarning(StabilityWarning):
-    """The constraint residual (drift) passed the threshold."""
-
-
-class BucklingWarning(StabilityWarning):
-    """A beam's compressive axial force approaches (or exceeds) its Euler buckling load."""
-
-
-class ModelValidityWarning(StabilityWarning):
-    """The linear-elastic FFRF model (small deformations) is outside its range of validity."""
+# (defined with the errors, so that simulate can warn without importing this module)
+from .errors import (  # noqa: E402
+    BucklingWarning,
+    DriftWarning,
+    ModelValidityWarning,
+    RankDeficiencyWarning,
+    StabilityWarning,
+)
 
 
 class IntegrationFailure(SolverError):  # type: ignore[misc, valid-type]
