@@ -72,7 +72,7 @@ pub struct GenAlphaOptions {
     /// 4.4 -> 2.3 iterations per step, errors against the geometrically exact reference
     /// unchanged to 0.01 % of the peak). The Newton error then scales with the local error, not
     /// with `rtol`: a convergence study at a tight `rtol` sees an order below 2 (double
-    /// pendulum: 1.5-1.8 at 0.01-0.3). `None`: the `rtol` level only.
+    /// pendulum: 1.4-1.8 at 0.01-0.3). `None`: the `rtol` level only.
     pub newton_local_error: Option<f64>,
 }
 
