@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from ukflex import scenes, simulate
+from ukflex import choice
 from ukflex.choice import choose_method, elastic_shares
 
 
@@ -32,6 +33,8 @@ def test_the_paper_scene_is_stiff_and_gets_generalized_alpha_with_a_step_from_it
     res = simulate(sys_, 0.1)
     assert res.method == "GENALPHA" and res.success
     assert res.extra["auto"]["step"] == pytest.approx(c.step) and "stiff" in res.extra["auto"]["reason"]
+    # Newton at the local error level (ukflex.choice.NEWTON_LOCAL_ERROR)
+    assert res.extra["auto"]["options"]["newton_local_error"] == choice.NEWTON_LOCAL_ERROR
     assert res.max_residual("position") < 1e-9
 
 

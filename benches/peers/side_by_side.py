@@ -3,7 +3,9 @@
 Both codes run the paper's slider-crank with gravity, 0..0.1 s, in ONE process, interleaved
 (every configuration of both codes once per repetition, alternating order), and report the
 median solve-only wall time (model building excluded for both; ukflex's ``method="auto"`` runs
-include the chooser's modal analysis).  Errors are measured against the same physical answer:
+include the chooser's modal analysis; both record their outputs at every step: Exudyn its sensors,
+ukflex the state, ``--outputs grid`` for 10001 dense outputs instead).  Errors are measured against
+the same physical answer:
 Exudyn's converged ANCF cable (benches/data/exudyn_ref_ancf.csv, N = 32, h = 7.8e-7), on the peak
 |v(0.5)|/Lb over 0..0.07 s (parabolic refinement) and on the whole v(0.5)/Lb history over
 0..0.1 s (max difference relative to the peak).
@@ -15,7 +17,7 @@ luck, not accuracy.  For each level the fastest reliable point of each code and 
 
 Optional (needs ``pip install exudyn``); not run in CI:
 
-    python benches/peers/side_by_side.py                  # ~2 min, writes benches/data/side_by_side.csv
+    python benches/peers/side_by_side.py --repeat 15      # ~1.5 min, writes benches/data/side_by_side.csv
     python benches/peers/side_by_side.py --repeat 3 --quick   # ~30 s
 """
 
@@ -35,23 +37,29 @@ import exudyn_slider_crank as es  # noqa: E402
 
 import ukflex  # noqa: E402
 from ukflex import scenes, simulate  # noqa: E402
+from ukflex.choice import NEWTON_LOCAL_ERROR  # noqa: E402
 
 DATA = os.path.normpath(os.path.join(HERE, "..", "data"))
 T_END, PEAK_END = 0.1, 0.07
 GRID = np.linspace(0.0, T_END, 10001)
 LEVELS = (5e-3, 1e-3)
 
-# (label, model, N, list of steps or None for auto, list of rtols for auto)
+# (label, model, N, list of steps or None for auto, list of rtols for auto, GENALPHA options)
+GA_STEPS = (4e-4, 2e-4, 1.75e-4, 1.5e-4, 1e-4, 7.5e-5, 6e-5, 5e-5, 2.5e-5)
+LOCAL = {"newton_local_error": NEWTON_LOCAL_ERROR}  # the Newton tolerance method="auto" sets
 UK_CONFIGS = [
-    ("ukflex auto", "nonlinear-ffrf", 4, None, (1e-5, 1e-6, 1e-7, 1e-8)),
-    ("ukflex auto", "ancf", 4, None, (1e-5, 1e-6, 1e-7, 1e-8)),
-    ("ukflex auto", "ancf", 8, None, (1e-6, 1e-7, 1e-8)),
-    ("ukflex GENALPHA", "nonlinear-ffrf", 4, (4e-4, 2e-4, 1.5e-4, 1e-4, 5e-5, 2.5e-5), None),
-    ("ukflex GENALPHA", "nonlinear-ffrf", 8, (2e-4, 1e-4, 5e-5, 2.5e-5), None),
-    ("ukflex GENALPHA", "ancf", 4, (4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5), None),
-    ("ukflex GENALPHA", "ancf", 8, (2e-4, 1e-4, 5e-5, 2.5e-5), None),
+    ("ukflex auto", "nonlinear-ffrf", 4, None, (1e-5, 1e-6, 1e-7, 1e-8), {}),
+    ("ukflex auto", "ancf", 4, None, (1e-5, 1e-6, 1e-7, 1e-8), {}),
+    ("ukflex auto", "ancf", 8, None, (1e-6, 1e-7, 1e-8), {}),
+    ("ukflex GENALPHA", "nonlinear-ffrf", 4, GA_STEPS, None, {}),
+    ("ukflex GENALPHA local", "nonlinear-ffrf", 4, GA_STEPS, None, LOCAL),
+    ("ukflex GENALPHA", "nonlinear-ffrf", 8, (2e-4, 1e-4, 5e-5, 2.5e-5), None, {}),
+    ("ukflex GENALPHA", "ancf", 4, (4e-4, 2e-4, 1e-4, 7.5e-5, 5e-5, 2.5e-5), None, {}),
+    ("ukflex GENALPHA local", "ancf", 4, (4e-4, 2e-4, 1e-4, 7.5e-5, 5e-5, 2.5e-5), None, LOCAL),
+    ("ukflex GENALPHA", "ancf", 8, (2e-4, 1e-4, 5e-5, 2.5e-5), None, {}),
 ]
-EXU_CONFIGS = [("Exudyn GA", "ancf", n, (4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5)) for n in (2, 4, 8)]
+EXU_CONFIGS = [("Exudyn GA", "ancf", 2, (4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5)), ("Exudyn GA", "ancf", 4, GA_STEPS),
+               ("Exudyn GA", "ancf", 8, (4e-4, 2e-4, 1.75e-4, 1.5e-4, 1e-4, 7.5e-5, 6e-5, 5e-5, 2.5e-5))]
 
 
 def uk_scene(model: str, n: int):
@@ -71,6 +79,9 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--quick", action="store_true", help="fewer configurations")
     ap.add_argument("--out", default=os.path.join(DATA, "side_by_side.csv"))
+    ap.add_argument("--outputs", choices=("steps", "grid"), default="steps",
+                    help="ukflex records the state at its step ends (default; Exudyn records its sensors at every "
+                         "step) or at 10001 times from the dense output (the old scope: ~25 %% of a run's time)")
     args = ap.parse_args(argv)
     t_ref, v_ref, _ = es.load_reference(os.path.join(DATA, "exudyn_ref_ancf.csv"))
     ref = {"t": t_ref, "v": v_ref}
@@ -79,13 +90,13 @@ def main(argv=None) -> int:
 
     runs = []  # (key, callable) -> callable returns (wall, t, v, info)
     systems = {}
-    for label, model, n, steps, rtols in UK_CONFIGS[: 3 if args.quick else None]:
+    for label, model, n, steps, rtols, extra in UK_CONFIGS[: 3 if args.quick else None]:
         systems.setdefault((model, n), uk_scene(model, n))
         sys_ = systems[(model, n)]
         for par in (rtols if steps is None else steps):
-            def run(sys_=sys_, par=par, auto=steps is None):
-                kw = {"rtol": par} if auto else {"method": "GENALPHA", "step": par}
-                res = simulate(sys_, T_END, t_eval=GRID, **kw)
+            def run(sys_=sys_, par=par, auto=steps is None, extra=extra):
+                kw = {"rtol": par} if auto else {"method": "GENALPHA", "step": par, **extra}
+                res = simulate(sys_, T_END, t_eval=GRID if args.outputs == "grid" else None, **kw)
                 wall = res.wall_time + (res.extra["auto"]["time"] if auto else 0.0)
                 _, v = res.beam_displacement("coupler", 0.5)
                 info = {"method": res.method, "step": res.extra.get("auto", {}).get("step", None if auto else par),
@@ -124,16 +135,16 @@ def main(argv=None) -> int:
         fh.write(f"# ukflex {ukflex.__version__} vs Exudyn {es.EXUDYN_VERSION}, paper scene with gravity, 0..0.1 s, solve-only "
                  f"medians of {args.repeat} interleaved repetitions, load {load0:.2f} -> {os.getloadavg()[0]:.2f}; "
                  f"errors vs exudyn_ref_ancf.csv; written by: python benches/peers/side_by_side.py --repeat {args.repeat}"
-                 f"{' --quick' if args.quick else ''}\n")
+                 f"{' --quick' if args.quick else ''} --outputs {args.outputs}\n")
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
     print(f"\n{elapsed:.0f} s; load {load0:.2f} -> {os.getloadavg()[0]:.2f}; wrote {args.out}\n")
-    print(f"{'code':16s} {'model':15s} {'N':>2s} {'param':>8s} {'method':9s} {'step':>9s} {'median ms':>9s} "
+    print(f"{'code':22s} {'model':15s} {'N':>2s} {'param':>8s} {'method':9s} {'step':>9s} {'median ms':>9s} "
           f"{'peak err':>9s} {'hist err':>9s}")
     for r in rows:
         step = f"{r['step']:.3g}" if r["step"] else "-"
-        print(f"{r['code']:16s} {r['model']:15s} {r['N']:2d} {r['param']:8.3g} {r['method'][:9]:9s} {step:>9s} "
+        print(f"{r['code']:22s} {r['model']:15s} {r['N']:2d} {r['param']:8.3g} {r['method'][:9]:9s} {step:>9s} "
               f"{r['median_ms']:9.1f} {100 * r['peak_err']:8.3f}% {100 * r['hist_err']:8.3f}%")
     print()
     for level in LEVELS:

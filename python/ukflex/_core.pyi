@@ -121,6 +121,7 @@ class System:
         max_wall_time: Optional[float] = None,
         min_step: float = 0.0,
         dense: bool = False,
+        newton_local_error: Optional[float] = None,
     ) -> Dict[str, Any]:
         """Native integration; dict with t (nt,), y (2n, nt), status, message, failure (None or
         cause, t, stage, index), statistics, dense (None or meta (nseg, 3), data, part_len)."""

@@ -29,7 +29,7 @@ METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 #: Integrators that run entirely in Rust with the GIL released (``System.integrate``):
 #: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
 NATIVE_METHODS = ("DOPRI5", "RADAU5", "GENALPHA")
-_NATIVE_OPTIONS = ("first_step", "max_step", "projection_tol", "rho_inf", "step", "jacobian")
+_NATIVE_OPTIONS = ("first_step", "max_step", "projection_tol", "rho_inf", "step", "jacobian", "newton_local_error")
 #: ``solve_ivp`` solver options passed through on the scipy paths.
 _SCIPY_OPTIONS = ("first_step", "max_step", "jac", "jac_sparsity", "lband", "uband")
 FORMULATIONS = ("uk", "uk-numpy", "cp")
@@ -200,7 +200,9 @@ def simulate(
         projection onto the constraints by default).  Names are case-insensitive.  Native
         methods take the options ``first_step``, ``max_step``, ``projection_tol`` (project onto
         the constraints after every accepted step whose residuals exceed it; 0: off) and
-        ``jacobian``, GENALPHA also ``rho_inf`` and ``step``; see docs/integrators.md.
+        ``jacobian``, GENALPHA also ``rho_inf``, ``step`` and ``newton_local_error`` (Newton may
+        stop at this fraction of the step's local error estimate; ``method="auto"`` sets it);
+        see docs/integrators.md.
     rtol : float
         Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s).
     atol : float or array of shape (2n,), optional
@@ -245,7 +247,7 @@ def simulate(
         ``step`` that cannot reach ``t_end`` within ``max_steps`` is refused up front.
     **options
         Solver options: ``first_step``, ``max_step``, ``jac``, ... (scipy); ``first_step``,
-        ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``jacobian`` (native).  An option
+        ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``newton_local_error``, ``jacobian`` (native).  An option
         the chosen method does not take raises :class:`UnknownOptionError` listing the valid
         ones.  For ``"Radau"`` and ``"BDF"`` the default ``jac`` is the core's finite-difference
         Jacobian ``System.jac``; ``nfev`` counts only the integrator's ``rhs`` calls.
@@ -687,7 +689,7 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
     for key in ("first_step", "max_step", "step"):
         if options.get(key) is not None:
             kwargs[key] = _positive(key, options[key])
-    for key in ("projection_tol", "rho_inf"):  # 0 is meaningful (projection off, full dissipation)
+    for key in ("projection_tol", "rho_inf", "newton_local_error"):  # 0 is meaningful (projection off, full dissipation)
         if options.get(key) is not None:
             kwargs[key] = _real(key, options[key])
     if options.get("jacobian") is not None:
@@ -760,7 +762,7 @@ def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
         choice.options, choice.rtol = {}, None
         choice.reason += f"; scipy {choice.method} because of the scipy option(s) {scipy_only}"
         return choice.method, options, choice
-    genalpha_only = sorted(set(options) & {"step", "rho_inf"})
+    genalpha_only = sorted(set(options) & {"step", "rho_inf", "newton_local_error"})
     if genalpha_only and choice.method != "GENALPHA":
         choice.method, choice.options, choice.rtol = "GENALPHA", {}, None
         choice.reason += f"; GENALPHA because of the option(s) {genalpha_only}"

@@ -531,13 +531,14 @@ impl PySystem {
     /// max_wall_time [s], min_step (smallest step size [s]); a run that exceeds one, or whose
     /// state or acceleration turns non-finite, ends with status -1 and the trajectory up to its
     /// last accepted step. dense: record every step's dense output (evaluate with
-    /// `ukflex._core.dense_eval`).
+    /// `ukflex._core.dense_eval`). newton_local_error (GENALPHA): Newton may stop at this
+    /// fraction of the local error estimate (None: at the rtol level only).
     ///
     /// Returns a dict: t (nt,), y (2n, nt), status (0 ok, -1 failed), message, failure (None,
     /// or a dict cause, t, stage, index), nfev, njev, nlu, naccept, nreject, jac_evals (UK calls
     /// inside Jacobians), wall_time [s], dense (None, or a dict meta (nseg, 3), data
     /// (nseg, width), part_len).
-    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=0.9, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false))]
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=0.9, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None))]
     #[allow(clippy::too_many_arguments)]
     fn integrate<'py>(
         &self,
@@ -560,6 +561,7 @@ impl PySystem {
         max_wall_time: Option<f64>,
         min_step: f64,
         dense: bool,
+        newton_local_error: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let jacobian = match jacobian {
             "central" => Differences::Central,
@@ -573,8 +575,9 @@ impl PySystem {
         if let Method::GenAlpha(go) = &mut method {
             go.rho_inf = rho_inf;
             go.step = step;
-        } else if step.is_some() {
-            return Err(PyValueError::new_err("step (a fixed step size) applies to GENALPHA only"));
+            go.newton_local_error = newton_local_error;
+        } else if step.is_some() || newton_local_error.is_some() {
+            return Err(PyValueError::new_err("step (a fixed step size) and newton_local_error apply to GENALPHA only"));
         }
         let mut y = vec![0.0; 2 * n];
         read_into("y0", &y0.as_array(), &mut y).map_err(to_py)?;

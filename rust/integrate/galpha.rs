@@ -29,6 +29,13 @@
 //! and are re-read every 64 steps or when Newton slows. The converged iterate is finished by
 //! one UK evaluation, `qdd_{n+1} = g(q_{n+1}, qd_{n+1})`: the accepted accelerations and
 //! multipliers are the UK solution (the difference is the Newton error, below the tolerance).
+//! Newton stops when its estimated remaining position error is below `NEWTON_KAPPA` in the
+//! error-test units of `rtol`, or (`GenAlphaOptions::newton_local_error`, what `method="auto"`
+//! uses), while it contracts fast, below a fraction of the last step's local error estimate:
+//! an error far below what the step size already commits changes nothing.
+//! As the UK evaluation amplifies a Newton error in the stiff directions by `~beta' omega^2`,
+//! its change of the iterate (as a position change `beta' (g - x)`) is held to the same
+//! tolerance, or Newton goes on.
 //!
 //! **Constraint drift.** The UK acceleration satisfies `A qdd = b` exactly, so positions and
 //! velocities drift only by the discretization error. With a projection tolerance the final UK
@@ -58,11 +65,20 @@ pub struct GenAlphaOptions {
     /// Projection onto the constraints after each step (with the factorization of the step's
     /// final kernel call).
     pub projection: Option<ProjectionTolerance>,
+    /// Let Newton stop, while it contracts fast, once its remaining position error is below
+    /// this fraction of the last step's local error estimate `h^2 |beta - 1/6| |a_{n+1} - a_n|`
+    /// (same norm) instead of the `rtol` level: a Newton error well below the discretization
+    /// error changes nothing the step size does not decide (paper scene, nonlinear FFRF N = 4:
+    /// 4.4 -> 2.3 iterations per step, errors against the geometrically exact reference
+    /// unchanged to 0.01 % of the peak). The Newton error then scales with the local error, not
+    /// with `rtol`: a convergence study at a tight `rtol` sees an order below 2 (double
+    /// pendulum: 1.4-1.8 at 0.01-0.3). `None`: the `rtol` level only.
+    pub newton_local_error: Option<f64>,
 }
 
 impl Default for GenAlphaOptions {
     fn default() -> Self {
-        GenAlphaOptions { rho_inf: 0.9, step: None, max_newton: 8, projection: None }
+        GenAlphaOptions { rho_inf: 0.9, step: None, max_newton: 8, projection: None, newton_local_error: None }
     }
 }
 
@@ -74,8 +90,13 @@ const REUSE_CONTRACTION: f64 = 0.2;
 const VELOCITY_TERMS_AGE: usize = 64;
 const REFRESH_CONTRACTION: f64 = 0.3;
 /// Newton stops when the estimated remaining position error, in the error-test units of
-/// `rtol`/`atol`, falls below this.
+/// `rtol`/`atol`, falls below this ...
 const NEWTON_KAPPA: f64 = 0.1;
+/// ... or, with `GenAlphaOptions::newton_local_error` and while Newton contracts at least as
+/// fast as this, below that fraction of the last step's local error estimate (a slower
+/// contraction keeps the strict tolerance: with one ratio measured, the estimate of the
+/// remaining error is not trustworthy; an ANCF coupler at h = 2e-4 diverged without this guard).
+const LOOSE_CONTRACTION: f64 = 0.1;
 
 pub struct GenAlpha {
     opts: Options,
@@ -130,6 +151,9 @@ pub struct GenAlpha {
     reject: bool,
     /// Local error estimate of the last accepted step (error-test units).
     err_prev: f64,
+    /// Local error estimate of the last accepted step in the Newton norm: the scale of the
+    /// looser Newton tolerance (`NEWTON_LOCAL_ERROR`).
+    le_prev: f64,
 }
 
 impl GenAlpha {
@@ -142,6 +166,11 @@ impl GenAlpha {
         if let Some(h) = go.step {
             if !(h > 0.0) || !h.is_finite() {
                 return Err(Error::argument("step", format!("must be positive and finite, got {h}")));
+            }
+        }
+        if let Some(k) = go.newton_local_error {
+            if !(k >= 0.0) || !k.is_finite() {
+                return Err(Error::argument("newton_local_error", format!("must be >= 0 and finite, got {k}")));
             }
         }
         if go.max_newton == 0 {
@@ -194,6 +223,7 @@ impl GenAlpha {
             reuse: false,
             reject: false,
             err_prev: 0.0,
+            le_prev: 0.0,
         })
     }
 
@@ -326,6 +356,8 @@ impl GenAlpha {
         let mut prev = f64::INFINITY;
         let mut theta = 0.0;
         let mut refreshed = false;
+        let (am, af) = (self.alpha_m, self.alpha_f);
+        let c_le = h * h * (self.beta - 1.0 / 6.0).abs();
         for k in 1..=self.go.max_newton {
             self.trial(h);
             let (r1, r2) = (&mut self.g, &mut self.r2);
@@ -355,6 +387,8 @@ impl GenAlpha {
                 self.g[i] = bp * self.rhs[i];
             }
             let d = self.newton_norm(&self.g);
+            // the looser tolerance: a fraction of the last step's local error estimate
+            let tol_le = tol.max(self.go.newton_local_error.unwrap_or(0.0) * self.le_prev);
             if !d.is_finite() {
                 // remembered: if the step size then shrinks to nothing, the run ends naming it
                 let (q, qd, qdd) = (&self.q_new, &self.qd_new, &self.x);
@@ -378,7 +412,9 @@ impl GenAlpha {
                 if theta >= 1.0 {
                     return Ok(None);
                 }
-                theta / (1.0 - theta) * d <= tol
+                // a fast contraction makes the estimate of the remaining error trustworthy:
+                // then the Newton error may be a fraction of the discretization error
+                theta / (1.0 - theta) * d <= if theta <= LOOSE_CONTRACTION { tol_le } else { tol }
             } else {
                 false
             };
@@ -386,10 +422,27 @@ impl GenAlpha {
                 // the UK acceleration at the converged state (the accepted solution; the
                 // difference is the Newton error), and the projection with its factorization
                 self.trial(h);
+                for i in 0..n {
+                    let a1 = ((1.0 - af) * self.x[i] + af * self.qdd_prev[i] - am * self.a_prev[i]) / (1.0 - am);
+                    self.g[i] = c_le * (a1 - self.a_prev[i]);
+                }
+                let le = self.newton_norm(&self.g);
                 sys.acc_projected(t1, &mut self.q_new, &mut self.qd_new, &mut self.g, self.go.projection)?;
                 self.st.stats.nfev += 1;
+                // the UK acceleration replaces the iterate: in the stiff directions it amplifies
+                // the Newton error by ~beta' omega^2, so its change, as a position change
+                // beta' (g - x), must itself be within the tolerance, or Newton goes on
+                if k < self.go.max_newton && tol_le > tol {
+                    for i in 0..n {
+                        self.rhs[i] = bp * (self.g[i] - self.x[i]);
+                    }
+                    if self.newton_norm(&self.rhs[..n]) > tol_le {
+                        prev = d.max(f64::MIN_POSITIVE);
+                        continue;
+                    }
+                }
+                self.le_prev = le;
                 sys.multipliers(&mut self.lam);
-                let (am, af) = (self.alpha_m, self.alpha_f);
                 for i in 0..n {
                     self.x[i] = self.g[i];
                     self.a_new[i] = ((1.0 - af) * self.g[i] + af * self.qdd_prev[i] - am * self.a_prev[i]) / (1.0 - am);
@@ -408,6 +461,7 @@ impl Stepper for GenAlpha {
         let n = self.n;
         self.st.start(t0, y0);
         self.reject = false;
+        self.le_prev = 0.0;
         let (q, qd) = y0.split_at(n);
         sys.acc(t0, q, qd, &mut self.qdd)?;
         self.st.stats.nfev += 1;
