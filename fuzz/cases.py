@@ -222,7 +222,9 @@ def _check_scene(case: Dict[str, Any]) -> List[Finding]:
         d = 1e-6 * np.where(translation, L, 1.0) * np.cos(np.arange(system.n_coords) + 1.0)
         expected = system.A(system.q0) @ d
         actual = system.phi(system.t0, system.q0 + d) - system.phi(system.t0, system.q0)
-        if _max_abs(actual - expected) > 1e-3 * _max_abs(expected) + 1e-15 * L:
+        # slack: rounding, and the second-order term |d|^2 / L ~ 1e-12 L of curved constraints
+        # (a distance probed nearly across its rod: A d is small, the curvature is not)
+        if _max_abs(actual - expected) > 1e-3 * _max_abs(expected) + 1e-11 * L:
             findings.append(("wrong", f"build: the state does not resolve a 1e-6 L motion (dPhi {_max_abs(actual):.3g} "
                                       f"vs A d {_max_abs(expected):.3g}): positions too far from the origin"))
         try:

@@ -199,3 +199,12 @@ def test_a_run_that_cannot_finish_within_its_budget_stops_early():
     res = ukflex.simulate(scenes.pendulum(), 1e9, method="RK45")
     assert res.status == -1 and res.stop["cause"] == "max_steps"
     assert "cannot suffice" in res.message and res.t.size > 100 and res.t[-1] < 1e9
+
+
+def test_a_scene_beyond_the_double_range_of_squares_is_refused():
+    # a pendulum of 1.8e308 m built (its energies were still finite) and overflowed at the first motion
+    s = ukflex.Scene(gravity=(0.0, -1.7))
+    bob = s.point_mass("bob", mass=0.22, position=(0.03, -0.5))
+    s.distance(s.ground.point(0.0, 0.0), bob.point(), length=1.7976931348623157e308)
+    with pytest.raises(InvalidSceneError, match="length scale 1.8e\\+308 m is beyond 1e\\+150 m"):
+        ukflex.System(s)

@@ -649,9 +649,19 @@ class System:
                 f"{self.RESOLUTION * scale / np.finfo(float).eps:.3g} m); place the origin near the mechanism"
             )
 
+    #: largest length scale [m]: beyond it squares of positions and velocities (energies, the
+    #: centripetal terms) overflow double precision; it is a unit mistake
+    MAX_LENGTH_SCALE = 1e150
+
     def _check_lengths(self, scale: float) -> None:
-        """Refuse a distance constraint shorter than the scene resolves: its direction (the row of
-        ``A``) is rounding noise and the correction would put the two points on top of each other."""
+        """Refuse a scene too large for double precision, and a distance constraint shorter than
+        the scene resolves: its direction (the row of ``A``) is rounding noise and the correction
+        would put the two points on top of each other."""
+        if scale > self.MAX_LENGTH_SCALE:
+            raise InvalidSceneError(
+                f"the scene's length scale {scale:.3g} m is beyond {self.MAX_LENGTH_SCALE:g} m: squares of positions "
+                "and velocities overflow double precision there; check the units"
+            )
         for j in self.description.get("joints", []):
             length = j.get("length")
             if j.get("kind") == "distance" and isinstance(length, (int, float)) and 0.0 < length < self.RESOLUTION * scale:
