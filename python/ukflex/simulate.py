@@ -204,7 +204,8 @@ def simulate(
         stop at this fraction of the step's local error estimate; ``method="auto"`` sets it);
         see docs/integrators.md.
     rtol : float
-        Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s).
+        Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s); below 100 x machine
+        epsilon it is raised to that floor with a warning, as ``solve_ivp`` does.
     atol : float or array of shape (2n,), optional
         Absolute tolerance; default ``1e-3 * rtol``.
     t_eval : array of shape (nt,), optional
@@ -297,6 +298,10 @@ def simulate(
     if t_end_f <= t0:
         raise InvalidArgumentError("t_end", f"must be greater than t0 = {t0}, got {t_end!r}")
     rtol = _positive("rtol", rtol)
+    if rtol < RTOL_MIN:  # as solve_ivp does: below it the error norm divides by rounding
+        warnings.warn(f"rtol = {rtol:g} is below {RTOL_MIN:.3g} (100 x machine epsilon); using {RTOL_MIN:.3g}",
+                      UserWarning, stacklevel=2)
+        rtol = RTOL_MIN
     if atol is None:
         atol_v: Any = 1e-3 * rtol
     elif np.ndim(atol) == 0 and not isinstance(atol, np.ma.MaskedArray):
@@ -409,6 +414,9 @@ def _check_drift(system: System, res: SimulationResult, rtol: float, atol: Any) 
     res.extra["drift"] = dict(max_position_residual=float(pos[worst]), t=float(res.t[worst]), limit=limit, message=text)
     warnings.warn(text, DriftWarning, stacklevel=3)
 
+
+#: smallest relative tolerance (solve_ivp's own floor: 100 x machine epsilon)
+RTOL_MIN = 100 * float(np.finfo(float).eps)
 
 #: scipy paths (about 0.1 ms of Python per step): after this many steps, and at each doubling,
 #: the pace so far is extrapolated to t_end ...
