@@ -5,6 +5,29 @@
 //! elements. Storing them banded keeps every per-call product O(n_f) instead of O(n_f^2).
 //! Everything here is allocation free after construction.
 
+/// `x . y` (over the shorter length) with four independent partial sums: a plain sum is one
+/// chain of dependent additions (the compiler may not reorder floating-point sums), which
+/// bounds the small dot products of the kernel by the adder's latency. The order is fixed, so
+/// results are reproducible.
+#[inline(always)]
+pub fn dot4(x: &[f64], y: &[f64]) -> f64 {
+    let k = x.len().min(y.len());
+    let (x, y) = (&x[..k], &y[..k]);
+    let mut s = [0.0f64; 4];
+    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
+    let (xr, yr) = (xc.remainder(), yc.remainder());
+    for (a, b) in xc.zip(yc) {
+        for j in 0..4 {
+            s[j] += a[j] * b[j];
+        }
+    }
+    let mut t = (s[0] + s[2]) + (s[1] + s[3]);
+    for (a, b) in xr.iter().zip(yr) {
+        t += a * b;
+    }
+    t
+}
+
 /// A square matrix stored by diagonals: entry (i, j) with |i - j| <= hb lives at
 /// `data[i * (2 hb + 1) + (j + hb - i)]`.
 #[derive(Debug, Clone)]

@@ -170,7 +170,7 @@ impl QrJacobi {
             let (head, tail) = self.qr.split_at_mut((k + 1) * n);
             let ck = &mut head[k * n..];
             let alpha = ck[k];
-            let xnorm2: f64 = ck[k + 1..n].iter().map(|x| x * x).sum();
+            let xnorm2 = crate::linalg::dot4(&ck[k + 1..n], &ck[k + 1..n]);
             if xnorm2 == 0.0 {
                 self.tau[k] = 0.0;
                 continue;
@@ -187,11 +187,7 @@ impl QrJacobi {
             let tau = self.tau[k];
             for j in 0..(m - k - 1) {
                 let cj = &mut tail[j * n..(j + 1) * n];
-                let mut s = cj[k];
-                for (a, b) in cj[k + 1..n].iter().zip(vk) {
-                    s += a * b;
-                }
-                s *= tau;
+                let s = (cj[k] + crate::linalg::dot4(&cj[k + 1..n], vk)) * tau;
                 cj[k] -= s;
                 for (a, b) in cj[k + 1..n].iter_mut().zip(vk) {
                     *a -= s * b;
@@ -305,11 +301,7 @@ impl QrJacobi {
                 continue;
             }
             let vk = &self.qr[k * n + k + 1..(k + 1) * n];
-            let mut s = self.tn[k];
-            for (a, b) in self.tn[k + 1..].iter().zip(vk) {
-                s += a * b;
-            }
-            s *= tau;
+            let s = (self.tn[k] + crate::linalg::dot4(&self.tn[k + 1..], vk)) * tau;
             self.tn[k] -= s;
             for (a, b) in self.tn[k + 1..].iter_mut().zip(vk) {
                 *a -= s * b;

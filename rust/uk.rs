@@ -230,12 +230,17 @@ pub fn correct(model: &Model, data: &mut Data) {
         apply_finvt(model, &data.bodies, &mut data.qdd);
         return;
     }
+    for i in 0..model.m {
+        data.residual[i] = data.gamma[i] - data.ajac.row_dot(i, &data.qdd_free);
+    }
+    correct_residual(model, data);
+}
+
+/// `correct` for the residual already in `data.residual` (dense paths).
+fn correct_residual(model: &Model, data: &mut Data) {
     let (n, m) = (model.n, model.m);
     let k = n.min(m);
     let rank = data.rank_info.rank;
-    for i in 0..m {
-        data.residual[i] = data.gamma[i] - data.ajac.row_dot(i, &data.qdd_free);
-    }
     if data.factored_with == Factored::FullRankQr {
         let qrj = data.qrj.as_mut().expect("factored with QR");
         qrj.full_rank_solve(&data.residual, &mut data.y, &mut data.lambda);
@@ -311,7 +316,13 @@ pub fn min_norm_correction(model: &Model, data: &mut Data, r: &[f64]) {
     data.qdd_free.fill(0.0);
     data.y.fill(0.0);
     data.gamma.copy_from_slice(r);
-    correct(model, data);
+    if data.factored_with == Factored::SparseGram {
+        correct(model, data);
+    } else {
+        // the residual is r itself (A 0 = 0)
+        data.residual.copy_from_slice(r);
+        correct_residual(model, data);
+    }
 }
 
 /// `qdd` at `(t, q, qd)` reusing the mass factor and the SVD of `B^T` already in `data`, which

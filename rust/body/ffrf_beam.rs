@@ -462,7 +462,7 @@ pub struct BeamData {
 
 #[inline]
 pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
-    x.iter().zip(y).map(|(p, q)| p * q).sum()
+    crate::linalg::dot4(x, y)
 }
 
 impl Beam {
@@ -676,7 +676,7 @@ impl Beam {
     pub fn mass_and_forces(&self, bd: &mut BeamData, q: &[f64], qd: &[f64], gravity: Option<[f64; 2]>, f: &mut [f64]) {
         let nf = self.n_f;
         let thd = qd[2];
-        let (s, c) = q[2].sin_cos();
+        let (s, c) = super::frame_sin_cos(q[2]);
         let (qf, qfd) = (&q[3..], &qd[3..]);
         let sig = self.first_moment(qf);
         let sigd = [dot(&self.s_bar[0], qfd), dot(&self.s_bar[1], qfd)]; // S_bar qd_f

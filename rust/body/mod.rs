@@ -495,13 +495,38 @@ fn body_slice<'r>(bodies: &[Body], bi: usize, row: &'r mut [f64], layout: Option
     &mut row[start..start + body.n_coords]
 }
 
+/// `(sin, cos)` of a floating frame's angle `theta`, memoized per thread. One evaluation of a
+/// scene reads the same body angle many times -- the body's own mass and forces, and every
+/// marker a constraint or force evaluates on it (the paper's slider-crank: ~9 reads of 3 angles
+/// per evaluation) -- and `sin_cos` is among the most expensive operations of the kernel. The
+/// cache is keyed by the exact bits of `theta` (a hit returns exactly what `sin_cos` returns),
+/// holds 8 angles, direct-mapped, and is per thread, so concurrent runs do not share it.
+#[inline]
+pub(crate) fn frame_sin_cos(theta: f64) -> (f64, f64) {
+    use std::cell::Cell;
+    thread_local! {
+        static CACHE: [Cell<(u64, f64, f64)>; 8] = const { [const { Cell::new((u64::MAX, 0.0, 0.0)) }; 8] };
+    }
+    let bits = theta.to_bits();
+    let slot = ((bits ^ (bits >> 17) ^ (bits >> 37)) & 7) as usize;
+    CACHE.with(|c| {
+        let (k, s, co) = c[slot].get();
+        if k == bits {
+            return (s, co);
+        }
+        let (s, co) = theta.sin_cos();
+        c[slot].set((bits, s, co));
+        (s, co)
+    })
+}
+
 /// The planar kinematics shared by the kinds with a floating frame `(x, y, theta)` (rigid
 /// bodies, FFRF beams): a body-frame point `pl` moving with body-frame velocity `vl`, on a
 /// frame at `(q[0], q[1])` with angle `q[2]`.
 #[inline]
 pub(crate) fn frame_point_state(pl: [f64; 2], vl: [f64; 2], phi_local: f64, omega_local: f64, q: &[f64], qd: &[f64]) -> MarkerState {
     let (th, thd) = (q[2], qd[2]);
-    let (s, c) = th.sin_cos();
+    let (s, c) = frame_sin_cos(th);
     let pw = [c * pl[0] - s * pl[1], s * pl[0] + c * pl[1]];
     let vw = [c * vl[0] - s * vl[1], s * vl[0] + c * vl[1]];
     let r_theta = [-pw[1], pw[0]];
@@ -547,7 +572,7 @@ pub(crate) fn add_frame_gravity(mass: f64, m_rr: &[[f64; 3]; 3], g: [f64; 2], f:
 /// `m R + A sig` (world first moment of a floating-frame body).
 #[inline]
 pub(crate) fn frame_mass_moment(mass: f64, sig: [f64; 2], q: &[f64]) -> [f64; 2] {
-    let (s, c) = q[2].sin_cos();
+    let (s, c) = frame_sin_cos(q[2]);
     [mass * q[0] + c * sig[0] - s * sig[1], mass * q[1] + s * sig[0] + c * sig[1]]
 }
 

@@ -377,7 +377,7 @@ impl Modal {
     pub fn mass_and_forces(&self, bd: &mut BeamData, q: &[f64], qd: &[f64], gravity: Option<[f64; 2]>, f: &mut [f64]) {
         let nf = self.n_f;
         let thd = qd[2];
-        let (s, c) = q[2].sin_cos();
+        let (s, c) = super::frame_sin_cos(q[2]);
         let (qf, qfd) = (&q[3..3 + nf], &qd[3..3 + nf]);
         let sig = [self.s_t[0] + dot(&self.s_bar[0], qf), self.s_t[1] + dot(&self.s_bar[1], qf)];
         let sigd = [dot(&self.s_bar[0], qfd), dot(&self.s_bar[1], qfd)];

@@ -62,7 +62,7 @@ impl Rigid {
     #[inline]
     pub fn mass_and_forces(&self, bd: &mut RigidData, q: &[f64], qd: &[f64], gravity: Option<[f64; 2]>, f: &mut [f64]) {
         let thd = qd[2];
-        let (s, c) = q[2].sin_cos();
+        let (s, c) = super::frame_sin_cos(q[2]);
         bd.m_rr = frame_mass_block(self.mass, self.sig(), self.j_ref, c, s);
         // A sig = (m_rr[1][2], -m_rr[0][2])
         f[0] = thd * thd * bd.m_rr[1][2];

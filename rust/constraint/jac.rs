@@ -104,7 +104,7 @@ impl SegJac {
     pub fn row_dot(&self, i: usize, v: &[f64]) -> f64 {
         let mut s = 0.0;
         for sg in self.row_segs(i) {
-            s += self.vals[sg.val..sg.val + sg.len].iter().zip(&v[sg.col..sg.col + sg.len]).map(|(a, b)| a * b).sum::<f64>();
+            s += crate::linalg::dot4(&self.vals[sg.val..sg.val + sg.len], &v[sg.col..sg.col + sg.len]);
         }
         s
     }

@@ -47,7 +47,7 @@
 //! positions `h^2 |beta - 1/6| |a_{n+1} - a_n|` (Zienkiewicz & Xie 1991) against
 //! `atol + rtol |q|`. Dense output: the cubic Hermite interpolant of `(q, qd)` at both ends.
 
-use super::lu::{lu_cm, lu_cm_solve};
+use super::lu::{inv_solve, inverse_from_lu_cm, lu_cm, lu_cm_solve};
 use super::{initial_step, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::correct::ProjectionTolerance;
 use crate::error::{Error, Result};
@@ -85,9 +85,11 @@ impl Default for GenAlphaOptions {
 /// Keep the factored iteration matrix for the next step while Newton contracts at least this
 /// well with it (the stiff directions turn with the bodies, so it ages within a few steps).
 const REUSE_CONTRACTION: f64 = 0.2;
+/// The Newton solve at which a factorization's inverse is formed (see `GenAlpha::solve_newton`).
+const INVERSE_AFTER: usize = 3;
 /// Re-read the slowly varying velocity terms (`C`, `db/dqd`) of the iteration matrix after this
 /// many steps, or at once when Newton contracts worse than `REFRESH_CONTRACTION`.
-const VELOCITY_TERMS_AGE: usize = 64;
+const VELOCITY_TERMS_AGE: usize = 1024;
 const REFRESH_CONTRACTION: f64 = 0.3;
 /// Newton stops when the estimated remaining position error, in the error-test units of
 /// `rtol`/`atol`, falls below this ...
@@ -124,7 +126,8 @@ pub struct GenAlpha {
     q_new: Vec<f64>,
     qd_new: Vec<f64>,
     g: Vec<f64>,
-    /// `[-M R; -A R]` and the correction.
+    /// The residual `[-r1; -r2]` and the correction.
+    res: Vec<f64>,
     rhs: Vec<f64>,
     /// Multipliers: the Newton unknown beside `qdd` (augmented iteration), and their value at
     /// the start of the step.
@@ -137,8 +140,12 @@ pub struct GenAlpha {
     cc: Vec<f64>,
     aa: Vec<f64>,
     bv: Vec<f64>,
-    /// Factored iteration matrix ((n+m) x (n+m)) and its pivots; the `h` it was built for.
+    /// Factored iteration matrix ((n+m) x (n+m)) and its pivots; the `h` it was built for;
+    /// its inverse (row-major), formed once the factorization has served `INVERSE_AFTER`
+    /// solves (then each Newton correction is one product with it); the solves so far.
     lu: Vec<f64>,
+    inv: Vec<f64>,
+    lu_solves: usize,
     piv: Vec<usize>,
     lu_h: f64,
     have_structure: bool,
@@ -205,6 +212,7 @@ impl GenAlpha {
             q_new: z(n),
             qd_new: z(n),
             g: z(n),
+            res: z(nm),
             rhs: z(nm),
             lam: z(m),
             lam_prev: z(m),
@@ -215,6 +223,8 @@ impl GenAlpha {
             aa: z(m * n),
             bv: z(m * n),
             lu: z(nm * nm),
+            inv: z(nm * nm),
+            lu_solves: 0,
             piv: vec![0; nm],
             lu_h: 0.0,
             have_structure: false,
@@ -260,7 +270,9 @@ impl GenAlpha {
         self.st.stats.nlu += 1;
         self.lu_h = h;
         self.assemble(h, 0.0);
-        if lu_cm(&mut self.lu, &mut self.piv, self.n + self.m) {
+        let nm = self.n + self.m;
+        self.lu_solves = 0;
+        if lu_cm(&mut self.lu, &mut self.piv, nm) {
             return Ok(());
         }
         // redundant constraint rows make the saddle-point matrix singular: regularize the
@@ -268,7 +280,7 @@ impl GenAlpha {
         let scale = self.mm.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300);
         self.assemble(h, -1e-12 * scale);
         self.st.stats.nlu += 1;
-        if !lu_cm(&mut self.lu, &mut self.piv, self.n + self.m) {
+        if !lu_cm(&mut self.lu, &mut self.piv, nm) {
             return Err(Error::Solver(format!("GENALPHA: iteration matrix singular at t = {}", self.st.t)));
         }
         Ok(())
@@ -296,6 +308,23 @@ impl GenAlpha {
                 col[n + s] = if r == s { reg } else { 0.0 };
             }
         }
+    }
+
+    /// `rhs = (iteration matrix)^-1 res`: with the LU factors for the first solves of a
+    /// factorization, with its inverse from then on (formed once: a matrix that serves many
+    /// steps pays it back many times, one refreshed every step does not pay it).
+    fn solve_newton(&mut self) {
+        let nm = self.n + self.m;
+        self.lu_solves += 1;
+        if self.lu_solves < INVERSE_AFTER {
+            self.rhs.copy_from_slice(&self.res);
+            lu_cm_solve(&self.lu, &self.piv, nm, &mut self.rhs);
+            return;
+        }
+        if self.lu_solves == INVERSE_AFTER {
+            inverse_from_lu_cm(&self.lu, &self.piv, nm, &mut self.inv);
+        }
+        inv_solve(&self.inv, nm, &self.res, &mut self.rhs);
     }
 
     /// Positions and velocities of the step for the unknown `x = qdd_{n+1}`.
@@ -348,7 +377,6 @@ impl GenAlpha {
     /// `theta`; `Ok(None)`: no convergence.
     fn attempt<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64, tol: f64) -> Result<Option<(usize, f64)>> {
         let (n, m) = (self.n, self.m);
-        let nm = n + m;
         let (bp, _) = self.primes(h);
         self.x.copy_from_slice(&self.qdd_prev);
         self.lam.copy_from_slice(&self.lam_prev);
@@ -370,12 +398,12 @@ impl GenAlpha {
                 refreshed = true;
             }
             for i in 0..n {
-                self.rhs[i] = -self.g[i];
+                self.res[i] = -self.g[i];
             }
             for r in 0..m {
-                self.rhs[n + r] = -self.r2[r];
+                self.res[n + r] = -self.r2[r];
             }
-            lu_cm_solve(&self.lu, &self.piv, nm, &mut self.rhs);
+            self.solve_newton();
             for i in 0..n {
                 self.x[i] += self.rhs[i];
             }
