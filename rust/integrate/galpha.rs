@@ -653,6 +653,11 @@ impl Stepper for GenAlpha {
         Ok(())
     }
 
+    fn expected_steps(&self, t0: f64, t_end: f64) -> Option<usize> {
+        let k = ((t_end - t0) / self.go.step?).ceil();
+        (k.is_finite() && k >= 0.0).then_some(k as usize)
+    }
+
     fn state(&self) -> &StepState {
         &self.st
     }

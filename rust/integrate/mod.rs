@@ -359,6 +359,11 @@ pub trait Stepper {
     }
     /// `y` was changed (post-step hook): re-evaluate what depends on it.
     fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()>;
+    /// The number of steps from `t0` to `t_end` when the method knows it in advance (a fixed
+    /// step): the recorded trajectory is then sized once instead of growing.
+    fn expected_steps(&self, _t0: f64, _t_end: f64) -> Option<usize> {
+        None
+    }
     fn state(&self) -> &StepState;
     fn state_mut(&mut self) -> &mut StepState;
 
@@ -535,7 +540,9 @@ pub fn integrate_dense<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys:
         }
     }
     let mut sol = Solution { dim, ..Default::default() };
-    let cap = t_eval.map(|te| te.len()).unwrap_or(1024);
+    // the trajectory's storage: sized once where the number of outputs is known (at most 8 MB
+    // ahead of time: beyond that it grows as it goes)
+    let cap = t_eval.map(|te| te.len()).or_else(|| stepper.expected_steps(t0, t_end).map(|k| k + 1)).unwrap_or(1024).min((1 << 20) / dim.max(1)).max(1);
     sol.t.reserve(cap);
     sol.y.reserve(cap * dim);
     let mut next = 0usize;
