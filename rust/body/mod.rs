@@ -594,3 +594,25 @@ pub(crate) fn finite_vec2(item: &str, what: &str, v: [f64; 2]) -> Result<[f64; 2
     check_finite_item(item, what, &v)?;
     Ok(v)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::frame_sin_cos;
+
+    #[test]
+    fn memoized_frame_sin_cos_is_exactly_sin_cos() {
+        // many angles through the 8 slots (collisions evict), each asked twice, and revisited
+        let angles: Vec<f64> = (0..200).map(|k| -7.0 + 0.0713 * k as f64).chain([0.0, -0.0, 1e-300, 3.0e5]).collect();
+        for _ in 0..2 {
+            for &a in &angles {
+                for _ in 0..2 {
+                    let (s, c) = frame_sin_cos(a);
+                    let (s0, c0) = a.sin_cos();
+                    assert_eq!((s.to_bits(), c.to_bits()), (s0.to_bits(), c0.to_bits()), "angle {a}");
+                }
+            }
+        }
+        // a non-finite angle is not cached as a finite one
+        assert!(frame_sin_cos(f64::NAN).0.is_nan());
+    }
+}
