@@ -85,8 +85,12 @@ impl Default for GenAlphaOptions {
 /// Keep the factored iteration matrix for the next step while Newton contracts at least this
 /// well with it (the stiff directions turn with the bodies, so it ages within a few steps).
 const REUSE_CONTRACTION: f64 = 0.2;
-/// The Newton solve at which a factorization's inverse is formed (see `GenAlpha::solve_newton`).
+/// The Newton solve at which a factorization's inverse is formed (see `GenAlpha::solve_newton`),
+/// for iteration matrices up to `INVERSE_MAX` square: the inverse wins by latency on small
+/// matrices; on large ones both solves are n^2 memory passes and the inverse would only add
+/// its n^3 and its n^2 of memory.
 const INVERSE_AFTER: usize = 3;
+const INVERSE_MAX: usize = 64;
 /// Re-read the slowly varying velocity terms (`C`, `db/dqd`) of the iteration matrix when Newton
 /// contracts worse than `REFRESH_CONTRACTION`, or at the latest after this many steps (a read
 /// is a finite-difference pass costing ~12 UK calls; every 64 steps it took 5 % of a run).
@@ -224,7 +228,7 @@ impl GenAlpha {
             aa: z(m * n),
             bv: z(m * n),
             lu: z(nm * nm),
-            inv: z(nm * nm),
+            inv: z(if nm <= INVERSE_MAX { nm * nm } else { 0 }),
             lu_solves: 0,
             piv: vec![0; nm],
             lu_h: 0.0,
@@ -317,7 +321,7 @@ impl GenAlpha {
     fn solve_newton(&mut self) {
         let nm = self.n + self.m;
         self.lu_solves += 1;
-        if self.lu_solves < INVERSE_AFTER {
+        if self.lu_solves < INVERSE_AFTER || nm > INVERSE_MAX {
             self.rhs.copy_from_slice(&self.res);
             lu_cm_solve(&self.lu, &self.piv, nm, &mut self.rhs);
             return;
