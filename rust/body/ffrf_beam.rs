@@ -460,10 +460,7 @@ pub struct BeamData {
     pub axial_force: Vec<f64>,
 }
 
-#[inline]
-pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
-    crate::linalg::dot4(x, y)
-}
+pub(crate) use crate::linalg::dot4 as dot;
 
 impl Beam {
     /// Initial guess: frame state from the description, elastic coordinates (default zero).
