@@ -201,7 +201,8 @@ def simulate(
         methods take the options ``first_step``, ``max_step``, ``projection_tol`` (project onto
         the constraints after every accepted step whose residuals exceed it; 0: off) and
         ``jacobian``, GENALPHA also ``rho_inf``, ``step`` and ``newton_local_error`` (Newton may
-        stop at this fraction of the step's local error estimate; ``method="auto"`` sets it);
+        stop at this fraction of the step's local error estimate; ``method="auto"`` sets it on
+        coarse steps, ``h omega_max >= 8``: on finer ones it feeds on its own error);
         see docs/integrators.md.
     rtol : float
         Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s); below 100 x machine
@@ -759,7 +760,7 @@ def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
     """``method="auto"``: the chooser of :mod:`ukflex.choice` for the Rust UK formulation; the
     NumPy references keep scipy's Radau.  Options that only scipy takes (``jac``, ``events``,
     ...) map the choice to its scipy counterpart (GENALPHA -> Radau, DOPRI5 -> DOP853)."""
-    from .choice import choose_method
+    from .choice import choose_method, local_newton_ok
 
     if formulation != "uk":
         return "Radau", options, None
@@ -776,6 +777,12 @@ def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
         choice.reason += f"; GENALPHA because of the option(s) {genalpha_only}"
     merged = dict(choice.options)
     merged.update(options)  # the user's own settings win (e.g. step=...)
+    if ("newton_local_error" in merged and "newton_local_error" not in options and merged.get("step") is not None
+            and not local_newton_ok(merged["step"], choice.omega_max)):
+        # the user's finer step: the strict Newton test (the looser one only on coarse steps)
+        del merged["newton_local_error"]
+        choice.options.pop("newton_local_error", None)
+        choice.reason += "; strict Newton test on the user's step (fine against omega_max)"
     return choice.method, merged, choice
 
 
