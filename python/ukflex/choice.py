@@ -22,8 +22,8 @@ local error estimate (a tighter Newton tolerance costs iterations and changes no
 size does not decide) -- the latter only on coarse steps, ``h omega_max >=
 LOCAL_NEWTON_MIN_STEP_OMEGA``: on finer steps the local error estimate is small, and the Newton
 error it lets through feeds back into the next estimates until it dominates them (measured: an
-ANCF coupler at rtol 1e-10 ended 9 % off the strict-Newton run of the same step).  Otherwise (rigid systems, soft or slow flexible ones, tight tolerances
-where a fifth-order method wins) it takes native DOPRI5 at the user's tolerances.  See
+ANCF coupler at rtol 1e-10 ended 9 % off the strict-Newton run of the same step).  Otherwise
+(rigid systems, soft or slow flexible ones, tight tolerances where a fifth-order method wins) it takes native DOPRI5 at the user's tolerances.  See
 docs/integrators.md.
 """
 

@@ -202,7 +202,8 @@ def simulate(
         the constraints after every accepted step whose residuals exceed it; 0: off) and
         ``jacobian``, GENALPHA also ``rho_inf``, ``step`` and ``newton_local_error`` (Newton may
         stop at this fraction of the step's local error estimate; ``method="auto"`` sets it on
-        coarse steps, ``h omega_max >= 8``: on finer ones it feeds on its own error);
+        coarse steps, ``h omega_max >= ukflex.choice.LOCAL_NEWTON_MIN_STEP_OMEGA``: on finer ones
+        it feeds on its own error);
         see docs/integrators.md.
     rtol : float
         Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s); below 100 x machine
