@@ -9,7 +9,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use common::*;
-use ukflex::integrate::{integrate, Dopri5, GenAlpha, GenAlphaOptions, Method, Options, Radau5, SecondOrderSystem, Stepper, UkSystem};
+use ukflex::integrate::{integrate, Dopri5, GenAlpha, GenAlphaOptions, Method, Options, Radau5, RadauM, RadauMOptions, SecondOrderSystem, Stepper, UkSystem};
 use ukflex::jacobian::Differences;
 use ukflex::jacobian::{uk_jacobian, JacobianWorkspace};
 use ukflex::{uk, Data, Model};
@@ -149,6 +149,15 @@ fn native_steps_do_not_allocate() {
         let st = ga.stats();
         assert!(st.nlu >= 1 && st.njev >= 1, "{st:?}");
         assert_eq!(n, 0, "GENALPHA (step {step:?}) allocated {n} times in 200 steps (stats {st:?})");
+    }
+    // Radau IIA on the second-order equations, fixed and controlled steps, with its projection
+    for step in [Some(2e-4), None] {
+        let ro = RadauMOptions { step, projection: Method::RadauM(RadauMOptions::default()).default_projection() };
+        let mut rm = RadauM::new(model.n, model.m, opts.clone(), ro).unwrap();
+        let n = steps_allocate(&mut rm, &model, 100);
+        let st = rm.stats();
+        assert!(st.nlu >= 2 && st.njev >= 1, "{st:?}");
+        assert_eq!(n, 0, "RADAU5M (step {step:?}) allocated {n} times in 100 steps (stats {st:?})");
     }
 }
 

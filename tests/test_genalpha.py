@@ -4,6 +4,7 @@ named errors."""
 
 import math
 import pathlib
+import sys
 
 import numpy as np
 import pytest
@@ -11,18 +12,8 @@ import pytest
 import ukflex
 from ukflex import choice, scenes
 
-DATA = pathlib.Path(__file__).resolve().parent.parent / "benches" / "data"
-
-
-def _exudyn_reference(name):
-    t, v = [], []
-    for line in (DATA / name).read_text().splitlines():
-        if line.startswith("#") or line.startswith("t,"):
-            continue
-        a, b = line.split(",")
-        t.append(float(a))
-        v.append(float(b))
-    return np.array(t), np.array(v)
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from _exudyn_ref import exudyn_reference  # noqa: E402
 
 
 def test_second_order_convergence_on_a_double_pendulum():
@@ -40,7 +31,7 @@ def test_second_order_convergence_on_a_double_pendulum():
 def test_slider_crank_against_the_geometrically_exact_reference():
     """ANCF coupler, 4 elements, h = 1e-4: the peak midpoint deflection within 0.2 % and the
     history within 1 % of Exudyn's converged ANCF cable (benches/data)."""
-    t_ref, v_ref = _exudyn_reference("exudyn_ref_ancf.csv")
+    t_ref, v_ref = exudyn_reference()
     system = scenes.slider_crank(formulation="ancf", elements=4).build()
     te = np.linspace(0.0, 0.1, 2001)
     res = ukflex.simulate(system, 0.1, method="GENALPHA", step=1e-4, t_eval=te)

@@ -28,7 +28,7 @@ __all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system",
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 #: Integrators that run entirely in Rust with the GIL released (``System.integrate``):
 #: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
-NATIVE_METHODS = ("DOPRI5", "RADAU5", "GENALPHA")
+NATIVE_METHODS = ("DOPRI5", "RADAU5", "GENALPHA", "RADAU5M")
 _NATIVE_OPTIONS = ("first_step", "max_step", "projection_tol", "rho_inf", "step", "jacobian", "newton_local_error")
 #: ``solve_ivp`` solver options passed through on the scipy paths.
 _SCIPY_OPTIONS = ("first_step", "max_step", "jac", "jac_sparsity", "lband", "uband")

@@ -46,6 +46,8 @@ fn implicit_bytes(model: &Model, what: &str) -> u64 {
         "jac" => 6 * n * n + saddle,
         "RADAU5" => 5 * n * n + saddle,
         "GENALPHA" => 3 * n * n + saddle,
+        // the complex iteration matrix (two parts) beside GENALPHA's buffers
+        "RADAU5M" => 3 * n * n + 3 * saddle,
         _ => 0,
     }
 }
@@ -518,12 +520,14 @@ impl PySystem {
     /// Integrate natively (Rust, GIL released) from (t0, y0) to t_end.
     ///
     /// method: "DOPRI5" (Dormand-Prince 5(4), dense output), "RADAU5" (Radau IIA order 5,
-    /// Rust finite-difference Jacobian) or "GENALPHA" (generalized-alpha with numerical
-    /// dissipation `rho_inf`, structured Newton matrix; fixed `step` or error-controlled).
+    /// Rust finite-difference Jacobian), "GENALPHA" (generalized-alpha with numerical
+    /// dissipation `rho_inf`, structured Newton matrix; fixed `step` or error-controlled) or
+    /// "RADAU5M" (Radau IIA order 5 on the constrained second-order equations with GENALPHA's
+    /// structured Newton matrix; fixed `step` or error-controlled).
     /// atol: float or (2n,) array. t_eval: output times (dense output) or None for every
     /// accepted step. projection_tol: project onto the constraint manifold after every accepted
-    /// step whose residuals exceed it (None: the method's default, 1e-11 for GENALPHA, off for
-    /// the others; 0: off). The run uses its own workspace (copying this System's pseudoinverse
+    /// step whose residuals exceed it (None: the method's default, 1e-11 for GENALPHA and RADAU5M,
+    /// off for the others; 0: off). The run uses its own workspace (copying this System's pseudoinverse
     /// tolerance, stabilization and backend), so several threads can integrate the same System
     /// concurrently.
     ///
@@ -538,7 +542,7 @@ impl PySystem {
     /// or a dict cause, t, stage, index), nfev, njev, nlu, naccept, nreject, jac_evals (UK calls
     /// inside Jacobians), wall_time [s], dense (None, or a dict meta (nseg, 3), data
     /// (nseg, width), part_len).
-    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=0.9, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None))]
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=None, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None))]
     #[allow(clippy::too_many_arguments)]
     fn integrate<'py>(
         &self,
@@ -554,7 +558,7 @@ impl PySystem {
         max_step: Option<f64>,
         max_steps: usize,
         projection_tol: Option<f64>,
-        rho_inf: f64,
+        rho_inf: Option<f64>,
         step: Option<f64>,
         jacobian: &str,
         max_nfev: Option<usize>,
@@ -571,13 +575,19 @@ impl PySystem {
         };
         let n = self.model.n;
         let mut method = Method::from_name(method)
-            .ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5' or 'GENALPHA')")))?;
-        if let Method::GenAlpha(go) = &mut method {
-            go.rho_inf = rho_inf;
-            go.step = step;
-            go.newton_local_error = newton_local_error;
-        } else if step.is_some() || newton_local_error.is_some() {
-            return Err(PyValueError::new_err("step (a fixed step size) and newton_local_error apply to GENALPHA only"));
+            .ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5', 'GENALPHA' or 'RADAU5M')")))?;
+        match &mut method {
+            Method::GenAlpha(go) => {
+                go.rho_inf = rho_inf.unwrap_or(go.rho_inf);
+                go.step = step;
+                go.newton_local_error = newton_local_error;
+            }
+            Method::RadauM(ro) if newton_local_error.is_none() && rho_inf.is_none() => ro.step = step,
+            Method::RadauM(_) => return Err(PyValueError::new_err("rho_inf and newton_local_error apply to GENALPHA only (RADAU5M is L-stable: no dissipation setting)")),
+            _ if step.is_some() || newton_local_error.is_some() || rho_inf.is_some() => {
+                return Err(PyValueError::new_err("step (a fixed step size) applies to GENALPHA and RADAU5M, rho_inf and newton_local_error to GENALPHA only"));
+            }
+            _ => {}
         }
         let mut y = vec![0.0; 2 * n];
         read_into("y0", &y0.as_array(), &mut y).map_err(to_py)?;
@@ -614,6 +624,7 @@ impl PySystem {
             Method::Dopri5 => 0,
             Method::Radau5 => implicit_bytes(model, "RADAU5"),
             Method::GenAlpha(_) => implicit_bytes(model, "GENALPHA"),
+            Method::RadauM(_) => implicit_bytes(model, "RADAU5M"),
         };
         let hint = "implicit methods factor dense n x n matrices; use method='DOPRI5' for a system this large, or raise memory_limit";
         Error::check_memory("the implicit integrator's n x n matrices", implicit, limit, hint).map_err(to_py)?;

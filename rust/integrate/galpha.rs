@@ -48,7 +48,7 @@
 //! `atol + rtol |q|`. Dense output: the cubic Hermite interpolant of `(q, qd)` at both ends.
 
 use super::lu::{inv_solve, inverse_from_lu_cm, lu_cm, lu_cm_solve};
-use super::{initial_step, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
+use super::{acc_and_multipliers, fixed_step_count, initial_step, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::correct::ProjectionTolerance;
 use crate::error::{Error, Result};
 
@@ -649,18 +649,11 @@ impl Stepper for GenAlpha {
     }
 
     fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
-        // the hook moved (q, qd) onto the constraints: the acceleration there
-        let n = self.n;
-        let (q, qd) = self.st.y.split_at(n);
-        sys.acc(self.st.t, q, qd, &mut self.qdd)?;
-        self.st.stats.nfev += 1;
-        sys.multipliers(&mut self.lam);
-        Ok(())
+        acc_and_multipliers(sys, &mut self.st, &mut self.qdd, &mut self.lam)
     }
 
     fn expected_steps(&self, t0: f64, t_end: f64) -> Option<usize> {
-        let k = ((t_end - t0) / self.go.step?).ceil();
-        (k.is_finite() && k >= 0.0).then_some(k as usize)
+        fixed_step_count(t0, t_end, self.go.step)
     }
 
     fn state(&self) -> &StepState {

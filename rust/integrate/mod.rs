@@ -25,10 +25,12 @@ mod dopri5;
 mod galpha;
 pub(crate) mod lu;
 mod radau5;
+mod radau_m;
 
 pub use dopri5::Dopri5;
 pub use galpha::{GenAlpha, GenAlphaOptions};
 pub use radau5::Radau5;
+pub use radau_m::{RadauM, RadauMOptions};
 
 use crate::correct::{self, ProjectWorkspace, ProjectionTolerance};
 use crate::data::Data;
@@ -415,6 +417,21 @@ fn initial_step<S: SecondOrderSystem>(sys: &mut S, t0: f64, y0: &[f64], f0: &[f6
     Ok((100.0 * h).min(h1).min(hmax))
 }
 
+/// Steps from `t0` to `t_end` with a fixed step `h` (`Stepper::expected_steps`).
+fn fixed_step_count(t0: f64, t_end: f64, h: Option<f64>) -> Option<usize> {
+    let k = ((t_end - t0) / h?).ceil();
+    (k.is_finite() && k >= 0.0).then_some(k as usize)
+}
+
+/// The acceleration and multipliers at the stepper's state (`Stepper::restart_at` of the
+/// implicit methods: a post-step hook moved `(q, qd)` onto the constraints).
+fn acc_and_multipliers<S: SecondOrderSystem>(sys: &mut S, st: &mut StepState, qdd: &mut [f64], lam: &mut [f64]) -> Result<()> {
+    let (q, qd) = st.y.split_at(qdd.len());
+    sys.acc(st.t, q, qd, qdd)?;
+    st.stats.nfev += 1;
+    sys.multipliers(lam);
+    Ok(())
+}
 
 /// What defines one step's dense output (`Stepper::dense_parts`).
 pub struct DenseParts<'a> {
@@ -483,6 +500,7 @@ impl DenseRecord {
             Method::Dopri5 => Dopri5::dense_eval(meta, parts, t, out),
             Method::Radau5 => Radau5::dense_eval(meta, parts, t, out),
             Method::GenAlpha(_) => GenAlpha::dense_eval(meta, parts, t, out),
+            Method::RadauM(_) => RadauM::dense_eval(meta, parts, t, out),
         }
     }
 }
@@ -633,6 +651,7 @@ pub enum Method {
     Dopri5,
     Radau5,
     GenAlpha(GenAlphaOptions),
+    RadauM(RadauMOptions),
 }
 
 /// Default projection of the generalized-alpha method: positions when `max |Phi| > 1e-11`,
@@ -646,6 +665,7 @@ impl Method {
             "DOPRI5" => Some(Method::Dopri5),
             "RADAU5" => Some(Method::Radau5),
             "GENALPHA" => Some(Method::GenAlpha(GenAlphaOptions::default())),
+            "RADAU5M" => Some(Method::RadauM(RadauMOptions::default())),
             _ => None,
         }
     }
@@ -653,7 +673,7 @@ impl Method {
     /// The projection a method uses unless told otherwise.
     pub fn default_projection(&self) -> Option<ProjectionTolerance> {
         match self {
-            Method::GenAlpha(_) => Some(GENALPHA_PROJECTION),
+            Method::GenAlpha(_) | Method::RadauM(_) => Some(GENALPHA_PROJECTION),
             Method::Dopri5 | Method::Radau5 => None,
         }
     }
@@ -678,6 +698,11 @@ pub fn integrate_uk(model: &Model, data: Data, method: Method, opts: Options, t0
             // the method projects with the factorization of its own last kernel call
             go.projection = sys.projection.take();
             let mut st = GenAlpha::new(model.n, model.m, opts, go)?;
+            integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
+        }
+        Method::RadauM(mut ro) => {
+            ro.projection = sys.projection.take();
+            let mut st = RadauM::new(model.n, model.m, opts, ro)?;
             integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
         }
     };

@@ -8,7 +8,7 @@ use super::lu::{lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
 use super::{initial_step, rhs, rms_norm, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::error::{Error, Result};
 
-mod rc {
+pub(super) mod rc {
     // Hairer & Wanner, RADAU5 (radau5.f), constants of the 3-stage Radau IIA method.
     pub const SQ6: f64 = 2.449_489_742_783_178;
     pub const C1: f64 = (4.0 - SQ6) / 10.0;
@@ -98,17 +98,17 @@ pub struct Radau5 {
     nsing: usize,
 }
 
-const NIT: usize = 7;
+pub(super) const NIT: usize = 7;
 /// Re-evaluate the Jacobian after a step only if the Newton contraction exceeded this.
 /// RADAU5's default is 0.001 (cheap Jacobians); Hairer recommends 0.1 when the Jacobian is
 /// costly, as here (a finite-difference Jacobian is ~4n UK calls). Measured on the paper scene:
 /// 20x fewer Jacobians, 3x faster with beam damping (docs/performance.md).
 const THET: f64 = 0.1;
-const SAFE: f64 = 0.9;
-const FACL: f64 = 5.0;
-const FACR: f64 = 0.125;
-const QUOT1: f64 = 1.0;
-const QUOT2: f64 = 1.2;
+pub(super) const SAFE: f64 = 0.9;
+pub(super) const FACL: f64 = 5.0;
+pub(super) const FACR: f64 = 0.125;
+pub(super) const QUOT1: f64 = 1.0;
+pub(super) const QUOT2: f64 = 1.2;
 
 impl Radau5 {
     pub fn new(n: usize, opts: Options) -> Result<Self> {

@@ -1,0 +1,721 @@
+//! 3-stage Radau IIA (order 5, L-stable) on the constrained second-order equations
+//! `M qdd + A^T lambda = Q(t, q, qd)`, `A qdd = b(t, q, qd)`, whose solution is the UK
+//! acceleration: `RADAU5M`. The accuracy of `RADAU5` on the resolved (bending) modes, the
+//! damping of the unresolved (axial, short-element) ones, at the per-iteration cost of
+//! `GENALPHA`: the same structured iteration matrix, the same acceleration-level residual, the
+//! same final UK evaluation and projection.
+//!
+//! **Stages.** With the Radau IIA matrix `a` (3 x 3, `c = ((4 - sqrt 6)/10, (4 + sqrt 6)/10, 1)`)
+//! applied to `(q, qd)`, the stage accelerations `W_j` are the unknowns:
+//! `V_i = qd_n + h sum_j a_ij W_j`, `Q_i = q_n + h c_i qd_n + h^2 sum_j (a^2)_ij W_j`, and each
+//! stage satisfies the acceleration-level equations at `(t_n + c_i h, Q_i, V_i)` with its own
+//! multipliers `Lambda_i`. The step ends at the last stage: `q_{n+1} = Q_3`, `qd_{n+1} = V_3`
+//! (stiffly accurate), and its acceleration and multipliers are the UK solution there (one UK
+//! evaluation per step, whose factorization also projects `q`, `qd` onto the constraints when
+//! they drifted beyond the projection tolerance).
+//!
+//! **Newton.** Simplified Newton on all stages with one structure `M`, `K = -dQ/dq`,
+//! `C = -dQ/dqd`, `A`, `db/dqd`. Its matrix is the sum of `I (x) [M, A^T; A, 0]`,
+//! `h a (x) [C, 0; -db/dqd, 0]` and `h^2 a^2 (x) [K, 0; 0, 0]`. Hairer's transformation
+//! `T^-1 a T` (block diagonal: one real eigenvalue `lambda`, one complex pair `mu`) decouples it
+//! into `[M + h lambda C + h^2 lambda^2 K, A^T; A - h lambda db/dqd, 0]` (real) and the same
+//! with `mu` (complex), each `(n+m)` square: GENALPHA's matrix with `(beta', gamma') =
+//! (h^2 lambda^2, h lambda)`. `M`, `K`, `A` are read where the first residual evaluation of a
+//! step left them (the last stage, the step's end); `C` and `db/dqd` (a finite-difference
+//! pass) when Newton fails or after `VELOCITY_TERMS_AGE` steps. Starting values: the last
+//! step's stage accelerations extrapolated (their quadratic in time). Stopping rule and
+//! step-size control are Hairer's (`RADAU5`: `fnewt`, the contraction estimate, Gustafsson's
+//! predictive control). The Newton norm takes the position corrections and the velocity
+//! corrections times `h` (the position error they make within a step), both with the position
+//! weights: velocity errors left by Newton would add up over the steps (a double pendulum at
+//! fixed steps lost its fifth order without them).
+//!
+//! **Error estimate.** Hairer's embedded estimate filtered by the real iteration matrix,
+//! `(fac1 I - J)^-1 (f_n + sum_i d_i Z_i / h)`, in second-order form: with `e_q`, `e_v` the
+//! position and velocity parts of the bracket, `x_q` solves the real iteration system (factored
+//! already) with the right-hand side
+//! `[h^2 lambda^2 (M e_v + C e_q) + h lambda M e_q; A (h^2 lambda^2 e_v + h lambda e_q)]`,
+//! and the test is on `x_q` alone (weights `atol + rtol max(|q_n|, |q_{n+1}|)` with RADAU5's
+//! internal tolerances `rtol' = 0.1 rtol^(2/3)`): the high-frequency velocity content that the
+//! step size does not resolve carries no information the user asked for.
+//!
+//! **Dense output.** The quintic Hermite interpolant of `q` from `q`, `qd`, `qdd` at both ends
+//! (error O(h^6)); `qd` its derivative.
+
+use super::lu::{lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
+// Hairer's Newton iterations per attempt and step-size control constants, as RADAU5 has them
+use super::radau5::{rc, FACL, FACR, NIT, QUOT1, QUOT2, SAFE};
+use super::{acc_and_multipliers, fixed_step_count, initial_step, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
+use crate::correct::ProjectionTolerance;
+use crate::error::{Error, Result};
+
+/// Settings of `RADAU5M`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RadauMOptions {
+    /// Fixed step size; `None`: error-controlled steps.
+    pub step: Option<f64>,
+    /// Projection onto the constraints after each step (with the final UK evaluation's
+    /// factorization).
+    pub projection: Option<ProjectionTolerance>,
+}
+
+/// Keep the factored matrices for the next step when Newton contracted at least this well and
+/// the step size did not change.
+const REUSE_CONTRACTION: f64 = 0.1;
+/// Re-read the velocity terms (`C`, `db/dqd`) at the latest after this many steps (and after a
+/// failed Newton iteration): as in GENALPHA.
+const VELOCITY_TERMS_AGE: usize = 1024;
+
+pub struct RadauM {
+    opts: Options,
+    ro: RadauMOptions,
+    n: usize,
+    m: usize,
+    st: StepState,
+    /// Internal tolerances of the positions (`rtol' = 0.1 rtol^(2/3)`, `atol' = rtol' atol / rtol`).
+    rtol: f64,
+    atol: Vec<f64>,
+    fnewt: f64,
+    /// Radau IIA matrix, its square, nodes; the transformation `T`, `T^-1` and the eigenvalues
+    /// of `a`: `lambda` (real), `mu = mu_re + i mu_im`.
+    a: [[f64; 3]; 3],
+    a2: [[f64; 3]; 3],
+    c: [f64; 3],
+    t: [[f64; 3]; 3],
+    ti: [[f64; 3]; 3],
+    lambda: f64,
+    mu: (f64, f64),
+    /// Acceleration and multipliers at `t` (the UK solution), and the step's start.
+    qdd: Vec<f64>,
+    lam: Vec<f64>,
+    q0: Vec<f64>,
+    v0: Vec<f64>,
+    a0: Vec<f64>,
+    /// Stage accelerations and multipliers (Newton unknowns), those of the last accepted step
+    /// (for the starting values) and its step size.
+    w: [Vec<f64>; 3],
+    ls: [Vec<f64>; 3],
+    w_old: [Vec<f64>; 3],
+    ls_old: [Vec<f64>; 3],
+    h_old: f64,
+    have_old: bool,
+    /// Stage states and residuals `[r1; r2]` ((n+m) each).
+    qs: [Vec<f64>; 3],
+    vs: [Vec<f64>; 3],
+    res: [Vec<f64>; 3],
+    r1: Vec<f64>,
+    r2: Vec<f64>,
+    /// Transformed right-hand sides / solutions: real, complex (re, im); (n+m) each.
+    xr: Vec<f64>,
+    xc: Vec<f64>,
+    xi: Vec<f64>,
+    tmp: Vec<f64>,
+    eq: Vec<f64>,
+    ev: Vec<f64>,
+    /// Structure: `M`, `K`, `C` (n x n), `A`, `db/dqd` (m x n), row-major.
+    mm: Vec<f64>,
+    kk: Vec<f64>,
+    cc: Vec<f64>,
+    aa: Vec<f64>,
+    bv: Vec<f64>,
+    /// Real iteration matrix (column-major LU) and complex one (row-major LU, parts).
+    lu_r: Vec<f64>,
+    piv_r: Vec<usize>,
+    lu_cr: Vec<f64>,
+    lu_ci: Vec<f64>,
+    piv_c: Vec<usize>,
+    lu_h: f64,
+    reuse: bool,
+    refresh: bool,
+    age: usize,
+    /// Step control state (Hairer).
+    faccon: f64,
+    theta: f64,
+    hacc: f64,
+    erracc: f64,
+    first: bool,
+    reject: bool,
+}
+
+/// 3 x 3 matrix product.
+fn mul3(x: &[[f64; 3]; 3], y: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut z = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            z[i][j] = (0..3).map(|k| x[i][k] * y[k][j]).sum();
+        }
+    }
+    z
+}
+
+impl RadauM {
+    /// `n` coordinates, `m` constraint rows.
+    pub fn new(n: usize, m: usize, opts: Options, ro: RadauMOptions) -> Result<Self> {
+        let atol_user = opts.validate(2 * n)?;
+        if let Some(h) = ro.step {
+            if !(h > 0.0) || !h.is_finite() {
+                return Err(Error::argument("step", format!("must be positive and finite, got {h}")));
+            }
+        }
+        let rtol = 0.1 * opts.rtol.powf(2.0 / 3.0);
+        let atol: Vec<f64> = atol_user[..n].iter().map(|a| rtol * a / opts.rtol).collect();
+        let fnewt = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
+        let s6 = 6f64.sqrt();
+        let a = [
+            [(88.0 - 7.0 * s6) / 360.0, (296.0 - 169.0 * s6) / 1800.0, (-2.0 + 3.0 * s6) / 225.0],
+            [(296.0 + 169.0 * s6) / 1800.0, (88.0 + 7.0 * s6) / 360.0, (-2.0 - 3.0 * s6) / 225.0],
+            [(16.0 - s6) / 36.0, (16.0 + s6) / 36.0, 1.0 / 9.0],
+        ];
+        let a2 = mul3(&a, &a);
+        let t = [[rc::T11, rc::T12, rc::T13], [rc::T21, rc::T22, rc::T23], [rc::T31, 1.0, 0.0]];
+        let ti = [[rc::TI11, rc::TI12, rc::TI13], [rc::TI21, rc::TI22, rc::TI23], [rc::TI31, rc::TI32, rc::TI33]];
+        // T^-1 a T = [[lambda, 0, 0], [0, p, -q], [0, q, p]]: read off, not assumed
+        let d = mul3(&ti, &mul3(&a, &t));
+        let lambda = d[0][0];
+        let mu = (d[1][1], d[2][1]);
+        let z = |k: usize| vec![0.0; k];
+        let nm = n + m;
+        let z3 = |k: usize| [z(k), z(k), z(k)];
+        Ok(RadauM {
+            opts,
+            ro,
+            n,
+            m,
+            st: StepState::new(2 * n),
+            rtol,
+            atol,
+            fnewt,
+            a,
+            a2,
+            c: [rc::C1, rc::C2, 1.0],
+            t,
+            ti,
+            lambda,
+            mu,
+            qdd: z(n),
+            lam: z(m),
+            q0: z(n),
+            v0: z(n),
+            a0: z(n),
+            w: z3(n),
+            ls: z3(m),
+            w_old: z3(n),
+            ls_old: z3(m),
+            h_old: 0.0,
+            have_old: false,
+            qs: z3(n),
+            vs: z3(n),
+            res: z3(nm),
+            r1: z(n),
+            r2: z(m),
+            xr: z(nm),
+            xc: z(nm),
+            xi: z(nm),
+            tmp: z(nm),
+            eq: z(n),
+            ev: z(n),
+            mm: z(n * n),
+            kk: z(n * n),
+            cc: z(n * n),
+            aa: z(m * n),
+            bv: z(m * n),
+            lu_r: z(nm * nm),
+            piv_r: vec![0; nm],
+            lu_cr: z(nm * nm),
+            lu_ci: z(nm * nm),
+            piv_c: vec![0; nm],
+            lu_h: 0.0,
+            reuse: false,
+            refresh: true,
+            age: 0,
+            faccon: 1.0,
+            theta: 1.0,
+            hacc: 0.0,
+            erracc: 0.0,
+            first: true,
+            reject: false,
+        })
+    }
+
+    /// Re-read `M`, `K`, `C`, `A`, `db/dqd` at the step's start.
+    fn read_structure<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
+        let t = self.st.t;
+        let (q, qd) = self.st.y.split_at(self.n);
+        if !sys.structure(t, q, qd, &mut self.mm, &mut self.kk, &mut self.cc, &mut self.aa, &mut self.bv)? {
+            return Err(Error::argument("method", "RADAU5M needs a system with a structured Jacobian (mass, stiffness, constraints)"));
+        }
+        self.st.stats.njev += 1;
+        self.refresh = false;
+        self.age = 0;
+        Ok(())
+    }
+
+    /// `M`, `K`, `A` where the last residual evaluation left them, and both factorizations for `h`.
+    fn refresh_matrices<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64) -> Result<()> {
+        let (q, qd) = (&self.qs[2], &self.vs[2]);
+        if !sys.stiff_structure(q, qd, &mut self.mm, &mut self.kk, &mut self.aa)? {
+            return Err(Error::argument("method", "RADAU5M needs a system with a structured Jacobian (mass, stiffness, constraints)"));
+        }
+        self.factor(h)
+    }
+
+    /// Assemble and factor the real and the complex iteration matrices for step `h`.
+    fn factor(&mut self, h: f64) -> Result<()> {
+        let (n, m) = (self.n, self.m);
+        let nm = n + m;
+        self.lu_h = h;
+        self.st.stats.nlu += 2;
+        let scale = self.mm.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300);
+        for reg in [0.0, -1e-12 * scale] {
+            // real: [M + g C + g^2 K, A^T; A - g Bv, reg I], g = h lambda (column-major)
+            let g = h * self.lambda;
+            let (g2r, gr, gi) = {
+                let (p, q) = (h * self.mu.0, h * self.mu.1);
+                (p * p - q * q, p, q)
+            };
+            let g2i = 2.0 * gr * gi;
+            for j in 0..n {
+                for i in 0..n {
+                    let (mij, cij, kij) = (self.mm[i * n + j], self.cc[i * n + j], self.kk[i * n + j]);
+                    self.lu_r[i + j * nm] = mij + g * cij + g * g * kij;
+                    self.lu_cr[i * nm + j] = mij + gr * cij + g2r * kij;
+                    self.lu_ci[i * nm + j] = gi * cij + g2i * kij;
+                }
+                for r in 0..m {
+                    let (arj, brj) = (self.aa[r * n + j], self.bv[r * n + j]);
+                    self.lu_r[(n + r) + j * nm] = arj - g * brj;
+                    self.lu_cr[(n + r) * nm + j] = arj - gr * brj;
+                    self.lu_ci[(n + r) * nm + j] = -gi * brj;
+                    // A^T block
+                    self.lu_r[j + (n + r) * nm] = arj;
+                    self.lu_cr[j * nm + n + r] = arj;
+                    self.lu_ci[j * nm + n + r] = 0.0;
+                }
+            }
+            for r in 0..m {
+                for s in 0..m {
+                    let v = if r == s { reg } else { 0.0 };
+                    self.lu_r[(n + r) + (n + s) * nm] = v;
+                    self.lu_cr[(n + r) * nm + n + s] = v;
+                    self.lu_ci[(n + r) * nm + n + s] = 0.0;
+                }
+            }
+            if lu_cm(&mut self.lu_r, &mut self.piv_r, nm) && lu_cplx(&mut self.lu_cr, &mut self.lu_ci, &mut self.piv_c, nm) {
+                return Ok(());
+            }
+            // redundant constraint rows make the saddle-point matrices singular: regularize
+            // the multiplier block (the corrections are unaffected where A has full row rank)
+            self.st.stats.nlu += 2;
+        }
+        Err(Error::Solver(format!("RADAU5M: iteration matrix singular at t = {}", self.st.t)))
+    }
+
+    /// Stage states from the stage accelerations.
+    fn stages(&mut self, h: f64) {
+        let n = self.n;
+        for i in 0..3 {
+            let (ci, ai, a2i) = (self.c[i], self.a[i], self.a2[i]);
+            let (qs, vs) = (&mut self.qs[i], &mut self.vs[i]);
+            for k in 0..n {
+                let (w0, w1, w2) = (self.w[0][k], self.w[1][k], self.w[2][k]);
+                vs[k] = self.v0[k] + h * (ai[0] * w0 + ai[1] * w1 + ai[2] * w2);
+                qs[k] = self.q0[k] + h * ci * self.v0[k] + h * h * (a2i[0] * w0 + a2i[1] * w1 + a2i[2] * w2);
+            }
+        }
+    }
+
+    /// Weights of the position norms.
+    fn scal(&self, i: usize) -> f64 {
+        self.atol[i] + self.rtol * self.q0[i].abs().max(self.qs[2][i].abs())
+    }
+
+
+    /// Starting values: the last step's stage accelerations and multipliers extrapolated
+    /// (quadratic through its three stages) to this step's stage times; on the first step (or
+    /// after a restart) the acceleration and multipliers at `t`.
+    fn predict(&mut self, h: f64) {
+        if !self.have_old {
+            for i in 0..3 {
+                self.w[i].copy_from_slice(&self.qdd);
+                self.ls[i].copy_from_slice(&self.lam);
+            }
+            return;
+        }
+        // old stage times relative to t: (c_j - 1) h_old; new ones: c_i h
+        let s: [f64; 3] = [(self.c[0] - 1.0) * self.h_old, (self.c[1] - 1.0) * self.h_old, 0.0];
+        for i in 0..3 {
+            let x = self.c[i] * h;
+            let l = [
+                (x - s[1]) * (x - s[2]) / ((s[0] - s[1]) * (s[0] - s[2])),
+                (x - s[0]) * (x - s[2]) / ((s[1] - s[0]) * (s[1] - s[2])),
+                (x - s[0]) * (x - s[1]) / ((s[2] - s[0]) * (s[2] - s[1])),
+            ];
+            for k in 0..self.n {
+                self.w[i][k] = l[0] * self.w_old[0][k] + l[1] * self.w_old[1][k] + l[2] * self.w_old[2][k];
+            }
+            for k in 0..self.m {
+                self.ls[i][k] = l[0] * self.ls_old[0][k] + l[1] * self.ls_old[1][k] + l[2] * self.ls_old[2][k];
+            }
+        }
+    }
+
+    /// One Newton attempt of step `h`. `Ok(Some(iterations))` on convergence, `Ok(None)` on
+    /// divergence or slow convergence (`self.st.h` is then the step to retry with).
+    fn newton<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64) -> Result<Option<usize>> {
+        let (n, m) = (self.n, self.m);
+        let nm = n + m;
+        let t0 = self.st.t;
+        self.faccon = self.faccon.max(f64::EPSILON).powf(0.8);
+        self.theta = self.theta.abs();
+        let mut dynold = 0.0f64;
+        let mut thqold = 0.0f64;
+        for k in 1..=NIT {
+            self.stages(h);
+            for i in 0..3 {
+                let ok = sys.augmented_residual(t0 + self.c[i] * h, &self.qs[i], &self.vs[i], &self.w[i], &self.ls[i], &mut self.r1, &mut self.r2)?;
+                if !ok {
+                    return Err(Error::argument("method", "RADAU5M needs a system with the acceleration-level residual"));
+                }
+                self.st.stats.nfev += 1;
+                self.res[i][..n].copy_from_slice(&self.r1);
+                self.res[i][n..].copy_from_slice(&self.r2);
+            }
+            if !self.res.iter().all(|r| r.iter().all(|x| x.is_finite())) {
+                let (q, qd) = (&self.qs, &self.vs);
+                self.st.nonfinite = [("q", &q[2]), ("qd", &qd[2])]
+                    .iter()
+                    .find_map(|(w, v)| v.iter().position(|x| !x.is_finite()).map(|i| (*w, i)))
+                    .or(Some(("qdd", 0)));
+                return Ok(None);
+            }
+            if k == 1 && !(self.reuse && h == self.lu_h) {
+                self.refresh_matrices(sys, h)?;
+            }
+            // transformed right-hand sides: -(T^-1 (x) I) R
+            for k2 in 0..nm {
+                let (r0, r1, r2) = (self.res[0][k2], self.res[1][k2], self.res[2][k2]);
+                self.xr[k2] = -(self.ti[0][0] * r0 + self.ti[0][1] * r1 + self.ti[0][2] * r2);
+                self.xc[k2] = -(self.ti[1][0] * r0 + self.ti[1][1] * r1 + self.ti[1][2] * r2);
+                self.xi[k2] = -(self.ti[2][0] * r0 + self.ti[2][1] * r1 + self.ti[2][2] * r2);
+            }
+            lu_cm_solve(&self.lu_r, &self.piv_r, nm, &mut self.xr);
+            lu_cplx_solve(&self.lu_cr, &self.lu_ci, &self.piv_c, nm, &mut self.xc, &mut self.xi);
+            self.st.stats.newton += 1;
+            // back: (T (x) I) X; the norm of the position and velocity corrections of all stages
+            let mut dyno = 0.0;
+            for k2 in 0..nm {
+                let (x0, x1, x2) = (self.xr[k2], self.xc[k2], self.xi[k2]);
+                for i in 0..3 {
+                    let d = self.t[i][0] * x0 + self.t[i][1] * x1 + self.t[i][2] * x2;
+                    if k2 < n {
+                        self.w[i][k2] += d;
+                    } else {
+                        self.ls[i][k2 - n] += d;
+                    }
+                }
+            }
+            for k2 in 0..n {
+                let (x0, x1, x2) = (self.xr[k2], self.xc[k2], self.xi[k2]);
+                let d: [f64; 3] = std::array::from_fn(|i| self.t[i][0] * x0 + self.t[i][1] * x1 + self.t[i][2] * x2);
+                let s = self.scal(k2);
+                for i in 0..3 {
+                    let dq = h * h * (self.a2[i][0] * d[0] + self.a2[i][1] * d[1] + self.a2[i][2] * d[2]);
+                    let dv = h * (self.a[i][0] * d[0] + self.a[i][1] * d[1] + self.a[i][2] * d[2]);
+                    dyno += (dq / s) * (dq / s) + (h * dv / s) * (h * dv / s);
+                }
+            }
+            let dyno = (dyno / (6 * n) as f64).sqrt();
+            if !dyno.is_finite() {
+                self.st.nonfinite = Some(("qdd", 0));
+                return Ok(None);
+            }
+            if k >= 2 {
+                let thq = dyno / dynold;
+                self.theta = if k == 2 { thq } else { (thq * thqold).sqrt() };
+                thqold = thq;
+                if self.theta < 0.99 {
+                    self.faccon = self.theta / (1.0 - self.theta);
+                    let dyth = self.faccon * dyno * self.theta.powi((NIT - 1 - k) as i32) / self.fnewt;
+                    if dyth >= 1.0 {
+                        let qnewt = dyth.clamp(1e-4, 20.0);
+                        self.st.h = 0.8 * h * qnewt.powf(-1.0 / (4.0 + NIT as f64 - 1.0 - k as f64));
+                        return Ok(None);
+                    }
+                } else {
+                    self.st.h = 0.5 * h;
+                    return Ok(None);
+                }
+            }
+            dynold = dyno.max(f64::EPSILON);
+            if self.faccon * dyno <= self.fnewt {
+                self.stages(h);
+                return Ok(Some(k));
+            }
+        }
+        self.st.h = 0.5 * h;
+        Ok(None)
+    }
+
+    /// Hairer's filtered error estimate on the positions (module docs); `second`: the variant
+    /// with a fresh evaluation at the estimated point (first step, after a rejection).
+    fn error_estimate<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64) -> Result<f64> {
+        let n = self.n;
+        let (hee1, hee2, hee3) = (rc::DD1 / h, rc::DD2 / h, rc::DD3 / h);
+        // e = f_n + sum_i d_i Z_i / h, Z_i the stage increments
+        for k in 0..n {
+            let zq = |i: usize| self.qs[i][k] - self.q0[k];
+            let zv = |i: usize| self.vs[i][k] - self.v0[k];
+            self.eq[k] = self.v0[k] + hee1 * zq(0) + hee2 * zq(1) + hee3 * zq(2);
+            self.ev[k] = self.a0[k] + hee1 * zv(0) + hee2 * zv(1) + hee3 * zv(2);
+        }
+        let mut err = self.filtered_norm(h);
+        if err >= 1.0 && (self.first || self.reject) {
+            // Hairer's second estimate: f at y_n + x instead of f_n (e_q += x_v, e_v += g(y_n + x) - a_n)
+            let g = h * self.lambda;
+            for k in 0..n {
+                let xq = self.tmp[k];
+                let xv = xq / g - self.eq[k];
+                self.r1[k] = self.q0[k] + xq;
+                // the velocities of the estimated point in the stage-1 buffer (rebuilt below)
+                self.vs[0][k] = self.v0[k] + xv;
+                self.eq[k] += xv;
+            }
+            sys.acc(self.st.t, &self.r1, &self.vs[0], &mut self.xc[..n])?;
+            self.st.stats.nfev += 1;
+            for k in 0..n {
+                self.ev[k] += self.xc[k] - self.a0[k];
+            }
+            err = self.filtered_norm(h);
+            self.stages(h);
+        }
+        Ok(err.max(1e-10))
+    }
+
+    /// `x_q` of the filtered estimate for the bracket in `eq`, `ev` (into `tmp[..n]`) and its
+    /// weighted RMS norm.
+    fn filtered_norm(&mut self, h: f64) -> f64 {
+        let (n, m) = (self.n, self.m);
+        let nm = n + m;
+        let g = h * self.lambda;
+        let g2 = g * g;
+        for i in 0..n {
+            let mrow = &self.mm[i * n..(i + 1) * n];
+            let crow = &self.cc[i * n..(i + 1) * n];
+            let mut s = 0.0;
+            for j in 0..n {
+                s += g2 * (mrow[j] * self.ev[j] + crow[j] * self.eq[j]) + g * mrow[j] * self.eq[j];
+            }
+            self.tmp[i] = s;
+        }
+        for r in 0..m {
+            let arow = &self.aa[r * n..(r + 1) * n];
+            self.tmp[n + r] = (0..n).map(|j| arow[j] * (g2 * self.ev[j] + g * self.eq[j])).sum();
+        }
+        lu_cm_solve(&self.lu_r, &self.piv_r, nm, &mut self.tmp);
+        let mut s = 0.0;
+        for i in 0..n {
+            let v = self.tmp[i] / self.scal(i);
+            s += v * v;
+        }
+        (s / n as f64).sqrt()
+    }
+}
+
+impl Stepper for RadauM {
+    fn init<S: SecondOrderSystem>(&mut self, sys: &mut S, t0: f64, y0: &[f64], t_end: f64) -> Result<()> {
+        let n = self.n;
+        self.st.start(t0, y0);
+        self.first = true;
+        self.reject = false;
+        self.have_old = false;
+        self.reuse = false;
+        self.faccon = 1.0;
+        self.theta = 1.0;
+        let (q, qd) = y0.split_at(n);
+        sys.acc(t0, q, qd, &mut self.qdd)?;
+        self.st.stats.nfev += 1;
+        sys.multipliers(&mut self.lam);
+        self.read_structure(sys)?;
+        let hmax = self.opts.max_step.min((t_end - t0).abs());
+        self.st.h = match (self.ro.step, self.opts.first_step) {
+            (Some(h), _) => h,
+            (None, Some(h)) => h.min(hmax),
+            (None, None) => {
+                let mut f0 = vec![0.0; 2 * n];
+                f0[..n].copy_from_slice(qd);
+                f0[n..].copy_from_slice(&self.qdd);
+                let (mut y1, mut f1) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
+                let atol = self.opts.validate(2 * n)?;
+                initial_step(sys, t0, y0, &f0, self.opts.rtol, &atol, 3, hmax, &mut y1, &mut f1, &mut self.st.stats.nfev)?
+            }
+        };
+        Ok(())
+    }
+
+    fn step<S: SecondOrderSystem>(&mut self, sys: &mut S, t_end: f64) -> Result<()> {
+        let n = self.n;
+        let fixed = self.ro.step.is_some();
+        self.q0.copy_from_slice(&self.st.y[..n]);
+        self.v0.copy_from_slice(&self.st.y[n..]);
+        self.a0.copy_from_slice(&self.qdd);
+        let cfac = SAFE * (1.0 + 2.0 * NIT as f64);
+        let mut fresh = false;
+        loop {
+            self.st.check_attempt("RADAU5M", &self.opts)?;
+            let mut h = self.st.h;
+            let last = self.st.t + 1.01 * h >= t_end;
+            if last {
+                h = t_end - self.st.t;
+            }
+            if self.refresh || self.age >= VELOCITY_TERMS_AGE {
+                self.read_structure(sys)?;
+                self.reuse = false;
+                fresh = true;
+            }
+            self.predict(h);
+            let Some(newt) = self.newton(sys, h)? else {
+                // Newton failed: fresh velocity terms at the same step first, then a smaller step
+                self.reuse = false;
+                if !fresh {
+                    self.refresh = true;
+                    self.st.h = h;
+                    continue;
+                }
+                if fixed {
+                    if h < 1e-3 * self.ro.step.expect("fixed") {
+                        return Err(Error::Solver(format!("RADAU5M: Newton did not converge at t = {} even with h = {h:e} (1/1000 of the fixed step)", self.st.t)));
+                    }
+                    self.st.h = 0.5 * h;
+                } else {
+                    self.st.h = self.st.h.min(0.5 * h);
+                }
+                self.reject = true;
+                if self.st.stats.naccept >= 1 {
+                    self.st.stats.nreject += 1;
+                }
+                continue;
+            };
+            let err = if fixed { 0.0 } else { self.error_estimate(sys, h)? };
+            let fac = SAFE.min(cfac / (newt + 2 * NIT) as f64);
+            let mut quot = FACR.max(FACL.min(err.powf(0.25) / fac));
+            let mut hnew = h / quot;
+            if err >= 1.0 {
+                // rejected
+                self.reject = true;
+                if self.first {
+                    self.st.h = 0.1 * h;
+                } else {
+                    self.st.h = hnew;
+                }
+                if self.st.stats.naccept >= 1 {
+                    self.st.stats.nreject += 1;
+                }
+                // keep the factorization only if h comes back to it
+                continue;
+            }
+            // accepted: the UK acceleration at the end (and the projection with its factorization)
+            self.first = false;
+            let t1 = if last { t_end } else { self.st.t + h };
+            let (mut q1, mut v1) = (std::mem::take(&mut self.qs[2]), std::mem::take(&mut self.vs[2]));
+            let r = sys.acc_projected(t1, &mut q1, &mut v1, &mut self.qdd, self.ro.projection);
+            self.st.stats.nfev += 1;
+            self.st.y[..n].copy_from_slice(&q1);
+            self.st.y[n..].copy_from_slice(&v1);
+            self.qs[2] = q1;
+            self.vs[2] = v1;
+            r?;
+            sys.multipliers(&mut self.lam);
+            self.st.stats.naccept += 1;
+            self.st.nonfinite = None;
+            self.st.t_old = self.st.t;
+            self.st.t = t1;
+            for i in 0..3 {
+                std::mem::swap(&mut self.w[i], &mut self.w_old[i]);
+                std::mem::swap(&mut self.ls[i], &mut self.ls_old[i]);
+            }
+            self.h_old = h;
+            self.have_old = true;
+            self.age += 1;
+            if fixed {
+                self.st.h = self.ro.step.expect("fixed");
+                self.reuse = self.theta <= REUSE_CONTRACTION;
+                return Ok(());
+            }
+            // Gustafsson's predictive control
+            if self.st.stats.naccept > 1 {
+                let facgus = ((self.hacc / h) * (err * err / self.erracc).powf(0.25) / SAFE).clamp(FACR, FACL);
+                quot = quot.max(facgus);
+                hnew = h / quot;
+            }
+            self.hacc = h;
+            self.erracc = err.max(1e-2);
+            hnew = hnew.min(self.opts.max_step);
+            if self.reject {
+                hnew = hnew.min(h);
+            }
+            self.reject = false;
+            let qt = hnew / h;
+            if self.theta <= REUSE_CONTRACTION && (QUOT1..=QUOT2).contains(&qt) {
+                self.st.h = h;
+                self.reuse = true;
+            } else {
+                self.st.h = hnew;
+                self.reuse = false;
+            }
+            return Ok(());
+        }
+    }
+
+    fn dense_parts(&self) -> DenseParts<'_> {
+        DenseParts { meta: [self.st.t_old, self.st.t, 0.0], parts: [&self.st.y, &self.q0, &self.v0, &self.a0, &self.qdd], count: 5 }
+    }
+
+    /// Quintic Hermite interpolation of `q` from `q`, `qd`, `qdd` at both ends (error O(h^6)),
+    /// `qd` from its derivative.
+    fn dense_eval(meta: [f64; 3], parts: &[&[f64]], t: f64, out: &mut [f64]) {
+        let n = out.len() / 2;
+        let [t0, t1, _] = meta;
+        let (y, q0, v0, a0, a1) = (parts[0], parts[1], parts[2], parts[3], parts[4]);
+        let h = t1 - t0;
+        if h == 0.0 {
+            out.copy_from_slice(y);
+            return;
+        }
+        let s = (t - t0) / h;
+        let (s2, s3) = (s * s, s * s * s);
+        let (s4, s5) = (s3 * s, s3 * s2);
+        // quintic Hermite basis and derivatives (d/ds)
+        let h0 = 1.0 - 10.0 * s3 + 15.0 * s4 - 6.0 * s5;
+        let h1 = s - 6.0 * s3 + 8.0 * s4 - 3.0 * s5;
+        let h2 = 0.5 * s2 - 1.5 * s3 + 1.5 * s4 - 0.5 * s5;
+        let h3 = 0.5 * s3 - s4 + 0.5 * s5;
+        let h4 = -4.0 * s3 + 7.0 * s4 - 3.0 * s5;
+        let h5 = 10.0 * s3 - 15.0 * s4 + 6.0 * s5;
+        let d0 = -30.0 * s2 + 60.0 * s3 - 30.0 * s4;
+        let d1 = 1.0 - 18.0 * s2 + 32.0 * s3 - 15.0 * s4;
+        let d2 = s - 4.5 * s2 + 6.0 * s3 - 2.5 * s4;
+        let d3 = 1.5 * s2 - 4.0 * s3 + 2.5 * s4;
+        let d4 = -12.0 * s2 + 28.0 * s3 - 15.0 * s4;
+        let d5 = 30.0 * s2 - 60.0 * s3 + 30.0 * s4;
+        let (q1, v1) = y.split_at(n);
+        for i in 0..n {
+            out[i] = h0 * q0[i] + h1 * h * v0[i] + h2 * h * h * a0[i] + h3 * h * h * a1[i] + h4 * h * v1[i] + h5 * q1[i];
+            out[n + i] = (d0 * q0[i] + d5 * q1[i]) / h + d1 * v0[i] + d4 * v1[i] + h * (d2 * a0[i] + d3 * a1[i]);
+        }
+    }
+
+    fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
+        acc_and_multipliers(sys, &mut self.st, &mut self.qdd, &mut self.lam)
+    }
+
+    fn expected_steps(&self, t0: f64, t_end: f64) -> Option<usize> {
+        fixed_step_count(t0, t_end, self.ro.step)
+    }
+
+    fn state(&self) -> &StepState {
+        &self.st
+    }
+    fn state_mut(&mut self) -> &mut StepState {
+        &mut self.st
+    }
+}
