@@ -182,7 +182,7 @@ def test_export_then_run(tmp_path):
     r = ukflex_cli("run", p, "--out", tmp_path, "--no-plot")
     assert r.returncode == 0, r.stderr
     assert "scene slider_crank: n = 12 coordinates" in r.stdout
-    assert "method auto -> GENALPHA: stiff" in r.stdout  # the exported file runs the default chooser
+    assert "method auto -> RADAU5M: stiff" in r.stdout  # the exported file runs the default chooser
     r = ukflex_cli("run", "pendulum", "--t-end", "0.1", "--out", tmp_path / "p", "--no-plot")
     assert r.returncode == 0, r.stderr
     assert "method auto -> DOPRI5: no elastic mode" in r.stdout

@@ -127,7 +127,7 @@ def test_result_helpers(tmp_path):
     assert set(res.residuals) == {"position", "velocity", "acceleration"}
     assert all(r.shape == (11,) for r in res.residuals.values())
     assert res.nfev > 0 and res.njev > 0 and res.nlu > 0 and res.wall_time > 0
-    assert res.status == 0 and res.method == "GENALPHA" and res.extra["auto"]["method"] == "GENALPHA" and res.formulation == "uk"
+    assert res.status == 0 and res.method == "RADAU5M" and res.extra["auto"]["method"] == "RADAU5M" and res.formulation == "uk"
     u0, v0 = res.beam_displacement("coupler", 0.0)
     assert np.allclose(u0, 0.0) and np.allclose(v0, 0.0)  # pinned frame origin
     _, v1 = res.beam_displacement("coupler", 1.0)

@@ -114,7 +114,7 @@ class System:
         max_step: Optional[float] = None,
         max_steps: int = 1_000_000,
         projection_tol: Optional[float] = None,
-        rho_inf: float = 0.9,
+        rho_inf: Optional[float] = None,
         step: Optional[float] = None,
         jacobian: str = "structured",
         max_nfev: Optional[int] = None,

@@ -5,26 +5,25 @@ is too long for its fastest mode.  The motions of interest are every flexible bo
 elastic mode (a mode that stores its potential energy in elastic or spring deformation, not in
 gravity or constraint forces: a pendulum's swing is not elastic) and everything slower;
 ``omega_c`` is the highest of those (without flexible bodies: the lowest spring mode).
-Generalized-alpha has a relative period error of about ``(omega h)^2 / 12``, and over the run
-the phase of that mode drifts by ``eps omega_c T`` radians.  The chooser gives it a phase
-budget ``phi = min(1, 1e5 rtol)`` rad (``rtol = 1e-6``: 0.1 rad over the whole run), so
 
-    eps = min(1e-2, phi / (omega_c T)),   h = sqrt(12 eps) / omega_c   (at most T / 20).
+The stiff choice is ``RADAU5M`` (Radau IIA, order 5, L-stable, on the constrained second-order
+equations) with a fixed step.  On a resolved mode ``omega`` its amplitude falls by about
+``RADAU_DECAY (omega h)^6`` per step (the phase lags by less), so over the run ``omega_c`` loses
+``RADAU_DECAY y^5 omega_c T`` of its amplitude, ``y = omega_c h``.  The chooser gives that the
+budget ``phi = min(1, 1e5 rtol)`` (``rtol = 1e-6``: 0.1 over the whole run) and caps ``y`` at
+``RADAU_MAX_STEP_OMEGA`` (0.3: ~20 steps per period of ``omega_c``; coarser steps made Newton
+fail on ANCF couplers and cost accuracy on the cantilever), so
+
+    y = min(0.3, (phi / (RADAU_DECAY omega_c T))^(1/5)),   h = y / omega_c   (at most T / 20).
 
 DOPRI5 has to resolve the fastest mode instead: on these scenes its own step control settles at
-``h omega_max ~ 0.5`` on average (measured 0.2-0.7 at rtol 1e-6..1e-8, paper scene and
-flexible four-bar) and a DOPRI5 step (6 UK calls) costs about twice a GENALPHA step.  So when
-``h omega_max > 0.5 / 2 = 0.25`` generalized-alpha is the cheaper way to the requested accuracy:
-the chooser takes GENALPHA with that fixed step (``rho_inf = 0.9``, projection on), which damps
-the fast modes instead of resolving them; its Newton iterations stop at ``max(rtol, eps / 10)``
-of each step's motion or, while they contract fast, at ``NEWTON_LOCAL_ERROR`` of the step's
-local error estimate (a tighter Newton tolerance costs iterations and changes nothing the step
-size does not decide) -- the latter only on coarse steps, ``h omega_max >=
-LOCAL_NEWTON_MIN_STEP_OMEGA``: on finer steps the local error estimate is small, and the Newton
-error it lets through feeds back into the next estimates until it dominates them (measured: an
-ANCF coupler at rtol 1e-10 ended 9 % off the strict-Newton run of the same step).  Otherwise
-(rigid systems, soft or slow flexible ones, tight tolerances where a fifth-order method wins) it takes native DOPRI5 at the user's tolerances.  See
-docs/integrators.md.
+``h omega_max ~ 0.5`` on average (measured 0.2-0.7 at rtol 1e-6..1e-8, paper scene and flexible
+four-bar), and a RADAU5M step costs about ``RADAU_COST_RATIO`` = 1.6 DOPRI5 steps.  So when
+``h omega_max > 0.5 x 1.6`` RADAU5M is the cheaper way to the requested accuracy: the chooser
+takes it with that fixed step (projection on; ``rtol`` sets its Newton tolerance), which damps
+the fast modes instead of resolving them.  Otherwise (rigid systems, soft or slow flexible ones)
+it takes native DOPRI5 at the user's tolerances.  GENALPHA (second order) runs when the user
+gives its own options (``rho_inf``, ``newton_local_error``).  See docs/integrators.md.
 """
 
 from __future__ import annotations
@@ -35,26 +34,29 @@ from typing import Any, Dict, Optional
 
 import numpy as np
 
-#: the chooser's constants (one place): phase budget per rtol and its cap [rad], period-error
-#: cap, fewest steps per run
+#: the chooser's constants (one place): amplitude budget per rtol and its cap, fewest steps per run
 PHASE_PER_RTOL = 1e5
 PHASE_CAP = 1.0
-PERIOD_ERROR_CAP = 1e-2
 MIN_STEPS = 20
-#: GENALPHA's Newton tolerance relative to the period-error target
-NEWTON_PER_PERIOD_ERROR = 0.1
-#: ... and, while Newton contracts fast, relative to each step's local error estimate
-#: (``newton_local_error``: 2.3 instead of 3.2-4.4 iterations per step on the paper scene, the
-#: same answer; docs/integrators.md)
+#: RADAU5M on a resolved mode: amplitude loss per step ``RADAU_DECAY (omega h)^6`` (|R(i y)| of
+#: Radau IIA: 1.3e-10 at y = 0.1, 1.3e-4 at y = 1; the phase lag is 2.3e-5 y^6)
+RADAU_DECAY = 1.3e-4
+#: ... its largest step in radians of omega_c: at y = 0.5 Newton failed on 109 of 337 attempts
+#: on the ANCF coupler (N = 4; 7 of 300 at 0.3) and the cantilever's history error rose 4x
+RADAU_MAX_STEP_OMEGA = 0.3
+#: DOPRI5's average h omega_max on stiff flexible scenes, and a RADAU5M step's cost in DOPRI5
+#: steps (nonlinear FFRF coupler N = 4: 17 us against 6 UK calls of ~1.7 us)
+EXPLICIT_STEP_OMEGA = 0.5
+RADAU_COST_RATIO = 1.6
+#: GENALPHA by hand (``newton_local_error``): the fraction of the local error estimate at which
+#: Newton may stop (2.3 instead of 3.2-4.4 iterations per step on the paper scene, the same
+#: answer; docs/integrators.md) ...
 NEWTON_LOCAL_ERROR = 0.3
-#: ... but only on steps this coarse against the fastest mode, ``h omega_max``: on the ANCF
+#: ... safe only on steps this coarse against the fastest mode, ``h omega_max``: on the ANCF
 #: coupler (N = 4 and 8) the looser test keeps the answer at ``h omega_max`` >= 3.5 with
 #: ``rho_inf`` 0.9 and >= 8.7 with 1.0, and lets it drift off at 2.2-2.6 (0.9) and 4.4 (1.0):
 #: the accepted Newton error feeds the next local error estimates (docs/integrators.md)
 LOCAL_NEWTON_MIN_STEP_OMEGA = 8.0
-#: DOPRI5's average h omega_max on stiff flexible scenes, and its step cost over a GENALPHA step
-EXPLICIT_STEP_OMEGA = 0.5
-EXPLICIT_COST_RATIO = 2.0
 #: a mode is elastic when more than this share of omega^2 comes from the potential energy's
 #: curvature (elastic strain, springs) rather than from gravity and constraint forces
 ELASTIC_SHARE = 0.5
@@ -72,7 +74,7 @@ class MethodChoice:
     omega_elastic: Optional[float] = None
     omega_max: float = 0.0
     step: Optional[float] = None
-    #: the integrator's rtol when it differs from the user's (GENALPHA's Newton tolerance)
+    #: the integrator's rtol when it differs from the user's
     rtol: Optional[float] = None
 
     def as_dict(self) -> Dict[str, Any]:
@@ -117,7 +119,7 @@ def lowest_elastic_frequency(system, omega, shapes, shares, q) -> Optional[float
 
 
 def local_newton_ok(h: float, omega_max: float) -> bool:
-    """Whether GENALPHA's Newton may stop at the local error level (``NEWTON_LOCAL_ERROR``) with
+    """Whether GENALPHA's Newton may stop at the local error level (``newton_local_error``) with
     step ``h`` on a system whose fastest mode is ``omega_max``: only on coarse steps."""
     return h * omega_max >= LOCAL_NEWTON_MIN_STEP_OMEGA
 
@@ -141,21 +143,18 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
         return MethodChoice("DOPRI5", omega_max=omega_max,
                             reason=f"no elastic mode (fastest mode {omega_max:.4g} rad/s): not stiff, explicit")
     phase = min(PHASE_CAP, PHASE_PER_RTOL * rtol)
-    eps = min(PERIOD_ERROR_CAP, phase / (omega_c * span))
-    h = min(math.sqrt(12.0 * eps) / omega_c, span / MIN_STEPS)
-    if h * omega_max > EXPLICIT_STEP_OMEGA / EXPLICIT_COST_RATIO:
-        options = {"step": h}
-        if local_newton_ok(h, omega_max):
-            options["newton_local_error"] = NEWTON_LOCAL_ERROR
+    y = min(RADAU_MAX_STEP_OMEGA, (phase / (RADAU_DECAY * omega_c * span)) ** 0.2)
+    h = min(y / omega_c, span / MIN_STEPS)
+    if h * omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:
         return MethodChoice(
-            "GENALPHA", options=options, omega_elastic=omega_c, omega_max=omega_max, step=h,
-            rtol=max(rtol, NEWTON_PER_PERIOD_ERROR * eps),
-            reason=(f"stiff: the step {h:.3g} s that resolves the lowest elastic mode ({omega_c:.4g} rad/s) to a "
-                    f"period error of {eps:.2g} is {h * omega_max:.3g}/omega_max ({omega_max:.4g} rad/s), beyond what an explicit method may take "
-                    f"(~{EXPLICIT_STEP_OMEGA / EXPLICIT_COST_RATIO:g}/omega_max at equal cost): generalized-alpha damps "
-                    "the fast modes instead of resolving them"))
+            "RADAU5M", options={"step": h}, omega_elastic=omega_c, omega_max=omega_max, step=h,
+            reason=(f"stiff: the step {h:.3g} s ({omega_c * h:.2g} rad of the lowest elastic mode, {omega_c:.4g} rad/s, "
+                    f"amplitude loss {RADAU_DECAY * (omega_c * h) ** 5 * omega_c * span:.1e} over the run) is "
+                    f"{h * omega_max:.3g}/omega_max ({omega_max:.4g} rad/s), beyond what an explicit method may take "
+                    f"(~{EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:g}/omega_max at equal cost): Radau IIA (order 5, "
+                    "L-stable) damps the fast modes instead of resolving them"))
     return MethodChoice(
         "DOPRI5", omega_elastic=omega_c, omega_max=omega_max,
         reason=(f"not stiff at this tolerance: the step {h:.3g} s that resolves the lowest elastic mode "
-                f"({omega_c:.4g} rad/s) to a period error of {eps:.2g} (phase {phase:.2g} rad over the run) is only "
+                f"({omega_c:.4g} rad/s) to an amplitude loss of {phase:.2g} over the run is only "
                 f"{h * omega_max:.3g}/omega_max ({omega_max:.4g} rad/s): explicit, fifth order, is cheaper"))

@@ -188,22 +188,25 @@ def simulate(
         End time [s], ``> t0`` (the system's initial time, normally 0).  Or give ``t_span``.
     method : str or scipy OdeSolver subclass
         ``"auto"`` (default): chosen from the constrained system's natural frequencies
-        (:mod:`ukflex.choice`, docs/integrators.md): native ``"GENALPHA"`` with a fixed step
+        (:mod:`ukflex.choice`, docs/integrators.md): native ``"RADAU5M"`` with a fixed step
         that resolves the lowest elastic mode when the fastest modes are far beyond it (stiff
         flexible scenes), native ``"DOPRI5"`` otherwise; the choice and its reason are in
         ``res.method`` and ``res.extra["auto"]``.  Or any ``solve_ivp`` method: ``"Radau"``,
         ``"BDF"``, ``"LSODA"``, ``"RK45"``, ``"RK23"``, ``"DOP853"``; or a native Rust integrator
         (all steps in Rust, GIL released, same result object): ``"DOPRI5"`` (Dormand-Prince 5(4),
-        dense output), ``"RADAU5"`` (Radau IIA order 5, Rust Jacobian) or ``"GENALPHA"``
-        (generalized-alpha for stiff flexible systems: numerical dissipation ``rho_inf``
-        (default 0.9), a structured Newton matrix, fixed ``step`` or error-controlled steps,
-        projection onto the constraints by default).  Names are case-insensitive.  Native
+        dense output), ``"RADAU5"`` (Radau IIA order 5 on the UK right-hand side, Rust Jacobian),
+        ``"RADAU5M"`` (Radau IIA order 5, L-stable, on the constrained second-order equations:
+        the structured Newton matrix, fixed ``step`` or error-controlled steps, projection onto
+        the constraints by default) or ``"GENALPHA"`` (generalized-alpha, second order:
+        numerical dissipation ``rho_inf`` (default 0.9), the same Newton matrix, fixed ``step``
+        or error-controlled steps, projection by default).  Names are case-insensitive.  Native
         methods take the options ``first_step``, ``max_step``, ``projection_tol`` (project onto
         the constraints after every accepted step whose residuals exceed it; 0: off) and
-        ``jacobian``, GENALPHA also ``rho_inf``, ``step`` and ``newton_local_error`` (Newton may
-        stop at this fraction of the step's local error estimate; ``method="auto"`` sets it on
-        coarse steps, ``h omega_max >= ukflex.choice.LOCAL_NEWTON_MIN_STEP_OMEGA``: on finer ones
-        it feeds on its own error);
+        ``jacobian``, RADAU5M and GENALPHA also ``step`` (with a fixed step ``rtol`` sets only
+        the Newton tolerance), GENALPHA also ``rho_inf`` and ``newton_local_error`` (Newton may
+        stop at this fraction of the step's local error estimate; safe only on coarse steps,
+        ``h omega_max >= ukflex.choice.LOCAL_NEWTON_MIN_STEP_OMEGA``: on finer ones it feeds on
+        its own error);
         see docs/integrators.md.
     rtol : float
         Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s); below 100 x machine
@@ -246,8 +249,8 @@ def simulate(
     max_wall_time : float, optional
         Wall-clock budget [s] (default: none).
     min_step : float
-        Smallest step size [s] (default 0: the rounding limit); a ``max_step`` or GENALPHA
-        ``step`` that cannot reach ``t_end`` within ``max_steps`` is refused up front.
+        Smallest step size [s] (default 0: the rounding limit); a ``max_step`` or fixed
+        ``step`` (RADAU5M, GENALPHA) that cannot reach ``t_end`` within ``max_steps`` is refused up front.
     **options
         Solver options: ``first_step``, ``max_step``, ``jac``, ... (scipy); ``first_step``,
         ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``newton_local_error``, ``jacobian`` (native).  An option
@@ -412,7 +415,7 @@ def _check_drift(system: System, res: SimulationResult, rtol: float, atol: Any) 
             f"min({DRIFT_FACTOR:g} x (rtol x length scale {scale:.3g} m + atol), {DRIFT_OF_SCALE:g} x length scale) = "
             f"{limit:.3g} m: the run did not deliver "
             "the requested accuracy (check the scene's units and scales, tighten rtol, or use a method with "
-            "projection such as GENALPHA)")
+            "projection such as RADAU5M or GENALPHA)")
     res.extra["drift"] = dict(max_position_residual=float(pos[worst]), t=float(res.t[worst]), limit=limit, message=text)
     warnings.warn(text, DriftWarning, stacklevel=3)
 
@@ -630,8 +633,9 @@ class DenseSolution:
 
     Each accepted step keeps its method's own interpolant, recorded in Rust during the run and
     evaluated in Rust: DOPRI5 its 4th-order continuous extension (Hairer's CONTD5), RADAU5 the
-    step's collocation polynomial (CONTR5), GENALPHA a cubic Hermite polynomial in ``q`` from
-    ``q`` and ``qd`` at the step's ends (``qd`` from its derivative).  Outside ``[t_min, t_max]``
+    step's collocation polynomial (CONTR5), RADAU5M a quintic Hermite polynomial in ``q`` from
+    ``q``, ``qd`` and ``qdd`` at the step's ends, GENALPHA a cubic one from ``q`` and ``qd``
+    (``qd`` from its derivative).  Outside ``[t_min, t_max]``
     the first or last step's polynomial is extrapolated (as ``OdeSolution`` does).
 
     Attributes
@@ -760,30 +764,28 @@ def _simulate_reference(system, formulation, t_end, method, rtol, atol, t_eval, 
 def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
     """``method="auto"``: the chooser of :mod:`ukflex.choice` for the Rust UK formulation; the
     NumPy references keep scipy's Radau.  Options that only scipy takes (``jac``, ``events``,
-    ...) map the choice to its scipy counterpart (GENALPHA -> Radau, DOPRI5 -> DOP853)."""
-    from .choice import choose_method, local_newton_ok
+    ...) map the choice to its scipy counterpart (RADAU5M -> Radau, DOPRI5 -> DOP853); options
+    that only GENALPHA takes (``rho_inf``, ``newton_local_error``) make it GENALPHA."""
+    from .choice import choose_method
 
     if formulation != "uk":
         return "Radau", options, None
     choice = choose_method(system, t0, t_end, rtol, q, qd)
     scipy_only = sorted(set(options) - set(_NATIVE_OPTIONS))
     if scipy_only:
-        choice.method = "Radau" if choice.method == "GENALPHA" else "DOP853"
+        choice.method = "Radau" if choice.method == "RADAU5M" else "DOP853"
         choice.options, choice.rtol = {}, None
         choice.reason += f"; scipy {choice.method} because of the scipy option(s) {scipy_only}"
         return choice.method, options, choice
-    genalpha_only = sorted(set(options) & {"step", "rho_inf", "newton_local_error"})
-    if genalpha_only and choice.method != "GENALPHA":
+    genalpha_only = sorted(set(options) & {"rho_inf", "newton_local_error"})
+    if genalpha_only:
         choice.method, choice.options, choice.rtol = "GENALPHA", {}, None
         choice.reason += f"; GENALPHA because of the option(s) {genalpha_only}"
+    elif "step" in options and choice.method == "DOPRI5":
+        choice.method, choice.options = "RADAU5M", {}
+        choice.reason += "; RADAU5M because of the option step (DOPRI5 has no fixed step)"
     merged = dict(choice.options)
     merged.update(options)  # the user's own settings win (e.g. step=...)
-    if ("newton_local_error" in merged and "newton_local_error" not in options and merged.get("step") is not None
-            and not local_newton_ok(merged["step"], choice.omega_max)):
-        # the user's finer step: the strict Newton test (the looser one only on coarse steps)
-        del merged["newton_local_error"]
-        choice.options.pop("newton_local_error", None)
-        choice.reason += "; strict Newton test on the user's step (fine against omega_max)"
     return choice.method, merged, choice
 
 

@@ -436,7 +436,9 @@ impl RadauM {
                 if self.theta < 0.99 {
                     self.faccon = self.theta / (1.0 - self.theta);
                     let dyth = self.faccon * dyno * self.theta.powi((NIT - 1 - k) as i32) / self.fnewt;
-                    if dyth >= 1.0 {
+                    // with a fixed step there is no smaller step to move to: Newton goes on while
+                    // it contracts (up to NIT iterations) instead of giving up on the prediction
+                    if dyth >= 1.0 && self.ro.step.is_none() {
                         let qnewt = dyth.clamp(1e-4, 20.0);
                         self.st.h = 0.8 * h * qnewt.powf(-1.0 / (4.0 + NIT as f64 - 1.0 - k as f64));
                         return Ok(None);
