@@ -13,10 +13,11 @@ import ukflex
 from ukflex import InvalidArgumentError, NonFiniteError, Scene, UnknownOptionError, scenes, simulate
 
 SCIPY = ("RK45", "DOP853", "Radau")
-NATIVE = ("DOPRI5", "RADAU5", "GENALPHA")
+NATIVE = ("DOPRI5", "RADAU5", "GENALPHA", "RADAU5M")
 #: event-time agreement with a tight scipy reference at rtol = 1e-9 (GENALPHA: its own
 #: second-order accuracy at its error-controlled step)
-EVENT_TOL = {"RK45": 1e-6, "DOP853": 1e-6, "Radau": 1e-6, "DOPRI5": 1e-6, "RADAU5": 1e-6, "GENALPHA": 1e-3}
+EVENT_TOL = {"RK45": 1e-6, "DOP853": 1e-6, "Radau": 1e-6, "DOPRI5": 1e-6, "RADAU5": 1e-6, "GENALPHA": 1e-3,
+             "RADAU5M": 1e-6}
 
 
 @pytest.fixture(scope="module")
@@ -163,7 +164,7 @@ def test_terminal_event_with_direction_matches_scipy(pendulum, method):
     np.testing.assert_allclose(res.y[:, -1], res.y_events[0][0], atol=1e-12)
 
 
-@pytest.mark.parametrize("method", ("RK45", "DOPRI5", "GENALPHA"))
+@pytest.mark.parametrize("method", ("RK45", "DOPRI5", "GENALPHA", "RADAU5M"))
 def test_event_count_terminal_and_non_terminal_and_args(pendulum, method):
     def ev(t, y, offset):
         return _bottom(t, y) - offset
@@ -205,7 +206,7 @@ def test_native_terminal_event_stops_before_a_later_failure():
 
 
 # ------------------------------------------------------------------------------ budgets, NaN, partial results
-@pytest.mark.parametrize("method", ("RK45", "Radau", "DOPRI5", "RADAU5", "GENALPHA"))
+@pytest.mark.parametrize("method", ("RK45", "Radau", "DOPRI5", "RADAU5", "GENALPHA", "RADAU5M"))
 @pytest.mark.parametrize("budget", ("max_steps", "max_nfev", "min_step"))
 def test_budgets_stop_with_status_cause_and_the_partial_result(pendulum, method, budget):
     value = {"max_steps": 20, "max_nfev": 150, "min_step": 0.5}[budget]
@@ -218,7 +219,7 @@ def test_budgets_stop_with_status_cause_and_the_partial_result(pendulum, method,
         assert res.t.size > 5  # the run so far is kept
 
 
-@pytest.mark.parametrize("method", ("RK45", "DOPRI5", "GENALPHA"))
+@pytest.mark.parametrize("method", ("RK45", "DOPRI5", "GENALPHA", "RADAU5M"))
 def test_wall_time_budget_ends_an_endless_run(pendulum, method):
     """``simulate(pendulum, 1e9, method="RK45")`` used to never return."""
     tic = time.perf_counter()
@@ -228,7 +229,7 @@ def test_wall_time_budget_ends_an_endless_run(pendulum, method):
     assert res.status == -1 and res.stop["cause"] == "max_wall_time" and res.t[-1] > 1.0
 
 
-@pytest.mark.parametrize("method", ("RK45", "Radau", "DOPRI5", "GENALPHA"))
+@pytest.mark.parametrize("method", ("RK45", "Radau", "DOPRI5", "GENALPHA", "RADAU5M"))
 def test_non_finite_state_mid_run_names_the_coordinate_and_keeps_the_run(method):
     """x'' = 1e100: x overflows near t = 1.4e104 s, after more than a hundred finite steps."""
     s = Scene()
