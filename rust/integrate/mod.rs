@@ -654,10 +654,11 @@ pub enum Method {
     RadauM(RadauMOptions),
 }
 
-/// Default projection of the generalized-alpha method: positions when `max |Phi| > 1e-11`,
-/// velocities when `max |A qd + Phi_t| > 1e-9` (absolute): keeps the drift of long runs bounded
-/// (targets 1e-10 and 1e-8) at a per-step cost that is nil while the drift is below.
-pub const GENALPHA_PROJECTION: ProjectionTolerance = ProjectionTolerance { position_tol: 1e-11, velocity_tol: 1e-9, max_iter: 5 };
+/// Default projection of the implicit methods on the constrained equations (GENALPHA, RADAU5M):
+/// positions when `max |Phi| > 1e-11`, velocities when `max |A qd + Phi_t| > 1e-9` (absolute):
+/// keeps the drift of long runs bounded (targets 1e-10 and 1e-8) at a per-step cost that is nil
+/// while the drift is below.
+pub const IMPLICIT_PROJECTION: ProjectionTolerance = ProjectionTolerance { position_tol: 1e-11, velocity_tol: 1e-9, max_iter: 5 };
 
 impl Method {
     pub fn from_name(name: &str) -> Option<Method> {
@@ -673,7 +674,7 @@ impl Method {
     /// The projection a method uses unless told otherwise.
     pub fn default_projection(&self) -> Option<ProjectionTolerance> {
         match self {
-            Method::GenAlpha(_) | Method::RadauM(_) => Some(GENALPHA_PROJECTION),
+            Method::GenAlpha(_) | Method::RadauM(_) => Some(IMPLICIT_PROJECTION),
             Method::Dopri5 | Method::Radau5 => None,
         }
     }
