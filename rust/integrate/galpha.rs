@@ -48,7 +48,7 @@
 //! `atol + rtol |q|`. Dense output: the cubic Hermite interpolant of `(q, qd)` at both ends.
 
 use super::lu::{inv_solve, inverse_from_lu_cm, lu_cm, lu_cm_solve};
-use super::{acc_and_multipliers, fixed_step_count, initial_step, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
+use super::{acc_and_multipliers, fixed_step_count, initial_step_second_order, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::correct::ProjectionTolerance;
 use crate::error::{Error, Result};
 
@@ -511,11 +511,7 @@ impl Stepper for GenAlpha {
             (None, Some(h)) => h.min(hmax),
             (None, None) => {
                 // Hairer's estimate for an order-2 error estimate, on the first-order system
-                let mut f0 = vec![0.0; 2 * n];
-                f0[..n].copy_from_slice(qd);
-                f0[n..].copy_from_slice(&self.qdd);
-                let (mut y1, mut f1) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
-                initial_step(sys, t0, y0, &f0, self.opts.rtol, &self.atol, 2, hmax, &mut y1, &mut f1, &mut self.st.stats.nfev)?
+                initial_step_second_order(sys, t0, y0, &self.qdd, self.opts.rtol, &self.atol, 2, hmax, &mut self.st.stats.nfev)?
             }
         };
         self.factor(self.st.h)?;

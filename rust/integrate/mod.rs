@@ -417,6 +417,19 @@ fn initial_step<S: SecondOrderSystem>(sys: &mut S, t0: f64, y0: &[f64], f0: &[f6
     Ok((100.0 * h).min(h1).min(hmax))
 }
 
+/// `initial_step` for a second-order system at `(t0, y0 = [q, qd])` with the acceleration
+/// `qdd` there (the implicit methods' first step when neither a fixed step nor `first_step` is
+/// given; allocates its three 2n buffers once per run).
+#[allow(clippy::too_many_arguments)]
+fn initial_step_second_order<S: SecondOrderSystem>(sys: &mut S, t0: f64, y0: &[f64], qdd: &[f64], rtol: f64, atol: &[f64], iord: i32, hmax: f64, nfev: &mut usize) -> Result<f64> {
+    let n = qdd.len();
+    let mut f0 = vec![0.0; 2 * n];
+    f0[..n].copy_from_slice(&y0[n..]);
+    f0[n..].copy_from_slice(qdd);
+    let (mut y1, mut f1) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
+    initial_step(sys, t0, y0, &f0, rtol, atol, iord, hmax, &mut y1, &mut f1, nfev)
+}
+
 /// Steps from `t0` to `t_end` with a fixed step `h` (`Stepper::expected_steps`).
 fn fixed_step_count(t0: f64, t_end: f64, h: Option<f64>) -> Option<usize> {
     let k = ((t_end - t0) / h?).ceil();

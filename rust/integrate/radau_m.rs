@@ -46,7 +46,7 @@
 use super::lu::{lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
 // Hairer's Newton iterations per attempt and step-size control constants, as RADAU5 has them
 use super::radau5::{rc, FACL, FACR, NIT, QUOT1, QUOT2, SAFE};
-use super::{acc_and_multipliers, fixed_step_count, initial_step, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
+use super::{acc_and_multipliers, fixed_step_count, initial_step_second_order, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::correct::ProjectionTolerance;
 use crate::error::{Error, Result};
 
@@ -552,12 +552,8 @@ impl Stepper for RadauM {
             (Some(h), _) => h,
             (None, Some(h)) => h.min(hmax),
             (None, None) => {
-                let mut f0 = vec![0.0; 2 * n];
-                f0[..n].copy_from_slice(qd);
-                f0[n..].copy_from_slice(&self.qdd);
-                let (mut y1, mut f1) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
                 let atol = self.opts.validate(2 * n)?;
-                initial_step(sys, t0, y0, &f0, self.opts.rtol, &atol, 3, hmax, &mut y1, &mut f1, &mut self.st.stats.nfev)?
+                initial_step_second_order(sys, t0, y0, &self.qdd, self.opts.rtol, &atol, 3, hmax, &mut self.st.stats.nfev)?
             }
         };
         Ok(())
