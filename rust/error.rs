@@ -35,6 +35,9 @@ pub enum Error {
     /// `min_step`).
     #[error("{message}")]
     Budget { what: String, message: String },
+    /// A run left its constraints: `||Phi||` at an accepted step beyond the drift bound.
+    #[error("the constraints drifted to ||Phi|| = {residual:.3e} at t = {t}, beyond the drift bound {limit:.3e}: the result is not the motion of the mechanism from there on")]
+    Drift { t: f64, residual: f64, limit: f64 },
     /// A solver kernel could not produce a result (e.g. SVD did not converge).
     #[error("solver failure: {0}")]
     Solver(String),

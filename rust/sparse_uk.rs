@@ -203,6 +203,7 @@ impl SparseUk {
             max_d = max_d.max(d);
         }
         self.trace_s = trace_s;
+        self.trace_sinv = f64::INFINITY;
         if !trace_s.is_finite() || !self.cholesky() {
             return None;
         }
@@ -222,6 +223,52 @@ impl SparseUk {
         } else {
             None
         }
+    }
+
+    /// After a `factor` whose Cholesky succeeded (`S` numerically positive definite, certified
+    /// or not): estimates `(sigma_min, sigma_max)` of `B` from `1 / sqrt(trace(S^-1))` (within
+    /// a factor `sqrt(m)` of `sigma_min`) and `sqrt(trace(S))` (within `sqrt(m)` of
+    /// `sigma_max`). `None` when the Cholesky failed. For diagnostics (the singular-passage
+    /// monitor), not for rank decisions.
+    pub fn conditioning_estimate(&self) -> Option<(f64, f64)> {
+        (self.trace_sinv.is_finite() && self.trace_sinv > 0.0).then(|| (1.0 / self.trace_sinv.sqrt(), self.trace_s.sqrt()))
+    }
+
+    /// How many eigenvalues of `S = B B^T` (squared singular values of `B`) are below `tau2`:
+    /// the negative pivots of the band `LDL^T` of `S - tau2 I` (Sylvester's law of inertia; no
+    /// pivoting: a diagnostic). From the `B^T` values of the last `factor`; leaves its
+    /// factorization intact (scratch: the selected-inverse band and a work vector).
+    pub fn count_below(&mut self, tau2: f64) -> usize {
+        let (m, hb) = (self.m, self.hb);
+        let w = hb + 1;
+        let (l, d) = (&mut self.z, &mut self.dx);
+        l.fill(0.0);
+        for &(idx, a, b, len) in &self.pairs {
+            let v: f64 = self.vals[a..a + len].iter().zip(&self.vals[b..b + len]).map(|(x, y)| x * y).sum();
+            l[idx] += v;
+        }
+        let mut below = 0;
+        for i in 0..m {
+            let lo = i.saturating_sub(hb);
+            for j in lo..i {
+                let klo = lo.max(j.saturating_sub(hb));
+                let mut s = l[i * w + (j + hb - i)];
+                for k in klo..j {
+                    s -= l[i * w + (k + hb - i)] * l[j * w + (k + hb - j)] * d[k];
+                }
+                l[i * w + (j + hb - i)] = if d[j] != 0.0 { s / d[j] } else { 0.0 };
+            }
+            let mut s = l[i * w + hb] - tau2;
+            for k in lo..i {
+                let lik = l[i * w + (k + hb - i)];
+                s -= lik * lik * d[k];
+            }
+            d[i] = s;
+            if s < 0.0 {
+                below += 1;
+            }
+        }
+        below
     }
 
     /// In-place band Cholesky of `self.band`; false on a non-positive or non-finite pivot.

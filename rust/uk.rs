@@ -220,6 +220,24 @@ pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
     Ok(data.rank_info)
 }
 
+/// Every singular value of `B = A F^-T` at the terms in `data` (after `evaluate`), in
+/// decreasing order: the dense SVD (O(n m^2); diagnostics, not the hot path). `None` above
+/// `EXACT_RANK_MAX_ROWS` rows. Leaves the dense factorization in `data`.
+pub fn singular_values(model: &Model, data: &mut Data) -> Result<Option<Vec<f64>>> {
+    if model.m == 0 || model.m > EXACT_RANK_MAX_ROWS {
+        return Ok(None);
+    }
+    data.ensure_dense(model)?;
+    let backend = data.svd_backend;
+    data.svd_backend = SvdBackend::Faer;
+    let r = factor_dense(model, data);
+    data.svd_backend = backend;
+    r?;
+    let k = model.n.min(model.m);
+    let s = data.svd_s.column_vector();
+    Ok(Some((0..k).map(|j| s[j]).collect()))
+}
+
 /// The constraint correction with the current factorization: `r = b - A a`,
 /// `y += U S^+ V^T r`, `lambda = -V S^+ S^+ V^T r`, `qdd = F^-T y`.
 pub fn correct(model: &Model, data: &mut Data) {

@@ -129,9 +129,15 @@ fn steps_allocate_with<St: Stepper>(stepper: &mut St, model: &Model, steps: usiz
 fn native_steps_do_not_allocate() {
     let model = Model::from_json(&paper_scene("timoshenko", 2, true)).unwrap();
     let opts = Options { rtol: 1e-6, atol: vec![1e-9], ..Default::default() };
+    let projection = Some(ukflex::integrate::default_projection(&vec![1e-9; 2 * model.n]));
     let mut dp = Dopri5::new(2 * model.n, opts.clone()).unwrap();
     let n = steps_allocate(&mut dp, &model, 300);
     assert_eq!(n, 0, "DOPRI5 allocated {n} times in 300 steps");
+    // with its projection and filtered error estimate (the default on constrained systems)
+    let mut dp = Dopri5::new(2 * model.n, opts.clone()).unwrap();
+    dp.projection = projection;
+    let n = steps_allocate(&mut dp, &model, 300);
+    assert_eq!(n, 0, "DOPRI5 (projection) allocated {n} times in 300 steps");
     let mut rd = Radau5::new(model.n, opts.clone()).unwrap();
     let n = steps_allocate(&mut rd, &model, 100);
     let st = rd.stats();
@@ -143,7 +149,7 @@ fn native_steps_do_not_allocate() {
     assert_eq!(n, 0, "RADAU5 (structured Jacobian) allocated {n} times in 100 steps");
     // generalized-alpha, fixed and controlled steps, with its projection
     for step in [Some(2e-4), None] {
-        let go = GenAlphaOptions { step, projection: Method::GenAlpha(GenAlphaOptions::default()).default_projection(), ..Default::default() };
+        let go = GenAlphaOptions { step, projection, ..Default::default() };
         let mut ga = GenAlpha::new(model.n, model.m, opts.clone(), go).unwrap();
         let n = steps_allocate(&mut ga, &model, 200);
         let st = ga.stats();
@@ -152,7 +158,7 @@ fn native_steps_do_not_allocate() {
     }
     // Radau IIA on the second-order equations, fixed and controlled steps, with its projection
     for step in [Some(2e-4), None] {
-        let ro = RadauMOptions { step, projection: Method::RadauM(RadauMOptions::default()).default_projection() };
+        let ro = RadauMOptions { step, projection };
         let mut rm = RadauM::new(model.n, model.m, opts.clone(), ro).unwrap();
         let n = steps_allocate(&mut rm, &model, 100);
         let st = rm.stats();

@@ -182,9 +182,15 @@ def test_a_run_that_loses_its_constraints_says_so():
     bob = s.point_mass("bob", mass=2.8524188109448385, position=(2.8216492434996586e-298, -0.5),
                        velocity=(-1.3678032781104694e-269, 0.0))
     s.distance(s.ground.point(0.0, 0.0), bob.point(), length=1.0)
-    with pytest.warns(DriftWarning, match="the run did not deliver the requested accuracy"):
-        res = ukflex.simulate(s.build(), 0.02, method="DOPRI5", rtol=1e-8, max_steps=20000)
-    assert res.extra["drift"]["max_position_residual"] > 1.0
+    system = s.build()
+    # by default (projection after every step, on_drift="stop") it ends with status -1, named
+    res = ukflex.simulate(system, 0.02, method="DOPRI5", rtol=1e-8, max_steps=20000)
+    assert res.status == -1 and res.stop["cause"] in ("max_steps", "drift", "min_step"), res.stop
+    # without the projection and told to go on, it warns and reports the drift
+    with pytest.warns(DriftWarning, match="the constraints drifted"):
+        res = ukflex.simulate(system, 0.02, method="DOPRI5", rtol=1e-8, max_steps=20000, projection_tol=0,
+                              on_drift="warn")
+    assert res.extra["drift"]["max_residual"] > 1.0
 
 
 def test_an_ordinary_run_does_not_warn_about_drift():

@@ -57,6 +57,7 @@ def stub_problems(stub_text: str, module) -> list:
     classes = {n.name: n for n in tree.body if isinstance(n, ast.ClassDef)}
     functions = {n.name: n for n in tree.body if isinstance(n, ast.FunctionDef)}
     assigned = {t.id for n in tree.body if isinstance(n, ast.Assign) for t in n.targets if isinstance(t, ast.Name)}
+    assigned |= {n.target.id for n in tree.body if isinstance(n, ast.AnnAssign) and isinstance(n.target, ast.Name)}
     stub_public = {n for n in set(classes) | set(functions) | assigned if not n.startswith("_")}
     runtime_public = {n for n in dir(module) if not n.startswith("_")}
     for n in sorted(runtime_public - stub_public):

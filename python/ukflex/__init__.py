@@ -22,6 +22,7 @@ from .errors import (
     MissingDependencyError,
     MemoryLimitError,
     NonFiniteError,
+    SingularConfigurationWarning,
     SingularMassError,
     SolverError,
     UkflexError,
@@ -98,4 +99,5 @@ __all__ = [
     "MissingDependencyError",
     "InvalidArgumentError",
     "UnknownOptionError",
+    "SingularConfigurationWarning",
 ]

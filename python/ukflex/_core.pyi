@@ -25,7 +25,19 @@ __all__ = [
     "SolverError",
     "ExpressionError",
     "MemoryLimitError",
+    "PROJECTION_PER_ATOL",
+    "PROJECTION_MOVE_LIMIT",
+    "normal_weight",
 ]
+
+#: The native methods' projection after each step: Newton on the positions to this fraction of
+#: the smallest position atol.
+PROJECTION_PER_ATOL: float
+#: Away from singular configurations a step whose projection moves the state by more than this
+#: many tolerance units is retried shorter.
+PROJECTION_MOVE_LIMIT: float
+def normal_weight(kappa: float, kappa_ref: float) -> float:
+    """Weight of the part of an error estimate across the constraints: min(1, kappa / kappa_ref)^2."""
 
 class UkflexError(Exception): ...
 class InvalidSceneError(UkflexError): ...
@@ -122,13 +134,25 @@ class System:
         min_step: float = 0.0,
         dense: bool = False,
         newton_local_error: Optional[float] = None,
+        drift_limit: Optional[float] = None,
+        on_drift: str = "stop",
+        monitor_singular: bool = True,
     ) -> Dict[str, Any]:
         """Native integration; dict with t (nt,), y (2n, nt), status, message, failure (None or
-        cause, t, stage, index), statistics, dense (None or meta (nseg, 3), data, part_len)."""
+        cause, t, stage, index), statistics, dense (None or meta (nseg, 3), data, part_len),
+        singular (the singular passages), drift (None or t_first, max_residual, t_max)."""
     def project(
         self, t: float, q: _F64, qd: _F64, tol: float = 1e-12, max_iter: int = 20
     ) -> Tuple[_F64, _F64, Dict[str, Any]]:
         """Project (q, qd) onto Phi = 0, A qd + Phi_t = 0 in the mass metric."""
+    def project_step(self, t: float, q: _F64, qd: _F64, position_tol: float, max_iter: int = 3) -> Tuple[_F64, _F64, float, bool]:
+        """The native methods' projection after a step: Newton on the positions until the correction is at
+        most position_tol, then the velocities; returns (q, qd, ||Phi||, whether Newton converged)."""
+    def tangent_project(self, t: float, q: _F64, v: _F64) -> Tuple[_F64, float]:
+        """The columns of v (n, k) projected onto the constraints' tangent space at (t, q) in the mass metric,
+        and sigma_min / sigma_max of A M^-1/2 there."""
+    def singular_passages(self, t: _F64, y: _F64) -> List[Dict[str, Any]]:
+        """Singular passages of a trajectory of accepted states t (k,), y (2n, k)."""
     def sensors(self, t: _F64, q: _F64, qd: _F64, reactions: bool = True) -> Dict[str, Any]:
         """Reactions (nt, items, 6), body energies (nt, bodies, 3), force potentials, dissipation power."""
         ...

@@ -123,6 +123,14 @@ def lowest_elastic_frequency(system, omega, shapes, shares, q) -> Optional[float
     return max(per_body) if per_body else float(omega[elastic].min())
 
 
+def _no_stiffness(system) -> bool:
+    """A scene of rigid bodies and point masses without spring elements has no elastic mode:
+    it cannot be stiff, so it needs no frequency analysis (leave out what a scene does not need)."""
+    if any(system.body_kind(b) not in ("rigid", "point_mass") for b in system.body_names):
+        return False
+    return not any(f.get("kind") == "spring_damper" for f in system.description.get("forces", []))
+
+
 def local_newton_ok(h: float, omega_max: float) -> bool:
     """Whether GENALPHA's Newton may stop at the local error level (``newton_local_error``) with
     step ``h`` on a system whose fastest mode is ``omega_max``: only on coarse steps."""
@@ -139,6 +147,9 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
         raise ValueError(f"rtol must be positive and finite, got {rtol!r}")
     if system.n_dof == 0:
         return MethodChoice("DOPRI5", reason="no degrees of freedom: the motion is prescribed")
+    if _no_stiffness(system):
+        return MethodChoice("DOPRI5", reason="no elastic mode (rigid bodies, no springs: no frequency analysis "
+                                             "needed): not stiff, explicit")
     omega, shapes = system.frequencies(t0, q, qd, modes=True)
     q = system.q0 if q is None else np.asarray(q, dtype=float)
     omega_max = float(np.abs(omega).max())

@@ -34,6 +34,7 @@ __all__ = [
     "StabilityWarning",
     "RankDeficiencyWarning",
     "DriftWarning",
+    "SingularConfigurationWarning",
     "BucklingWarning",
     "ModelValidityWarning",
 ]
@@ -114,6 +115,12 @@ class RankDeficiencyWarning(StabilityWarning):
 
 class DriftWarning(StabilityWarning):
     """The constraint residual (drift) passed the threshold."""
+
+
+class SingularConfigurationWarning(StabilityWarning):
+    """The run passed a singular configuration of its constraints (the Jacobian came close to
+    losing rank) with a method that may leave the mechanism's branch or lose accuracy there
+    (``res.extra["singular"]``, docs/integrators.md)."""
 
 
 class BucklingWarning(StabilityWarning):

@@ -35,6 +35,7 @@ __all__ = [
     "chain",
     "rope",
     "lattice",
+    "n_four_bar",
     "gravity_vector",
     "scene_parameters",
     "SCENES",
@@ -556,7 +557,7 @@ def rope(links: int = 64, length: float = 2.0, mass: float = 0.5, span: float = 
 
 @_checked
 def lattice(columns: int = 4, rows: int = 4, cell: float = 0.25, mass: float = 0.1, shear: float = 0.3,
-            beams: str = "links", gravity: Any = True) -> Scene:
+            beams: str = "links", gravity: Any = True, speed: float = 0.0) -> Scene:
     """A shear lattice: ``rows`` levels of ``columns`` square cells of pinned rigid bars, hung
     from ``columns + 1`` ground pins (every cell a closed four-bar loop).
 
@@ -565,9 +566,12 @@ def lattice(columns: int = 4, rows: int = 4, cell: float = 0.25, mass: float = 0
     per cell (pinned at every node, the constraints independent: ``m = rows (6 columns + 2)``,
     one degree of freedom per level), with ``beams="continuous"`` one bar per level through all
     the nodes (a parallel-crank linkage: ``columns - 1`` redundant rows per level, rank
-    ``m - rows (columns - 1)``). Each bar has mass ``mass``; released from rest with every hanger
-    tilted by ``shear`` (rad, alternating in sign from level to level), under gravity. A
-    consistent state; conservative: ``T + V`` is constant."""
+    ``m - rows (columns - 1)``). Each bar has mass ``mass``; released with every hanger tilted by
+    ``shear`` (rad, alternating in sign from level to level) and turning at ``speed`` (rad/s,
+    counterclockwise; default 0: from rest), under gravity. A consistent state; conservative:
+    ``T + V`` is constant. With ``beams="continuous"`` and enough ``speed`` the hangers pass the
+    horizontal, where each level's parallel cranks lie along their beam and the rank of the
+    constraints drops (singular configurations, docs/integrators.md)."""
     w, h = int(columns), int(rows)
     if w < 1 or w != columns or h < 1 or h != rows:
         raise ValueError(f"columns and rows must be positive integers, got columns={columns!r}, rows={rows!r}")
@@ -582,36 +586,81 @@ def lattice(columns: int = 4, rows: int = 4, cell: float = 0.25, mass: float = 0
     span = w * cell
     x0 = 0.0  # the level's left node
     top = [s.ground.point(i * cell, 0.0) for i in range(w + 1)]
+    v_top = (0.0, 0.0)  # velocity of the level above (its bars translate)
     for r in range(h):
         a = shear if r % 2 == 0 else -shear
-        # hanger direction: straight down turned by a
+        # hanger direction: straight down turned by a; its rate `speed` moves the tip by w x d
         dx, dy = cell * math.sin(a), -cell * math.cos(a)
+        tip_v = (v_top[0] - speed * dy, v_top[1] + speed * dx)
         y_top = -r * cell * math.cos(shear)
         x_top = x0
         bottom = []
         for i in range(w + 1):
             xt = x_top + i * cell
             hb = s.rigid_body(f"hanger{r}_{i}", mass=mass, inertia=inertia,
-                              position=(xt + 0.5 * dx, y_top + 0.5 * dy), angle=math.atan2(dy, dx))
+                              position=(xt + 0.5 * dx, y_top + 0.5 * dy), angle=math.atan2(dy, dx),
+                              velocity=(0.5 * (v_top[0] + tip_v[0]), 0.5 * (v_top[1] + tip_v[1])), angular_velocity=speed)
             s.revolute(top[i], hb.point(-0.5 * cell, 0.0), name=f"hang{r}_{i}")
             bottom.append(hb.point(0.5 * cell, 0.0))
         x0 = x_top + dx
         yb = y_top + dy
+        v_top = tip_v
         if beams == "links":
             nodes = []
             for i in range(w):
-                b = s.rigid_body(f"bar{r}_{i}", mass=mass, inertia=inertia, position=(x0 + (i + 0.5) * cell, yb))
+                b = s.rigid_body(f"bar{r}_{i}", mass=mass, inertia=inertia, position=(x0 + (i + 0.5) * cell, yb),
+                                 velocity=tip_v)
                 s.revolute(bottom[i], b.point(-0.5 * cell, 0.0), name=f"left{r}_{i}")
                 s.revolute(bottom[i + 1], b.point(0.5 * cell, 0.0), name=f"right{r}_{i}")
                 nodes.append(b.point(-0.5 * cell, 0.0))
             nodes.append(b.point(0.5 * cell, 0.0))
         else:
-            b = s.rigid_body(f"beam{r}", mass=mass * w, inertia=mass * w * span**2 / 12.0, position=(x0 + 0.5 * span, yb))
+            b = s.rigid_body(f"beam{r}", mass=mass * w, inertia=mass * w * span**2 / 12.0, position=(x0 + 0.5 * span, yb),
+                             velocity=tip_v)
             nodes = []
             for i in range(w + 1):
                 s.revolute(bottom[i], b.point((i - 0.5 * w) * cell, 0.0), name=f"node{r}_{i}")
                 nodes.append(b.point((i - 0.5 * w) * cell, 0.0))
         top = nodes
+    return s
+
+
+@_checked
+def n_four_bar(loops: int = 2, angle: float = math.pi / 4, velocity: float = 1.0, link: float = 1.0, mass: float = 1.0,
+               gravity: Any = True) -> Scene:
+    """The N four-bar mechanism of the MBS benchmark library (problem A02): ``loops`` four-bar
+    loops in a row, ``2 loops + 1`` uniform rods of length ``link`` and mass ``mass``: ``loops +
+    1`` cranks pinned to the ground ``link`` apart, ``loops`` couplers joining their tips.
+
+    The cranks start at ``angle`` (rad from the +X axis; the benchmark's figure: 45 degrees) and
+    the first crank's tip, point B0, moves at ``velocity`` along +X (the benchmark: 1 m/s); under
+    gravity (-Y). Every time the cranks pass the horizontal the constraint Jacobian loses rank
+    and the mobility jumps from 1 to ``loops + 1``: a singular configuration. The physical
+    motion is the parallelogram one (every crank at the same angle, the couplers translating):
+    one pendulum-like equation in the crank angle (docs/integrators.md).
+    """
+    n = int(loops)
+    if n < 1 or n != loops:
+        raise ValueError(f"n_four_bar: loops must be a positive integer, got {loops!r}")
+    if not link > 0.0 or not mass > 0.0:
+        raise ValueError(f"n_four_bar: link and mass must be positive, got link={link!r}, mass={mass!r}")
+    s = Scene(gravity=gravity_vector(gravity))
+    L, m = link, mass
+    c, sn = math.cos(angle), math.sin(angle)
+    if abs(sn) < 1e-9:
+        raise ValueError("n_four_bar: the cranks must not start horizontal (a singular configuration)")
+    omega = -velocity / (L * sn)  # B0 moves at `velocity` along +X
+    cranks = []
+    for k in range(n + 1):
+        b = s.rigid_body(f"crank{k}", mass=m, inertia=m * L**2 / 12.0, com=(L / 2, 0.0), position=(k * L, 0.0),
+                         angle=angle, angular_velocity=omega)
+        s.revolute(s.ground.point(k * L, 0.0), b.point(0.0, 0.0), name=f"A{k}")
+        cranks.append(b)
+    for k in range(n):
+        cp = s.rigid_body(f"coupler{k}", mass=m, inertia=m * L**2 / 12.0, com=(L / 2, 0.0),
+                          position=(k * L + L * c, L * sn), velocity=(-L * sn * omega, L * c * omega))
+        s.revolute(cranks[k].point(L, 0.0), cp.point(0.0, 0.0), name=f"B{k}")
+        s.revolute(cranks[k + 1].point(L, 0.0), cp.point(L, 0.0), name=f"C{k}")
     return s
 
 
@@ -626,6 +675,7 @@ SCENES: Dict[str, Callable[..., Scene]] = {
     "chain": chain,
     "rope": rope,
     "lattice": lattice,
+    "n_four_bar": n_four_bar,
 }
 
 

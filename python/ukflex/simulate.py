@@ -13,12 +13,15 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union, 
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.integrate import OdeSolver
+from scipy.integrate import DOP853, OdeSolver
+from scipy.integrate._ivp.rk import RungeKutta
 from scipy.integrate._ivp.common import OdeSolution
+from scipy.integrate import DenseOutput
 from scipy.integrate._ivp.ivp import METHODS as _SCIPY_SOLVERS, find_active_events, handle_events, prepare_events
 
 from . import _core
-from .errors import DriftWarning, InvalidArgumentError, NonFiniteError, UnknownOptionError
+from .errors import (DriftWarning, InvalidArgumentError, NonFiniteError, SingularConfigurationWarning, SolverError,
+                     UnknownOptionError)
 from .results import SimulationResult
 from .scene import Scene
 from .system import System, length_scale
@@ -172,6 +175,7 @@ def simulate(
     max_nfev: int = DEFAULT_MAX_NFEV,
     max_wall_time: Optional[float] = None,
     min_step: float = 0.0,
+    on_drift: str = "stop",
     **options: Any,
 ) -> SimulationResult:
     """Integrate the equations of motion from the system's consistent initial state to ``t_end``.
@@ -251,6 +255,13 @@ def simulate(
     min_step : float
         Smallest step size [s] (default 0: the rounding limit); a ``max_step`` or fixed
         ``step`` (RADAU5M, GENALPHA) that cannot reach ``t_end`` within ``max_steps`` is refused up front.
+    on_drift : {"stop", "warn"}
+        What a run does when the constraint residual ``||Phi||`` of an accepted step passes the
+        drift bound ``min(1000 (rtol L + atol), 0.01 L)`` (``L``: the scene's length scale;
+        ``res.extra["drift_limit"]``): ``"stop"`` (default) ends it there with ``status = -1``,
+        its partial result and a message naming the time and the residual (a result that left
+        its constraints is not the mechanism's motion); ``"warn"`` goes on and reports it
+        (:class:`ukflex.DriftWarning`, ``res.extra["drift"]``).
     **options
         Solver options: ``first_step``, ``max_step``, ``jac``, ... (scipy); ``first_step``,
         ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``newton_local_error``, ``jacobian`` (native).  An option
@@ -262,7 +273,11 @@ def simulate(
     -------
     SimulationResult
         ``t`` (nt,), ``y`` (2n, nt) = ``[q; qd]``, residual norms, statistics, ``t_events``,
-        ``y_events``, ``sol``.  A run that exceeds a budget or meets a non-finite state stops
+        ``y_events``, ``sol``.  ``res.extra["singular"]``: the singular passages of the run
+        (where the constraint Jacobian came close to losing rank: time, ``sigma_ratio`` of
+        ``A M^-1/2`` there against the run's best, rank before, at and after; docs/integrators.md);
+        a method that may leave the mechanism's branch there (``branch_keeping(method)`` is
+        false) also warns with :class:`ukflex.SingularConfigurationWarning`.  A run that exceeds a budget or meets a non-finite state stops
         with ``status = -1``, keeps the trajectory up to its last accepted step and says why
         in ``res.message`` and ``res.stop`` (cause, time, coordinate).
 
@@ -283,6 +298,8 @@ def simulate(
         raise InvalidArgumentError(
             "method", f"native method {method!r} integrates the Rust UK formulation only, not {formulation!r}")
     _check_options(method, formulation, options)
+    if on_drift not in ("stop", "warn"):
+        raise InvalidArgumentError("on_drift", f"must be 'stop' or 'warn', got {on_drift!r}")
     system = as_system(scene_or_system)
     n = system.n_coords
     if t_span is not None:
@@ -366,59 +383,138 @@ def simulate(
         res = simulate(system, None, method, run_rtol, atol, t_eval_v, formulation, t_span=(t0, t_end_f), q0=q_init,
                        qd0=qd_init, partition=partition, progress=progress, events=ev_list or None,
                        dense_output=dense_output, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
-                       max_wall_time=budget.max_wall_time, min_step=budget.min_step, **options)
+                       max_wall_time=budget.max_wall_time, min_step=budget.min_step, on_drift=on_drift, **options)
         if choice is not None:
             res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
         return res
     y0 = np.concatenate([q_init, qd_init])
+    guard = _Guard(drift_limit(system, rtol, atol_v), on_drift == "stop")
     if method in NATIVE_METHODS:
         res = _simulate_native(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
-                               dense_output)
+                               dense_output, guard)
         if progress is not None and res.t.size:
             progress(float(res.t[-1]))
     elif formulation != "uk":
         res = _simulate_reference(
             system, formulation, t_end_f, method, rtol, atol_v, t_eval_v, q_init, qd_init, partition, options
         )
+        _guard_after(system, res, guard)
         if progress is not None and res.t.size:
             progress(float(res.t[-1]))
     else:
         if method in ("Radau", "BDF") and "jac" not in options:
             options["jac"] = system.jac  # Rust finite differences, GIL released
         res = _simulate_scipy(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
-                              dense_output, progress)
-    _check_drift(system, res, rtol, atol_v)
+                              dense_output, progress, guard)
+    _report(system, res, guard, method, options)
     return res
 
 
-#: a run whose constraint residual passes this many times (rtol x length scale + atol) did not
-#: deliver the accuracy it was asked for: it says so (DriftWarning, res.extra["drift"]) ...
+#: the drift bound: a run whose constraint residual passes this many times (rtol x length scale
+#: + atol) did not deliver the accuracy it was asked for ...
 DRIFT_FACTOR = 1000.0
-#: ... as does a run whose constraints drifted by more than this fraction of the scene's length
+#: ... nor did a run whose constraints drifted by more than this fraction of the scene's length
 #: scale, whatever the tolerances (an absolute atol of 1e-11 m cannot resolve a 1e-16 m pendulum)
 DRIFT_OF_SCALE = 1e-2
 
 
-def _check_drift(system: System, res: SimulationResult, rtol: float, atol: Any) -> None:
-    """Warn when the positions left the constraints far beyond the requested tolerance (e.g.
-    accelerations of 1e30 m/s^2 cancelled by the UK correction to their rounding, 1e14 m/s^2):
-    a result is never wrong silently. The residuals are already part of every result."""
-    pos = np.asarray(res.residuals.get("position", ()), dtype=float)
-    if pos.size == 0:
-        return
+def drift_limit(system: System, rtol: float, atol: Any) -> float:
+    """The drift bound of a run at ``rtol``, ``atol`` on ``||Phi||``:
+    ``min(DRIFT_FACTOR (rtol L + atol), DRIFT_OF_SCALE L)``, ``L`` the scene's length scale."""
     scale = length_scale(system.description)
-    limit = min(DRIFT_FACTOR * (rtol * scale + float(np.min(atol))), DRIFT_OF_SCALE * scale)
-    worst = int(np.argmax(pos))
-    if not pos[worst] > limit:
-        return
-    text = (f"the constraints drifted to ||Phi|| = {pos[worst]:.3g} m at t = {res.t[worst]:.6g} s, more than "
-            f"min({DRIFT_FACTOR:g} x (rtol x length scale {scale:.3g} m + atol), {DRIFT_OF_SCALE:g} x length scale) = "
-            f"{limit:.3g} m: the run did not deliver "
-            "the requested accuracy (check the scene's units and scales, tighten rtol, or use a method with "
-            "projection such as RADAU5M or GENALPHA)")
-    res.extra["drift"] = dict(max_position_residual=float(pos[worst]), t=float(res.t[worst]), limit=limit, message=text)
-    warnings.warn(text, DriftWarning, stacklevel=3)
+    return min(DRIFT_FACTOR * (rtol * scale + float(np.min(atol))), DRIFT_OF_SCALE * scale)
 
+
+class _Guard:
+    """What a run checks at every accepted step: the drift bound (``on_drift``)."""
+
+    def __init__(self, limit: float, stop: bool):
+        self.limit, self.stop = limit, stop
+
+
+#: the methods that keep a mechanism on its branch through a singular configuration (with their
+#: default projection): native DOPRI5 and scipy's explicit Runge-Kutta methods, which project
+#: onto the constraints after every step and filter their error estimate onto the constraints'
+#: tangent space (docs/integrators.md, singular configurations; tests/test_singular.py)
+BRANCH_KEEPING = ("DOPRI5", "RK23", "RK45", "DOP853")
+
+
+def branch_keeping(method: Any, options: Optional[Dict[str, Any]] = None) -> bool:
+    """Whether ``method`` (with ``options``) keeps the mechanism on its branch at singular
+    configurations; the others warn when a run passes one (:class:`SingularConfigurationWarning`)."""
+    name = method if isinstance(method, str) else getattr(method, "__name__", "")
+    if name not in BRANCH_KEEPING and not (inspect.isclass(method) and issubclass(method, RungeKutta)):
+        return False
+    return not (options and options.get("projection_tol") == 0)
+
+
+def _drift_text(residual: float, t: float, limit: float) -> str:
+    return (f"the constraints drifted to ||Phi|| = {residual:.3g} at t = {t:.6g} s, beyond the drift bound "
+            f"{limit:.3g} (min({DRIFT_FACTOR:g} x (rtol x length scale + atol), {DRIFT_OF_SCALE:g} x length scale)): "
+            "the result is not the mechanism's motion from there on (check the scene's units and scales, tighten "
+            "rtol, or keep the default projection)")
+
+
+def _guard_after(system: System, res: SimulationResult, guard: _Guard) -> None:
+    """The drift guard for a run made elsewhere (the NumPy references): the residual norms of
+    the outputs against the bound; with ``on_drift="stop"`` the result ends before the first
+    output beyond it."""
+    pos = np.asarray(res.residuals.get("position", ()), dtype=float)
+    bad = np.flatnonzero(~(pos <= guard.limit))
+    if bad.size == 0:
+        return
+    k = int(bad[0])
+    text = _drift_text(float(pos[k]), float(res.t[k]), guard.limit)
+    if guard.stop:
+        t_bad = float(res.t[k])
+        res.t, res.q, res.qd = res.t[:k], res.q[:, :k], res.qd[:, :k]
+        res.residuals = {key: v[:k] for key, v in res.residuals.items()}
+        res.status = -1
+        res.message = text + (f"; the result holds the run up to t = {res.t[-1]:.9g} s" if k else "")
+        res.stop = {"cause": "drift", "t": float(res.t[-1]) if k else t_bad, "message": res.message}
+    else:
+        worst = int(np.argmax(np.where(np.isfinite(pos), pos, np.inf)))
+        res.extra["drift"] = dict(t_first=float(res.t[k]), max_residual=float(pos[worst]), t_max=float(res.t[worst]))
+
+
+def _report(system: System, res: SimulationResult, guard: _Guard, method: Any, options: Dict[str, Any]) -> None:
+    """What every run reports: the drift bound, a drift beyond it (``on_drift="warn"``), the
+    singular passages (and a warning when the method may leave the branch there)."""
+    res.extra["drift_limit"] = guard.limit
+    d = res.extra.get("drift")
+    if d is not None:
+        text = _drift_text(d["max_residual"], d["t_max"], guard.limit)
+        d["message"] = text
+        warnings.warn(text, DriftWarning, stacklevel=3)
+    passages = res.extra.get("singular")
+    if passages is None:
+        passages = res.extra["singular"] = _passages(system, res)
+    if passages and not branch_keeping(method, options):
+        name = method if isinstance(method, str) else getattr(method, "__name__", str(method))
+        ts = ", ".join(f"{p['t']:.6g}" for p in passages[:3]) + (", ..." if len(passages) > 3 else "")
+        warnings.warn(f"the run passed {len(passages)} singular configuration(s) of the constraints (t = {ts} s; "
+                      f"res.extra['singular']): {name} may leave the mechanism's branch or lose its accuracy there; "
+                      "DOPRI5 (method='auto' on non-stiff scenes) keeps the branch (docs/integrators.md)",
+                      SingularConfigurationWarning, stacklevel=3)
+
+
+def _passages(system: System, res: SimulationResult) -> List[Dict[str, Any]]:
+    """Singular passages of a run made elsewhere, from its recorded states (the steps when the
+    run kept them, else the outputs)."""
+    steps = res.extra.pop("_steps", None)
+    t, y = (steps if steps is not None else (res.t, res.y))
+    if system.n_constraints == 0 or np.size(t) < 3:
+        return []
+    keep = np.concatenate([[True], np.diff(t) > 0])
+    return list(system.core.singular_passages(np.ascontiguousarray(t[keep]), np.ascontiguousarray(y[:, keep])))
+
+
+#: the projection after each step of scipy's explicit methods: Newton on the positions to this
+#: fraction of the smallest position atol (the native default, ``integrate::PROJECTION_PER_ATOL``)
+_NATIVE_PROJECTION_PER_ATOL = float(_core.PROJECTION_PER_ATOL)
+#: ... and a step whose projection moves the state further (in units of the tolerance) away
+#: from singular configurations is retried shorter (``dopri5::PROJECTION_MOVE_LIMIT``)
+_PROJECTION_MOVE_LIMIT = float(_core.PROJECTION_MOVE_LIMIT)
 
 #: smallest relative tolerance (solve_ivp's own floor: 100 x machine epsilon)
 RTOL_MIN = 100 * float(np.finfo(float).eps)
@@ -459,6 +555,8 @@ def _stop_info(system: System, cause: str, t: float, stage: str = "", index: Opt
         msg = f"work budget max_steps cannot suffice: stopped at t = {t:.9g} s ({detail}); the result holds the run up to there"
     elif cause in ("max_steps", "max_nfev", "max_wall_time"):
         msg = f"work budget {cause} exhausted at t = {t:.9g} s ({detail}); the result holds the run up to there"
+    elif cause == "drift":
+        msg = f"{detail}; the result holds the run up to t = {t:.9g} s"
     elif cause == "min_step":
         msg = f"step size below the minimum at t = {t:.9g} s ({detail}); the result holds the run up to there"
     else:
@@ -467,9 +565,97 @@ def _stop_info(system: System, cause: str, t: float, stage: str = "", index: Opt
     return info, msg
 
 
-def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, budget, events, dense, progress):
+class _EndShifted(DenseOutput):
+    """A step's interpolant moved by ``theta (y_end' - y_end)``: it ends at the projected state."""
+
+    def __init__(self, inner: DenseOutput, shift: np.ndarray):
+        super().__init__(inner.t_old, inner.t)
+        self.inner, self.shift = inner, shift
+
+    def _call_impl(self, t):
+        theta = (np.asarray(t) - self.t_old) / (self.t - self.t_old) if self.t != self.t_old else np.ones_like(t)
+        return self.inner._call_impl(t) + (np.multiply.outer(self.shift, theta) if np.ndim(t) else self.shift * theta)
+
+
+def _end_shifted(sol: DenseOutput, shift: Optional[np.ndarray]) -> DenseOutput:
+    return sol if shift is None else _EndShifted(sol, shift)
+
+
+def _tangent_filtered(cls: type, system: System) -> type:
+    """scipy's explicit Runge-Kutta class ``cls`` with the part of its local error estimate across
+    the constraints (at the step's new state, ``System.tangent_project``) weighed by
+    ``normal_weight``, as native DOPRI5 does (docs/integrators.md, singular configurations)."""
+    n = system.n_coords
+    project = system.core.tangent_project
+
+    def filtered(self: Any, vectors: List[np.ndarray], h: float) -> List[np.ndarray]:
+        y_new = self.y + h * (self.K[:-1].T @ self.B)
+        cols = np.column_stack([v[:n] for v in vectors] + [v[n:] for v in vectors])
+        p, kappa = project(self.t + h, np.ascontiguousarray(y_new[:n]), np.ascontiguousarray(cols))
+        kappa_ref = getattr(self, "_kappa_ref", kappa)
+        self._kappa_ref = max(kappa_ref, kappa)
+        # the part across the constraints kept at the weight normal_weight (as native DOPRI5)
+        self._weight = _core.normal_weight(kappa, kappa_ref)
+        p += math.sqrt(self._weight) * (cols - p)
+        k = len(vectors)
+        return [np.concatenate([p[:, i], p[:, k + i]]) for i in range(k)]
+
+    if issubclass(cls, DOP853):
+        class Filtered(cls):  # type: ignore[misc, valid-type]
+            def _estimate_error_norm(self, K, h, scale):  # DOP853's own combination of its two estimates
+                e5, e3 = filtered(self, [K.T @ self.E5, K.T @ self.E3], h)
+                err5, err3 = e5 / scale, e3 / scale
+                n5, n3 = float(np.linalg.norm(err5)) ** 2, float(np.linalg.norm(err3)) ** 2
+                if n5 == 0 and n3 == 0:
+                    return 0.0
+                return np.abs(h) * n5 / np.sqrt((n5 + 0.01 * n3) * len(scale))
+    else:
+        class Filtered(cls):  # type: ignore[misc, valid-type, no-redef]
+            def _estimate_error(self, K, h):
+                return filtered(self, [K.T @ self.E], h)[0] * h
+    Filtered.__name__ = cls.__name__
+    return Filtered
+
+
+def _after_step(system, solver, fun, project, position_tol, atol, rtol, n, saved):
+    """After an accepted step of a scipy solver on a constrained system: the projection of the
+    explicit methods (with the step undone when its Newton does not converge: the error across
+    the constraints, which the filtered estimate leaves to it, is then beyond its reach) and
+    ``||Phi||`` of the state. Returns ``(||Phi||, the dense output's end shift, undone)``."""
+    q1, v1 = solver.y[:n], solver.y[n:]
+    if not project:
+        return float(np.linalg.norm(system.phi(float(solver.t), q1))), None, False
+    q1, v1, phi, converged = system.core.project_step(float(solver.t), q1, v1, position_tol)
+    if not converged:
+        solver.t, solver.y, solver.f = saved[:3]
+        solver.h_abs = 0.3 * saved[3]
+        solver.status = "running"
+        return phi, None, True
+    y_new = np.concatenate([q1, v1])
+    floor = 100.0 * np.finfo(float).eps * np.abs(y_new).max()  # the rounding of the largest entry
+    moved = np.sqrt(np.mean(((y_new - solver.y) / (atol + rtol * np.abs(y_new) + floor)) ** 2))
+    if getattr(solver, "_weight", 1.0) == 1.0 and moved > _PROJECTION_MOVE_LIMIT and getattr(solver, "_projected", False):
+        # away from singular configurations: an estimate blind to an error the projection
+        # would hide (as native DOPRI5)
+        solver.t, solver.y, solver.f = saved[:3]
+        solver.h_abs = 0.3 * saved[3]
+        solver.status = "running"
+        return phi, None, True
+    # RK23/RK45 interpolate from the step's start and stages: moved to the new end; DOP853's
+    # interpolant reads the end state itself
+    shift = None if isinstance(solver, DOP853) else y_new - solver.y
+    solver.y = y_new
+    solver._projected = True  # a start off the constraints moves the first step only
+    if moved > 1.0:
+        solver.f = fun(solver.t, y_new)
+    return phi, shift, False
+
+
+def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, budget, events, dense, progress, guard):
     """``solve_ivp``'s loop over a scipy ``OdeSolver``, with work budgets, a non-finite check
-    with its cause, and the trajectory kept when the run stops early."""
+    with its cause, the drift guard at every step, and the trajectory kept when the run stops
+    early. scipy's explicit Runge-Kutta methods project onto the constraints after every step
+    and filter their error estimate (``_tangent_filtered``), as native DOPRI5 does."""
     n = system.n_coords
     rhs = system.rhs
     nfev = [0]
@@ -479,11 +665,11 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
         if nfev[0] > budget.max_nfev:
             raise _Stop("max_nfev")
         try:
-            out = rhs(t, y)  # the core refuses a non-finite y
+            out = rhs(t, y)  # the core refuses a non-finite y (and a non-finite result)
         except NonFiniteError:
             bad = np.flatnonzero(~np.isfinite(y))
             if not bad.size:
-                raise
+                raise _Stop("non_finite", "qdd", 0) from None
             i = int(bad[0])
             raise _Stop("non_finite", "q" if i < n else "qd", i % n) from None
         if not np.isfinite(out).all():
@@ -492,6 +678,15 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
 
     solver_cls = _SCIPY_SOLVERS[method] if isinstance(method, str) else method
     name = method if isinstance(method, str) else method.__name__
+    # explicit Runge-Kutta on a constrained system: projection after every step, filtered estimate
+    project = system.n_constraints > 0 and issubclass(solver_cls, RungeKutta)
+    if project:
+        solver_cls = _tangent_filtered(solver_cls, system)
+    atol_q = float(np.min(np.broadcast_to(atol, (2 * n,))[:n]))
+    position_tol = _NATIVE_PROJECTION_PER_ATOL * atol_q
+    saved = None
+    t_steps: List[float] = [t0]
+    y_steps: List[np.ndarray] = [y0]
     start = time.perf_counter()
     ts: List[Any] = [] if t_eval is not None else [t0]
     ys: List[Any] = [] if t_eval is not None else [y0]
@@ -505,6 +700,7 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
     t_eval_i = 0
     steps = 0
     solver = None
+    drift: Dict[str, Any] = {}
     try:
         solver = solver_cls(fun, t0, y0, tf, rtol=rtol, atol=atol, **options)
         if events:
@@ -532,6 +728,8 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
                                                     f"{budget.max_steps}; shorten t_end or raise max_steps")
             if budget.max_wall_time is not None and time.perf_counter() - start > budget.max_wall_time:
                 raise _Stop("max_wall_time")
+            if project:
+                saved = (solver.t, solver.y, solver.f, solver.h_abs)
             try:
                 message = solver.step()
             except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # e.g. lu_factor on infinities
@@ -541,6 +739,29 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
                 status = -1
                 break
             steps += 1
+            shift = None
+            try:
+                phi, shift, undo = _after_step(system, solver, fun, project, position_tol, atol, rtol, n, saved) \
+                    if solver.status != "failed" and system.n_constraints > 0 else (0.0, None, False)
+            except (NonFiniteError, SolverError) as exc:
+                cause = "non_finite" if isinstance(exc, NonFiniteError) else "solver"
+                stop, message = _stop_info(system, cause, float(solver.t_old or t0), detail=str(exc))
+                status = -1
+                break
+            if undo:
+                continue
+            if solver.status != "failed" and system.n_constraints > 0:
+                if not phi <= guard.limit:
+                    if guard.stop:
+                        stop, message = _stop_info(system, "drift", float(solver.t_old or t0),
+                                                   detail=_drift_text(phi, float(solver.t), guard.limit))
+                        status = -1
+                        break
+                    d = drift.setdefault("report", dict(t_first=float(solver.t), max_residual=phi, t_max=float(solver.t)))
+                    if phi > d["max_residual"]:
+                        d.update(max_residual=phi, t_max=float(solver.t))
+                t_steps.append(float(solver.t))
+                y_steps.append(solver.y.copy())
             if solver.status == "finished":
                 status = 0
             elif solver.status == "failed":
@@ -548,7 +769,7 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
                 status = -1
                 break
             t_old, t, y = solver.t_old, solver.t, solver.y
-            sol = solver.dense_output() if dense else None
+            sol = _end_shifted(solver.dense_output(), shift) if dense else None
             if dense:
                 interpolants.append(sol)
             if events:
@@ -556,7 +777,7 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
                 active = find_active_events(g, g_new, event_dir)
                 if active.size > 0:
                     if sol is None:
-                        sol = solver.dense_output()
+                        sol = _end_shifted(solver.dense_output(), shift)
                     event_count[active] += 1
                     root_indices, roots, terminate = handle_events(sol, events, active, event_count, max_events,
                                                                    t_old, t)
@@ -577,7 +798,7 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
                 i_new = np.searchsorted(t_eval, t, side="right")
                 if i_new > t_eval_i:
                     if sol is None:
-                        sol = solver.dense_output()
+                        sol = _end_shifted(solver.dense_output(), shift)
                     ts.append(t_eval[t_eval_i:i_new])
                     ys.append(sol(t_eval[t_eval_i:i_new]))
                     t_eval_i = i_new
@@ -609,9 +830,14 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
     sol_obj = None
     if dense and interpolants:
         sol_obj = OdeSolution(ti, interpolants, alt_segment=method in ("BDF", "LSODA"))
+    extra: Dict[str, Any] = {"steps": steps}
+    if "report" in drift:
+        extra["drift"] = drift["report"]
+    if system.n_constraints > 0:
+        extra["_steps"] = (np.asarray(t_steps), np.column_stack(y_steps))
     return _result(system, t_arr, y_arr, name, rtol, atol, nfev=solver.nfev if solver is not None else nfev[0],
                    njev=getattr(solver, "njev", 0), nlu=getattr(solver, "nlu", 0), wall=wall, status=status,
-                   message=message, stop=stop, t_events=t_events, y_events=y_events, sol=sol_obj, extra={"steps": steps})
+                   message=message, stop=stop, t_events=t_events, y_events=y_events, sol=sol_obj, extra=extra)
 
 
 def _result(system, t, y, method, rtol, atol, *, nfev, njev, nlu, wall, status, message, stop, t_events, y_events,
@@ -693,7 +919,7 @@ def _native_events(sol: DenseSolution, events: List[Callable], t0: float, y0: np
     return t_events, y_events, None
 
 
-def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options, budget, events, dense):
+def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options, budget, events, dense, guard):
     """Run a native Rust integrator (``System.integrate``: all steps in Rust, GIL released).
 
     Dense output is recorded in Rust during the run; events are located on it afterwards and a
@@ -713,7 +939,8 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
     out = system.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),
                            atol_arr, te, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
                            max_wall_time=budget.max_wall_time, min_step=budget.min_step,
-                           dense=bool(dense or events), **kwargs)
+                           dense=bool(dense or events), drift_limit=guard.limit,
+                           on_drift="stop" if guard.stop else "warn", **kwargs)
     t, y, status, message = np.asarray(out["t"]), np.asarray(out["y"]), int(out["status"]), str(out["message"])
     stop = None
     if out["failure"] is not None:
@@ -726,6 +953,7 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
         d = out["dense"]
         sol = DenseSolution(method, d["meta"], d["data"], d["part_len"])
     t_events = y_events = None
+    t_term = None
     if events and sol is not None:
         t_events, y_events, t_term = _native_events(sol, events, t0, y0)
         if t_term is not None:
@@ -739,6 +967,10 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
     elif events:
         t_events, y_events = [[] for _ in events], [[] for _ in events]
     extra = {k: out[k] for k in ("naccept", "nreject", "newton_iterations", "jac_evals")}
+    extra["singular"] = [dict(p) for p in out["singular"] if t_term is None or p["t"] <= t_term] if events else \
+        [dict(p) for p in out["singular"]]
+    if out["drift"] is not None:
+        extra["drift"] = dict(out["drift"])
     return _result(system, t, y, method, rtol, atol, nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"],
                    wall=out["wall_time"], status=status, message=message, stop=stop, t_events=t_events,
                    y_events=y_events, sol=sol if dense else None, extra=extra)

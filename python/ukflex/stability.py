@@ -206,8 +206,9 @@ def run(
     atol_v = 1e-3 * rtol if atol is None else float(atol)
     te = None if t_eval is None else np.asarray(t_eval, dtype=float)
     if method.upper() in NATIVE_METHODS:
+        # "none" and Baumgarte: no projection (the native methods project by default)
         res = simulate(system, t_end, method.upper(), rtol=rtol, atol=atol_v, t_eval=te, max_step=max_step,
-                       max_steps=max_steps, projection_tol=proj_tol)
+                       max_steps=max_steps, projection_tol=0.0 if proj_tol is None else proj_tol)
     else:
         res = _run_scipy(system, float(t_end), method, rtol, atol_v, te, proj_tol, interval, max_step, max_nfev)
     res.extra["stabilization"] = label

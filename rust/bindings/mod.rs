@@ -98,7 +98,7 @@ pub(crate) fn to_py(e: Error) -> PyErr {
         Error::Shape { .. } | Error::Argument { .. } => PyValueError::new_err(msg),
         Error::NonFinite { .. } => NonFiniteError::new_err(msg),
         Error::SingularMass { .. } => SingularMassError::new_err(msg),
-        Error::Solver(_) | Error::Budget { .. } => SolverError::new_err(msg),
+        Error::Solver(_) | Error::Budget { .. } | Error::Drift { .. } => SolverError::new_err(msg),
         Error::Expression { text, position, .. } => Python::attach(|py| {
             let err = ExpressionError::new_err(msg);
             let v = err.value(py);
@@ -181,6 +181,13 @@ fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<
     mat(py, out, dim, k)
 }
 
+/// The weight of the part of an error estimate across the constraints at conditioning `kappa`
+/// against the run's best `kappa_ref` (`integrate::normal_weight`, docs/integrators.md).
+#[pyfunction]
+fn normal_weight(kappa: f64, kappa_ref: f64) -> f64 {
+    crate::integrate::normal_weight(kappa.max(0.0), kappa_ref)
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -197,6 +204,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SolverError", py.get_type::<SolverError>())?;
     m.add("ExpressionError", py.get_type::<ExpressionError>())?;
     m.add("MemoryLimitError", py.get_type::<MemoryLimitError>())?;
+    m.add("PROJECTION_PER_ATOL", crate::integrate::PROJECTION_PER_ATOL)?;
+    m.add("PROJECTION_MOVE_LIMIT", crate::integrate::PROJECTION_MOVE_LIMIT)?;
+    m.add_function(wrap_pyfunction!(normal_weight, m)?)?;
     Ok(())
 }
 

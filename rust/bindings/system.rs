@@ -6,7 +6,7 @@ use std::sync::Mutex;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 
 use super::sensors::read_states;
 use super::{check_time, finite_out, mat, read_into, to_py, SolverError, Vector};
@@ -16,7 +16,8 @@ use crate::correct::{self, CorrectOptions};
 use crate::data::{Data, RankTolerance, Stabilization, SvdBackend, UkSolver};
 use crate::dynamics;
 use crate::error::Error;
-use crate::integrate::{integrate_uk, Method, Options};
+use crate::integrate::singular::{Passage, SingularMonitor};
+use crate::integrate::{integrate_uk, Method, Options, UkSystem};
 use crate::jacobian::{assemble_first_order, Differences, JacobianWorkspace};
 use crate::model::Model;
 use crate::sensors;
@@ -50,6 +51,23 @@ fn implicit_bytes(model: &Model, what: &str) -> u64 {
         "RADAU5M" => 3 * n * n + 3 * saddle,
         _ => 0,
     }
+}
+
+/// The singular passages of a run as a list of dicts (t, sigma_ratio, sigma_ratio_ref,
+/// rank_before, rank_at, rank_after).
+fn passages_list<'py>(py: Python<'py>, passages: &[Passage]) -> PyResult<Bound<'py, PyList>> {
+    let out = PyList::empty(py);
+    for p in passages {
+        let pd = PyDict::new(py);
+        pd.set_item("t", p.t)?;
+        pd.set_item("sigma_ratio", p.ratio)?;
+        pd.set_item("sigma_ratio_ref", p.ratio_ref)?;
+        pd.set_item("rank_before", p.rank_before)?;
+        pd.set_item("rank_at", p.rank_at)?;
+        pd.set_item("rank_after", p.rank_after)?;
+        out.append(pd)?;
+    }
+    Ok(out)
 }
 
 /// A compiled scene: the immutable model and its workspace. Safe to share between threads
@@ -542,7 +560,7 @@ impl PySystem {
     /// or a dict cause, t, stage, index), nfev, njev, nlu, naccept, nreject, jac_evals (UK calls
     /// inside Jacobians), wall_time [s], dense (None, or a dict meta (nseg, 3), data
     /// (nseg, width), part_len).
-    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=None, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None))]
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=None, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None, drift_limit=None, on_drift="stop", monitor_singular=true))]
     #[allow(clippy::too_many_arguments)]
     fn integrate<'py>(
         &self,
@@ -566,6 +584,9 @@ impl PySystem {
         min_step: f64,
         dense: bool,
         newton_local_error: Option<f64>,
+        drift_limit: Option<f64>,
+        on_drift: &str,
+        monitor_singular: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let jacobian = match jacobian {
             "central" => Differences::Central,
@@ -599,11 +620,10 @@ impl PySystem {
         };
         let t_eval: Option<Vec<f64>> = t_eval.map(|a| a.as_array().iter().copied().collect());
         let max_step = max_step.unwrap_or(f64::INFINITY);
-        let projection = match projection_tol {
-            None => method.default_projection(),
-            Some(0.0) => None,
-            Some(p) if p > 0.0 && p.is_finite() => Some(crate::correct::ProjectionTolerance { position_tol: p, velocity_tol: p, max_iter: 20 }),
-            Some(p) => return Err(PyValueError::new_err(format!("projection_tol must be >= 0 and finite, got {p}"))),
+        let stop_on_drift = match on_drift {
+            "stop" => true,
+            "warn" => false,
+            other => return Err(PyValueError::new_err(format!("on_drift must be 'stop' or 'warn', got {other:?}"))),
         };
         let opts = Options {
             rtol,
@@ -614,8 +634,17 @@ impl PySystem {
             max_nfev: max_nfev.unwrap_or(usize::MAX),
             max_wall_time: max_wall_time.unwrap_or(f64::INFINITY),
             min_step,
+            drift_limit: drift_limit.unwrap_or(f64::INFINITY),
+            stop_on_drift,
+            monitor_singular,
         };
-        opts.validate(2 * n).map_err(to_py)?;
+        let atol_full = opts.validate(2 * n).map_err(to_py)?;
+        let projection = match projection_tol {
+            None => Some(crate::integrate::default_projection(&atol_full)),
+            Some(0.0) => None,
+            Some(p) if p > 0.0 && p.is_finite() => Some(crate::correct::ProjectionTolerance { position_tol: p, velocity_tol: p, max_iter: 20 }),
+            Some(p) => return Err(PyValueError::new_err(format!("projection_tol must be >= 0 and finite, got {p}"))),
+        };
         // a fresh workspace with this System's settings: the run does not hold the lock
         let (tolerance, stabilization, backend, solver, limit) =
             self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.stabilization, ws.data.svd_backend, ws.data.uk_solver, ws.data.memory_limit)))?;
@@ -688,7 +717,122 @@ impl PySystem {
         d.set_item("newton_iterations", sol.stats.newton)?;
         d.set_item("jac_evals", jac_evals)?;
         d.set_item("wall_time", wall)?;
+        d.set_item("singular", passages_list(py, &sol.singular)?)?;
+        match sol.drift {
+            None => d.set_item("drift", py.None())?,
+            Some(r) => {
+                let dd = PyDict::new(py);
+                dd.set_item("t_first", r.t_first)?;
+                dd.set_item("max_residual", r.max_residual)?;
+                dd.set_item("t_max", r.t_max)?;
+                d.set_item("drift", dd)?;
+            }
+        }
         Ok(d)
+    }
+
+    /// The singular passages of a trajectory of accepted states (times `t` (k,), states `y`
+    /// (2n, k)), as the native runs report them (`integrate(...)["singular"]`): for runs made
+    /// elsewhere (the scipy methods, the NumPy references). One factorization per state.
+    fn singular_passages<'py>(&self, py: Python<'py>, t: Vector<'py>, y: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyList>> {
+        let n = self.model.n;
+        let tv: Vec<f64> = t.as_array().to_vec();
+        let ya = y.as_array();
+        if ya.shape() != [2 * n, tv.len()] {
+            return Err(PyValueError::new_err(format!("singular_passages: expected y of shape ({}, {}), got {:?}", 2 * n, tv.len(), ya.shape())));
+        }
+        if tv.iter().any(|x| !x.is_finite()) || ya.iter().any(|x| !x.is_finite()) {
+            return Err(to_py(Error::NonFinite { what: "singular_passages: t or y".into(), index: 0 }));
+        }
+        if tv.windows(2).any(|w| !(w[1] > w[0])) {
+            return Err(PyValueError::new_err("singular_passages: t must be strictly increasing"));
+        }
+        let (tolerance, solver, limit) = self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.uk_solver, ws.data.memory_limit)))?;
+        let model = &self.model;
+        let mut data = Data::build(model, solver, limit).map_err(to_py)?;
+        data.tolerance = tolerance;
+        let states: Vec<Vec<f64>> = (0..tv.len()).map(|k| (0..2 * n).map(|i| ya[[i, k]]).collect()).collect();
+        let passages = py.detach(|| -> Result<Vec<Passage>, Error> {
+            let mut sys = UkSystem::new(model, data);
+            let mut mon = SingularMonitor::new(n);
+            for (k, yk) in states.iter().enumerate() {
+                mon.push(&mut sys, tv[k], yk)?;
+            }
+            Ok(mon.passages)
+        });
+        passages_list(py, &passages.map_err(to_py)?)
+    }
+
+    /// `V - M^-1 A^T (A M^-1 A^T)^+ A V` at `(t, q)`: the columns of `V` (n, k) projected onto
+    /// the tangent space of the constraints in the mass metric (the filter of the explicit
+    /// methods' error estimates, docs/integrators.md).
+    /// Returns (the projected V, sigma_min / sigma_max of `A M^-1/2` at q).
+    fn tangent_project<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, v: PyReadonlyArray2<'py, f64>) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
+        let n = self.model.n;
+        let va = v.as_array();
+        if va.shape().len() != 2 || va.shape()[0] != n {
+            return Err(PyValueError::new_err(format!("tangent_project: expected V of shape ({n}, k), got {:?}", va.shape())));
+        }
+        let k = va.shape()[1];
+        let mut cols: Vec<Vec<f64>> = (0..k).map(|j| (0..n).map(|i| va[[i, j]]).collect()).collect();
+        if cols.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(to_py(Error::NonFinite { what: "tangent_project: V".into(), index: 0 }));
+        }
+        let ratio = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, None)?;
+            if model.m == 0 {
+                return Ok(1.0);
+            }
+            let q = ws.q.clone();
+            uk::evaluate(model, &mut ws.data, t, &q, &ws.qd.clone(), false)?;
+            uk::factor_constraints(model, &mut ws.data)?;
+            let info = ws.data.rank_info;
+            let ratio = if info.sigma_max > 0.0 { info.sigma_min_kept / info.sigma_max } else { 1.0 };
+            let mut r = vec![0.0; model.m];
+            for c in cols.iter_mut() {
+                for (i, ri) in r.iter_mut().enumerate() {
+                    *ri = ws.data.ajac.row_dot(i, c);
+                }
+                uk::min_norm_correction(model, &mut ws.data, &r);
+                for (x, d) in c.iter_mut().zip(&ws.data.qdd) {
+                    *x -= d;
+                }
+            }
+            Ok(ratio)
+        })?;
+        let mut out = vec![0.0; n * k];
+        for (j, c) in cols.iter().enumerate() {
+            for i in 0..n {
+                out[i * k + j] = c[i];
+            }
+        }
+        finite_out("tangent_project", &out).map_err(to_py)?;
+        Ok((mat(py, out, n, k)?, ratio))
+    }
+
+    /// The projection the native methods make after every accepted step
+    /// (`correct::ProjectionTolerance`): Newton on the positions until the correction's largest
+    /// entry is at most `position_tol` (at most `max_iter` steps), then the velocities.
+    /// Returns (q, qd, ||Phi|| at the new q, whether Newton converged).
+    #[pyo3(signature = (t, q, qd, position_tol, max_iter=3))]
+    #[allow(clippy::type_complexity)]
+    fn project_step<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, position_tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64, bool)> {
+        if !(position_tol >= 0.0) || !position_tol.is_finite() {
+            return Err(PyValueError::new_err(format!("position_tol must be >= 0 and finite, got {position_tol}")));
+        }
+        let (qn, qdn, phi0, phi1) = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            let (mut qn, mut qdn) = (ws.q.clone(), ws.qd.clone());
+            let mut pws = correct::ProjectWorkspace::new(model);
+            let tol = correct::ProjectionTolerance { position_tol, velocity_tol: position_tol, max_iter };
+            let out = correct::project_in_place(model, &mut ws.data, &mut pws, t, &mut qn, &mut qdn, tol)?;
+            finite_out("project_step", &qn)?;
+            finite_out("project_step", &qdn)?;
+            Ok((qn, qdn, out.phi_norm, out.converged))
+        })?;
+        Ok((PyArray1::from_vec(py, qn), PyArray1::from_vec(py, qdn), phi0, phi1))
     }
 
     /// Constraint stabilization inside qdd/rhs: kind "none" or "baumgarte" with alpha, beta

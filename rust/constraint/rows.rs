@@ -46,11 +46,20 @@ pub fn point_on_line(bodies: &[Body], p: &Marker, l: &Marker, sp: &MarkerState, 
         - sl.omega * sl.omega * (nv[0] * d[0] + nv[1] * d[1]));
 }
 
-/// Relative angle `phi_a - phi_b - f(t)`, `f = (f, f', f'')`.
+/// `x` wrapped into `[-pi, pi)`: the same angle, the nearest turn.
+#[inline]
+pub fn wrap_angle(x: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    x - TAU * ((x + PI) / TAU).floor()
+}
+
+/// Relative angle `phi_a - phi_b - f(t)`, `f = (f, f', f'')`, wrapped to the nearest turn: a
+/// marker angle read off a direction (an ANCF slope, `atan2`) jumps by `2 pi` where it passes
+/// `+-pi`, and a body turns any number of times (docs/integrators.md, continuous angles).
 #[inline]
 pub fn angle(bodies: &[Body], a: &Marker, b: &Marker, sa: &MarkerState, sb: &MarkerState, f: (f64, f64, f64), n_cols: usize, out: &mut ConstraintOut, k: usize) {
     if let Some(phi) = out.phi.as_deref_mut() {
-        phi[k] = sa.phi - sb.phi - f.0;
+        phi[k] = wrap_angle(sa.phi - sb.phi - f.0);
     }
     let layout = Some(out.layout);
     let row = &mut out.jac[k * n_cols..(k + 1) * n_cols];

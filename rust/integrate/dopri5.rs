@@ -1,7 +1,17 @@
 //! Dormand-Prince 5(4) with Hairer's step-size control (PI, beta = 0.04) and his 4th-order
 //! dense output (`DOPRI5`, Hairer, Norsett & Wanner, Solving ODEs I, II.5).
+//!
+//! On a constrained system, with a projection (the default): after every accepted step the
+//! state is projected onto the constraints with the factorization of the step's last stage
+//! (FSAL, at the new state); a projection whose Newton does not converge rejects the step. The
+//! part of the local error estimate across the constraints counts with the weight
+//! `normal_weight`: in full away from singular configurations, less and less near one, where it
+//! is amplified by `1 / sigma_min` and measured in full it would shrink the step without end and
+//! drive the state into the singular configuration, where it may leave its branch
+//! (docs/integrators.md, singular configurations).
 
-use super::{initial_step, rhs, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
+use super::{initial_step, normal_weight, rhs, weigh_error, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
+use crate::correct::ProjectionTolerance;
 use crate::error::Result;
 
 mod dp {
@@ -55,7 +65,26 @@ pub struct Dopri5 {
     rcont: [Vec<f64>; 5],
     facold: f64,
     reject: bool,
+    /// Projection after every accepted step (and the filtered error estimate), on constrained
+    /// systems.
+    pub projection: Option<ProjectionTolerance>,
+    /// The best conditioning of the constraints over the run's steps (`normal_weight`).
+    kappa_ref: f64,
+    /// The last accepted step away from singular configurations, and the steps taken near one.
+    h_far: f64,
+    pub near_steps: usize,
 }
+
+/// At a singular configuration -- the conditioning of the constraints below `AT_SINGULAR`
+/// times the run's best -- the step does not shrink below `NEAR_STEP_FLOOR` times the last step
+/// away from one (`normal_weight` = 1): there even the filtered error estimate is the rounding of
+/// the right-hand side amplified by `1 / kappa^2` (docs/integrators.md, singular configurations).
+pub const NEAR_STEP_FLOOR: f64 = 0.5;
+/// Away from singular configurations a step whose projection moves the state by more than this
+/// many units of the error tolerance (weighted RMS) is rejected.
+pub const PROJECTION_MOVE_LIMIT: f64 = 10.0;
+const ROUNDING_UNITS: f64 = 100.0;
+pub const AT_SINGULAR: f64 = 1e-3;
 
 impl Dopri5 {
     pub fn new(dim: usize, opts: Options) -> Result<Self> {
@@ -71,6 +100,10 @@ impl Dopri5 {
             rcont: [z(), z(), z(), z(), z()],
             facold: 1e-4,
             reject: false,
+            projection: None,
+            kappa_ref: 0.0,
+            h_far: 0.0,
+            near_steps: 0,
         })
     }
 }
@@ -81,6 +114,9 @@ impl Stepper for Dopri5 {
         self.facold = 1e-4;
         self.reject = false;
         rhs(sys, t0, &self.st.y, &mut self.k[0])?;
+        self.kappa_ref = sys.conditioning_ratio();
+        self.h_far = 0.0;
+        self.near_steps = 0;
         self.st.stats.nfev += 1;
         let hmax = self.opts.max_step.min((t_end - t0).abs());
         self.st.h = match self.opts.first_step {
@@ -141,11 +177,20 @@ impl Stepper for Dopri5 {
             }
             rhs(sys, tph, y1, k7)?;
             self.st.stats.nfev += 6;
+            // the local error estimate (into ysti), filtered onto the tangent space at y1
+            for i in 0..dim {
+                ys[i] = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
+            }
+            // the part of the estimate across the constraints weighed by `normal_weight`
+            let project = self.projection.is_some() && sys.n_constraints() > 0;
+            let kappa = sys.conditioning_ratio();
+            if project {
+                weigh_error(sys, ys, dim / 2, self.kappa_ref);
+            }
             let mut err = 0.0;
             for i in 0..dim {
-                let e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
                 let sk = self.atol[i] + self.opts.rtol * y[i].abs().max(y1[i].abs());
-                err += (e / sk) * (e / sk);
+                err += (ys[i] / sk) * (ys[i] / sk);
             }
             let err = (err / dim as f64).sqrt();
             if !err.is_finite() {
@@ -157,33 +202,98 @@ impl Stepper for Dopri5 {
             let fac11 = err.powf(EXPO1);
             let fac = (fac11 / self.facold.powf(BETA) / SAFE).clamp(FACC2, FACC1);
             let mut hnew = h / fac;
-            if err <= 1.0 {
+            // at a singular configuration the estimate cannot be trusted below a fraction of the
+            // step the motion had away from it: the step goes over the configuration instead of
+            // into it, and the projection lands it on its branch
+            let near = project && normal_weight(kappa, self.kappa_ref) < 1.0;
+            let at = project && kappa < AT_SINGULAR * self.kappa_ref;
+            let floor = if at { NEAR_STEP_FLOOR * self.h_far } else { 0.0 };
+            if err <= 1.0 || h.abs() <= floor {
+                // the projection with the factorization of the last stage (at y1): the filtered
+                // estimate leaves the error across the constraints to it, so a projection that
+                // does not converge (that error beyond the reach of Newton) rejects the step
+                let mut moved = 0.0;
+                if let (true, Some(tol)) = (project, self.projection) {
+                    ys.copy_from_slice(y1);
+                    let n = dim / 2;
+                    let (q1, v1) = y1.split_at_mut(n);
+                    let out = sys.project_step(tph, q1, v1, tol)?;
+                    if !out.converged {
+                        self.st.h = 0.3 * h;
+                        self.reject = true;
+                        if self.st.stats.naccept >= 1 {
+                            self.st.stats.nreject += 1;
+                        }
+                        continue;
+                    }
+                    // (weights with the rounding of the largest entry: a projection only
+                    // moves below it at the rounding level)
+                    let floor = ROUNDING_UNITS * f64::EPSILON * y1.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                    for i in 0..dim {
+                        let sk = self.atol[i] + self.opts.rtol * y1[i].abs() + floor;
+                        moved += ((y1[i] - ys[i]) / sk).powi(2);
+                    }
+                    moved = (moved / dim as f64).sqrt();
+                    // away from singular configurations the estimate measured the error across
+                    // the constraints too: a projection far beyond it means the estimate was
+                    // blind (an acceleration error the same in every stage, e.g. a huge force
+                    // cancelled to its rounding), and the projection would land the state on a
+                    // wrong point of the constraints
+                    // (from the second step on: a start off the constraints moves the first)
+                    if !near && moved > PROJECTION_MOVE_LIMIT && self.st.stats.naccept > 0 {
+                        self.st.h = 0.3 * h;
+                        self.reject = true;
+                        if self.st.stats.naccept >= 1 {
+                            self.st.stats.nreject += 1;
+                        }
+                        continue;
+                    }
+                } else {
+                    ys.copy_from_slice(y1);
+                }
                 self.facold = err.max(1e-4);
+                self.kappa_ref = self.kappa_ref.max(kappa);
                 self.st.stats.naccept += 1;
-                // dense output
+                // dense output (ys: the step's own end); a projection moves the end point, and
+                // the interpolant with it by theta (y1 - ys)
                 let [r0, r1, r2, r3, r4] = &mut self.rcont;
                 for i in 0..dim {
-                    let ydiff = y1[i] - y[i];
+                    let ydiff = ys[i] - y[i];
                     let bspl = h * k1[i] - ydiff;
                     r0[i] = y[i];
-                    r1[i] = ydiff;
+                    r1[i] = y1[i] - y[i];
                     r2[i] = bspl;
                     r3[i] = ydiff - h * k7[i] - bspl;
                     r4[i] = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
                 }
                 std::mem::swap(k1, k7);
                 std::mem::swap(&mut self.st.y, &mut self.y1);
+                if moved > 1.0 {
+                    rhs(sys, tph, &self.st.y, &mut self.k[0])?;
+                    self.st.stats.nfev += 1;
+                }
                 self.st.t_old = t;
                 self.st.t = if tph >= t_end { t_end } else { tph };
                 hnew = hnew.abs().min(hmax);
                 if self.reject {
                     hnew = hnew.min(h.abs());
                 }
+                if near {
+                    // without a degree of freedom (a driven mechanism) the filtered estimate is
+                    // zero: no step longer than the last one away from the singular configuration
+                    self.near_steps += 1;
+                    if self.h_far > 0.0 && sys.conditioning_rank() >= dim / 2 {
+                        hnew = hnew.min(self.h_far);
+                    }
+                    hnew = hnew.max(floor);
+                } else {
+                    self.h_far = h.abs();
+                }
                 self.reject = false;
                 self.st.h = hnew;
                 return Ok(());
             }
-            hnew = h / FACC1.min(fac11 / SAFE);
+            hnew = (h / FACC1.min(fac11 / SAFE)).max(floor);
             self.reject = true;
             if self.st.stats.naccept >= 1 {
                 self.st.stats.nreject += 1;
@@ -218,6 +328,9 @@ impl Stepper for Dopri5 {
     }
     fn state_mut(&mut self) -> &mut StepState {
         &mut self.st
+    }
+    fn options(&self) -> &Options {
+        &self.opts
     }
 }
 

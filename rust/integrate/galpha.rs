@@ -658,4 +658,7 @@ impl Stepper for GenAlpha {
     fn state_mut(&mut self) -> &mut StepState {
         &mut self.st
     }
+    fn options(&self) -> &Options {
+        &self.opts
+    }
 }

@@ -26,13 +26,15 @@ mod galpha;
 pub(crate) mod lu;
 mod radau5;
 mod radau_m;
+pub mod singular;
 
-pub use dopri5::Dopri5;
+pub use dopri5::{Dopri5, PROJECTION_MOVE_LIMIT};
 pub use galpha::{GenAlpha, GenAlphaOptions};
 pub use radau5::Radau5;
 pub use radau_m::{RadauM, RadauMOptions};
 
-use crate::correct::{self, ProjectWorkspace, ProjectionTolerance};
+use crate::correct::{self, ProjectOutcome, ProjectWorkspace, ProjectionTolerance};
+use crate::data::RankInfo;
 use crate::data::Data;
 use crate::dynamics;
 use crate::error::{Error, Result};
@@ -52,6 +54,11 @@ pub trait SecondOrderSystem {
     /// Return `true` if `y` was changed.
     fn post_step(&mut self, _t: f64, _y: &mut [f64]) -> Result<bool> {
         Ok(false)
+    }
+    /// Whether `post_step` projects onto the constraints (then a method may filter its error
+    /// estimate with `project_tangent`).
+    fn projects(&self) -> bool {
+        false
     }
     /// Number of constraint rows (the `A` of `structure`).
     fn n_constraints(&self) -> usize {
@@ -78,9 +85,51 @@ pub trait SecondOrderSystem {
     /// the residuals exceed `tol`, with the factorization that `acc` made (one kernel call for
     /// both). `qdd` is the acceleration at the state before the projection (which moves it by
     /// the drift, below the tolerances). Returns whether `(q, qd)` changed.
-    fn acc_projected(&mut self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64], _tol: Option<ProjectionTolerance>) -> Result<bool> {
+    fn acc_projected(&mut self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64], _tol: Option<ProjectionTolerance>) -> Result<ProjectOutcome> {
         self.acc(t, q, qd, qdd)?;
-        Ok(false)
+        Ok(ProjectOutcome::default())
+    }
+    /// Project `(q, qd)` onto the constraints as `tol` says, with the factorization of the last
+    /// `acc` call when it was at `(t, q)` (otherwise after a fresh one). Returns what changed
+    /// and `||Phi||` at the returned positions.
+    fn project_step(&mut self, _t: f64, _q: &mut [f64], _qd: &mut [f64], _tol: ProjectionTolerance) -> Result<ProjectOutcome> {
+        Ok(ProjectOutcome::default())
+    }
+    /// Remove from `v` (length n) its component across the constraint manifold at the state of
+    /// the last `acc` call: `v <- v - M^-1 A^T (A M^-1 A^T)^+ A v`, the mass-orthogonal
+    /// projection onto the tangent space `A v = 0` (a local error estimate filtered this way
+    /// measures the error along the motion, not the error that the projection removes anyway).
+    /// `keep`: the fraction of the part across the constraints that stays (0: the projection
+    /// onto the tangent space; `normal_weight(...).sqrt()` for an error estimate).
+    fn project_tangent(&mut self, _v: &mut [f64], _keep: f64) {}
+    /// `sigma_min / sigma_max` of `B = A M^-1/2` at the last factorization (1 without
+    /// constraints): against the run's best it weighs the part of an error estimate across the
+    /// constraints (`normal_weight`).
+    fn conditioning_ratio(&self) -> f64 {
+        1.0
+    }
+    /// The numerical rank of the constraints at the last factorization (0 without constraints):
+    /// `n` minus it is the number of degrees of freedom there.
+    fn conditioning_rank(&self) -> usize {
+        0
+    }
+    /// The conditioning of the constraints at `(t, q)`: the smallest kept and the largest
+    /// singular value of the mass-weighted Jacobian `B = A M^-1/2`, and its numerical rank
+    /// (`None` without constraints). From the last factorization when it was made at (about)
+    /// these positions, else from a fresh one (which overwrites the workspace).
+    fn conditioning(&mut self, _t: f64, _q: &[f64]) -> Result<Option<Conditioning>> {
+        Ok(None)
+    }
+    /// How many singular values of `B = A M^-1/2` at `(t, q)` are at most `ratio` times the
+    /// largest (the dimension that opens up at a singular configuration); `None` when not
+    /// available (no constraints, or too many rows for a dense SVD).
+    fn small_singular_values(&mut self, _t: f64, _q: &[f64], _ratio: f64) -> Result<Option<usize>> {
+        Ok(None)
+    }
+    /// `||Phi(q, t)||` (Euclidean): known after a projection or an `acc` call at `(t, q)`,
+    /// evaluated otherwise.
+    fn constraint_residual(&mut self, _t: f64, _q: &[f64]) -> Result<f64> {
+        Ok(0.0)
     }
     /// The cheap, fast-varying part of `structure` -- `M`, `K`, `A` -- at the state of the last
     /// `acc` or `augmented_residual` call `(q, qd)` (an implementation may reuse what that call
@@ -110,24 +159,94 @@ fn rhs<S: SecondOrderSystem + ?Sized>(sys: &mut S, t: f64, y: &[f64], dy: &mut [
     sys.acc(t, &y[..n], &y[n..], dqd)
 }
 
+/// The conditioning of the constraint Jacobian at a state (`SecondOrderSystem::conditioning`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Conditioning {
+    /// Smallest kept and largest singular value of `B = A M^-1/2` (exact after an SVD; the
+    /// certified bounds after the full-rank QR and sparse paths: `RankInfo`).
+    pub sigma_min: f64,
+    pub sigma_max: f64,
+    pub rank: usize,
+}
+
+impl Conditioning {
+    fn from_rank_info(r: &RankInfo) -> Self {
+        Conditioning { sigma_min: r.sigma_min_kept, sigma_max: r.sigma_max, rank: r.rank }
+    }
+    /// `sigma_min / sigma_max` (1 without kept singular values).
+    pub fn ratio(&self) -> f64 {
+        if self.sigma_max > 0.0 && self.sigma_min.is_finite() { self.sigma_min / self.sigma_max } else { 1.0 }
+    }
+}
+
 /// The UK equations of motion of a model as a `SecondOrderSystem`.
 pub struct UkSystem<'a> {
     pub model: &'a Model,
     pub data: Data,
     pub jws: JacobianWorkspace,
-    /// Optional projection onto `Phi = 0`, `A qd + Phi_t = 0` after each accepted step whose
-    /// residuals exceed the tolerances: `correct::project_in_place` settings.
+    /// Projection onto `Phi = 0`, `A qd + Phi_t = 0` after each accepted step
+    /// (`correct::ProjectionTolerance`); the steppers that project with their own last kernel
+    /// call take it over (`integrate_uk`).
     pub projection: Option<ProjectionTolerance>,
     pws: ProjectWorkspace,
     /// UK evaluations spent inside finite-difference Jacobians (full, factorization-reusing).
     pub jac_full_evals: usize,
     pub jac_cheap_evals: usize,
+    /// Positions and time of the last `acc` call; `ready`: `data` still holds its
+    /// factorization and `Phi` (nothing else has written the workspace since).
+    acc_q: Vec<f64>,
+    acc_t: f64,
+    ready: bool,
+    /// The rank report of the last factorization of `B` and its positions (for `conditioning`).
+    fact_q: Vec<f64>,
+    fact_info: Option<RankInfo>,
+    /// `||Phi||` at `res_q`, `res_t` when `res_valid`.
+    res_q: Vec<f64>,
+    res_t: f64,
+    res_norm: f64,
+    res_valid: bool,
+    zeros: Vec<f64>,
+    rm: Vec<f64>,
+    lam: Vec<f64>,
+}
+
+/// Positions this close (relative to their size) share their conditioning for
+/// `SecondOrderSystem::conditioning` (the projection after a step moves them by the drift).
+const CONDITIONING_SAME_Q: f64 = 1e-6;
+
+fn norm2(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 impl<'a> UkSystem<'a> {
     pub fn new(model: &'a Model, data: Data) -> Self {
+        let (n, m) = (model.n, model.m);
         let jws = JacobianWorkspace::new(model);
-        UkSystem { model, data, jws, projection: None, pws: ProjectWorkspace::new(model), jac_full_evals: 0, jac_cheap_evals: 0 }
+        UkSystem {
+            model, data, jws, projection: None, pws: ProjectWorkspace::new(model), jac_full_evals: 0, jac_cheap_evals: 0,
+            acc_q: vec![0.0; n], acc_t: f64::NAN, ready: false, fact_q: vec![0.0; n], fact_info: None,
+            res_q: vec![0.0; n], res_t: f64::NAN, res_norm: 0.0, res_valid: false, zeros: vec![0.0; n], rm: vec![0.0; m], lam: vec![0.0; m],
+        }
+    }
+
+    /// After a kernel call that factored `B` at `(t, q)` with `Phi`.
+    fn record_factorization(&mut self, t: f64, q: &[f64]) {
+        if self.model.m == 0 {
+            return;
+        }
+        self.acc_q.copy_from_slice(q);
+        self.acc_t = t;
+        self.ready = true;
+        self.fact_q.copy_from_slice(q);
+        self.fact_info = Some(self.data.rank_info);
+        self.res_q.copy_from_slice(q);
+        self.res_t = t;
+        self.res_norm = norm2(&self.data.phi);
+        self.res_valid = true;
+    }
+
+    fn at_last_acc(&self, t: f64, q: &[f64]) -> bool {
+        self.ready && t == self.acc_t && q == &self.acc_q[..]
     }
 }
 
@@ -137,11 +256,18 @@ impl SecondOrderSystem for UkSystem<'_> {
     }
     #[inline]
     fn acc(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &mut [f64]) -> Result<()> {
-        uk::acceleration(self.model, &mut self.data, t, q, qd)?;
+        self.ready = false;
+        if self.model.m == 0 {
+            uk::acceleration(self.model, &mut self.data, t, q, qd)?;
+        } else {
+            uk::acceleration_with_phi(self.model, &mut self.data, t, q, qd)?;
+            self.record_factorization(t, q);
+        }
         qdd.copy_from_slice(&self.data.qdd);
         check_state_finite(t, q, qd, qdd)
     }
     fn jac(&mut self, t: f64, q: &[f64], qd: &[f64], jq: &mut [f64], jv: &mut [f64]) -> Result<()> {
+        self.ready = false;
         uk_jacobian(self.model, &mut self.data, &mut self.jws, t, q, qd, jq, jv)?;
         self.jac_full_evals += self.jws.full_evals;
         self.jac_cheap_evals += self.jws.cheap_evals;
@@ -149,14 +275,24 @@ impl SecondOrderSystem for UkSystem<'_> {
     }
     fn post_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool> {
         let Some(p) = self.projection else { return Ok(false) };
+        self.ready = false;
         let n = self.model.n;
         let (q, qd) = y.split_at_mut(n);
-        correct::project_in_place(self.model, &mut self.data, &mut self.pws, t, q, qd, p)
+        let out = correct::project_in_place(self.model, &mut self.data, &mut self.pws, t, q, qd, p)?;
+        self.res_q.copy_from_slice(q);
+        self.res_t = t;
+        self.res_norm = out.phi_norm;
+        self.res_valid = true;
+        Ok(out.changed)
     }
     fn n_constraints(&self) -> usize {
         self.model.m
     }
+    fn projects(&self) -> bool {
+        self.projection.is_some() && self.model.m > 0
+    }
     fn augmented_residual(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], lambda: &[f64], r1: &mut [f64], r2: &mut [f64]) -> Result<bool> {
+        self.ready = false;
         let (model, data) = (self.model, &mut self.data);
         let n = model.n;
         dynamics::mass_and_forces(model, data, q, qd);
@@ -174,16 +310,121 @@ impl SecondOrderSystem for UkSystem<'_> {
     fn multipliers(&self, out: &mut [f64]) {
         out.copy_from_slice(&self.data.lambda);
     }
-    fn acc_projected(&mut self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64], tol: Option<ProjectionTolerance>) -> Result<bool> {
-        let Some(tol) = tol else {
-            return self.acc(t, q, qd, qdd).map(|_| false);
-        };
-        uk::acceleration_with_phi(self.model, &mut self.data, t, q, qd)?;
-        qdd.copy_from_slice(&self.data.qdd);
-        correct::project_with_factorization(self.model, &mut self.data, &mut self.pws, t, q, qd, tol)
+    fn acc_projected(&mut self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64], tol: Option<ProjectionTolerance>) -> Result<ProjectOutcome> {
+        self.acc(t, q, qd, qdd)?;
+        match tol {
+            Some(tol) => self.project_step(t, q, qd, tol),
+            None => Ok(ProjectOutcome { phi_norm: self.res_norm, ..Default::default() }),
+        }
+    }
+    fn project_step(&mut self, t: f64, q: &mut [f64], qd: &mut [f64], tol: ProjectionTolerance) -> Result<ProjectOutcome> {
+        if self.model.m == 0 {
+            return Ok(ProjectOutcome::default());
+        }
+        if !self.at_last_acc(t, q) {
+            uk::acceleration_with_phi(self.model, &mut self.data, t, q, qd)?;
+            self.record_factorization(t, q);
+        }
+        self.ready = false;
+        let out = correct::project_with_factorization(self.model, &mut self.data, &mut self.pws, t, q, qd, tol)?;
+        self.res_q.copy_from_slice(q);
+        self.res_t = t;
+        self.res_norm = out.phi_norm;
+        self.res_valid = true;
+        Ok(out)
+    }
+    fn project_tangent(&mut self, v: &mut [f64], keep: f64) {
+        let (model, data) = (self.model, &mut self.data);
+        if model.m == 0 {
+            return;
+        }
+        for (i, r) in self.rm.iter_mut().enumerate() {
+            *r = data.ajac.row_dot(i, v);
+        }
+        self.lam.copy_from_slice(&data.lambda);
+        uk::min_norm_correction(model, data, &self.rm);
+        for (x, d) in v.iter_mut().zip(&data.qdd) {
+            *x -= (1.0 - keep) * d;
+        }
+        data.lambda.copy_from_slice(&self.lam);
+    }
+    fn conditioning_ratio(&self) -> f64 {
+        if self.model.m == 0 {
+            return 1.0;
+        }
+        Conditioning::from_rank_info(&self.data.rank_info).ratio()
+    }
+    fn conditioning_rank(&self) -> usize {
+        if self.model.m == 0 { 0 } else { self.data.rank_info.rank }
+    }
+    fn conditioning(&mut self, t: f64, q: &[f64]) -> Result<Option<Conditioning>> {
+        if self.model.m == 0 {
+            return Ok(None);
+        }
+        if let Some(info) = self.fact_info {
+            let size = q.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+            if q.iter().zip(&self.fact_q).all(|(a, b)| (a - b).abs() <= CONDITIONING_SAME_Q * size) {
+                return Ok(Some(Conditioning::from_rank_info(&info)));
+            }
+        }
+        self.ready = false;
+        let (model, data) = (self.model, &mut self.data);
+        uk::evaluate(model, data, t, q, &self.zeros, false)?;
+        // the sparse path's estimate where its Cholesky succeeds (no dense fallback near a
+        // singular configuration: that is where the monitor looks)
+        // singular configuration: that is where the monitor looks). Where the steps have full
+        // rank a failed Cholesky means sigma_min^2 below its rounding: singular to working
+        // precision. With redundant rows it always fails: the dense path decides.
+        let full_rank = self.fact_info.is_none_or(|i| i.rank == model.m);
+        if let (Some(sp), true) = (data.sparse.as_mut(), full_rank) {
+            let info = sp.factor(model, &data.bodies, &data.ajac, &data.tolerance);
+            self.fact_info = None;
+            let (sigma_min, sigma_max) = sp.conditioning_estimate().unwrap_or((0.0, sp.trace_s.sqrt()));
+            let rank = info.map_or(model.m, |i| i.rank);
+            return Ok(Some(Conditioning { sigma_min, sigma_max, rank }));
+        }
+        uk::factor_constraints(model, data)?;
+        self.fact_q.copy_from_slice(q);
+        self.fact_info = Some(data.rank_info);
+        Ok(Some(Conditioning::from_rank_info(&data.rank_info)))
+    }
+    fn small_singular_values(&mut self, t: f64, q: &[f64], ratio: f64) -> Result<Option<usize>> {
+        if self.model.m == 0 {
+            return Ok(None);
+        }
+        self.ready = false;
+        self.fact_info = None;
+        let (model, data) = (self.model, &mut self.data);
+        uk::evaluate(model, data, t, q, &self.zeros, false)?;
+        // the sparse path: Sylvester's inertia of S - tau^2 I (tau: ratio x the upper bound
+        // sqrt(trace S) of sigma_max); else every singular value from the dense SVD
+        if let Some(sp) = data.sparse.as_mut() {
+            sp.factor(model, &data.bodies, &data.ajac, &data.tolerance);
+            let tau = ratio * sp.trace_s.sqrt();
+            return Ok(Some(sp.count_below(tau * tau)));
+        }
+        let Some(s) = uk::singular_values(model, data)? else { return Ok(None) };
+        let top = s.first().copied().unwrap_or(0.0);
+        Ok(Some(s.iter().filter(|x| **x <= ratio * top).count()))
+    }
+    fn constraint_residual(&mut self, t: f64, q: &[f64]) -> Result<f64> {
+        if self.model.m == 0 {
+            return Ok(0.0);
+        }
+        if self.res_valid && t == self.res_t && q == &self.res_q[..] {
+            return Ok(self.res_norm);
+        }
+        self.ready = false;
+        dynamics::constraints(self.model, &mut self.data, t, q, &self.zeros, true);
+        self.res_q.copy_from_slice(q);
+        self.res_t = t;
+        self.res_norm = norm2(&self.data.phi);
+        self.res_valid = true;
+        Ok(self.res_norm)
     }
     fn stiff_structure(&mut self, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], a: &mut [f64]) -> Result<bool> {
         // `uk::acceleration` / `augmented_residual` left the body blocks and A of (q, qd) in `data`
+        self.ready = false;
         let (model, data) = (self.model, &mut self.data);
         data.ensure_dense_jac()?;
         dynamics::dense_mass_into(model, data, m);
@@ -192,6 +433,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         Ok(true)
     }
     fn structure(&mut self, t: f64, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], c: &mut [f64], a: &mut [f64], bv: &mut [f64]) -> Result<bool> {
+        self.ready = false;
         let (model, data) = (self.model, &mut self.data);
         data.ensure_dense_jac()?;
         dynamics::mass_and_forces(model, data, q, qd);
@@ -222,11 +464,21 @@ pub struct Options {
     /// Smallest step size allowed [s]: a step below it ends the run (0: only the rounding
     /// limit `|t| eps`).
     pub min_step: f64,
+    /// The drift bound: an accepted step whose `||Phi||` exceeds it ends the run
+    /// (`Error::Drift`) when `stop_on_drift`, else is reported in `Solution::drift`
+    /// (infinite: no check).
+    pub drift_limit: f64,
+    pub stop_on_drift: bool,
+    /// Watch the conditioning of the constraints for singular passages (`Solution::singular`).
+    pub monitor_singular: bool,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { rtol: 1e-6, atol: vec![1e-9], first_step: None, max_step: f64::INFINITY, max_steps: 1_000_000, max_nfev: usize::MAX, max_wall_time: f64::INFINITY, min_step: 0.0 }
+        Options {
+            rtol: 1e-6, atol: vec![1e-9], first_step: None, max_step: f64::INFINITY, max_steps: 1_000_000, max_nfev: usize::MAX,
+            max_wall_time: f64::INFINITY, min_step: 0.0, drift_limit: f64::INFINITY, stop_on_drift: true, monitor_singular: true,
+        }
     }
 }
 
@@ -259,6 +511,9 @@ impl Options {
         }
         if !(self.max_wall_time > 0.0) {
             return bad(format!("max_wall_time must be positive, got {}", self.max_wall_time));
+        }
+        if !(self.drift_limit > 0.0) {
+            return bad(format!("drift_limit must be positive, got {}", self.drift_limit));
         }
         Ok(v)
     }
@@ -368,6 +623,8 @@ pub trait Stepper {
     }
     fn state(&self) -> &StepState;
     fn state_mut(&mut self) -> &mut StepState;
+    /// The run's settings.
+    fn options(&self) -> &Options;
 
     fn t(&self) -> f64 {
         self.state().t
@@ -544,6 +801,19 @@ pub struct Solution {
     pub failure: Option<Failure>,
     /// The dense output of every accepted step (when asked for).
     pub dense: Option<DenseRecord>,
+    /// Singular passages (`singular::SingularMonitor`).
+    pub singular: Vec<singular::Passage>,
+    /// With `stop_on_drift = false`: the first accepted step beyond the drift bound and the
+    /// largest `||Phi||` of the run's steps.
+    pub drift: Option<DriftReport>,
+}
+
+/// Where a run that was allowed to go on left its drift bound (`Options::stop_on_drift`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriftReport {
+    pub t_first: f64,
+    pub max_residual: f64,
+    pub t_max: f64,
 }
 
 /// Integrate from `(t0, y0)` to `t_end`. Outputs at `t_eval` (strictly increasing, within
@@ -581,9 +851,18 @@ pub fn integrate_dense<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys:
     let mut record = if dense { Some(DenseRecord::default()) } else { None };
     // the last accepted (finite) state's time: where a failed run's trajectory ends
     let mut t_good = t0;
+    let (drift_limit, stop_on_drift, monitor_singular) = {
+        let o = stepper.options();
+        (o.drift_limit, o.stop_on_drift, o.monitor_singular)
+    };
+    let mut monitor = (monitor_singular && sys.n_constraints() > 0).then(|| singular::SingularMonitor::new(dim / 2));
+    let mut drift: Option<DriftReport> = None;
     // the run; a failure ends it with the trajectory up to there
     let mut run = |sol: &mut Solution| -> Result<()> {
         stepper.init(sys, t0, y0, t_end)?;
+        if let Some(mon) = monitor.as_mut() {
+            mon.push(sys, t0, y0)?;
+        }
         match t_eval {
             None => {
                 sol.t.push(t0);
@@ -611,6 +890,23 @@ pub fn integrate_dense<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys:
             }
             if sys.post_step(t, stepper.y_mut())? {
                 stepper.restart_at(sys)?;
+            }
+            // no success on garbage: the accepted state within the drift bound
+            if drift_limit.is_finite() && sys.n_constraints() > 0 {
+                let r = sys.constraint_residual(t, &stepper.y()[..n])?;
+                if !(r <= drift_limit) {
+                    if stop_on_drift {
+                        return Err(Error::Drift { t, residual: r, limit: drift_limit });
+                    }
+                    let d = drift.get_or_insert(DriftReport { t_first: t, max_residual: r, t_max: t });
+                    if r > d.max_residual {
+                        d.max_residual = r;
+                        d.t_max = t;
+                    }
+                }
+            }
+            if let Some(mon) = monitor.as_mut() {
+                mon.push(sys, t, stepper.y())?;
             }
             if let Some(rec) = record.as_mut() {
                 rec.push(&stepper.dense_parts());
@@ -645,6 +941,7 @@ pub fn integrate_dense<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys:
             let t = t_good;
             sol.failure = Some(match e {
                 Error::Budget { what, .. } => Failure { cause: what, t, ..Default::default() },
+                Error::Drift { .. } => Failure { cause: "drift".into(), t, ..Default::default() },
                 Error::NonFinite { what, index } => {
                     let stage = what.split(' ').next().unwrap_or("").to_string();
                     Failure { cause: "non_finite".into(), t, stage, index: Some(index) }
@@ -655,6 +952,8 @@ pub fn integrate_dense<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys:
     }
     sol.stats = stepper.stats();
     sol.dense = record;
+    sol.singular = monitor.map(|m| m.passages).unwrap_or_default();
+    sol.drift = drift;
     Ok(sol)
 }
 
@@ -667,11 +966,60 @@ pub enum Method {
     RadauM(RadauMOptions),
 }
 
-/// Default projection of the implicit methods on the constrained equations (GENALPHA, RADAU5M):
-/// positions when `max |Phi| > 1e-11`, velocities when `max |A qd + Phi_t| > 1e-9` (absolute):
-/// keeps the drift of long runs bounded (targets 1e-10 and 1e-8) at a per-step cost that is nil
-/// while the drift is below.
-pub const IMPLICIT_PROJECTION: ProjectionTolerance = ProjectionTolerance { position_tol: 1e-11, velocity_tol: 1e-9, max_iter: 5 };
+/// The weight of the part of a local error estimate across the constraints, for the methods
+/// that project after every step: 1 while the conditioning `kappa = sigma_min / sigma_max` of
+/// the constraints at the step's end is at least `NEAR_SINGULAR` times the run's best
+/// `kappa_ref`, 0 below (the estimate filtered onto the constraints' tangent space).
+///
+/// Near a singular configuration that part is amplified by `1 / kappa` and more; the
+/// projection removes it, and counted it shrinks the step without end and drives the state
+/// into the singular configuration, where it may leave its branch (docs/integrators.md,
+/// singular configurations; a weight `(kappa / kappa_ref)^2` instead of the cut still did, at
+/// rtol 1e-10 on the N four-bar). Away from one it counts in full: the dense output between
+/// the steps is not projected, so a driven mechanism without degrees of freedom (whose whole
+/// error lies across the constraints) keeps its outputs on the constraints.
+pub fn normal_weight(kappa: f64, kappa_ref: f64) -> f64 {
+    if kappa.is_finite() && kappa < NEAR_SINGULAR * kappa_ref {
+        0.0
+    } else {
+        1.0
+    }
+}
+
+/// `normal_weight`'s cut, against the run's best conditioning.
+pub const NEAR_SINGULAR: f64 = 0.5;
+
+/// `e` (halves of length `n`: positions, velocities) with its part across the constraints kept
+/// at the weight `normal_weight(kappa, kappa_ref)` (`project_tangent` at the last kernel call).
+fn weigh_error<S: SecondOrderSystem + ?Sized>(sys: &mut S, e: &mut [f64], n: usize, kappa_ref: f64) {
+    let keep = normal_weight(sys.conditioning_ratio(), kappa_ref).sqrt();
+    if keep < 1.0 {
+        for chunk in e.chunks_mut(n) {
+            sys.project_tangent(chunk, keep);
+        }
+    }
+}
+
+/// The default projection after every accepted step, for every method on a constrained
+/// system: Newton on the positions until the correction's largest entry is at most
+/// `PROJECTION_PER_ATOL` times the smallest absolute tolerance of the positions (1e-11 m at the
+/// default `atol = 1e-9`), at most `PROJECTION_MAX_ITER` steps; the velocities in one step,
+/// when their correction exceeds the same fraction of the velocities' smallest atol. Its cost
+/// is two corrections with the step's own factorization and one evaluation of the constraints
+/// per step; it keeps the drift of long runs at the tolerance and the motion on its branch at
+/// singular configurations (`correct::ProjectionTolerance`).
+pub const PROJECTION_PER_ATOL: f64 = 1e-2;
+pub const PROJECTION_MAX_ITER: usize = 3;
+
+/// `default_projection` for the expanded absolute tolerance `atol` (2n entries).
+pub fn default_projection(atol: &[f64]) -> ProjectionTolerance {
+    let n = atol.len() / 2;
+    let tol = |part: &[f64]| {
+        let smallest = part.iter().fold(f64::INFINITY, |m, a| m.min(*a));
+        if smallest.is_finite() && smallest > 0.0 { PROJECTION_PER_ATOL * smallest } else { 0.0 }
+    };
+    ProjectionTolerance { position_tol: tol(&atol[..n]), velocity_tol: tol(&atol[n..]), max_iter: PROJECTION_MAX_ITER }
+}
 
 impl Method {
     pub fn from_name(name: &str) -> Option<Method> {
@@ -684,13 +1032,6 @@ impl Method {
         }
     }
 
-    /// The projection a method uses unless told otherwise.
-    pub fn default_projection(&self) -> Option<ProjectionTolerance> {
-        match self {
-            Method::GenAlpha(_) | Method::RadauM(_) => Some(IMPLICIT_PROJECTION),
-            Method::Dopri5 | Method::Radau5 => None,
-        }
-    }
 }
 
 /// Convenience: run `method` on the UK system of `model` with a workspace `data`.
@@ -702,6 +1043,8 @@ pub fn integrate_uk(model: &Model, data: Data, method: Method, opts: Options, t0
     let sol = match method {
         Method::Dopri5 => {
             let mut st = Dopri5::new(2 * model.n, opts)?;
+            // projects with the factorization of its last stage
+            st.projection = sys.projection.take();
             integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
         }
         Method::Radau5 => {

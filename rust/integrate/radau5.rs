@@ -5,7 +5,7 @@
 //! of `integrate`).
 
 use super::lu::{lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
-use super::{initial_step, rhs, rms_norm, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
+use super::{initial_step, rhs, rms_norm, weigh_error, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::error::{Error, Result};
 
 pub(super) mod rc {
@@ -90,6 +90,8 @@ pub struct Radau5 {
     theta: f64,
     hacc: f64,
     erracc: f64,
+    /// The best conditioning of the constraints over the run's steps (`normal_weight`).
+    kappa_ref: f64,
     first: bool,
     reject: bool,
     caljac: bool,
@@ -154,6 +156,7 @@ impl Radau5 {
             theta: THET,
             hacc: 0.0,
             erracc: 0.0,
+            kappa_ref: 0.0,
             first: true,
             reject: false,
             caljac: false,
@@ -246,6 +249,12 @@ impl Radau5 {
             tmp[i] = tmp2[i] + self.f0[i];
         }
         self.solve_real(&mut tmp);
+        // with a projection after each step: the part across the constraints weighed by
+        // `normal_weight` (the last kernel call was the third stage, at about y_{n+1})
+        let filter = sys.projects();
+        if filter {
+            weigh_error(sys, &mut tmp, dim / 2, self.kappa_ref);
+        }
         let mut err = rms_norm(&tmp, &self.scal).max(1e-10);
         if err >= 1.0 && (self.first || self.reject) {
             for i in 0..dim {
@@ -260,6 +269,9 @@ impl Radau5 {
             std::mem::swap(&mut self.ystage, &mut ystage);
             r?;
             self.solve_real(&mut tmp);
+            if filter {
+                weigh_error(sys, &mut tmp, dim / 2, self.kappa_ref);
+            }
             err = rms_norm(&tmp, &self.scal).max(1e-10);
         }
         self.tmp = tmp;
@@ -290,6 +302,7 @@ impl Stepper for Radau5 {
         self.theta = THET;
         self.nsing = 0;
         rhs(sys, t0, &self.st.y, &mut self.f0)?;
+        self.kappa_ref = sys.conditioning_ratio();
         self.st.stats.nfev += 1;
         self.update_scal();
         let hmax = self.opts.max_step.min((t_end - t0).abs());
@@ -477,6 +490,7 @@ impl Stepper for Radau5 {
                 self.first = false;
                 self.st.stats.naccept += 1;
                 self.nsing = 0;
+                self.kappa_ref = self.kappa_ref.max(sys.conditioning_ratio());
                 // Gustafsson's predictive controller
                 if self.st.stats.naccept > 1 {
                     let facgus = ((self.hacc / h) * (err * err / self.erracc).powf(0.25) / SAFE).clamp(FACR, FACL);
@@ -567,6 +581,14 @@ impl Stepper for Radau5 {
         }
     }
     fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
+        // the post-step hook moved y: the collocation polynomial follows by (1 + s) (y - c0),
+        // so the dense output still ends at the state
+        let [c0, c1, ..] = &mut self.cont;
+        for i in 0..c0.len() {
+            let d = self.st.y[i] - c0[i];
+            c0[i] += d;
+            c1[i] += d;
+        }
         rhs(sys, self.st.t, &self.st.y, &mut self.f0)?;
         self.st.stats.nfev += 1;
         self.update_scal();
@@ -577,6 +599,9 @@ impl Stepper for Radau5 {
     }
     fn state_mut(&mut self) -> &mut StepState {
         &mut self.st
+    }
+    fn options(&self) -> &Options {
+        &self.opts
     }
 }
 

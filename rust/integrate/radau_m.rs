@@ -46,7 +46,7 @@
 use super::lu::{lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
 // Hairer's Newton iterations per attempt and step-size control constants, as RADAU5 has them
 use super::radau5::{rc, FACL, FACR, NIT, QUOT1, QUOT2, SAFE};
-use super::{acc_and_multipliers, fixed_step_count, initial_step_second_order, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
+use super::{acc_and_multipliers, fixed_step_count, initial_step_second_order, weigh_error, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::correct::ProjectionTolerance;
 use crate::error::{Error, Result};
 
@@ -136,6 +136,8 @@ pub struct RadauM {
     erracc: f64,
     first: bool,
     reject: bool,
+    /// The best conditioning of the constraints over the run's steps (`normal_weight`).
+    kappa_ref: f64,
 }
 
 /// 3 x 3 matrix product.
@@ -235,6 +237,7 @@ impl RadauM {
             erracc: 0.0,
             first: true,
             reject: false,
+            kappa_ref: 0.0,
         })
     }
 
@@ -469,7 +472,7 @@ impl RadauM {
 
     /// Hairer's filtered error estimate on the positions (module docs); `second`: the variant
     /// with a fresh evaluation at the estimated point (first step, after a rejection).
-    fn error_estimate<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64) -> Result<f64> {
+    fn error_estimate<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64, filter: bool) -> Result<f64> {
         let n = self.n;
         let (hee1, hee2, hee3) = (rc::DD1 / h, rc::DD2 / h, rc::DD3 / h);
         // e = f_n + sum_i d_i Z_i / h, Z_i the stage increments
@@ -479,7 +482,7 @@ impl RadauM {
             self.eq[k] = self.v0[k] + hee1 * zq(0) + hee2 * zq(1) + hee3 * zq(2);
             self.ev[k] = self.a0[k] + hee1 * zv(0) + hee2 * zv(1) + hee3 * zv(2);
         }
-        let mut err = self.filtered_norm(h);
+        let mut err = self.filtered_norm(sys, h, filter);
         if err >= 1.0 && (self.first || self.reject) {
             // Hairer's second estimate: f at y_n + x instead of f_n (e_q += x_v, e_v += g(y_n + x) - a_n)
             let g = h * self.lambda;
@@ -496,7 +499,7 @@ impl RadauM {
             for k in 0..n {
                 self.ev[k] += self.xc[k] - self.a0[k];
             }
-            err = self.filtered_norm(h);
+            err = self.filtered_norm(sys, h, filter);
             self.stages(h);
         }
         Ok(err.max(1e-10))
@@ -504,7 +507,7 @@ impl RadauM {
 
     /// `x_q` of the filtered estimate for the bracket in `eq`, `ev` (into `tmp[..n]`) and its
     /// weighted RMS norm.
-    fn filtered_norm(&mut self, h: f64) -> f64 {
+    fn filtered_norm<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64, tangent: bool) -> f64 {
         let (n, m) = (self.n, self.m);
         let nm = n + m;
         let g = h * self.lambda;
@@ -523,6 +526,9 @@ impl RadauM {
             self.tmp[n + r] = (0..n).map(|j| arow[j] * (g2 * self.ev[j] + g * self.eq[j])).sum();
         }
         lu_cm_solve(&self.lu_r, &self.piv_r, nm, &mut self.tmp);
+        if tangent {
+            weigh_error(sys, &mut self.tmp[..n], n, self.kappa_ref);
+        }
         let mut s = 0.0;
         for i in 0..n {
             let v = self.tmp[i] / self.scal(i);
@@ -546,6 +552,7 @@ impl Stepper for RadauM {
         sys.acc(t0, q, qd, &mut self.qdd)?;
         self.st.stats.nfev += 1;
         sys.multipliers(&mut self.lam);
+        self.kappa_ref = sys.conditioning_ratio();
         self.read_structure(sys)?;
         let hmax = self.opts.max_step.min((t_end - t0).abs());
         self.st.h = match (self.ro.step, self.opts.first_step) {
@@ -602,7 +609,19 @@ impl Stepper for RadauM {
                 }
                 continue;
             };
-            let err = if fixed { 0.0 } else { self.error_estimate(sys, h)? };
+            // the UK evaluation at the step's end first: with a projection its factorization
+            // filters the error estimate onto the constraints' tangent space (see DOPRI5), and on
+            // acceptance it is the step's final acceleration
+            let t1 = if last { t_end } else { self.st.t + h };
+            let project = self.ro.projection.is_some() && self.m > 0;
+            let mut kappa = 1.0;
+            if project {
+                sys.acc(t1, &self.qs[2], &self.vs[2], &mut self.qdd)?;
+                self.st.stats.nfev += 1;
+                sys.multipliers(&mut self.lam);
+                kappa = sys.conditioning_ratio();
+            }
+            let err = if fixed { 0.0 } else { self.error_estimate(sys, h, project)? };
             let fac = SAFE.min(cfac / (newt + 2 * NIT) as f64);
             let mut quot = FACR.max(FACL.min(err.powf(0.25) / fac));
             let mut hnew = h / quot;
@@ -620,18 +639,22 @@ impl Stepper for RadauM {
                 // keep the factorization only if h comes back to it
                 continue;
             }
-            // accepted: the UK acceleration at the end (and the projection with its factorization)
+            // accepted: the projection with the factorization of the final UK evaluation
             self.first = false;
-            let t1 = if last { t_end } else { self.st.t + h };
+            self.kappa_ref = self.kappa_ref.max(kappa);
             let (mut q1, mut v1) = (std::mem::take(&mut self.qs[2]), std::mem::take(&mut self.vs[2]));
-            let r = sys.acc_projected(t1, &mut q1, &mut v1, &mut self.qdd, self.ro.projection);
-            self.st.stats.nfev += 1;
+            let r = match self.ro.projection {
+                Some(tol) if project => sys.project_step(t1, &mut q1, &mut v1, tol).map(|_| ()),
+                _ => {
+                    self.st.stats.nfev += 1;
+                    sys.acc(t1, &q1, &v1, &mut self.qdd).map(|_| sys.multipliers(&mut self.lam))
+                }
+            };
             self.st.y[..n].copy_from_slice(&q1);
             self.st.y[n..].copy_from_slice(&v1);
             self.qs[2] = q1;
             self.vs[2] = v1;
             r?;
-            sys.multipliers(&mut self.lam);
             self.st.stats.naccept += 1;
             self.st.nonfinite = None;
             self.st.t_old = self.st.t;
@@ -724,5 +747,8 @@ impl Stepper for RadauM {
     }
     fn state_mut(&mut self) -> &mut StepState {
         &mut self.st
+    }
+    fn options(&self) -> &Options {
+        &self.opts
     }
 }

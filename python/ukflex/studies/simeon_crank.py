@@ -25,7 +25,7 @@ import numpy as np
 from ..flexible import FlexibleData, InterfacePoint
 from ..reference import testset_crank as ts
 from ..scene import ConstantSpeed, Scene
-from ..simulate import simulate
+from ..simulate import NATIVE_METHODS, simulate
 
 __all__ = ["rod_data", "crank_scene", "crank_state", "run"]
 
@@ -125,7 +125,12 @@ def run(nonlinear: bool = False, rtol: float = 1e-12, method: str = "DOPRI5", re
     walls, res = [], None
     for _ in range(max(1, repeats)):
         t0 = time.perf_counter()
-        res = simulate(system, 0.1, method=method, rtol=rtol, atol=rtol * 1e-3, q0=q0, qd0=qd0)
+        # the Test Set's initial positions hold its constraints to 2e-10 only (the wrist pin's x,
+        # printed digits): the native methods' projection would move them onto the constraints
+        # and ring the rod's fast modes (5e-7 in the modal velocities, 6.3 digits instead of
+        # 9.1): the reproduction integrates the Test Set's state as given, without it
+        opts = {"projection_tol": 0.0} if str(method).upper() in NATIVE_METHODS else {}
+        res = simulate(system, 0.1, method=method, rtol=rtol, atol=rtol * 1e-3, q0=q0, qd0=qd0, **opts)
         walls.append(time.perf_counter() - t0)
     assert res is not None
     y = testset_components(res)
