@@ -60,6 +60,27 @@ pub fn energies_into(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], bodi
     }
 }
 
+/// The potentials `-tau phi` of the torques over a run of `nt` states (`fp`: `nt` rows of
+/// `model.forces.len()`, as `energies_into` wrote them), with each frame angle `phi` unwrapped
+/// from state to state: a marker angle read off a direction (an ANCF slope) jumps by `2 pi`
+/// where it passes `+-pi`, and the work of a torque over several turns is not periodic.
+pub fn unwrap_torque_potentials(model: &Model, fp: &mut [f64], nt: usize) {
+    let nf = model.forces.len();
+    for (i, f) in model.forces.iter().enumerate() {
+        let crate::force::ForceKind::Torque { torque, .. } = f.kind else { continue };
+        if torque == 0.0 {
+            continue;
+        }
+        let mut prev: Option<f64> = None;
+        for k in 0..nt {
+            let phi = -fp[k * nf + i] / torque;
+            let phi = prev.map_or(phi, |p| p + crate::constraint::rows::wrap_angle(phi - p));
+            fp[k * nf + i] = -torque * phi;
+            prev = Some(phi);
+        }
+    }
+}
+
 /// Power dissipated by the damping forces at `(q, qd)` (>= 0): `-qd . Q_odd` with
 /// `Q_odd = (Q(q, qd) - Q(q, -qd)) / 2`, the part of the generalized forces odd in `qd`. The
 /// inertial velocity terms are quadratic in `qd` and the elastic, gravity and constant loads do

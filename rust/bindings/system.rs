@@ -1060,6 +1060,7 @@ impl PySystem {
                 sensors::energies_into(model, &mut ws.data, qk, qdk, &mut be[k * nb * 3..(k + 1) * nb * 3], &mut fp[k * nf..(k + 1) * nf]);
                 dp[k] = sensors::dissipation_power(model, &mut ws.data, qk, qdk, &mut v, &mut f);
             }
+            sensors::unwrap_torque_potentials(model, &mut fp, nt);
             Ok(())
         })?;
         let d = PyDict::new(py);
