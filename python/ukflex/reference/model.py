@@ -361,6 +361,12 @@ class _Cable:
 
 
 # ----------------------------------------------------------------------------------------
+def _wrap(x: float) -> float:
+    """An angle row's residual at the nearest turn, ``[-pi, pi)``: a relative angle is the same
+    modulo 2 pi (a body may turn any number of times; a direction's angle passes +-pi)."""
+    return x - 2.0 * math.pi * math.floor((x + math.pi) / (2.0 * math.pi))
+
+
 # Markers, motions
 # ----------------------------------------------------------------------------------------
 
@@ -798,7 +804,7 @@ class ReferenceModel:
                 gam[i:i + 2] = -(ava - avb)
                 i += 2
                 if kind == "weld":
-                    Phi[i] = pa - pb - phi0
+                    Phi[i] = _wrap(pa - pb - phi0)
                     A[i] = Jpa - Jpb
                     gam[i] = -(hpa - hpb)
                     i += 1
@@ -814,7 +820,7 @@ class ReferenceModel:
                 gam[i] = -(nl @ (ava - avb) - 2.0 * pdb * (tl @ dd) - pdb * pdb * (nl @ d) - (tl @ d) * hpb)
                 i += 1
                 if kind == "prismatic":
-                    Phi[i] = pa - pb - phi0
+                    Phi[i] = _wrap(pa - pb - phi0)
                     A[i] = Jpa - Jpb
                     gam[i] = -(hpa - hpb)
                     i += 1
@@ -823,7 +829,7 @@ class ReferenceModel:
                 _, ma, mb, mot = drv
                 _, _, pa, Jpa, *_ = ma.kin(q, qd, n)
                 _, _, pb, Jpb, *_ = mb.kin(q, qd, n)
-                Phi[i] = pa - pb - mot(t)
+                Phi[i] = _wrap(pa - pb - mot(t))
                 A[i] = Jpa - Jpb
                 gam[i] = mot(t, 2) - (_phi_velocity_term(ma, q, qd) - _phi_velocity_term(mb, q, qd))
             else:
