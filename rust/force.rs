@@ -56,6 +56,15 @@ impl Force {
         Ok(Force { name, kind })
     }
 
+    /// The markers this force acts through (its generalized force depends on their states only).
+    pub fn markers(&self) -> [Option<&Marker>; 2] {
+        match &self.kind {
+            ForceKind::PointForce { point, .. } => [Some(point), None],
+            ForceKind::Torque { frame, .. } => [Some(frame), None],
+            ForceKind::SpringDamper { a, b, .. } => [Some(a), Some(b)],
+        }
+    }
+
     /// Add this force's generalized force to `qvec` (length n).
     #[inline]
     pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], qvec: &mut [f64]) {

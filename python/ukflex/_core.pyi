@@ -122,9 +122,12 @@ class System:
         min_step: float = 0.0,
         dense: bool = False,
         newton_local_error: Optional[float] = None,
+        linear_solver: str = "auto",
     ) -> Dict[str, Any]:
         """Native integration; dict with t (nt,), y (2n, nt), status, message, failure (None or
-        cause, t, stage, index), statistics, dense (None or meta (nseg, 3), data, part_len)."""
+        cause, t, stage, index), statistics, dense (None or meta (nseg, 3), data, part_len).
+        linear_solver: how GENALPHA and RADAU5M factor their Newton matrices ("auto", "dense",
+        "sparse": band LU after a fill-reducing order, docs/scale.md)."""
     def project(
         self, t: float, q: _F64, qd: _F64, tol: float = 1e-12, max_iter: int = 20
     ) -> Tuple[_F64, _F64, Dict[str, Any]]:

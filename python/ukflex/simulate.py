@@ -29,7 +29,7 @@ METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 #: Integrators that run entirely in Rust with the GIL released (``System.integrate``):
 #: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
 NATIVE_METHODS = ("DOPRI5", "RADAU5", "GENALPHA", "RADAU5M")
-_NATIVE_OPTIONS = ("first_step", "max_step", "projection_tol", "rho_inf", "step", "jacobian", "newton_local_error")
+_NATIVE_OPTIONS = ("first_step", "max_step", "projection_tol", "rho_inf", "step", "jacobian", "newton_local_error", "linear_solver")
 #: ``solve_ivp`` solver options passed through on the scipy paths.
 _SCIPY_OPTIONS = ("first_step", "max_step", "jac", "jac_sparsity", "lband", "uband")
 FORMULATIONS = ("uk", "uk-numpy", "cp")
@@ -253,7 +253,8 @@ def simulate(
         ``step`` (RADAU5M, GENALPHA) that cannot reach ``t_end`` within ``max_steps`` is refused up front.
     **options
         Solver options: ``first_step``, ``max_step``, ``jac``, ... (scipy); ``first_step``,
-        ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``newton_local_error``, ``jacobian`` (native).  An option
+        ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``newton_local_error``, ``jacobian``, ``linear_solver``
+        (native; ``"auto"``, ``"dense"`` or ``"sparse"`` Newton matrices, docs/scale.md).  An option
         the chosen method does not take raises :class:`UnknownOptionError` listing the valid
         ones.  For ``"Radau"`` and ``"BDF"`` the default ``jac`` is the core's finite-difference
         Jacobian ``System.jac``; ``nfev`` counts only the integrator's ``rhs`` calls.
@@ -706,8 +707,9 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
     for key in ("projection_tol", "rho_inf", "newton_local_error"):  # 0 is meaningful (projection off, full dissipation)
         if options.get(key) is not None:
             kwargs[key] = _real(key, options[key])
-    if options.get("jacobian") is not None:
-        kwargs["jacobian"] = str(options["jacobian"])
+    for key in ("jacobian", "linear_solver"):
+        if options.get(key) is not None:
+            kwargs[key] = str(options[key])
     atol_arr = np.atleast_1d(np.asarray(atol, dtype=float))
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
     out = system.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),

@@ -16,7 +16,7 @@ use crate::correct::{self, CorrectOptions};
 use crate::data::{Data, RankTolerance, Stabilization, SvdBackend, UkSolver};
 use crate::dynamics;
 use crate::error::Error;
-use crate::integrate::{integrate_uk, Method, Options};
+use crate::integrate::{integrate_uk, LinearSolver, Method, NewtonMatrices, Options};
 use crate::jacobian::{assemble_first_order, Differences, JacobianWorkspace};
 use crate::model::Model;
 use crate::sensors;
@@ -542,7 +542,7 @@ impl PySystem {
     /// or a dict cause, t, stage, index), nfev, njev, nlu, naccept, nreject, jac_evals (UK calls
     /// inside Jacobians), wall_time [s], dense (None, or a dict meta (nseg, 3), data
     /// (nseg, width), part_len).
-    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=None, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None))]
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=None, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None, linear_solver="auto"))]
     #[allow(clippy::too_many_arguments)]
     fn integrate<'py>(
         &self,
@@ -566,7 +566,9 @@ impl PySystem {
         min_step: f64,
         dense: bool,
         newton_local_error: Option<f64>,
+        linear_solver: &str,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let linear_solver = LinearSolver::parse(linear_solver).map_err(to_py)?;
         let jacobian = match jacobian {
             "central" => Differences::Central,
             "forward" => Differences::Forward,
@@ -614,22 +616,30 @@ impl PySystem {
             max_nfev: max_nfev.unwrap_or(usize::MAX),
             max_wall_time: max_wall_time.unwrap_or(f64::INFINITY),
             min_step,
+            linear_solver,
         };
         opts.validate(2 * n).map_err(to_py)?;
         // a fresh workspace with this System's settings: the run does not hold the lock
         let (tolerance, stabilization, backend, solver, limit) =
             self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.stabilization, ws.data.svd_backend, ws.data.uk_solver, ws.data.memory_limit)))?;
         let model = &self.model;
+        // the run's own workspace (built before releasing the GIL so that a refusal is an error)
+        let data = Data::build(model, solver, limit).map_err(to_py)?;
+        // GENALPHA and RADAU5M: the sparse Newton matrices where they pay (or when asked for),
+        // decided here so that the dense ones are refused before the run when too large
+        let mut opts = opts;
+        if let Method::GenAlpha(_) | Method::RadauM(_) = method {
+            opts.linear_solver = NewtonMatrices::resolve(model, &data, linear_solver, matches!(method, Method::RadauM(_))).map_err(to_py)?;
+        }
         let implicit = match method {
             Method::Dopri5 => 0,
+            _ if opts.linear_solver == LinearSolver::Sparse => 0,
             Method::Radau5 => implicit_bytes(model, "RADAU5"),
             Method::GenAlpha(_) => implicit_bytes(model, "GENALPHA"),
             Method::RadauM(_) => implicit_bytes(model, "RADAU5M"),
         };
-        let hint = "implicit methods factor dense n x n matrices; use method='DOPRI5' for a system this large, or raise memory_limit";
+        let hint = "implicit methods factor dense n x n matrices here; use method='DOPRI5' for a system this large, linear_solver='sparse', or raise memory_limit";
         Error::check_memory("the implicit integrator's n x n matrices", implicit, limit, hint).map_err(to_py)?;
-        // the run's own workspace (built before releasing the GIL so that a refusal is an error)
-        let data = Data::build(model, solver, limit).map_err(to_py)?;
         let result = py.detach(|| {
             catch_unwind(AssertUnwindSafe(|| {
                 let mut data = data;

@@ -124,6 +124,17 @@ impl Body {
         }
     }
 
+    /// Half-bandwidth, in body coordinates, of the body's own blocks of `M`, `K = -dQ/dq` and
+    /// `C = -dQ/dqd` (entries `(i, j)` with `|i - j|` above it are zero): an ANCF cable's are
+    /// element-coupled (`ancf_cable::HB`), every other kind's dense. The structural pattern of
+    /// the implicit methods' sparse Newton matrices (`sparse_newton`).
+    pub fn coupling_halfwidth(&self) -> usize {
+        match &self.kind {
+            BodyKind::AncfBeam(_) => ancf_cable::HB.min(self.n_coords.saturating_sub(1)),
+            _ => self.n_coords.saturating_sub(1),
+        }
+    }
+
     /// Number of elastic coordinates.
     pub fn n_f(&self) -> usize {
         self.elastic_range().len()
@@ -416,6 +427,18 @@ impl Marker {
     /// A marker fixed in the world frame.
     pub fn ground(point: [f64; 2], angle: f64) -> Marker {
         Marker { body: None, angle, shape: MarkerShape::Ground(point) }
+    }
+
+    /// The body and the range of its body coordinates this marker's position, angle and their
+    /// rates depend on (`None`: the ground): an ANCF cable marker its element's eight
+    /// coordinates, a marker on any other kind all of its body's. The structural pattern of the
+    /// constraint rows and forces that use it (`sparse_newton`).
+    pub fn coords(&self, bodies: &[Body]) -> Option<(usize, std::ops::Range<usize>)> {
+        let bi = self.body?;
+        Some(match &self.shape {
+            MarkerShape::Cable(p) => (bi, p.first..p.first + 8),
+            _ => (bi, 0..bodies[bi].n_coords),
+        })
     }
 
     /// Whether the marker frame can rotate with its body (false for the ground and particles,
