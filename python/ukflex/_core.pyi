@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 _F64 = npt.NDArray[np.float64]
+_I64 = npt.NDArray[np.int64]
 
 __all__ = [
     "System",
@@ -25,6 +26,7 @@ __all__ = [
     "SolverError",
     "ExpressionError",
     "MemoryLimitError",
+    "BudgetError",
 ]
 
 class UkflexError(Exception): ...
@@ -36,6 +38,7 @@ class ExpressionError(InvalidSceneError):
     position: int
     expression: str
 class MemoryLimitError(UkflexError): ...
+class BudgetError(SolverError): ...
 
 @final
 class System:
@@ -49,7 +52,12 @@ class System:
     def memory_limit(self) -> int:
         """Bytes any lazily sized group of buffers may take (MemoryLimitError above)."""
     def M(self, q: _F64) -> _F64:
-        """Mass matrix, shape (n, n)."""
+        """Mass matrix, shape (n, n) (MemoryLimitError above memory_limit)."""
+    def M_sparse(self, q: _F64) -> Tuple[_I64, _I64, _F64]:
+        """Mass matrix in coordinate form: (rows, cols, values) of the body blocks."""
+    def linearization(self, t: float, q: _F64, qd: _F64) -> Dict[str, Any]:
+        """Constrained linearization in sparse form: rows, cols, M, K (coordinate pattern),
+        a_rows, a_cols, A, qdd, lambda, colors (ukflex.modes)."""
     def Q(self, t: float, q: _F64, qd: _F64) -> _F64:
         """Generalized forces (applied + quadratic velocity + elastic), shape (n,)."""
     def phi(self, t: float, q: _F64) -> _F64:
@@ -171,8 +179,10 @@ class System:
         position_tol: float = 1e-12,
         velocity_tol: float = 1e-10,
         max_iterations: int = 50,
+        max_wall_time: Optional[float] = None,
     ) -> Dict[str, Any]:
-        """Initial-state correction with held coordinates; a report dict."""
+        """Initial-state correction with held coordinates; a report dict (BudgetError past
+        max_wall_time seconds)."""
 
 @final
 class SceneChecker:

@@ -277,6 +277,7 @@ def simulate(
     NonFiniteError
         NaN or infinity in an input array.
     """
+    call_start = time.perf_counter()  # max_wall_time covers every stage from here
     if formulation not in FORMULATIONS:
         raise InvalidArgumentError("formulation", f"unknown formulation {formulation!r}; expected one of {FORMULATIONS}")
     method = _method_name(method)
@@ -284,7 +285,11 @@ def simulate(
         raise InvalidArgumentError(
             "method", f"native method {method!r} integrates the Rust UK formulation only, not {formulation!r}")
     _check_options(method, formulation, options)
-    system = as_system(scene_or_system)
+    if max_wall_time is not None and not isinstance(scene_or_system, System):
+        # a scene is built here: its initial-state correction spends the same budget
+        system = as_system(scene_or_system, max_wall_time=_positive("max_wall_time", max_wall_time))
+    else:
+        system = as_system(scene_or_system)
     n = system.n_coords
     if t_span is not None:
         if t_end is not None:
@@ -329,7 +334,7 @@ def simulate(
     qd_init = system.qd0 if qd0 is None else _real_array("qd0", qd0, (n,))
     budget = _Budget(_count("max_steps", max_steps), _count("max_nfev", max_nfev),
                      None if max_wall_time is None else _positive("max_wall_time", max_wall_time),
-                     0.0 if min_step == 0 else _positive("min_step", min_step))
+                     0.0 if min_step == 0 else _positive("min_step", min_step), call_start)
     for key in ("max_step", "step"):  # a step size that cannot reach t_end within the step budget
         if options.get(key) is not None:
             h = _positive(key, options[key])
@@ -360,14 +365,27 @@ def simulate(
             "formulation", f"events, dense_output and args need formulation='uk' (the NumPy reference {formulation!r} "
             "runs its own solve_ivp call)")
     if method == "auto":
+        from .modes import BudgetExceeded
+
         start = time.perf_counter()
-        method, options, choice = _resolve_auto(system, formulation, t0, t_end_f, rtol, q_init, qd_init, options)
+        try:
+            method, options, choice = _resolve_auto(system, formulation, t0, t_end_f, rtol, q_init, qd_init, options,
+                                                    budget.deadline)
+        except BudgetExceeded as exc:
+            return _spent_before_start(system, t0, q_init, qd_init, rtol, atol_v, budget, f"method='auto''s {exc.stage}",
+                                       time.perf_counter() - start)
         choice_time = time.perf_counter() - start
+        if budget.remaining() is not None and budget.remaining() <= 0.0:
+            res = _spent_before_start(system, t0, q_init, qd_init, rtol, atol_v, budget,
+                                      "method='auto''s modal analysis", choice_time)
+            if choice is not None:
+                res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
+            return res
         run_rtol = choice.rtol if choice is not None and choice.rtol is not None else rtol
         res = simulate(system, None, method, run_rtol, atol, t_eval_v, formulation, t_span=(t0, t_end_f), q0=q_init,
                        qd0=qd_init, partition=partition, progress=progress, events=ev_list or None,
                        dense_output=dense_output, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
-                       max_wall_time=budget.max_wall_time, min_step=budget.min_step, **options)
+                       max_wall_time=budget.remaining(), min_step=budget.min_step, **options)
         if choice is not None:
             res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
         return res
@@ -433,8 +451,27 @@ FORECAST_FACTOR = 100
 
 
 class _Budget:
-    def __init__(self, max_steps: int, max_nfev: int, max_wall_time: Optional[float], min_step: float):
+    def __init__(self, max_steps: int, max_nfev: int, max_wall_time: Optional[float], min_step: float,
+                 start: Optional[float] = None):
         self.max_steps, self.max_nfev, self.max_wall_time, self.min_step = max_steps, max_nfev, max_wall_time, min_step
+        #: ``time.perf_counter()`` when the wall-time budget runs out (counted from the call)
+        start = time.perf_counter() if start is None else start
+        self.deadline = None if max_wall_time is None else start + max_wall_time
+
+    def remaining(self) -> Optional[float]:
+        """Seconds of wall time left (None: no budget)."""
+        return None if self.deadline is None else self.deadline - time.perf_counter()
+
+
+def _spent_before_start(system, t0, q, qd, rtol, atol, budget, stage: str, wall: float) -> SimulationResult:
+    """The result of a run whose wall-time budget ran out before its first step (status -1,
+    the initial state only), naming the stage that spent it."""
+    y = np.concatenate([q, qd])[:, None]
+    message = (f"work budget max_wall_time = {budget.max_wall_time} s exhausted before the first step, in {stage}; "
+               f"the result holds the initial state only")
+    stop = {"cause": "max_wall_time", "t": float(t0), "stage": stage, "message": message}
+    return _result(system, np.array([float(t0)]), y, "auto", rtol, atol, nfev=0, njev=0, nlu=0, wall=wall, status=-1,
+                   message=message, stop=stop, t_events=None, y_events=None, sol=None, extra={})
 
 
 class _Stop(Exception):
@@ -531,7 +568,7 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
                     raise _Stop("max_steps", detail=f"at this pace ({steps} steps for {done:.3g} s) reaching t_end needs "
                                                     f"about {needed:.3g} steps, more than {FORECAST_FACTOR} x max_steps = "
                                                     f"{budget.max_steps}; shorten t_end or raise max_steps")
-            if budget.max_wall_time is not None and time.perf_counter() - start > budget.max_wall_time:
+            if budget.deadline is not None and time.perf_counter() > budget.deadline:
                 raise _Stop("max_wall_time")
             try:
                 message = solver.step()
@@ -714,7 +751,8 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
     out = system.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),
                            atol_arr, te, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
-                           max_wall_time=budget.max_wall_time, min_step=budget.min_step,
+                           max_wall_time=None if budget.deadline is None else max(budget.remaining(), 1e-9),
+                           min_step=budget.min_step,
                            dense=bool(dense or events), **kwargs)
     t, y, status, message = np.asarray(out["t"]), np.asarray(out["y"]), int(out["status"]), str(out["message"])
     stop = None
@@ -763,7 +801,7 @@ def _simulate_reference(system, formulation, t_end, method, rtol, atol, t_eval, 
         wall_time=out.wall_time, status=out.status, message=out.message, extra=extra)
 
 
-def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
+def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options, deadline=None):
     """``method="auto"``: the chooser of :mod:`ukflex.choice` for the Rust UK formulation; the
     NumPy references keep scipy's Radau.  Options that only scipy takes (``jac``, ``events``,
     ...) map the choice to its scipy counterpart (RADAU5M -> Radau, DOPRI5 -> DOP853); options
@@ -772,7 +810,7 @@ def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
 
     if formulation != "uk":
         return "Radau", options, None
-    choice = choose_method(system, t0, t_end, rtol, q, qd)
+    choice = choose_method(system, t0, t_end, rtol, q, qd, deadline=deadline)
     scipy_only = sorted(set(options) - set(_NATIVE_OPTIONS))
     if scipy_only:
         choice.method = "Radau" if choice.method == "RADAU5M" else "DOP853"

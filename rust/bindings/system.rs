@@ -95,6 +95,12 @@ impl PySystem {
     fn body_names(&self) -> Vec<String> {
         self.model.bodies.iter().map(|b| b.name.clone()).collect()
     }
+
+    /// Refuse a dense `count` arrays of `k x k` above the memory limit (before allocating).
+    fn check_square(&self, what: &str, k: usize, count: u64, hint: &str) -> PyResult<()> {
+        let limit = self.with_ws(|_, ws| Ok(ws.data.memory_limit))?;
+        Error::check_memory(what, 8 * count * (k as u64) * (k as u64), limit, hint).map_err(to_py)
+    }
 }
 
 #[pymethods]
@@ -191,6 +197,7 @@ impl PySystem {
     #[allow(non_snake_case)]
     fn M<'py>(&self, py: Python<'py>, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.model.n;
+        self.check_square("System.M (dense n x n)", n, 1, "M is n x n dense; use System.M_sparse (scipy.sparse), or raise memory_limit")?;
         let m = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
             dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
@@ -199,6 +206,73 @@ impl PySystem {
             Ok(m)
         })?;
         mat(py, m, n, n)
+    }
+
+    /// The mass matrix M(q) in coordinate form: (rows, cols, values), the entries of the body
+    /// blocks (O(nnz), no n x n allocation; `scipy.sparse.coo_array((v, (r, c)), (n, n))`).
+    #[allow(non_snake_case)]
+    #[allow(clippy::type_complexity)]
+    fn M_sparse<'py>(&self, py: Python<'py>, q: Vector<'py>) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>)> {
+        let (r, c, v) = self.with_ws(|model, ws| {
+            Self::load(ws, &q, None)?;
+            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            let (mut r, mut c, mut v) = (Vec::new(), Vec::new(), Vec::new());
+            for (body, bd) in model.bodies.iter().zip(&ws.data.bodies) {
+                let o = body.offset as i64;
+                body.dense_block(bd, &mut |i, j, x| {
+                    if x != 0.0 {
+                        r.push(o + i as i64);
+                        c.push(o + j as i64);
+                        v.push(x);
+                    }
+                });
+            }
+            finite_out("M(q)", &v)?;
+            Ok((r, c, v))
+        })?;
+        Ok((PyArray1::from_vec(py, r), PyArray1::from_vec(py, c), PyArray1::from_vec(py, v)))
+    }
+
+    /// The constrained linearization at (t, q, qd) in sparse form, for the modal analysis
+    /// (`System.frequencies`): a dict with rows, cols (the coordinate pattern: bodies, forces,
+    /// the coordinates of each constraint row), M and K there (K = -d/dq (Q - M qdd -
+    /// A^T lambda) at the UK acceleration and multipliers of the state, central differences
+    /// coloured by the pattern: O(n)), a_rows, a_cols, A (the structural entries of A), qdd,
+    /// lambda, and colors (difference pairs used). On the constraints' tangent space K is the
+    /// stiffness of the dense modal analysis, `-N^T M dqdd/dq N`.
+    fn linearization<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyDict>> {
+        use crate::sparse_newton::{fill_a, fill_linearized_stiffness, fill_mass, Pattern, Structure};
+        let out = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            let n = model.n;
+            let p = Pattern::new(model, &ws.data.ajac, true, ws.data.memory_limit)?;
+            uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+            let (qdd, lambda) = (ws.data.qdd.clone(), ws.data.lambda.clone());
+            let mut s = Structure::new(p);
+            fill_mass(model, &ws.data, &mut s);
+            fill_a(&ws.data, &mut s);
+            let (mut qv, mut f, mut k) = (vec![0.0; n], vec![0.0; n], vec![0.0; s.pattern.nnz()]);
+            fill_linearized_stiffness(model, &mut ws.data, t, &ws.q, &ws.qd, &qdd, &lambda, &s.pattern, &mut qv, &mut f, &mut k);
+            finite_out("the linearized stiffness", &k)?;
+            Ok((s, k, qdd, lambda))
+        })?;
+        let (s, k, qdd, lambda) = out;
+        let p = &s.pattern;
+        let (rows, cols): (Vec<i64>, Vec<i64>) = p.entries().map(|(i, j)| (i as i64, j as i64)).unzip();
+        let (ar, ac): (Vec<i64>, Vec<i64>) = p.a_entries().map(|(r, j)| (r as i64, j as i64)).unzip();
+        let d = PyDict::new(py);
+        d.set_item("rows", PyArray1::from_vec(py, rows))?;
+        d.set_item("cols", PyArray1::from_vec(py, cols))?;
+        d.set_item("colors", p.colors())?;
+        d.set_item("a_rows", PyArray1::from_vec(py, ar))?;
+        d.set_item("a_cols", PyArray1::from_vec(py, ac))?;
+        d.set_item("M", PyArray1::from_vec(py, s.m))?;
+        d.set_item("K", PyArray1::from_vec(py, k))?;
+        d.set_item("A", PyArray1::from_vec(py, s.a))?;
+        d.set_item("qdd", PyArray1::from_vec(py, qdd))?;
+        d.set_item("lambda", PyArray1::from_vec(py, lambda))?;
+        Ok(d)
     }
 
     /// Generalized forces Q(t, q, qd) = applied + quadratic velocity + elastic, shape (n,).
@@ -794,6 +868,7 @@ impl PySystem {
             BodyKind::Beam(beam) => beam,
             BodyKind::AncfBeam(cable) => {
                 let nb = b.n_coords;
+                self.check_square("System.beam_matrices (two dense n_b x n_b)", nb, 2, "raise memory_limit")?;
                 let mut m = vec![0.0; nb * nb];
                 cable.dense_block(&Default::default(), &mut |i, j, v| m[i * nb + j] = v);
                 let mut k = Banded::zeros(nb, ancf_cable::HB);
@@ -803,6 +878,7 @@ impl PySystem {
             _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam"))),
         };
         let nf = beam.n_f;
+        self.check_square("System.beam_matrices (two dense n_f x n_f)", nf, 2, "raise memory_limit")?;
         Ok((mat(py, beam.m_ff.to_dense(), nf, nf)?, mat(py, beam.k_ff.to_dense(), nf, nf)?))
     }
 
@@ -832,6 +908,9 @@ impl PySystem {
         let nb = b.n_coords;
         let mut qv = vec![0.0; self.model.n];
         read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
+        if matches!(b.kind, BodyKind::AncfBeam(_) | BodyKind::Beam(_) | BodyKind::Flexible(_)) {
+            self.check_square("System.tangent_stiffness (dense n_b x n_b)", nb, 1, "raise memory_limit")?;
+        }
         let k = match &b.kind {
             BodyKind::AncfBeam(cable) => {
                 let mut k = Banded::zeros(nb, ancf_cable::HB);
@@ -1081,9 +1160,13 @@ impl PySystem {
     /// projection (the initial-state correction). Returns a dict: q, qd, iterations,
     /// position_residual_before/after, velocity_residual_before/after (NaN when the positions
     /// failed), phi (m,), velocity (m,), positions_ok, velocities_ok.
-    #[pyo3(signature = (t, q, qd, hold, position_tol=1e-12, velocity_tol=1e-10, max_iterations=50))]
+    #[pyo3(signature = (t, q, qd, hold, position_tol=1e-12, velocity_tol=1e-10, max_iterations=50, max_wall_time=None))]
     #[allow(clippy::too_many_arguments)]
-    fn correct<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize) -> PyResult<Bound<'py, PyDict>> {
+    fn correct<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize, max_wall_time: Option<f64>) -> PyResult<Bound<'py, PyDict>> {
+        let max_wall_time = max_wall_time.unwrap_or(f64::INFINITY);
+        if !(max_wall_time > 0.0) {
+            return Err(PyValueError::new_err(format!("max_wall_time must be positive, got {max_wall_time}")));
+        }
         for (what, v) in [("position_tol", position_tol), ("velocity_tol", velocity_tol)] {
             if !(v > 0.0) || !v.is_finite() {
                 return Err(PyValueError::new_err(format!("{what} must be positive and finite, got {v}")));
@@ -1094,7 +1177,7 @@ impl PySystem {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
             let (qv, qdv) = (ws.q.clone(), ws.qd.clone());
-            correct::correct(model, &mut ws.data, t, &qv, &qdv, &opts)
+            correct::correct_within(model, &mut ws.data, t, &qv, &qdv, &opts, max_wall_time)
         })?;
         let d = PyDict::new(py);
         d.set_item("q", PyArray1::from_vec(py, c.q))?;

@@ -53,7 +53,7 @@ impl LinearSolver {
 
 /// Below this size `n + m` of the Newton matrix `Auto` stays dense: measured on the ANCF wire
 /// pendulum and the paper's scenes (docs/scale.md, "The implicit methods").
-pub const SPARSE_NEWTON_MIN: usize = 96;
+pub const SPARSE_NEWTON_MIN: usize = 64;
 
 /// `Auto`: sparse when the matrix is large enough and its band after RCM is narrow (the band
 /// LU's work well below the dense `(n+m)^3 / 3`).
