@@ -271,8 +271,15 @@ impl Structure {
 
     /// `out = X x` for a coordinate-block value array `vals` (`M`, `K` or `C`).
     pub fn mul(&self, vals: &[f64], x: &[f64], out: &mut [f64]) {
+        self.mul_add(vals, x, out, false);
+    }
+
+    /// `out (+)= X x` (`add`: accumulate into `out`).
+    pub fn mul_add(&self, vals: &[f64], x: &[f64], out: &mut [f64], add: bool) {
         let p = &self.pattern;
-        out[..p.n].fill(0.0);
+        if !add {
+            out[..p.n].fill(0.0);
+        }
         for j in 0..p.n {
             let xj = x[j];
             if xj != 0.0 {
@@ -513,6 +520,12 @@ pub struct BandNewton {
     cplx: Option<BandLu<C64>>,
     xr: Vec<f64>,
     xc: Vec<C64>,
+    /// Right-hand sides of the first-order solves (`solve_first_order_*`): real and imaginary
+    /// parts, n + m each, and two n-long scratch vectors.
+    fr: Vec<f64>,
+    fi: Vec<f64>,
+    vr: Vec<f64>,
+    vi: Vec<f64>,
 }
 
 impl BandNewton {
@@ -531,7 +544,8 @@ impl BandNewton {
         let at = s.pattern.a_entries().map(|(r, j)| real.index(perm[j], perm[n + r])).collect();
         let diag = (0..s.pattern.m).map(|r| real.index(perm[n + r], perm[n + r])).collect();
         let cplx = complex.then(|| BandLu::<C64>::new(size, hb, hb));
-        BandNewton { s, layout, cc, ar, at, diag, real, cplx, xr: vec![0.0; size], xc: vec![C64::default(); if complex { size } else { 0 }] }
+        let z = |k: usize| vec![0.0; k];
+        BandNewton { s, layout, cc, ar, at, diag, real, cplx, xr: z(size), xc: vec![C64::default(); if complex { size } else { 0 }], fr: z(size), fi: z(size), vr: z(n), vi: z(n) }
     }
 
     /// Assemble `[M + gc C + gk K, A^T; A - gc db/dqd, reg I]` and factor it. `false`: singular.
@@ -581,6 +595,94 @@ impl BandNewton {
         for (i, &p) in perm.iter().enumerate() {
             x[i] = self.xr[p];
         }
+    }
+
+    /// `out (+)= X x` for an `A`-pattern value array (`A` or `db/dqd`), `sign` times.
+    fn mul_a_into(&self, vals: &[f64], sign: f64, x: &[f64], out: &mut [f64], add: bool) {
+        let p = &self.s.pattern;
+        if !add {
+            out[..p.m].fill(0.0);
+        }
+        for j in 0..p.n {
+            let xj = sign * x[j];
+            if xj != 0.0 {
+                for e in p.acol_ptr[j]..p.acol_ptr[j + 1] {
+                    out[p.arow[e]] += vals[e] * xj;
+                }
+            }
+        }
+    }
+
+    /// RADAU5's real solve with the structured Jacobian `J = [[0, I], [Jq, Jv]]`
+    /// (`M Jq + A^T . = -K`, `A Jq = 0`; `M Jv + A^T . = -C`, `A Jv = db/dqd`):
+    /// `(g I - J) [x1; x2] = [r1; r2]` (`x`: 2n, in place) through the saddle point
+    /// `[M + C/g + K/g^2, A^T; A - Bv/g, 0] [x1; mu] = [M (r2 + g r1) + C r1; A (r2 + g r1) - Bv r1] / g^2`,
+    /// `x2 = g x1 - r1` (no product with the dense `Jq`, `Jv`). Needs `factor_real(1/g^2, 1/g, .)`.
+    pub fn solve_first_order_real(&mut self, g: f64, x: &mut [f64]) {
+        let (n, m) = (self.s.pattern.n, self.s.pattern.m);
+        let (r1, r2) = x.split_at_mut(n);
+        let mut fr = std::mem::take(&mut self.fr);
+        let mut vr = std::mem::take(&mut self.vr);
+        for i in 0..n {
+            vr[i] = r2[i] + g * r1[i];
+        }
+        self.s.mul_add(&self.s.m, &vr, &mut fr[..n], false);
+        self.s.mul_add(&self.s.c, r1, &mut fr[..n], true);
+        self.mul_a_into(&self.s.a, 1.0, &vr, &mut fr[n..n + m], false);
+        self.mul_a_into(&self.s.bv, -1.0, r1, &mut fr[n..n + m], true);
+        let s = 1.0 / (g * g);
+        for v in fr.iter_mut() {
+            *v *= s;
+        }
+        self.solve_real(&mut fr);
+        for i in 0..n {
+            let x1 = fr[i];
+            r2[i] = g * x1 - r1[i];
+            r1[i] = x1;
+        }
+        self.fr = fr;
+        self.vr = vr;
+    }
+
+    /// The same with a complex `g` (RADAU5's complex eigenvalue; `xr`, `xi`: 2n each); needs
+    /// `factor_complex(1/g^2, 1/g, .)`.
+    pub fn solve_first_order_complex(&mut self, g: C64, xr: &mut [f64], xi: &mut [f64]) {
+        let (n, m) = (self.s.pattern.n, self.s.pattern.m);
+        let (r1r, r2r) = xr.split_at_mut(n);
+        let (r1i, r2i) = xi.split_at_mut(n);
+        let (mut fr, mut fi) = (std::mem::take(&mut self.fr), std::mem::take(&mut self.fi));
+        let (mut vr, mut vi) = (std::mem::take(&mut self.vr), std::mem::take(&mut self.vi));
+        for i in 0..n {
+            vr[i] = r2r[i] + g.re * r1r[i] - g.im * r1i[i];
+            vi[i] = r2i[i] + g.re * r1i[i] + g.im * r1r[i];
+        }
+        for (f, v, r1) in [(&mut fr, &vr, &*r1r), (&mut fi, &vi, &*r1i)] {
+            self.s.mul_add(&self.s.m, v, &mut f[..n], false);
+            self.s.mul_add(&self.s.c, r1, &mut f[..n], true);
+            self.mul_a_into(&self.s.a, 1.0, v, &mut f[n..n + m], false);
+            self.mul_a_into(&self.s.bv, -1.0, r1, &mut f[n..n + m], true);
+        }
+        // times 1 / g^2
+        let g2 = g * g;
+        let d = g2.re * g2.re + g2.im * g2.im;
+        let (sr, si) = (g2.re / d, -g2.im / d);
+        for k in 0..n + m {
+            let (a, b) = (fr[k], fi[k]);
+            fr[k] = a * sr - b * si;
+            fi[k] = a * si + b * sr;
+        }
+        self.solve_complex(&mut fr, &mut fi);
+        for i in 0..n {
+            let (x1r, x1i) = (fr[i], fi[i]);
+            r2r[i] = g.re * x1r - g.im * x1i - r1r[i];
+            r2i[i] = g.re * x1i + g.im * x1r - r1i[i];
+            r1r[i] = x1r;
+            r1i[i] = x1i;
+        }
+        self.fr = fr;
+        self.fi = fi;
+        self.vr = vr;
+        self.vi = vi;
     }
 
     /// `(xr + i xi) <- H^-1 (xr + i xi)` with the complex factors.

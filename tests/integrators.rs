@@ -178,6 +178,12 @@ fn native_steps_do_not_allocate() {
             assert!(st.nlu >= 2 && st.njev >= 1, "{st:?}");
             assert_eq!(n, 0, "sparse RADAU5M (step {step:?}) allocated {n} times in 100 steps (stats {st:?})");
         }
+        // RADAU5 with the structured Jacobian solves its iteration matrices as sparse saddle points
+        let mut rd = Radau5::new(model.n, opts.clone()).unwrap();
+        let n = steps_allocate_with(&mut rd, &model, 100, |sys| sys.jws.scheme = Differences::Structured);
+        let st = rd.stats();
+        assert!(st.njev >= 1 && st.nlu >= 2, "{st:?}");
+        assert_eq!(n, 0, "sparse RADAU5 allocated {n} times in 100 steps (stats {st:?})");
     }
 }
 

@@ -6,7 +6,7 @@
 
 mod common;
 use common::*;
-use ukflex::integrate::{integrate, GenAlpha, GenAlphaOptions, LinearSolver, Method, NewtonMatrices, Options, RadauM, RadauMOptions, SecondOrderSystem, UkSystem};
+use ukflex::integrate::{integrate, GenAlpha, Radau5, GenAlphaOptions, LinearSolver, Method, NewtonMatrices, Options, RadauM, RadauMOptions, SecondOrderSystem, UkSystem};
 use ukflex::sparse_newton::{BandLayout, Pattern};
 use ukflex::{Data, Model};
 
@@ -113,6 +113,12 @@ fn run(model: &Model, method: &str, step: Option<f64>, t_end: f64, ls: LinearSol
         }
     }
     let sol = match method {
+        "RADAU5" => {
+            // the structured Jacobian: its iteration matrices are saddle points
+            sys.jws.scheme = ukflex::jacobian::Differences::Structured;
+            let mut st = Radau5::new(model.n, opts).unwrap();
+            integrate(&mut st, &mut sys, 0.0, &y0, t_end, None).unwrap()
+        }
         "GENALPHA" => {
             let go = GenAlphaOptions { step, projection: Method::GenAlpha(GenAlphaOptions::default()).default_projection(), ..Default::default() };
             let mut st = GenAlpha::new(model.n, model.m, opts, go).unwrap();
@@ -137,14 +143,19 @@ fn sparse_and_dense_newton_runs_give_the_same_answer_to_rounding() {
         ("wire 6", wire_scene(6), 2e-3),
     ] {
         let model = Model::from_json(&json).unwrap();
-        for (method, step) in [("GENALPHA", Some(1e-4)), ("GENALPHA", None), ("RADAU5M", Some(2e-4)), ("RADAU5M", None)] {
+        for (method, step) in [("GENALPHA", Some(1e-4)), ("GENALPHA", None), ("RADAU5M", Some(2e-4)), ("RADAU5M", None), ("RADAU5", None)] {
             let (yd, sd) = run(&model, method, step, t_end, LinearSolver::Dense, false);
             let (ys, ss) = run(&model, method, step, t_end, LinearSolver::Sparse, false);
             let (yu, _) = run(&model, method, step, t_end, LinearSolver::Dense, true);
             let d = rel_diff(&ys, &yd);
             let du = rel_diff(&yu, &yd);
             println!("{name:20} {method:8} step {step:?}: steps {} / {}, Newton {} / {}, relative difference {d:.1e} (dense, 1 ulp: {du:.1e})", sd.naccept, ss.naccept, sd.newton, ss.newton);
-            assert_eq!((sd.naccept, sd.nreject), (ss.naccept, ss.nreject), "{name} {method} {step:?}: the same steps");
+            if method != "RADAU5" {
+                // the same matrices, factored differently: the same step sequence (RADAU5's
+                // saddle-point form is another route to its iteration matrices' solutions, whose
+                // rounding may move an error estimate across 1: a few steps differ)
+                assert_eq!((sd.naccept, sd.nreject), (ss.naccept, ss.nreject), "{name} {method} {step:?}: the same steps");
+            }
             // rounding: within what one ulp of the initial state changes (stiff runs amplify it)
             assert!(d <= (5.0 * du).max(1e-11), "{name} {method} {step:?}: sparse and dense differ by {d:e} (1 ulp: {du:e})");
         }

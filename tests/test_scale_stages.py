@@ -164,3 +164,15 @@ def test_a_budget_spent_in_autos_analysis_gives_status_minus_one_naming_it():
 def test_a_scene_given_to_simulate_is_built_within_the_budget():
     with pytest.raises(ukflex.BudgetError, match="initial-state correction"):
         ukflex.simulate(_inconsistent_cable_crank(64), 1e-3, max_wall_time=1e-9)
+
+
+@pytest.mark.parametrize("make", [lambda: scenes.cantilever(elements=40, tip_force=(0.0, -2.0), strain="linear"),
+                                  lambda: scenes.chain(links=30, angle=-0.5),
+                                  lambda: scenes.pinned_beam(elements=40, gravity=True)])
+def test_sparse_equilibrium_is_the_dense_one(make):
+    sp, de = make().build(), _dense_reference(make().build())
+    assert sp.n_coords >= sp.SPARSE_MODES_MIN
+    a, b = sp.equilibrium(), de.equilibrium()
+    assert np.max(np.abs(a.q - b.q)) <= 1e-8 * max(1.0, np.max(np.abs(b.q)))
+    assert np.allclose(a.multipliers, b.multipliers, rtol=1e-6, atol=1e-8 * np.max(np.abs(b.multipliers)))
+    assert a.position_residual <= 1e-10 and a.force_residual <= 1e-8 * max(1.0, np.max(np.abs(b.multipliers)))

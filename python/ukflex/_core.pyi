@@ -55,9 +55,11 @@ class System:
         """Mass matrix, shape (n, n) (MemoryLimitError above memory_limit)."""
     def M_sparse(self, q: _F64) -> Tuple[_I64, _I64, _F64]:
         """Mass matrix in coordinate form: (rows, cols, values) of the body blocks."""
-    def linearization(self, t: float, q: _F64, qd: _F64) -> Dict[str, Any]:
+    def linearization(
+        self, t: float, q: _F64, qd: _F64, qdd: Optional[_F64] = None, lam: Optional[_F64] = None, stiffness: bool = True
+    ) -> Dict[str, Any]:
         """Constrained linearization in sparse form: rows, cols, M, K (coordinate pattern),
-        a_rows, a_cols, A, qdd, lambda, colors (ukflex.modes)."""
+        a_rows, a_cols, A, qdd, lambda, colors (ukflex.modes); qdd, lam held if given."""
     def Q(self, t: float, q: _F64, qd: _F64) -> _F64:
         """Generalized forces (applied + quadratic velocity + elastic), shape (n,)."""
     def phi(self, t: float, q: _F64) -> _F64:

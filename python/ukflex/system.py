@@ -644,24 +644,30 @@ class System:
         if not (tol > 0 and math.isfinite(tol)) or int(max_iterations) < 1:
             raise ValueError(f"tol must be positive and max_iterations >= 1, got {tol!r}, {max_iterations!r}")
         zero = np.zeros(n)
-        lam = np.zeros(m)
+        if n >= self.SPARSE_MODES_MIN:
+            residual, step_of, lam = self._equilibrium_sparse_parts(t, q)
+        else:
+            lam = np.zeros(m)
 
-        def residual(q, lam):
-            A = np.asarray(self.A(q)).reshape(m, n)
-            return np.concatenate([np.asarray(self.Q(t, q, zero)) - A.T @ lam, np.asarray(self.phi(t, q))])
+            def residual(q, lam):
+                A = np.asarray(self.A(q)).reshape(m, n)
+                return np.concatenate([np.asarray(self.Q(t, q, zero)) - A.T @ lam, np.asarray(self.phi(t, q))])
+
+            def step_of(q, lam, r):
+                J = np.zeros((n + m, n + m))
+                for j in range(n):
+                    h = 1e-6 * max(1.0, abs(q[j]))
+                    qp, qm = q.copy(), q.copy()
+                    qp[j] += h
+                    qm[j] -= h
+                    J[:, j] = (residual(qp, lam) - residual(qm, lam)) / (2.0 * h)
+                A = np.asarray(self.A(q)).reshape(m, n)
+                J[:n, n:] = -A.T
+                return np.linalg.lstsq(J, -r, rcond=None)[0]
 
         r = residual(q, lam)
         for it in range(1, int(max_iterations) + 1):
-            J = np.zeros((n + m, n + m))
-            for j in range(n):
-                h = 1e-6 * max(1.0, abs(q[j]))
-                qp, qm = q.copy(), q.copy()
-                qp[j] += h
-                qm[j] -= h
-                J[:, j] = (residual(qp, lam) - residual(qm, lam)) / (2.0 * h)
-            A = np.asarray(self.A(q)).reshape(m, n)
-            J[:n, n:] = -A.T
-            step = np.linalg.lstsq(J, -r, rcond=None)[0]
+            step = step_of(q, lam, r)
             alpha, norm0 = 1.0, np.linalg.norm(r)
             while True:  # backtracking on |R|
                 q_new, lam_new = q + alpha * step[:n], lam + alpha * step[n:]
@@ -683,6 +689,46 @@ class System:
             f"max |Q - A^T lambda| = {np.max(np.abs(r[:n]), initial=0.0):.3e}, max |Phi| = "
             f"{np.max(np.abs(r[n:]), initial=0.0):.3e} (a scene without a static equilibrium, e.g. a free body "
             "under gravity, or a start too far from it)")
+
+    def _equilibrium_sparse_parts(self, t: float, q: np.ndarray):
+        """``equilibrium`` above :attr:`SPARSE_MODES_MIN` coordinates: ``(residual, step,
+        lam0)`` for the same Newton iteration and line search, with the sparse tangent
+        ``[-K, -A^T; A, 0]`` (``K = -d/dq (Q - A^T lambda)`` at the iterate's multipliers: the
+        core's coloured differences, O(n)) and a sparse LU.  The multipliers start from the UK
+        solution at rest (the constraint forces that hold the start; from zero, a mechanism
+        whose links carry their weight only through its joints has a singular first tangent,
+        which the dense path passes with a least-squares step); a tangent still exactly singular
+        is shifted by 1e-10 of its scale on the stiffness block and 1e-12 on the multiplier
+        block."""
+        from scipy.sparse import bmat, coo_array, identity
+        from scipy.sparse.linalg import splu
+
+        n, m = self.n_coords, self.n_constraints
+        zero = np.zeros(n)
+
+        def parts(q, lam, stiffness):
+            lin = self.core.linearization(t, q, zero, zero, lam, stiffness)
+            A = coo_array((np.asarray(lin["A"]), (np.asarray(lin["a_rows"]), np.asarray(lin["a_cols"]))), shape=(m, n)).tocsr()
+            K = coo_array((np.asarray(lin["K"]), (np.asarray(lin["rows"]), np.asarray(lin["cols"]))), shape=(n, n)).tocsc()
+            return A, K
+
+        def residual(q, lam):
+            A, _ = parts(q, lam, False)
+            return np.concatenate([np.asarray(self.Q(t, q, zero)) - A.T @ lam, np.asarray(self.phi(t, q))])
+
+        def step_of(q, lam, r):
+            A, K = parts(q, lam, True)
+            J = bmat([[-K, -A.T], [A, None]], format="csc") if m else (-K).tocsc()
+            try:
+                return splu(J).solve(-r)
+            except RuntimeError:  # exactly singular: a neutral direction or redundant rows
+                scale = max(float(abs(K).max()) if K.nnz else 0.0, float(abs(A).max()) if A.nnz else 0.0, 1e-300)
+                shift = -K - 1e-10 * scale * identity(n)
+                Js = bmat([[shift, -A.T], [A, -1e-12 * scale * identity(m)]], format="csc") if m else shift.tocsc()
+                return splu(Js).solve(-r)
+
+        lam = np.asarray(self.multipliers(t, q, zero), dtype=float) if m else np.zeros(0)
+        return residual, step_of, lam
 
     # ------------------------------------------------------------------------------ correction
     @staticmethod

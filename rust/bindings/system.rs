@@ -239,22 +239,43 @@ impl PySystem {
     /// A^T lambda) at the UK acceleration and multipliers of the state, central differences
     /// coloured by the pattern: O(n)), a_rows, a_cols, A (the structural entries of A), qdd,
     /// lambda, and colors (difference pairs used). On the constraints' tangent space K is the
-    /// stiffness of the dense modal analysis, `-N^T M dqdd/dq N`.
-    fn linearization<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyDict>> {
+    /// stiffness of the dense modal analysis, `-N^T M dqdd/dq N`. With `qdd` and `lam` given,
+    /// those are held instead of the UK solution's (`System.equilibrium`: zero and the Newton
+    /// iterate); `stiffness=False` skips K (then all zero): M and A alone, one evaluation.
+    #[pyo3(signature = (t, q, qd, qdd=None, lam=None, stiffness=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn linearization<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, qdd: Option<Vector<'py>>, lam: Option<Vector<'py>>, stiffness: bool) -> PyResult<Bound<'py, PyDict>> {
         use crate::sparse_newton::{fill_a, fill_linearized_stiffness, fill_mass, Pattern, Structure};
+        let (n, m) = (self.model.n, self.model.m);
+        let mut held = (vec![0.0; n], vec![0.0; m]);
+        match (&qdd, &lam) {
+            (Some(a), Some(l)) => {
+                read_into("qdd", &a.as_array(), &mut held.0).map_err(to_py)?;
+                read_into("lam", &l.as_array(), &mut held.1).map_err(to_py)?;
+            }
+            (None, None) => {}
+            _ => return Err(PyValueError::new_err("linearization: give both qdd and lam, or neither (the UK solution at the state)")),
+        }
+        let given = qdd.is_some();
         let out = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
-            let n = model.n;
             let p = Pattern::new(model, &ws.data.ajac, true, ws.data.memory_limit)?;
-            uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
-            let (qdd, lambda) = (ws.data.qdd.clone(), ws.data.lambda.clone());
+            let (qdd, lambda) = if given {
+                crate::uk::evaluate(model, &mut ws.data, t, &ws.q, &ws.qd, false)?;
+                held
+            } else {
+                uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+                (ws.data.qdd.clone(), ws.data.lambda.clone())
+            };
             let mut s = Structure::new(p);
             fill_mass(model, &ws.data, &mut s);
             fill_a(&ws.data, &mut s);
             let (mut qv, mut f, mut k) = (vec![0.0; n], vec![0.0; n], vec![0.0; s.pattern.nnz()]);
-            fill_linearized_stiffness(model, &mut ws.data, t, &ws.q, &ws.qd, &qdd, &lambda, &s.pattern, &mut qv, &mut f, &mut k);
-            finite_out("the linearized stiffness", &k)?;
+            if stiffness {
+                fill_linearized_stiffness(model, &mut ws.data, t, &ws.q, &ws.qd, &qdd, &lambda, &s.pattern, &mut qv, &mut f, &mut k);
+                finite_out("the linearized stiffness", &k)?;
+            }
             Ok((s, k, qdd, lambda))
         })?;
         let (s, k, qdd, lambda) = out;
@@ -704,6 +725,16 @@ impl PySystem {
         let mut opts = opts;
         if let Method::GenAlpha(_) | Method::RadauM(_) = method {
             opts.linear_solver = NewtonMatrices::resolve(model, &data, linear_solver, matches!(method, Method::RadauM(_))).map_err(to_py)?;
+        }
+        if method == Method::Radau5 {
+            // with the structured Jacobian RADAU5 solves its iteration matrices as saddle points
+            opts.linear_solver = match jacobian {
+                Differences::Structured => NewtonMatrices::resolve(model, &data, linear_solver, true).map_err(to_py)?,
+                _ if linear_solver == LinearSolver::Sparse => {
+                    return Err(PyValueError::new_err("linear_solver='sparse' with RADAU5 needs jacobian='structured' (a difference Jacobian is dense)"));
+                }
+                _ => LinearSolver::Dense,
+            };
         }
         let implicit = match method {
             Method::Dopri5 => 0,

@@ -108,6 +108,11 @@ pub trait SecondOrderSystem {
     fn check_memory(&self, _what: &str, _bytes: u64) -> Result<()> {
         Ok(())
     }
+    /// Whether `jac` is the structured linearization (saddle-point solves with `structure`):
+    /// RADAU5 may then solve its iteration matrices as saddle points, sparse.
+    fn structured_jacobian(&self) -> bool {
+        false
+    }
 }
 
 /// A non-finite state or acceleration ends a run: `Error::NonFinite` with `what` naming the
@@ -228,6 +233,9 @@ impl SecondOrderSystem for UkSystem<'_> {
     }
     fn check_memory(&self, what: &str, bytes: u64) -> Result<()> {
         Error::check_memory(what, bytes, self.data.memory_limit, "raise memory_limit")
+    }
+    fn structured_jacobian(&self) -> bool {
+        self.jws.scheme == Differences::Structured
     }
     fn structure(&mut self, t: f64, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], c: &mut [f64], a: &mut [f64], bv: &mut [f64]) -> Result<bool> {
         let (model, data) = (self.model, &mut self.data);

@@ -142,22 +142,31 @@ impl NewtonMatrices {
     /// system has the sparse structure), the dense one otherwise.
     pub fn for_system<S: SecondOrderSystem>(sys: &mut S, asked: LinearSolver, complex: bool, inverse: bool, method: &str) -> Result<Self> {
         let (n, m) = (sys.n(), sys.n_constraints());
-        if asked != LinearSolver::Dense {
-            match sys.sparse_structure()? {
-                Some(s) => {
-                    let layout = BandLayout::new(&s.pattern);
-                    if asked == LinearSolver::Sparse || prefer_sparse(&layout) {
-                        sys.check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex))?;
-                        return Ok(NewtonMatrices { inner: Inner::Sparse(Box::new(BandNewton::new(s, layout, complex))) });
-                    }
-                }
-                None if asked == LinearSolver::Sparse => {
-                    return Err(Error::argument("linear_solver", format!("{method}: this system has no sparse structure (use 'dense' or 'auto')")));
-                }
-                None => {}
-            }
+        Ok(match Self::band_for_system(sys, asked, complex, method)? {
+            Some(b) => NewtonMatrices { inner: Inner::Sparse(Box::new(b)) },
+            None => Self::dense(n, m, complex, inverse),
+        })
+    }
+
+    /// The sparse form alone: `Some` when `asked` is `Sparse`, or `Auto` and it pays
+    /// (`prefer_sparse`); `None` for the dense form. `Sparse` on a system without a sparse
+    /// structure is an error.
+    pub fn band_for_system<S: SecondOrderSystem>(sys: &mut S, asked: LinearSolver, complex: bool, method: &str) -> Result<Option<BandNewton>> {
+        if asked == LinearSolver::Dense {
+            return Ok(None);
         }
-        Ok(Self::dense(n, m, complex, inverse))
+        match sys.sparse_structure()? {
+            Some(s) => {
+                let layout = BandLayout::new(&s.pattern);
+                if asked == LinearSolver::Sparse || prefer_sparse(&layout) {
+                    sys.check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex))?;
+                    return Ok(Some(BandNewton::new(s, layout, complex)));
+                }
+                Ok(None)
+            }
+            None if asked == LinearSolver::Sparse => Err(Error::argument("linear_solver", format!("{method}: this system has no sparse structure (use 'dense' or 'auto')"))),
+            None => Ok(None),
+        }
     }
 
     /// What `for_system` will take for the UK system of `model` (its workspace `data`):
