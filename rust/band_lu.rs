@@ -105,18 +105,23 @@ pub struct BandLu<T: Scalar> {
     ld: usize,
     ab: Vec<T>,
     piv: Vec<usize>,
+    /// After `factor`: per column, the number of nonzero entries of `L` below the diagonal and
+    /// of `U` above it (their profile within the band: pivoting fills the top `kl` rows only
+    /// near the rows it exchanged, so the solves skip the zeros beyond).
+    lcount: Vec<u32>,
+    ucount: Vec<u32>,
 }
 
 impl<T: Scalar> BandLu<T> {
     /// Storage for an `n x n` matrix with `kl` sub- and `ku` super-diagonals (all zero).
     pub fn new(n: usize, kl: usize, ku: usize) -> Self {
         let ld = 2 * kl + ku + 1;
-        BandLu { n, kl, ku, ld, ab: vec![T::default(); ld * n], piv: vec![0; n] }
+        BandLu { n, kl, ku, ld, ab: vec![T::default(); ld * n], piv: vec![0; n], lcount: vec![0; n], ucount: vec![0; n] }
     }
 
     /// Bytes `new(n, kl, ku)` allocates.
     pub fn bytes(n: usize, kl: usize, ku: usize) -> u64 {
-        (n as u64) * ((2 * kl + ku + 1) as u64 * std::mem::size_of::<T>() as u64 + 8)
+        (n as u64) * ((2 * kl + ku + 1) as u64 * std::mem::size_of::<T>() as u64 + 16)
     }
 
     pub fn n(&self) -> usize {
@@ -206,12 +211,21 @@ impl<T: Scalar> BandLu<T> {
                 }
             }
         }
+        // the profile of the factors inside the band, for the solves
+        let zero = T::default();
+        for j in 0..n {
+            let col = j * ld + kv;
+            let km = kl.min(n - 1 - j);
+            self.lcount[j] = (1..=km).rev().find(|&i| self.ab[col + i] != zero).unwrap_or(0) as u32;
+            let top = kv.min(j);
+            self.ucount[j] = (1..=top).rev().find(|&d| self.ab[col - d] != zero).unwrap_or(0) as u32;
+        }
         true
     }
 
     /// Solve `A x = b` in place with the factors (`gbtrs`, no transpose).
     pub fn solve(&self, x: &mut [T]) {
-        let (n, kl, ld) = (self.n, self.kl, self.ld);
+        let (n, ld) = (self.n, self.ld);
         let kv = self.kl + self.ku;
         debug_assert!(x.len() >= n);
         // L (unit, with the interchanges in the order they were made)
@@ -222,7 +236,7 @@ impl<T: Scalar> BandLu<T> {
             }
             let xj = x[j];
             if xj != T::default() {
-                let km = kl.min(n - 1 - j);
+                let km = self.lcount[j] as usize;
                 let col = j * ld + kv;
                 for (xi, &l) in x[j + 1..=j + km].iter_mut().zip(&self.ab[col + 1..=col + km]) {
                     *xi = *xi - l * xj;
@@ -235,7 +249,7 @@ impl<T: Scalar> BandLu<T> {
             let xj = x[j] / self.ab[col];
             x[j] = xj;
             if xj != T::default() {
-                let lo = j.saturating_sub(kv);
+                let lo = j - self.ucount[j] as usize;
                 for (r, xr) in x[lo..j].iter_mut().enumerate() {
                     *xr = *xr - self.ab[col - (j - lo) + r] * xj;
                 }

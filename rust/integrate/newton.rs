@@ -52,14 +52,20 @@ impl LinearSolver {
 }
 
 /// Below this size `n + m` of the Newton matrix `Auto` stays dense: measured on the ANCF wire
-/// pendulum and the paper's scenes (docs/scale.md, "The implicit methods").
+/// pendulum and the chain (`benches/crossover.py`, docs/scale.md "Crossovers"): GENALPHA's dense
+/// path (with its inverse solves on small matrices) wins up to n + m ~ 60, the band LU from ~70 ...
 pub const SPARSE_NEWTON_MIN: usize = 64;
+/// ... while RADAU5M (and RADAU5), with a real and a complex matrix, wins with the band LU from
+/// n + m ~ 38 (1.4-3.5x there).
+pub const SPARSE_NEWTON_MIN_COMPLEX: usize = 32;
 
-/// `Auto`: sparse when the matrix is large enough and its band after RCM is narrow (the band
-/// LU's work well below the dense `(n+m)^3 / 3`).
-pub fn prefer_sparse(layout: &BandLayout) -> bool {
-    let size = layout.size as f64;
-    layout.size >= SPARSE_NEWTON_MIN && 8.0 * layout.factor_flops() < size * size * size / 3.0
+/// `Auto`: sparse when the matrix is large enough (`complex`: with the complex one of Radau
+/// IIA) and its band after RCM covers at most half of it (a scene whose flexible bodies are
+/// dense FFRF blocks, or a hub that couples everything, has a band as wide as the matrix: the
+/// band LU would do the dense work with more bookkeeping).
+pub fn prefer_sparse(layout: &BandLayout, complex: bool) -> bool {
+    let min = if complex { SPARSE_NEWTON_MIN_COMPLEX } else { SPARSE_NEWTON_MIN };
+    layout.size >= min && 2 * (2 * layout.hb + 1) <= layout.size
 }
 
 /// The solve with a factorization at which GENALPHA forms its inverse (dense, small only).
@@ -158,7 +164,7 @@ impl NewtonMatrices {
         match sys.sparse_structure()? {
             Some(s) => {
                 let layout = BandLayout::new(&s.pattern);
-                if asked == LinearSolver::Sparse || prefer_sparse(&layout) {
+                if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) {
                     sys.check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex))?;
                     return Ok(Some(BandNewton::new(s, layout, complex)));
                 }
@@ -177,7 +183,7 @@ impl NewtonMatrices {
         }
         let p = Pattern::new(model, &data.ajac, false, data.memory_limit)?;
         let layout = BandLayout::new(&p);
-        if asked == LinearSolver::Sparse || prefer_sparse(&layout) {
+        if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) {
             Error::check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex), data.memory_limit, "raise memory_limit")?;
             return Ok(LinearSolver::Sparse);
         }
