@@ -13,10 +13,11 @@ the implicit methods' time per step on the MBS benchmark A02 (N four-bar), in on
   GENALPHA and RADAU5M at a fixed step of 1e-3 s for 200 steps, ``System.integrate`` whole,
   sparse and dense Newton matrices.
 
+Every measurement runs in a fresh process (``--worker``; its start-up is not timed: a long-lived
+process that has built many large systems spends more in its allocator and garbage collector).
 ``--baseline PYTHON``: the same measurements also with another build of ukflex (e.g. the code
-before this change, installed in another virtualenv), run as a subprocess interleaved with this
-one's, round by round (the timings are taken inside each process; its start-up is not timed).
-Medians of ``--repeat`` rounds.
+before this change, installed in another virtualenv), interleaved with this one's, round by
+round.  Medians of ``--repeat`` rounds.
 
 Usage::
 
@@ -136,18 +137,21 @@ def main() -> None:
             return None
         return (kind, size, variant.split("/")[0] + "/default") if kind == "a02" else c
 
+    def worker(python, case):
+        out = subprocess.run([python, __file__, "--worker", json.dumps(list(case))], capture_output=True, text=True,
+                             check=True)
+        return float(out.stdout.strip().splitlines()[-1])
+
     times: Dict[tuple, List[float]] = {}
     t_start = time.perf_counter()
     for r in range(a.repeat):
         done = set()
         for c in cases:
-            times.setdefault(("this",) + c, []).append(measure(*c))
+            times.setdefault(("this",) + c, []).append(worker(sys.executable, c))
             b = base_of(c)
             if b is not None and b not in done:
                 done.add(b)
-                out = subprocess.run([a.baseline, __file__, "--worker", json.dumps(list(b))], capture_output=True, text=True,
-                                     check=True)
-                times.setdefault(("baseline",) + b, []).append(float(out.stdout.strip().splitlines()[-1]))
+                times.setdefault(("baseline",) + b, []).append(worker(a.baseline, b))
         print(f"round {r + 1}/{a.repeat} done ({time.perf_counter() - t_start:.0f} s)", flush=True)
     med = {k: statistics.median(v) for k, v in times.items()}
     print(f"\nmedians of {a.repeat} interleaved rounds, load average {os.getloadavg()[0]:.1f}")

@@ -164,14 +164,15 @@ fn sparse_and_dense_newton_runs_give_the_same_answer_to_rounding() {
 
 #[test]
 fn auto_takes_the_sparse_newton_matrices_where_they_were_measured_to_pay() {
-    // (scene, sparse for RADAU5M, sparse for GENALPHA): the measured crossovers (n + m ~ 38
-    // and ~ 64, benches/crossover.py) and the band condition (the paper's FFRF coupler of 16
+    // (scene, sparse for RADAU5M, sparse for GENALPHA): the measured crossovers (n + m = 50
+    // and 100, benches/crossover.py) and the band condition (the paper's FFRF coupler of 16
     // elements is one dense body: its band is the whole matrix)
     for (json, radau, galpha) in [
         (paper_scene("timoshenko", 1, true), false, false),
         (paper_scene("euler-bernoulli", 16, true), false, false),
         (wire_scene(4), false, false),
         (wire_scene(12), true, false),
+        (wire_scene(24), true, true),
         (wire_scene(64), true, true),
         (chain_scene(64), true, true),
     ] {

@@ -176,3 +176,17 @@ def test_sparse_equilibrium_is_the_dense_one(make):
     assert np.max(np.abs(a.q - b.q)) <= 1e-8 * max(1.0, np.max(np.abs(b.q)))
     assert np.allclose(a.multipliers, b.multipliers, rtol=1e-6, atol=1e-8 * np.max(np.abs(b.multipliers)))
     assert a.position_residual <= 1e-10 and a.force_residual <= 1e-8 * max(1.0, np.max(np.abs(b.multipliers)))
+
+
+@pytest.mark.parametrize("method", ["GENALPHA", "RADAU5M"])
+def test_redundant_rows_on_the_sparse_newton_path(method):
+    """The parallel-crank lattice (W - 1 redundant rows a level): the singular saddle point is
+    regularized on the multiplier block as on the dense path, with the same answer."""
+    s = scenes.lattice(columns=4, rows=3, beams="continuous").build()
+    assert s.core.rank_info(0.0, s.q0, s.qd0)["rank"] < s.n_constraints
+    out = {ls: s.integrate(0.0, s.y0, 0.05, method=method, step=1e-3, linear_solver=ls) for ls in ("dense", "sparse")}
+    assert out["dense"]["status"] == out["sparse"]["status"] == 0
+    yd, ys = np.asarray(out["dense"]["y"]), np.asarray(out["sparse"]["y"])
+    assert np.max(np.abs(ys - yd)) <= 1e-12 * np.max(np.abs(yd))
+    # the constraints hold (the projection after every step)
+    assert np.max(np.abs(s.phi(0.05, ys[: s.n_coords, -1]))) <= 1e-10

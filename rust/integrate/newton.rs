@@ -52,12 +52,13 @@ impl LinearSolver {
 }
 
 /// Below this size `n + m` of the Newton matrix `Auto` stays dense: measured on the ANCF wire
-/// pendulum and the chain (`benches/crossover.py`, docs/scale.md "Crossovers"): GENALPHA's dense
-/// path (with its inverse solves on small matrices) wins up to n + m ~ 60, the band LU from ~70 ...
-pub const SPARSE_NEWTON_MIN: usize = 64;
-/// ... while RADAU5M (and RADAU5), with a real and a complex matrix, wins with the band LU from
-/// n + m ~ 38 (1.4-3.5x there).
-pub const SPARSE_NEWTON_MIN_COMPLEX: usize = 32;
+/// pendulum and the chain (`benches/crossover.py`, two runs, docs/scale.md "Crossovers"):
+/// GENALPHA's dense path (with its inverse solves on small matrices) wins or ties up to
+/// n + m ~ 70 on the wire, the band LU wins in both runs from ~100 (1.1-1.7x) ...
+pub const SPARSE_NEWTON_MIN: usize = 100;
+/// ... while RADAU5M (and RADAU5), with a real and a complex matrix, wins with the band LU in
+/// both runs from n + m ~ 54 (1.6-1.9x; at ~40 the runs disagree, 0.4-3.5x).
+pub const SPARSE_NEWTON_MIN_COMPLEX: usize = 50;
 
 /// `Auto`: sparse when the matrix is large enough (`complex`: with the complex one of Radau
 /// IIA) and its band after RCM covers at most half of it (a scene whose flexible bodies are
