@@ -190,3 +190,11 @@ def test_redundant_rows_on_the_sparse_newton_path(method):
     assert np.max(np.abs(ys - yd)) <= 1e-12 * np.max(np.abs(yd))
     # the constraints hold (the projection after every step)
     assert np.max(np.abs(s.phi(0.05, ys[: s.n_coords, -1]))) <= 1e-10
+
+
+def test_a_budget_spent_before_a_native_runs_first_step_names_it():
+    s = wire(64).build()
+    res = ukflex.simulate(s, 0.05, method="RADAU5M", step=1e-4, max_wall_time=1e-9)
+    assert res.status == -1 and res.stop["cause"] == "max_wall_time"
+    assert "before its first step" in res.stop["stage"] and "RADAU5M" in res.message
+    assert res.t.size == 1

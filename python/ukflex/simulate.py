@@ -760,6 +760,9 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
         f = out["failure"]
         stop, msg = _stop_info(system, f["cause"], f["t"], f["stage"], f["index"], message)
         message = msg if f["cause"] != "solver" else message + f" (the result holds the run up to t = {f['t']:.9g} s)"
+        if f["cause"] == "max_wall_time" and out["naccept"] == 0:  # spent before the first step
+            stop["stage"] = f"{method}'s setup (before its first step)"
+            message += f"; spent before the first step, in {stop['stage']}"
         stop["message"] = message
     sol = None
     if out["dense"] is not None and len(out["dense"]["meta"]):

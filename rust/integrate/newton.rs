@@ -162,7 +162,13 @@ impl NewtonMatrices {
         if asked == LinearSolver::Dense {
             return Ok(None);
         }
-        match sys.sparse_structure()? {
+        let structure = match sys.sparse_structure() {
+            // `Auto`: a pattern above the memory limit (a dense body of many coordinates) means the
+            // dense form, whose own check then speaks
+            Err(Error::Memory { .. }) if asked == LinearSolver::Auto => return Ok(None),
+            r => r?,
+        };
+        match structure {
             Some(s) => {
                 let layout = BandLayout::new(&s.pattern);
                 if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) {
@@ -182,7 +188,10 @@ impl NewtonMatrices {
         if asked == LinearSolver::Dense {
             return Ok(LinearSolver::Dense);
         }
-        let p = Pattern::new(model, &data.ajac, false, data.memory_limit)?;
+        let p = match Pattern::new(model, &data.ajac, false, data.memory_limit) {
+            Err(Error::Memory { .. }) if asked == LinearSolver::Auto => return Ok(LinearSolver::Dense),
+            r => r?,
+        };
         let layout = BandLayout::new(&p);
         if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) {
             Error::check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex), data.memory_limit, "raise memory_limit")?;
