@@ -333,7 +333,9 @@ pub struct Correction {
 ///
 /// When no coordinate is held and the workspace has the sparse UK path, this is the UK solve
 /// itself with `Q = 0`, `b = r` (O(n), the sparse path's rank certificate or its dense
-/// fallback); otherwise the dense SVD of `A_f F^-T` below (O(n m^2)).
+/// fallback); otherwise the dense SVD of `A_f F^-T` below (O(n m^2)): a body whose coordinates
+/// are all free is factored by its own `M_b = F_b F_b^T` (banded for an ANCF cable: O(n_b)),
+/// a body with held coordinates by the dense Cholesky of its free block.
 fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Result<Vec<f64>> {
     let (n, m) = (model.n, model.m);
     if m > 0 && data.sparse.is_some() && free.iter().all(|f| *f) {
@@ -356,16 +358,27 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
     for (p, &i) in idx.iter().enumerate() {
         pos[i] = p;
     }
-    let mut blocks: Vec<(usize, usize)> = Vec::new(); // (first compact index, size) per body
+    let hint = "the initial-state correction with held coordinates solves densely in the free coordinates and the constraint rows; hold fewer coordinates (hold=None) or raise memory_limit";
+    Error::check_memory("the initial-state correction (free coordinates x constraint rows)", 8 * (k as u64 + m as u64) * m as u64 * 3, data.memory_limit, hint)?;
+    // per body with free coordinates: (first compact index, size, whole body: its own factor)
+    let mut blocks: Vec<(usize, usize, usize, bool)> = Vec::new();
     let mut mf = vec![0.0; 0];
     let mut offsets = Vec::new();
-    for (body, bd) in model.bodies.iter().zip(&data.bodies) {
+    for (b, body) in model.bodies.iter().enumerate() {
         let local: Vec<usize> = (body.offset..body.offset + body.n_coords).filter(|&i| free[i]).collect();
         let kb = local.len();
         if kb == 0 {
             continue;
         }
         let first = pos[local[0]];
+        if kb == body.n_coords {
+            body.factor(&mut data.bodies[b])?;
+            blocks.push((first, kb, b, true));
+            offsets.push(0);
+            continue;
+        }
+        let bd = &data.bodies[b];
+        Error::check_memory("the initial-state correction (a body's free mass block)", 8 * (kb * kb) as u64, data.memory_limit, hint)?;
         let mut blk = vec![0.0; kb * kb];
         body.dense_block(bd, &mut |i, j, v| {
             let (gi, gj) = (body.offset + i, body.offset + j);
@@ -376,7 +389,7 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
         if !cholesky(&mut blk, kb) {
             return Err(Error::SingularMass { item: format!("body '{}': mass block of the corrected coordinates", body.name) });
         }
-        blocks.push((first, kb));
+        blocks.push((first, kb, b, false));
         offsets.push(mf.len());
         mf.extend_from_slice(&blk);
     }
@@ -394,8 +407,12 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
                 }
             }
         }
-        for (&(first, kb), &off) in blocks.iter().zip(&offsets) {
-            lower_solve(&mf[off..off + kb * kb], kb, &mut col[first..first + kb]);
+        for (&(first, kb, b, whole), &off) in blocks.iter().zip(&offsets) {
+            if whole {
+                model.bodies[b].finv(&data.bodies[b], &mut col[first..first + kb]);
+            } else {
+                lower_solve(&mf[off..off + kb * kb], kb, &mut col[first..first + kb]);
+            }
         }
         for p in 0..k {
             bt[(p, i)] = col[p];
@@ -419,8 +436,12 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
             }
         }
     }
-    for (&(first, kb), &off) in blocks.iter().zip(&offsets) {
-        upper_solve(&mf[off..off + kb * kb], kb, &mut y[first..first + kb]);
+    for (&(first, kb, b, whole), &off) in blocks.iter().zip(&offsets) {
+        if whole {
+            model.bodies[b].finvt(&data.bodies[b], &mut y[first..first + kb]);
+        } else {
+            upper_solve(&mf[off..off + kb * kb], kb, &mut y[first..first + kb]);
+        }
     }
     for (p, &g) in idx.iter().enumerate() {
         dx[g] = y[p];
@@ -478,6 +499,23 @@ fn upper_solve(l: &[f64], k: usize, x: &mut [f64]) {
 /// `opts.hold`: damped Newton on the positions (the step halved while `max |Phi|` grows, stop
 /// after 5 iterations without halving the best residual), then one velocity projection.
 pub fn correct(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], opts: &CorrectOptions) -> Result<Correction> {
+    correct_within(model, data, t, q, qd, opts, f64::INFINITY)
+}
+
+/// `correct` within a wall-time budget of `max_wall_time` seconds (checked before every Newton
+/// iteration and before the velocity projection): past it `Error::Budget` (`max_wall_time`)
+/// saying how far the correction got.
+pub fn correct_within(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], opts: &CorrectOptions, max_wall_time: f64) -> Result<Correction> {
+    let started = std::time::Instant::now();
+    let over = |it: usize, res: f64| -> Result<()> {
+        if max_wall_time.is_finite() && started.elapsed().as_secs_f64() > max_wall_time {
+            return Err(Error::Budget {
+                what: "max_wall_time".into(),
+                message: format!("the initial-state correction: wall time over max_wall_time = {max_wall_time} s after {it} Newton iteration(s) (max |Phi| = {res:.3e})"),
+            });
+        }
+        Ok(())
+    };
     let (n, m) = (model.n, model.m);
     if opts.hold.len() != n {
         return Err(Error::Shape { what: "hold".into(), expected: n, got: opts.hold.len() });
@@ -491,6 +529,7 @@ pub fn correct(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], op
     let (mut res, mut best, mut it, mut stall) = (r0, r0, 0usize, 0usize);
     let mut r = vec![0.0; m];
     while res > opts.position_tol && it < opts.max_iterations {
+        over(it, res)?;
         it += 1;
         mass_and_forces(model, data, &q, &zeros);
         constraints(model, data, t, &q, &zeros, false);
@@ -543,6 +582,7 @@ pub fn correct(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], op
     if !positions_ok {
         return Ok(out);
     }
+    over(it, res)?;
     mass_and_forces(model, data, &out.q, &zeros);
     constraints(model, data, t, &out.q, &zeros, false);
     let mut vres = vec![0.0; m];

@@ -56,6 +56,15 @@ impl Force {
         Ok(Force { name, kind })
     }
 
+    /// The markers this force acts through (its generalized force depends on their states only).
+    pub fn markers(&self) -> [Option<&Marker>; 2] {
+        match &self.kind {
+            ForceKind::PointForce { point, .. } => [Some(point), None],
+            ForceKind::Torque { frame, .. } => [Some(frame), None],
+            ForceKind::SpringDamper { a, b, .. } => [Some(a), Some(b)],
+        }
+    }
+
     /// Add this force's generalized force to `qvec` (length n).
     #[inline]
     pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], qvec: &mut [f64]) {
@@ -82,6 +91,24 @@ impl Force {
                 a.add_point_jacobian(bodies, &sa, [-f * e[0], -f * e[1]], qvec);
                 b.add_point_jacobian(bodies, &sb, [f * e[0], f * e[1]], qvec);
             }
+        }
+    }
+
+    /// `1/2 k ldot^2` of a spring-damper for the motion `v` at `q` (its length's first-order
+    /// change squared: the spring's share of a mode's stiffness; 0 for the loads).
+    pub fn material_energy(&self, bodies: &[Body], q: &[f64], v: &[f64]) -> f64 {
+        match &self.kind {
+            ForceKind::SpringDamper { a, b, stiffness, .. } => {
+                let (sa, sb) = (a.state(bodies, q, v), b.state(bodies, q, v));
+                let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];
+                let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                if l == 0.0 {
+                    return 0.0;
+                }
+                let ldot = (d[0] * (sa.v[0] - sb.v[0]) + d[1] * (sa.v[1] - sb.v[1])) / l;
+                0.5 * stiffness * ldot * ldot
+            }
+            ForceKind::PointForce { .. } | ForceKind::Torque { .. } => 0.0,
         }
     }
 

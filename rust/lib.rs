@@ -11,6 +11,7 @@
 // form of a positivity check; kernels take the state slices and the outputs they write.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord, clippy::too_many_arguments)]
 
+pub mod band_lu;
 pub mod body;
 pub mod constraint;
 pub mod correct;
@@ -25,6 +26,7 @@ pub mod linalg;
 pub mod model;
 pub mod sensors;
 pub mod small_svd;
+pub mod sparse_newton;
 pub mod sparse_uk;
 pub mod uk;
 

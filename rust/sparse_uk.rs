@@ -38,8 +38,6 @@
 //! width `w` has `hb ~ 2 w`, and `uk::prefer_sparse` keeps the dense path where the band is
 //! too wide to pay.
 
-use std::collections::VecDeque;
-
 use crate::body::BodyData;
 use crate::constraint::jac::SegJac;
 use crate::data::{RankInfo, RankTolerance};
@@ -418,31 +416,5 @@ fn rcm(m: usize, rows_of_body: &[Vec<(usize, usize)>]) -> Vec<usize> {
         a.sort_unstable();
         a.dedup();
     }
-    let deg: Vec<usize> = adj.iter().map(Vec::len).collect();
-    let mut order = Vec::with_capacity(m);
-    let mut seen = vec![false; m];
-    let mut by_degree: Vec<usize> = (0..m).collect();
-    by_degree.sort_by_key(|&i| (deg[i], i));
-    for &start in &by_degree {
-        if seen[start] {
-            continue;
-        }
-        let mut queue = VecDeque::from([start]);
-        seen[start] = true;
-        while let Some(v) = queue.pop_front() {
-            order.push(v);
-            let mut next: Vec<usize> = adj[v].iter().copied().filter(|&u| !seen[u]).collect();
-            next.sort_by_key(|&u| (deg[u], u));
-            for u in next {
-                seen[u] = true;
-                queue.push_back(u);
-            }
-        }
-    }
-    order.reverse();
-    let mut perm = vec![0; m];
-    for (p, &row) in order.iter().enumerate() {
-        perm[row] = p;
-    }
-    perm
+    crate::sparse_newton::rcm(&adj)
 }

@@ -9,7 +9,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use common::*;
-use ukflex::integrate::{integrate, Dopri5, GenAlpha, GenAlphaOptions, Method, Options, Radau5, RadauM, RadauMOptions, SecondOrderSystem, Stepper, UkSystem};
+use ukflex::integrate::{integrate, Dopri5, GenAlpha, GenAlphaOptions, LinearSolver, Options, Radau5, RadauM, RadauMOptions, SecondOrderSystem, Stepper, UkSystem};
 use ukflex::jacobian::Differences;
 use ukflex::jacobian::{uk_jacobian, JacobianWorkspace};
 use ukflex::{uk, Data, Model};
@@ -164,6 +164,32 @@ fn native_steps_do_not_allocate() {
         let st = rm.stats();
         assert!(st.nlu >= 2 && st.njev >= 1, "{st:?}");
         assert_eq!(n, 0, "RADAU5M (step {step:?}) allocated {n} times in 100 steps (stats {st:?})");
+    }
+    // the sparse Newton matrices (band LU, coloured velocity differences): the paper scene, an
+    // ANCF coupler and a chain, both implicit methods
+    for json in [paper_scene("timoshenko", 2, true), ancf_paper_scene(4, true), chain_scene(12)] {
+        let model = Model::from_json(&json).unwrap();
+        let opts = Options { linear_solver: LinearSolver::Sparse, ..opts.clone() };
+        for step in [Some(2e-4), None] {
+            let go = GenAlphaOptions { step, projection, ..Default::default() };
+            let mut ga = GenAlpha::new(model.n, model.m, opts.clone(), go).unwrap();
+            let n = steps_allocate(&mut ga, &model, 100);
+            let st = ga.stats();
+            assert!(st.nlu >= 1 && st.njev >= 1, "{st:?}");
+            assert_eq!(n, 0, "sparse GENALPHA (step {step:?}) allocated {n} times in 100 steps (stats {st:?})");
+            let ro = RadauMOptions { step, projection };
+            let mut rm = RadauM::new(model.n, model.m, opts.clone(), ro).unwrap();
+            let n = steps_allocate(&mut rm, &model, 100);
+            let st = rm.stats();
+            assert!(st.nlu >= 2 && st.njev >= 1, "{st:?}");
+            assert_eq!(n, 0, "sparse RADAU5M (step {step:?}) allocated {n} times in 100 steps (stats {st:?})");
+        }
+        // RADAU5 with the structured Jacobian solves its iteration matrices as sparse saddle points
+        let mut rd = Radau5::new(model.n, opts.clone()).unwrap();
+        let n = steps_allocate_with(&mut rd, &model, 100, |sys| sys.jws.scheme = Differences::Structured);
+        let st = rd.stats();
+        assert!(st.njev >= 1 && st.nlu >= 2, "{st:?}");
+        assert_eq!(n, 0, "sparse RADAU5 allocated {n} times in 100 steps (stats {st:?})");
     }
 }
 

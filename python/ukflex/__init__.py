@@ -15,6 +15,7 @@ Rust core (``ukflex._core``, private) + Python API:
 """
 
 from .errors import (
+    BudgetError,
     ExpressionError,
     InconsistentInitialStateError,
     InvalidArgumentError,
@@ -94,6 +95,7 @@ __all__ = [
     "SolverError",
     "NonFiniteError",
     "MemoryLimitError",
+    "BudgetError",
     "InconsistentInitialStateError",
     "ExpressionError",
     "MissingDependencyError",

@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 _F64 = npt.NDArray[np.float64]
+_I64 = npt.NDArray[np.int64]
 
 __all__ = [
     "System",
@@ -28,6 +29,7 @@ __all__ = [
     "PROJECTION_PER_ATOL",
     "PROJECTION_MOVE_LIMIT",
     "normal_weight",
+    "BudgetError",
 ]
 
 #: The native methods' projection after each step: Newton on the positions to this fraction of
@@ -48,6 +50,7 @@ class ExpressionError(InvalidSceneError):
     position: int
     expression: str
 class MemoryLimitError(UkflexError): ...
+class BudgetError(SolverError): ...
 
 @final
 class System:
@@ -61,7 +64,14 @@ class System:
     def memory_limit(self) -> int:
         """Bytes any lazily sized group of buffers may take (MemoryLimitError above)."""
     def M(self, q: _F64) -> _F64:
-        """Mass matrix, shape (n, n)."""
+        """Mass matrix, shape (n, n) (MemoryLimitError above memory_limit)."""
+    def M_sparse(self, q: _F64) -> Tuple[_I64, _I64, _F64]:
+        """Mass matrix in coordinate form: (rows, cols, values) of the body blocks."""
+    def linearization(
+        self, t: float, q: _F64, qd: _F64, qdd: Optional[_F64] = None, lam: Optional[_F64] = None, stiffness: bool = True
+    ) -> Dict[str, Any]:
+        """Constrained linearization in sparse form: rows, cols, M, K (coordinate pattern),
+        a_rows, a_cols, A, qdd, lambda, colors (ukflex.modes); qdd, lam held if given."""
     def Q(self, t: float, q: _F64, qd: _F64) -> _F64:
         """Generalized forces (applied + quadratic velocity + elastic), shape (n,)."""
     def phi(self, t: float, q: _F64) -> _F64:
@@ -134,13 +144,16 @@ class System:
         min_step: float = 0.0,
         dense: bool = False,
         newton_local_error: Optional[float] = None,
+        linear_solver: str = "auto",
         drift_limit: Optional[float] = None,
         on_drift: str = "stop",
         monitor_singular: bool = True,
     ) -> Dict[str, Any]:
         """Native integration; dict with t (nt,), y (2n, nt), status, message, failure (None or
         cause, t, stage, index), statistics, dense (None or meta (nseg, 3), data, part_len),
-        singular (the singular passages), drift (None or t_first, max_residual, t_max)."""
+        singular (the singular passages), drift (None or t_first, max_residual, t_max).
+        linear_solver: how GENALPHA and RADAU5M factor their Newton matrices ("auto", "dense",
+        "sparse": band LU after a fill-reducing order, docs/scale.md)."""
     def project(
         self, t: float, q: _F64, qd: _F64, tol: float = 1e-12, max_iter: int = 20
     ) -> Tuple[_F64, _F64, Dict[str, Any]]:
@@ -151,6 +164,8 @@ class System:
     def tangent_project(self, t: float, q: _F64, v: _F64) -> Tuple[_F64, float]:
         """The columns of v (n, k) projected onto the constraints' tangent space at (t, q) in the mass metric,
         and sigma_min / sigma_max of A M^-1/2 there."""
+    def material_energies(self, q: _F64, shapes: _F64) -> _F64:
+        """1/2 v^T K_m v per column v of shapes (n, k): the bodies' material stiffness and the springs."""
     def singular_passages(self, t: _F64, y: _F64) -> List[Dict[str, Any]]:
         """Singular passages of a trajectory of accepted states t (k,), y (2n, k)."""
     def sensors(self, t: _F64, q: _F64, qd: _F64, reactions: bool = True) -> Dict[str, Any]:
@@ -192,8 +207,10 @@ class System:
         position_tol: float = 1e-12,
         velocity_tol: float = 1e-10,
         max_iterations: int = 50,
+        max_wall_time: Optional[float] = None,
     ) -> Dict[str, Any]:
-        """Initial-state correction with held coordinates; a report dict."""
+        """Initial-state correction with held coordinates; a report dict (BudgetError past
+        max_wall_time seconds)."""
 
 @final
 class SceneChecker:

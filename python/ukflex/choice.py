@@ -62,11 +62,15 @@ NEWTON_LOCAL_ERROR = 0.3
 #: ``rho_inf`` 0.9 and >= 8.7 with 1.0, and lets it drift off at 2.2-2.6 (0.9) and 4.4 (1.0):
 #: the accepted Newton error feeds the next local error estimates (docs/integrators.md)
 LOCAL_NEWTON_MIN_STEP_OMEGA = 8.0
-#: a mode is elastic when more than this share of omega^2 comes from the potential energy's
-#: curvature (elastic strain, springs) rather than from gravity and constraint forces
+#: a mode is elastic when more than this share of omega^2 is the material stiffness of its strains
+#: (elastic bodies, springs) rather than gravity, constraint forces or stress (``elastic_shares``)
 ELASTIC_SHARE = 0.5
 #: a mode belongs to a flexible body when it carries at least this share of the mode's kinetic energy
 BODY_SHARE = 0.2
+#: large systems (``System.SPARSE_MODES_MIN`` coordinates and more): the sparse modal analysis
+#: starts from this many lowest modes and takes four times more until every flexible body's
+#: lowest elastic mode is among them; ``omega_max`` comes from ``System.max_frequency``
+FIRST_MODES = 8
 
 
 @dataclass
@@ -87,18 +91,18 @@ class MethodChoice:
 
 
 def elastic_shares(system, omega: np.ndarray, shapes: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Share of each mode's ``omega^2`` that is curvature of the potential energy along the
-    mode (gravity is linear in the positions and drops out; strain and spring energy stay)."""
+    """Share of each mode's ``omega^2`` that is elastic: ``2 E_m / omega^2``, ``E_m`` the strain
+    energy of the mode's first-order strains with the material stiffness alone, plus its springs'
+    (``System.core.material_energies``; the mode is mass-normalized, so ``omega^2`` is its whole
+    stiffness).  A swing stores none, whether the body is a rigid link, an FFRF beam (whose
+    reference frame turns) or an ANCF cable (whose nodes turn, and whose tension's geometric
+    stiffness is the same gravity restoring force): the models of one body get the same rule."""
     shares = np.zeros(omega.size)
-    U0 = system.potential_energy(q)
-    for k in range(omega.size):
-        if omega[k] <= 0.0:
-            continue
-        v = shapes[:, k]
-        eps = 1e-5 / max(float(np.abs(v).max()), 1e-300)
-        curv = (system.potential_energy(q + eps * v) - 2.0 * U0 + system.potential_energy(q - eps * v)) / eps**2
-        # the mode is mass-normalized: its kinetic coefficient is 1, so omega^2 is its stiffness
-        shares[k] = curv / omega[k] ** 2
+    live = omega > 0.0
+    if live.any():
+        e = np.asarray(system.core.material_energies(np.ascontiguousarray(q, dtype=float),
+                                                     np.ascontiguousarray(shapes[:, live], dtype=float)))
+        shares[live] = 2.0 * e / omega[live] ** 2
     return shares
 
 
@@ -110,25 +114,60 @@ def lowest_elastic_frequency(system, omega, shapes, shares, q) -> Optional[float
     elastic = (omega > 0.0) & (shares > ELASTIC_SHARE)
     if not elastic.any():
         return None
-    M = np.asarray(system.M(q))
-    per_body = []
+    per_body = [w for w in _lowest_per_body(system, omega, shapes, elastic, q).values() if w is not None]
+    return max(per_body) if per_body else float(omega[elastic].min())
+
+
+def _lowest_per_body(system, omega, shapes, elastic, q) -> Dict[str, Optional[float]]:
+    """Each flexible body's lowest elastic mode among ``omega`` (None if none is there)."""
+    sparse = system.n_coords >= system.SPARSE_MODES_MIN
+    M = system.M_sparse(q) if sparse else np.asarray(system.M(q))
+    out: Dict[str, Optional[float]] = {}
     for body in system.body_names:
         if system.body_kind(body) in ("rigid", "point_mass"):
             continue
         sl = system.body_slice(body)
-        kinetic = np.einsum("ik,ij,jk->k", shapes[sl], M[sl, sl], shapes[sl])  # mass-normalized: sums to 1
+        if sparse:
+            kinetic = np.einsum("ik,ik->k", shapes[sl], M[sl, sl] @ shapes[sl])
+        else:
+            kinetic = np.einsum("ik,ij,jk->k", shapes[sl], M[sl, sl], shapes[sl])  # mass-normalized: sums to 1
         mine = elastic & (kinetic > BODY_SHARE)
-        if mine.any():
-            per_body.append(float(omega[mine].min()))
-    return max(per_body) if per_body else float(omega[elastic].min())
+        out[body] = float(omega[mine].min()) if mine.any() else None
+    return out
 
 
-def _no_stiffness(system) -> bool:
-    """A scene of rigid bodies and point masses without spring elements has no elastic mode:
-    it cannot be stiff, so it needs no frequency analysis (leave out what a scene does not need)."""
+def _has_elastic_potential(system) -> bool:
+    """Whether any mode can store strain or spring energy: a flexible body or a spring."""
     if any(system.body_kind(b) not in ("rigid", "point_mass") for b in system.body_names):
-        return False
-    return not any(f.get("kind") == "spring_damper" for f in system.description.get("forces", []))
+        return True
+    return any(f.get("kind") == "spring_damper" and float(f.get("stiffness", 0.0)) > 0.0
+               for f in system.description.get("forces", []))
+
+
+def _spectrum(system, t0, q, qd, deadline):
+    """``(omega, shapes, omega_max)`` for the chooser.  Small systems: every mode.  Large ones
+    (sparse, ``System.SPARSE_MODES_MIN``): ``omega_max`` from ``System.max_frequency`` and the
+    lowest modes by shift-invert Lanczos, ``FIRST_MODES`` then four times more until every
+    flexible body's lowest elastic mode is among them; ``(None, None, omega_max)`` when no mode
+    can be elastic (no flexible body, no spring)."""
+    if system.n_coords < system.SPARSE_MODES_MIN:
+        omega, shapes = system.frequencies(t0, q, qd, modes=True)
+        return omega, shapes, float(np.abs(omega).max())
+    omega_max = system.max_frequency(t0, q, qd, deadline=deadline)
+    if not _has_elastic_potential(system):
+        return None, None, omega_max
+    qq = system.q0 if q is None else np.asarray(q, dtype=float)
+    n_dof, k = system.n_dof, FIRST_MODES
+    while True:
+        omega, shapes = system.frequencies(t0, q, qd, modes=True, count=min(k, n_dof), deadline=deadline)
+        if omega.size >= n_dof:
+            break
+        elastic = (omega > 0.0) & (elastic_shares(system, omega, shapes, qq) > ELASTIC_SHARE)
+        found = _lowest_per_body(system, omega, shapes, elastic, qq)
+        if (found and all(w is not None for w in found.values())) or (not found and elastic.any()):
+            break
+        k *= 4
+    return omega, shapes, max(omega_max, float(np.abs(omega).max()))
 
 
 def local_newton_ok(h: float, omega_max: float) -> bool:
@@ -138,8 +177,9 @@ def local_newton_ok(h: float, omega_max: float) -> bool:
 
 
 def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.ndarray] = None,
-                  qd: Optional[np.ndarray] = None) -> MethodChoice:
-    """The integrator ``method="auto"`` runs for ``system`` over ``[t0, t_end]`` at ``rtol``."""
+                  qd: Optional[np.ndarray] = None, deadline: Optional[float] = None) -> MethodChoice:
+    """The integrator ``method="auto"`` runs for ``system`` over ``[t0, t_end]`` at ``rtol``
+    (``deadline``: a ``time.perf_counter()`` value; past it ``ukflex.modes.BudgetExceeded``)."""
     span = float(t_end) - float(t0)
     if not (math.isfinite(span) and span > 0.0):
         raise ValueError(f"t_end must be finite and greater than t0 = {t0}, got {t_end!r}")
@@ -147,14 +187,16 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
         raise ValueError(f"rtol must be positive and finite, got {rtol!r}")
     if system.n_dof == 0:
         return MethodChoice("DOPRI5", reason="no degrees of freedom: the motion is prescribed")
-    if _no_stiffness(system):
+    if not _has_elastic_potential(system):  # leave out what a scene does not need
         return MethodChoice("DOPRI5", reason="no elastic mode (rigid bodies, no springs: no frequency analysis "
                                              "needed): not stiff, explicit")
-    omega, shapes = system.frequencies(t0, q, qd, modes=True)
+    omega, shapes, omega_max = _spectrum(system, t0, q, qd, deadline)
     q = system.q0 if q is None else np.asarray(q, dtype=float)
-    omega_max = float(np.abs(omega).max())
-    shares = elastic_shares(system, omega, shapes, q)
-    omega_c = lowest_elastic_frequency(system, omega, shapes, shares, q)
+    if omega is None:
+        omega_c = None
+    else:
+        shares = elastic_shares(system, omega, shapes, q)
+        omega_c = lowest_elastic_frequency(system, omega, shapes, shares, q)
     if omega_c is None:
         return MethodChoice("DOPRI5", omega_max=omega_max,
                             reason=f"no elastic mode (fastest mode {omega_max:.4g} rad/s): not stiff, explicit")

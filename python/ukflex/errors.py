@@ -26,6 +26,7 @@ __all__ = [
     "SolverError",
     "NonFiniteError",
     "MemoryLimitError",
+    "BudgetError",
     "InconsistentInitialStateError",
     "ExpressionError",
     "MissingDependencyError",
@@ -48,6 +49,9 @@ NonFiniteError = core.NonFiniteError
 #: An allocation would exceed the System's ``memory_limit`` (refused before allocating; the
 #: message names the buffers and a way out).
 MemoryLimitError = core.MemoryLimitError
+#: A work budget ran out before the work was done: ``max_wall_time`` of a build's initial-state
+#: correction (a :class:`SolverError`; a run that spends its budget returns ``status = -1``).
+BudgetError = core.BudgetError
 
 
 class InconsistentInitialStateError(UkflexError):  # type: ignore[misc, valid-type]

@@ -32,7 +32,7 @@ METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 #: Integrators that run entirely in Rust with the GIL released (``System.integrate``):
 #: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
 NATIVE_METHODS = ("DOPRI5", "RADAU5", "GENALPHA", "RADAU5M")
-_NATIVE_OPTIONS = ("first_step", "max_step", "projection_tol", "rho_inf", "step", "jacobian", "newton_local_error")
+_NATIVE_OPTIONS = ("first_step", "max_step", "projection_tol", "rho_inf", "step", "jacobian", "newton_local_error", "linear_solver")
 #: ``solve_ivp`` solver options passed through on the scipy paths.
 _SCIPY_OPTIONS = ("first_step", "max_step", "jac", "jac_sparsity", "lband", "uband")
 FORMULATIONS = ("uk", "uk-numpy", "cp")
@@ -264,7 +264,8 @@ def simulate(
         (:class:`ukflex.DriftWarning`, ``res.extra["drift"]``).
     **options
         Solver options: ``first_step``, ``max_step``, ``jac``, ... (scipy); ``first_step``,
-        ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``newton_local_error``, ``jacobian`` (native).  An option
+        ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``newton_local_error``, ``jacobian``, ``linear_solver``
+        (native; ``"auto"``, ``"dense"`` or ``"sparse"`` Newton matrices, docs/scale.md).  An option
         the chosen method does not take raises :class:`UnknownOptionError` listing the valid
         ones.  For ``"Radau"`` and ``"BDF"`` the default ``jac`` is the core's finite-difference
         Jacobian ``System.jac``; ``nfev`` counts only the integrator's ``rhs`` calls.
@@ -291,6 +292,7 @@ def simulate(
     NonFiniteError
         NaN or infinity in an input array.
     """
+    call_start = time.perf_counter()  # max_wall_time covers every stage from here
     if formulation not in FORMULATIONS:
         raise InvalidArgumentError("formulation", f"unknown formulation {formulation!r}; expected one of {FORMULATIONS}")
     method = _method_name(method)
@@ -300,7 +302,11 @@ def simulate(
     _check_options(method, formulation, options)
     if on_drift not in ("stop", "warn"):
         raise InvalidArgumentError("on_drift", f"must be 'stop' or 'warn', got {on_drift!r}")
-    system = as_system(scene_or_system)
+    if max_wall_time is not None and not isinstance(scene_or_system, System):
+        # a scene is built here: its initial-state correction spends the same budget
+        system = as_system(scene_or_system, max_wall_time=_positive("max_wall_time", max_wall_time))
+    else:
+        system = as_system(scene_or_system)
     n = system.n_coords
     if t_span is not None:
         if t_end is not None:
@@ -345,7 +351,7 @@ def simulate(
     qd_init = system.qd0 if qd0 is None else _real_array("qd0", qd0, (n,))
     budget = _Budget(_count("max_steps", max_steps), _count("max_nfev", max_nfev),
                      None if max_wall_time is None else _positive("max_wall_time", max_wall_time),
-                     0.0 if min_step == 0 else _positive("min_step", min_step))
+                     0.0 if min_step == 0 else _positive("min_step", min_step), call_start)
     for key in ("max_step", "step"):  # a step size that cannot reach t_end within the step budget
         if options.get(key) is not None:
             h = _positive(key, options[key])
@@ -376,14 +382,27 @@ def simulate(
             "formulation", f"events, dense_output and args need formulation='uk' (the NumPy reference {formulation!r} "
             "runs its own solve_ivp call)")
     if method == "auto":
+        from .modes import BudgetExceeded
+
         start = time.perf_counter()
-        method, options, choice = _resolve_auto(system, formulation, t0, t_end_f, rtol, q_init, qd_init, options)
+        try:
+            method, options, choice = _resolve_auto(system, formulation, t0, t_end_f, rtol, q_init, qd_init, options,
+                                                    budget.deadline)
+        except BudgetExceeded as exc:
+            return _spent_before_start(system, t0, q_init, qd_init, rtol, atol_v, budget, f"method='auto''s {exc.stage}",
+                                       time.perf_counter() - start)
         choice_time = time.perf_counter() - start
+        if budget.remaining() is not None and budget.remaining() <= 0.0:
+            res = _spent_before_start(system, t0, q_init, qd_init, rtol, atol_v, budget,
+                                      "method='auto''s modal analysis", choice_time)
+            if choice is not None:
+                res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
+            return res
         run_rtol = choice.rtol if choice is not None and choice.rtol is not None else rtol
         res = simulate(system, None, method, run_rtol, atol, t_eval_v, formulation, t_span=(t0, t_end_f), q0=q_init,
                        qd0=qd_init, partition=partition, progress=progress, events=ev_list or None,
                        dense_output=dense_output, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
-                       max_wall_time=budget.max_wall_time, min_step=budget.min_step, on_drift=on_drift, **options)
+                       max_wall_time=budget.remaining(), min_step=budget.min_step, on_drift=on_drift, **options)
         if choice is not None:
             res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
         return res
@@ -528,8 +547,27 @@ FORECAST_FACTOR = 100
 
 
 class _Budget:
-    def __init__(self, max_steps: int, max_nfev: int, max_wall_time: Optional[float], min_step: float):
+    def __init__(self, max_steps: int, max_nfev: int, max_wall_time: Optional[float], min_step: float,
+                 start: Optional[float] = None):
         self.max_steps, self.max_nfev, self.max_wall_time, self.min_step = max_steps, max_nfev, max_wall_time, min_step
+        #: ``time.perf_counter()`` when the wall-time budget runs out (counted from the call)
+        start = time.perf_counter() if start is None else start
+        self.deadline = None if max_wall_time is None else start + max_wall_time
+
+    def remaining(self) -> Optional[float]:
+        """Seconds of wall time left (None: no budget)."""
+        return None if self.deadline is None else self.deadline - time.perf_counter()
+
+
+def _spent_before_start(system, t0, q, qd, rtol, atol, budget, stage: str, wall: float) -> SimulationResult:
+    """The result of a run whose wall-time budget ran out before its first step (status -1,
+    the initial state only), naming the stage that spent it."""
+    y = np.concatenate([q, qd])[:, None]
+    message = (f"work budget max_wall_time = {budget.max_wall_time} s exhausted before the first step, in {stage}; "
+               f"the result holds the initial state only")
+    stop = {"cause": "max_wall_time", "t": float(t0), "stage": stage, "message": message}
+    return _result(system, np.array([float(t0)]), y, "auto", rtol, atol, nfev=0, njev=0, nlu=0, wall=wall, status=-1,
+                   message=message, stop=stop, t_events=None, y_events=None, sol=None, extra={})
 
 
 class _Stop(Exception):
@@ -726,7 +764,7 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
                     raise _Stop("max_steps", detail=f"at this pace ({steps} steps for {done:.3g} s) reaching t_end needs "
                                                     f"about {needed:.3g} steps, more than {FORECAST_FACTOR} x max_steps = "
                                                     f"{budget.max_steps}; shorten t_end or raise max_steps")
-            if budget.max_wall_time is not None and time.perf_counter() - start > budget.max_wall_time:
+            if budget.deadline is not None and time.perf_counter() > budget.deadline:
                 raise _Stop("max_wall_time")
             if project:
                 saved = (solver.t, solver.y, solver.f, solver.h_abs)
@@ -932,13 +970,15 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
     for key in ("projection_tol", "rho_inf", "newton_local_error"):  # 0 is meaningful (projection off, full dissipation)
         if options.get(key) is not None:
             kwargs[key] = _real(key, options[key])
-    if options.get("jacobian") is not None:
-        kwargs["jacobian"] = str(options["jacobian"])
+    for key in ("jacobian", "linear_solver"):
+        if options.get(key) is not None:
+            kwargs[key] = str(options[key])
     atol_arr = np.atleast_1d(np.asarray(atol, dtype=float))
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
     out = system.integrate(float(t0), np.ascontiguousarray(y0, dtype=float), float(t_end), method, float(rtol),
                            atol_arr, te, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
-                           max_wall_time=budget.max_wall_time, min_step=budget.min_step,
+                           max_wall_time=None if budget.deadline is None else max(budget.remaining(), 1e-9),
+                           min_step=budget.min_step,
                            dense=bool(dense or events), drift_limit=guard.limit,
                            on_drift="stop" if guard.stop else "warn", **kwargs)
     t, y, status, message = np.asarray(out["t"]), np.asarray(out["y"]), int(out["status"]), str(out["message"])
@@ -947,6 +987,9 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
         f = out["failure"]
         stop, msg = _stop_info(system, f["cause"], f["t"], f["stage"], f["index"], message)
         message = msg if f["cause"] != "solver" else message + f" (the result holds the run up to t = {f['t']:.9g} s)"
+        if f["cause"] == "max_wall_time" and out["naccept"] == 0:  # spent before the first step
+            stop["stage"] = f"{method}'s setup (before its first step)"
+            message += f"; spent before the first step, in {stop['stage']}"
         stop["message"] = message
     sol = None
     if out["dense"] is not None and len(out["dense"]["meta"]):
@@ -993,7 +1036,7 @@ def _simulate_reference(system, formulation, t_end, method, rtol, atol, t_eval, 
         wall_time=out.wall_time, status=out.status, message=out.message, extra=extra)
 
 
-def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
+def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options, deadline=None):
     """``method="auto"``: the chooser of :mod:`ukflex.choice` for the Rust UK formulation; the
     NumPy references keep scipy's Radau.  Options that only scipy takes (``jac``, ``events``,
     ...) map the choice to its scipy counterpart (RADAU5M -> Radau, DOPRI5 -> DOP853); options
@@ -1002,7 +1045,7 @@ def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options):
 
     if formulation != "uk":
         return "Radau", options, None
-    choice = choose_method(system, t0, t_end, rtol, q, qd)
+    choice = choose_method(system, t0, t_end, rtol, q, qd, deadline=deadline)
     scipy_only = sorted(set(options) - set(_NATIVE_OPTIONS))
     if scipy_only:
         choice.method = "Radau" if choice.method == "RADAU5M" else "DOP853"

@@ -155,9 +155,13 @@ class System:
         rank-revealing fallback) or ``"auto"`` (sparse for long chains, ropes and tracks).
         See docs/scale.md. ``core.uk_solver`` tells which path the last call took.
     memory_limit : float, optional
-        Bytes any lazily sized group of buffers may take (default 2 GiB): the dense
-        ``n x n`` matrices of ``jac`` and of the implicit native integrators, the dense UK
+        Bytes any lazily sized group of buffers may take (default 2 GiB): every dense
+        ``n x n`` array (``M``, ``jac``, ``tangent_stiffness``, the implicit native integrators'
+        dense Newton matrices, the dense modal analysis), the sparse structures, the dense UK
         fallback. Above it :class:`ukflex.MemoryLimitError` is raised before allocating.
+    max_wall_time : float, optional
+        Wall-time budget [s] of the initial-state correction (default: none); past it
+        :class:`ukflex.BudgetError` is raised saying how far the correction got.
 
     Attributes
     ----------
@@ -204,6 +208,7 @@ class System:
         t0: float = 0.0,
         uk_solver: str = "auto",
         memory_limit: Optional[float] = None,
+        max_wall_time: Optional[float] = None,
     ):
         if isinstance(description, dict):
             _, self.description = normalize(description)
@@ -215,6 +220,7 @@ class System:
         self._build_options: Dict[str, Any] = {
             "correct": correct, "hold": hold if hold is None or isinstance(hold, str) else list(hold),
             "position_tol": position_tol, "velocity_tol": velocity_tol, "max_iterations": max_iterations, "t0": t0,
+            "max_wall_time": max_wall_time,
         }
         self._settings: Dict[str, tuple] = {}
         self._core_options: Dict[str, Any] = {"uk_solver": uk_solver, "memory_limit": memory_limit}
@@ -244,7 +250,7 @@ class System:
             self._tol_note = (f" = {self.RESOLUTION:g} of the scene's length scale {scale:.3g} m"
                               if tol < float(position_tol) else "")
             self.q0, self.qd0, self.initial_correction = self._correct(
-                self.q_guess, self.qd_guess, hold, tol, velocity_tol, max_iterations
+                self.q_guess, self.qd_guess, hold, tol, velocity_tol, max_iterations, max_wall_time
             )
         else:
             self.q0, self.qd0 = self.q_guess.copy(), self.qd_guess.copy()
@@ -366,9 +372,14 @@ class System:
 
     @property
     def n_dof(self) -> int:
-        """``n - rank(A(q0))``: degrees of freedom at the initial state."""
+        """``n - rank(A(q0))``: degrees of freedom at the initial state (above
+        :attr:`SPARSE_MODES_MIN` coordinates the rank of the UK solve at the initial state:
+        the sparse path's certified full rank, or the dense rank-revealing fallback's)."""
         if self.n_constraints == 0:
             return self.n_coords
+        if self.n_coords >= self.SPARSE_MODES_MIN:
+            info = self.core.rank_info(self.t0, self.q0, self.qd0, exact=False)
+            return self.n_coords - int(info["rank"])
         return self.n_coords - int(np.linalg.matrix_rank(self.A(self.q0)))
 
     def __repr__(self) -> str:
@@ -445,12 +456,28 @@ class System:
         M = self.M(self.q0 if q is None else np.asarray(q, dtype=float))
         return M[sl, sl]
 
+    def M_sparse(self, q: Optional[np.ndarray] = None):
+        """The mass matrix at ``q`` (default ``q0``) as a ``scipy.sparse`` CSR array (n, n): the
+        body blocks, no dense ``n x n`` allocation."""
+        from scipy.sparse import coo_array
+
+        n = self.n_coords
+        r, c, v = self.core.M_sparse(np.ascontiguousarray(self.q0 if q is None else q, dtype=float))
+        return coo_array((np.asarray(v), (np.asarray(r), np.asarray(c))), shape=(n, n)).tocsr()
+
+    #: from this many coordinates on, ``frequencies(count=k)``, ``max_frequency`` and ``n_dof``
+    #: take the sparse path (sparse linearization, shift-invert Lanczos, the UK solve's rank):
+    #: measured crossover, docs/scale.md
+    SPARSE_MODES_MIN = 64
+
     def frequencies(
         self,
         t: Optional[float] = None,
         q: Optional[np.ndarray] = None,
         qd: Optional[np.ndarray] = None,
         modes: bool = False,
+        count: Optional[int] = None,
+        deadline: Optional[float] = None,
     ):
         """Natural frequencies [rad/s] of the constrained system linearized at a state.
 
@@ -465,19 +492,31 @@ class System:
         constrained modal analysis; on a moving state (a driven crank) the centrifugal stiffening
         at that state is included.
 
+        With ``count=k`` only the ``k`` modes nearest zero (the slowest; ascending).  From
+        :attr:`SPARSE_MODES_MIN` coordinates on (and ``k`` below half the degrees of freedom)
+        they come without a dense eigenproblem: the core's sparse linearization (coloured
+        differences, O(n); the same stiffness on the tangent space) and shift-invert Lanczos
+        with a sparse saddle-point factorization (:mod:`ukflex.modes`).  All modes of a system
+        that large are dense work: its ``n x n`` arrays are checked against ``memory_limit``.
+
         Parameters
         ----------
         t, q, qd : optional
             The state; default the system's initial state ``t0, q0, qd0``.
         modes : bool
             Also return the mode shapes in ``q`` coordinates.
+        count : int, optional
+            Only the ``count`` modes nearest zero.
+        deadline : float, optional
+            A ``time.perf_counter()`` value: past it :class:`ukflex.modes.BudgetExceeded` is
+            raised naming the stage (``simulate``'s ``max_wall_time`` for ``method="auto"``).
 
         Returns
         -------
         omega : ndarray (k,)
-            ``k = n - rank(A)`` frequencies in ascending order, ``omega = sign(lam) sqrt(|lam|)``
-            for the eigenvalues ``lam`` of the reduced problem: a negative value is an unstable
-            (divergent) direction, ~0 a free rigid-body motion.
+            ``k = n - rank(A)`` frequencies (or ``count``) in ascending order,
+            ``omega = sign(lam) sqrt(|lam|)`` for the eigenvalues ``lam`` of the reduced problem:
+            a negative value is an unstable (divergent) direction, ~0 a free rigid-body motion.
         shapes : ndarray (n, k), only with ``modes=True``
             Mass-normalized (``shapes.T @ M @ shapes = I``) mode shapes.
         """
@@ -490,16 +529,69 @@ class System:
         for name, v in (("q", q), ("qd", qd)):
             if v.shape != (n,):
                 raise ValueError(f"{name}: expected shape ({n},), got {v.shape}")
-        jac = np.asarray(self.core.jac(t, np.concatenate([q, qd]), "central"))
-        Jq = jac[n:, :n]
-        M = np.asarray(self.M(q))
-        N = null_space(np.asarray(self.A(q))) if self.n_constraints else np.eye(n)
-        Mr = N.T @ M @ N
-        Kr = -(N.T @ (M @ Jq) @ N)
+        if count is not None:
+            count = int(count)
+            if count < 1:
+                raise ValueError(f"count must be at least 1, got {count}")
+        large = n >= self.SPARSE_MODES_MIN
+        if large and count is not None:
+            from . import modes as _modes
+
+            n_dof = n - _modes._rank(self, t, q, qd)
+            if 2 * count < n_dof:
+                return _modes.lowest_modes(self, t, q, qd, count, modes=modes, deadline=deadline)
+        if large:
+            # every mode (or most of them) of a large system: dense eigenproblem on the sparse
+            # linearization (no 4n UK calls of differences); its n x n arrays checked first
+            from . import modes as _modes
+
+            self._check_dense("the dense modal analysis (n x n arrays)", 6 * 8 * n * n)
+            Ms, Ks, As, _ = _modes.linearization(self, t, q, qd)
+            M = Ms.toarray()
+            N = null_space(As.toarray()) if self.n_constraints else np.eye(n)
+            Mr = N.T @ M @ N
+            Kr = N.T @ (Ks @ N)
+        else:
+            jac = np.asarray(self.core.jac(t, np.concatenate([q, qd]), "central"))
+            Jq = jac[n:, :n]
+            M = np.asarray(self.M(q))
+            N = null_space(np.asarray(self.A(q))) if self.n_constraints else np.eye(n)
+            Mr = N.T @ M @ N
+            Kr = -(N.T @ (M @ Jq) @ N)
         Kr = 0.5 * (Kr + Kr.T)
         lam, V = eigh(Kr, 0.5 * (Mr + Mr.T))
         omega = np.sign(lam) * np.sqrt(np.abs(lam))
+        if count is not None and count < omega.size:
+            keep = np.sort(np.argsort(np.abs(omega), kind="stable")[:count])
+            omega, V = omega[keep], V[:, keep]
         return (omega, N @ V) if modes else omega
+
+    def max_frequency(self, t: Optional[float] = None, q: Optional[np.ndarray] = None,
+                      qd: Optional[np.ndarray] = None, deadline: Optional[float] = None) -> float:
+        """The fastest natural frequency ``omega_max`` [rad/s] of the constrained system
+        linearized at a state (default the initial state): below :attr:`SPARSE_MODES_MIN`
+        coordinates the largest ``|omega|`` of :meth:`frequencies`; above, Lanczos on the sparse
+        linearization in the constraints' tangent space (:func:`ukflex.modes.max_frequency`: an
+        estimate from below, within 1e-3 on the scenes measured, docs/scale.md)."""
+        t = self.t0 if t is None else float(t)
+        q = self.q0 if q is None else np.asarray(q, dtype=float)
+        qd = self.qd0 if qd is None else np.asarray(qd, dtype=float)
+        if self.n_coords >= self.SPARSE_MODES_MIN:
+            from . import modes as _modes
+
+            return abs(_modes.max_frequency(self, t, q, qd, deadline=deadline))
+        omega = self.frequencies(t, q, qd)
+        return float(np.abs(omega).max()) if omega.size else 0.0
+
+    def _check_dense(self, what: str, nbytes: float) -> None:
+        """Refuse a dense Python-side allocation above the System's ``memory_limit``."""
+        from .errors import MemoryLimitError
+
+        limit = int(self.core.memory_limit)
+        if nbytes > limit:
+            raise MemoryLimitError(
+                f"{what} needs about {nbytes / 2**20:.1f} MiB, above the memory limit of {limit / 2**20:.1f} MiB; "
+                "ask for the lowest modes only (count=k: sparse), or raise memory_limit")
 
     def equilibrium(
         self,
@@ -552,24 +644,30 @@ class System:
         if not (tol > 0 and math.isfinite(tol)) or int(max_iterations) < 1:
             raise ValueError(f"tol must be positive and max_iterations >= 1, got {tol!r}, {max_iterations!r}")
         zero = np.zeros(n)
-        lam = np.zeros(m)
+        if n >= self.SPARSE_MODES_MIN:
+            residual, step_of, lam = self._equilibrium_sparse_parts(t, q)
+        else:
+            lam = np.zeros(m)
 
-        def residual(q, lam):
-            A = np.asarray(self.A(q)).reshape(m, n)
-            return np.concatenate([np.asarray(self.Q(t, q, zero)) - A.T @ lam, np.asarray(self.phi(t, q))])
+            def residual(q, lam):
+                A = np.asarray(self.A(q)).reshape(m, n)
+                return np.concatenate([np.asarray(self.Q(t, q, zero)) - A.T @ lam, np.asarray(self.phi(t, q))])
+
+            def step_of(q, lam, r):
+                J = np.zeros((n + m, n + m))
+                for j in range(n):
+                    h = 1e-6 * max(1.0, abs(q[j]))
+                    qp, qm = q.copy(), q.copy()
+                    qp[j] += h
+                    qm[j] -= h
+                    J[:, j] = (residual(qp, lam) - residual(qm, lam)) / (2.0 * h)
+                A = np.asarray(self.A(q)).reshape(m, n)
+                J[:n, n:] = -A.T
+                return np.linalg.lstsq(J, -r, rcond=None)[0]
 
         r = residual(q, lam)
         for it in range(1, int(max_iterations) + 1):
-            J = np.zeros((n + m, n + m))
-            for j in range(n):
-                h = 1e-6 * max(1.0, abs(q[j]))
-                qp, qm = q.copy(), q.copy()
-                qp[j] += h
-                qm[j] -= h
-                J[:, j] = (residual(qp, lam) - residual(qm, lam)) / (2.0 * h)
-            A = np.asarray(self.A(q)).reshape(m, n)
-            J[:n, n:] = -A.T
-            step = np.linalg.lstsq(J, -r, rcond=None)[0]
+            step = step_of(q, lam, r)
             alpha, norm0 = 1.0, np.linalg.norm(r)
             while True:  # backtracking on |R|
                 q_new, lam_new = q + alpha * step[:n], lam + alpha * step[n:]
@@ -591,6 +689,46 @@ class System:
             f"max |Q - A^T lambda| = {np.max(np.abs(r[:n]), initial=0.0):.3e}, max |Phi| = "
             f"{np.max(np.abs(r[n:]), initial=0.0):.3e} (a scene without a static equilibrium, e.g. a free body "
             "under gravity, or a start too far from it)")
+
+    def _equilibrium_sparse_parts(self, t: float, q: np.ndarray):
+        """``equilibrium`` above :attr:`SPARSE_MODES_MIN` coordinates: ``(residual, step,
+        lam0)`` for the same Newton iteration and line search, with the sparse tangent
+        ``[-K, -A^T; A, 0]`` (``K = -d/dq (Q - A^T lambda)`` at the iterate's multipliers: the
+        core's coloured differences, O(n)) and a sparse LU.  The multipliers start from the UK
+        solution at rest (the constraint forces that hold the start; from zero, a mechanism
+        whose links carry their weight only through its joints has a singular first tangent,
+        which the dense path passes with a least-squares step); a tangent still exactly singular
+        is shifted by 1e-10 of its scale on the stiffness block and 1e-12 on the multiplier
+        block."""
+        from scipy.sparse import bmat, coo_array, identity
+        from scipy.sparse.linalg import splu
+
+        n, m = self.n_coords, self.n_constraints
+        zero = np.zeros(n)
+
+        def parts(q, lam, stiffness):
+            lin = self.core.linearization(t, q, zero, zero, lam, stiffness)
+            A = coo_array((np.asarray(lin["A"]), (np.asarray(lin["a_rows"]), np.asarray(lin["a_cols"]))), shape=(m, n)).tocsr()
+            K = coo_array((np.asarray(lin["K"]), (np.asarray(lin["rows"]), np.asarray(lin["cols"]))), shape=(n, n)).tocsc()
+            return A, K
+
+        def residual(q, lam):
+            A, _ = parts(q, lam, False)
+            return np.concatenate([np.asarray(self.Q(t, q, zero)) - A.T @ lam, np.asarray(self.phi(t, q))])
+
+        def step_of(q, lam, r):
+            A, K = parts(q, lam, True)
+            J = bmat([[-K, -A.T], [A, None]], format="csc") if m else (-K).tocsc()
+            try:
+                return splu(J).solve(-r)
+            except RuntimeError:  # exactly singular: a neutral direction or redundant rows
+                scale = max(float(abs(K).max()) if K.nnz else 0.0, float(abs(A).max()) if A.nnz else 0.0, 1e-300)
+                shift = -K - 1e-10 * scale * identity(n)
+                Js = bmat([[shift, -A.T], [A, -1e-12 * scale * identity(m)]], format="csc") if m else shift.tocsc()
+                return splu(Js).solve(-r)
+
+        lam = np.asarray(self.multipliers(t, q, zero), dtype=float) if m else np.zeros(0)
+        return residual, step_of, lam
 
     # ------------------------------------------------------------------------------ correction
     @staticmethod
@@ -712,10 +850,10 @@ class System:
             "and their units"
         )
 
-    def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations):
+    def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations, max_wall_time=None):
         held = self._held_mask(hold)
         c = self.core.correct(self.t0, q_guess, qd_guess, [bool(h) for h in held], position_tol=position_tol,
-                              velocity_tol=velocity_tol, max_iterations=max_iterations)
+                              velocity_tol=velocity_tol, max_iterations=max_iterations, max_wall_time=max_wall_time)
         if not c["positions_ok"]:
             phi = np.asarray(c["phi"])
             raise InconsistentInitialStateError(

@@ -27,6 +27,7 @@ create_exception!(ukflex, NonFiniteError, UkflexError, "An input array holds NaN
 create_exception!(ukflex, SolverError, UkflexError, "A solver kernel failed.");
 create_exception!(ukflex, ExpressionError, InvalidSceneError, "A driver's motion expression does not parse; `position` is the 0-based character index.");
 create_exception!(ukflex, MemoryLimitError, UkflexError, "An allocation would exceed the System's memory limit (refused before allocating).");
+create_exception!(ukflex, BudgetError, SolverError, "A work budget (max_wall_time, ...) ran out before the work was done (e.g. the initial-state correction of a build).");
 
 /// A 1-D float64 input. float64 vectors (what scipy passes) are read in place, strided or
 /// not; anything else array-like is converted once with `numpy.asarray(x, dtype=float64)`, and
@@ -98,7 +99,8 @@ pub(crate) fn to_py(e: Error) -> PyErr {
         Error::Shape { .. } | Error::Argument { .. } => PyValueError::new_err(msg),
         Error::NonFinite { .. } => NonFiniteError::new_err(msg),
         Error::SingularMass { .. } => SingularMassError::new_err(msg),
-        Error::Solver(_) | Error::Budget { .. } | Error::Drift { .. } => SolverError::new_err(msg),
+        Error::Solver(_) | Error::Drift { .. } => SolverError::new_err(msg),
+        Error::Budget { .. } => BudgetError::new_err(msg),
         Error::Expression { text, position, .. } => Python::attach(|py| {
             let err = ExpressionError::new_err(msg);
             let v = err.value(py);
@@ -207,6 +209,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("PROJECTION_PER_ATOL", crate::integrate::PROJECTION_PER_ATOL)?;
     m.add("PROJECTION_MOVE_LIMIT", crate::integrate::PROJECTION_MOVE_LIMIT)?;
     m.add_function(wrap_pyfunction!(normal_weight, m)?)?;
+    m.add("BudgetError", py.get_type::<BudgetError>())?;
     Ok(())
 }
 

@@ -17,7 +17,7 @@ use crate::data::{Data, RankTolerance, Stabilization, SvdBackend, UkSolver};
 use crate::dynamics;
 use crate::error::Error;
 use crate::integrate::singular::{Passage, SingularMonitor};
-use crate::integrate::{integrate_uk, Method, Options, UkSystem};
+use crate::integrate::{integrate_uk, LinearSolver, Method, NewtonMatrices, Options, UkSystem};
 use crate::jacobian::{assemble_first_order, Differences, JacobianWorkspace};
 use crate::model::Model;
 use crate::sensors;
@@ -112,6 +112,12 @@ impl PySystem {
 
     fn body_names(&self) -> Vec<String> {
         self.model.bodies.iter().map(|b| b.name.clone()).collect()
+    }
+
+    /// Refuse a dense `count` arrays of `k x k` above the memory limit (before allocating).
+    fn check_square(&self, what: &str, k: usize, count: u64, hint: &str) -> PyResult<()> {
+        let limit = self.with_ws(|_, ws| Ok(ws.data.memory_limit))?;
+        Error::check_memory(what, 8 * count * (k as u64) * (k as u64), limit, hint).map_err(to_py)
     }
 }
 
@@ -209,6 +215,7 @@ impl PySystem {
     #[allow(non_snake_case)]
     fn M<'py>(&self, py: Python<'py>, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.model.n;
+        self.check_square("System.M (dense n x n)", n, 1, "M is n x n dense; use System.M_sparse (scipy.sparse), or raise memory_limit")?;
         let m = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
             dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
@@ -217,6 +224,94 @@ impl PySystem {
             Ok(m)
         })?;
         mat(py, m, n, n)
+    }
+
+    /// The mass matrix M(q) in coordinate form: (rows, cols, values), the entries of the body
+    /// blocks (O(nnz), no n x n allocation; `scipy.sparse.coo_array((v, (r, c)), (n, n))`).
+    #[allow(non_snake_case)]
+    #[allow(clippy::type_complexity)]
+    fn M_sparse<'py>(&self, py: Python<'py>, q: Vector<'py>) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>)> {
+        let (r, c, v) = self.with_ws(|model, ws| {
+            Self::load(ws, &q, None)?;
+            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            let (mut r, mut c, mut v) = (Vec::new(), Vec::new(), Vec::new());
+            for (body, bd) in model.bodies.iter().zip(&ws.data.bodies) {
+                let o = body.offset as i64;
+                body.dense_block(bd, &mut |i, j, x| {
+                    if x != 0.0 {
+                        r.push(o + i as i64);
+                        c.push(o + j as i64);
+                        v.push(x);
+                    }
+                });
+            }
+            finite_out("M(q)", &v)?;
+            Ok((r, c, v))
+        })?;
+        Ok((PyArray1::from_vec(py, r), PyArray1::from_vec(py, c), PyArray1::from_vec(py, v)))
+    }
+
+    /// The constrained linearization at (t, q, qd) in sparse form, for the modal analysis
+    /// (`System.frequencies`): a dict with rows, cols (the coordinate pattern: bodies, forces,
+    /// the coordinates of each constraint row), M and K there (K = -d/dq (Q - M qdd -
+    /// A^T lambda) at the UK acceleration and multipliers of the state, central differences
+    /// coloured by the pattern: O(n)), a_rows, a_cols, A (the structural entries of A), qdd,
+    /// lambda, and colors (difference pairs used). On the constraints' tangent space K is the
+    /// stiffness of the dense modal analysis, `-N^T M dqdd/dq N`. With `qdd` and `lam` given,
+    /// those are held instead of the UK solution's (`System.equilibrium`: zero and the Newton
+    /// iterate); `stiffness=False` skips K (then all zero): M and A alone, one evaluation.
+    #[pyo3(signature = (t, q, qd, qdd=None, lam=None, stiffness=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn linearization<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, qdd: Option<Vector<'py>>, lam: Option<Vector<'py>>, stiffness: bool) -> PyResult<Bound<'py, PyDict>> {
+        use crate::sparse_newton::{fill_a, fill_linearized_stiffness, fill_mass, Pattern, Structure};
+        let (n, m) = (self.model.n, self.model.m);
+        let mut held = (vec![0.0; n], vec![0.0; m]);
+        match (&qdd, &lam) {
+            (Some(a), Some(l)) => {
+                read_into("qdd", &a.as_array(), &mut held.0).map_err(to_py)?;
+                read_into("lam", &l.as_array(), &mut held.1).map_err(to_py)?;
+            }
+            (None, None) => {}
+            _ => return Err(PyValueError::new_err("linearization: give both qdd and lam, or neither (the UK solution at the state)")),
+        }
+        let given = qdd.is_some();
+        let out = self.with_ws(|model, ws| {
+            check_time(t)?;
+            Self::load(ws, &q, Some(&qd))?;
+            let p = Pattern::new(model, &ws.data.ajac, true, ws.data.memory_limit)?;
+            let (qdd, lambda) = if given {
+                crate::uk::evaluate(model, &mut ws.data, t, &ws.q, &ws.qd, false)?;
+                held
+            } else {
+                uk::acceleration(model, &mut ws.data, t, &ws.q, &ws.qd)?;
+                (ws.data.qdd.clone(), ws.data.lambda.clone())
+            };
+            let mut s = Structure::new(p);
+            fill_mass(model, &ws.data, &mut s);
+            fill_a(&ws.data, &mut s);
+            let (mut qv, mut f, mut k) = (vec![0.0; n], vec![0.0; n], vec![0.0; s.pattern.nnz()]);
+            if stiffness {
+                fill_linearized_stiffness(model, &mut ws.data, t, &ws.q, &ws.qd, &qdd, &lambda, &s.pattern, &mut qv, &mut f, &mut k);
+                finite_out("the linearized stiffness", &k)?;
+            }
+            Ok((s, k, qdd, lambda))
+        })?;
+        let (s, k, qdd, lambda) = out;
+        let p = &s.pattern;
+        let (rows, cols): (Vec<i64>, Vec<i64>) = p.entries().map(|(i, j)| (i as i64, j as i64)).unzip();
+        let (ar, ac): (Vec<i64>, Vec<i64>) = p.a_entries().map(|(r, j)| (r as i64, j as i64)).unzip();
+        let d = PyDict::new(py);
+        d.set_item("rows", PyArray1::from_vec(py, rows))?;
+        d.set_item("cols", PyArray1::from_vec(py, cols))?;
+        d.set_item("colors", p.colors())?;
+        d.set_item("a_rows", PyArray1::from_vec(py, ar))?;
+        d.set_item("a_cols", PyArray1::from_vec(py, ac))?;
+        d.set_item("M", PyArray1::from_vec(py, s.m))?;
+        d.set_item("K", PyArray1::from_vec(py, k))?;
+        d.set_item("A", PyArray1::from_vec(py, s.a))?;
+        d.set_item("qdd", PyArray1::from_vec(py, qdd))?;
+        d.set_item("lambda", PyArray1::from_vec(py, lambda))?;
+        Ok(d)
     }
 
     /// Generalized forces Q(t, q, qd) = applied + quadratic velocity + elastic, shape (n,).
@@ -560,7 +655,7 @@ impl PySystem {
     /// or a dict cause, t, stage, index), nfev, njev, nlu, naccept, nreject, jac_evals (UK calls
     /// inside Jacobians), wall_time [s], dense (None, or a dict meta (nseg, 3), data
     /// (nseg, width), part_len).
-    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=None, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None, drift_limit=None, on_drift="stop", monitor_singular=true))]
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=None, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None, linear_solver="auto", drift_limit=None, on_drift="stop", monitor_singular=true))]
     #[allow(clippy::too_many_arguments)]
     fn integrate<'py>(
         &self,
@@ -584,10 +679,12 @@ impl PySystem {
         min_step: f64,
         dense: bool,
         newton_local_error: Option<f64>,
+        linear_solver: &str,
         drift_limit: Option<f64>,
         on_drift: &str,
         monitor_singular: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let linear_solver = LinearSolver::parse(linear_solver).map_err(to_py)?;
         let jacobian = match jacobian {
             "central" => Differences::Central,
             "forward" => Differences::Forward,
@@ -634,6 +731,7 @@ impl PySystem {
             max_nfev: max_nfev.unwrap_or(usize::MAX),
             max_wall_time: max_wall_time.unwrap_or(f64::INFINITY),
             min_step,
+            linear_solver,
             drift_limit: drift_limit.unwrap_or(f64::INFINITY),
             stop_on_drift,
             monitor_singular,
@@ -649,16 +747,33 @@ impl PySystem {
         let (tolerance, stabilization, backend, solver, limit) =
             self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.stabilization, ws.data.svd_backend, ws.data.uk_solver, ws.data.memory_limit)))?;
         let model = &self.model;
+        // the run's own workspace (built before releasing the GIL so that a refusal is an error)
+        let data = Data::build(model, solver, limit).map_err(to_py)?;
+        // GENALPHA and RADAU5M: the sparse Newton matrices where they pay (or when asked for),
+        // decided here so that the dense ones are refused before the run when too large
+        let mut opts = opts;
+        if let Method::GenAlpha(_) | Method::RadauM(_) = method {
+            opts.linear_solver = NewtonMatrices::resolve(model, &data, linear_solver, matches!(method, Method::RadauM(_))).map_err(to_py)?;
+        }
+        if method == Method::Radau5 {
+            // with the structured Jacobian RADAU5 solves its iteration matrices as saddle points
+            opts.linear_solver = match jacobian {
+                Differences::Structured => NewtonMatrices::resolve(model, &data, linear_solver, true).map_err(to_py)?,
+                _ if linear_solver == LinearSolver::Sparse => {
+                    return Err(PyValueError::new_err("linear_solver='sparse' with RADAU5 needs jacobian='structured' (a difference Jacobian is dense)"));
+                }
+                _ => LinearSolver::Dense,
+            };
+        }
         let implicit = match method {
             Method::Dopri5 => 0,
+            _ if opts.linear_solver == LinearSolver::Sparse => 0,
             Method::Radau5 => implicit_bytes(model, "RADAU5"),
             Method::GenAlpha(_) => implicit_bytes(model, "GENALPHA"),
             Method::RadauM(_) => implicit_bytes(model, "RADAU5M"),
         };
-        let hint = "implicit methods factor dense n x n matrices; use method='DOPRI5' for a system this large, or raise memory_limit";
+        let hint = "implicit methods factor dense n x n matrices here; use method='DOPRI5' for a system this large, linear_solver='sparse', or raise memory_limit";
         Error::check_memory("the implicit integrator's n x n matrices", implicit, limit, hint).map_err(to_py)?;
-        // the run's own workspace (built before releasing the GIL so that a refusal is an error)
-        let data = Data::build(model, solver, limit).map_err(to_py)?;
         let result = py.detach(|| {
             catch_unwind(AssertUnwindSafe(|| {
                 let mut data = data;
@@ -729,6 +844,35 @@ impl PySystem {
             }
         }
         Ok(d)
+    }
+
+    /// For each column `v` of `shapes` (n, k): `1/2 v^T K_m v` summed over the bodies' material
+    /// stiffness (the strain energy of the motion's first-order strains, no stress terms) and the
+    /// springs (`Body::material_energy`, `Force::material_energy`), at `q`. Of a mass-normalized
+    /// mode of frequency `omega`, `2 E / omega^2` is the share of its stiffness that is elastic
+    /// (`ukflex.choice`).
+    fn material_energies<'py>(&self, py: Python<'py>, q: Vector<'py>, shapes: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.model.n;
+        let mut qv = vec![0.0; n];
+        read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
+        let sa = shapes.as_array();
+        if sa.shape()[0] != n {
+            return Err(PyValueError::new_err(format!("material_energies: expected shapes of shape ({n}, k), got {:?}", sa.shape())));
+        }
+        let k = sa.shape()[1];
+        let mut v = vec![0.0; n];
+        let mut out = Vec::with_capacity(k);
+        for j in 0..k {
+            for i in 0..n {
+                v[i] = sa[[i, j]];
+            }
+            crate::error::check_finite("shapes", &v).map_err(to_py)?;
+            let bodies: f64 = self.model.bodies.iter().map(|b| b.material_energy(&qv, &v)).sum();
+            let springs: f64 = self.model.forces.iter().map(|f| f.material_energy(&self.model.bodies, &qv, &v)).sum();
+            out.push(bodies + springs);
+        }
+        finite_out("material_energies", &out).map_err(to_py)?;
+        Ok(PyArray1::from_vec(py, out))
     }
 
     /// The singular passages of a trajectory of accepted states (times `t` (k,), states `y`
@@ -928,6 +1072,7 @@ impl PySystem {
             BodyKind::Beam(beam) => beam,
             BodyKind::AncfBeam(cable) => {
                 let nb = b.n_coords;
+                self.check_square("System.beam_matrices (two dense n_b x n_b)", nb, 2, "raise memory_limit")?;
                 let mut m = vec![0.0; nb * nb];
                 cable.dense_block(&Default::default(), &mut |i, j, v| m[i * nb + j] = v);
                 let mut k = Banded::zeros(nb, ancf_cable::HB);
@@ -937,6 +1082,7 @@ impl PySystem {
             _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam"))),
         };
         let nf = beam.n_f;
+        self.check_square("System.beam_matrices (two dense n_f x n_f)", nf, 2, "raise memory_limit")?;
         Ok((mat(py, beam.m_ff.to_dense(), nf, nf)?, mat(py, beam.k_ff.to_dense(), nf, nf)?))
     }
 
@@ -966,6 +1112,9 @@ impl PySystem {
         let nb = b.n_coords;
         let mut qv = vec![0.0; self.model.n];
         read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
+        if matches!(b.kind, BodyKind::AncfBeam(_) | BodyKind::Beam(_) | BodyKind::Flexible(_)) {
+            self.check_square("System.tangent_stiffness (dense n_b x n_b)", nb, 1, "raise memory_limit")?;
+        }
         let k = match &b.kind {
             BodyKind::AncfBeam(cable) => {
                 let mut k = Banded::zeros(nb, ancf_cable::HB);
@@ -1216,9 +1365,13 @@ impl PySystem {
     /// projection (the initial-state correction). Returns a dict: q, qd, iterations,
     /// position_residual_before/after, velocity_residual_before/after (NaN when the positions
     /// failed), phi (m,), velocity (m,), positions_ok, velocities_ok.
-    #[pyo3(signature = (t, q, qd, hold, position_tol=1e-12, velocity_tol=1e-10, max_iterations=50))]
+    #[pyo3(signature = (t, q, qd, hold, position_tol=1e-12, velocity_tol=1e-10, max_iterations=50, max_wall_time=None))]
     #[allow(clippy::too_many_arguments)]
-    fn correct<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize) -> PyResult<Bound<'py, PyDict>> {
+    fn correct<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize, max_wall_time: Option<f64>) -> PyResult<Bound<'py, PyDict>> {
+        let max_wall_time = max_wall_time.unwrap_or(f64::INFINITY);
+        if !(max_wall_time > 0.0) {
+            return Err(PyValueError::new_err(format!("max_wall_time must be positive, got {max_wall_time}")));
+        }
         for (what, v) in [("position_tol", position_tol), ("velocity_tol", velocity_tol)] {
             if !(v > 0.0) || !v.is_finite() {
                 return Err(PyValueError::new_err(format!("{what} must be positive and finite, got {v}")));
@@ -1229,7 +1382,7 @@ impl PySystem {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
             let (qv, qdv) = (ws.q.clone(), ws.qd.clone());
-            correct::correct(model, &mut ws.data, t, &qv, &qdv, &opts)
+            correct::correct_within(model, &mut ws.data, t, &qv, &qdv, &opts, max_wall_time)
         })?;
         let d = PyDict::new(py);
         d.set_item("q", PyArray1::from_vec(py, c.q))?;

@@ -43,6 +43,15 @@ pub const BENDING_RULE: [(f64, f64); 2] = {
     [(0.5 - A, 0.5), (0.5 + A, 0.5)]
 };
 
+/// Which element matrix `AncfCable::visit_matrices` visits: the tangent stiffness, the strain-rate
+/// damping (`beta` times the material part) or the material part alone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Part {
+    Tangent,
+    Damping,
+    Material,
+}
+
 /// Hermite shape functions of an element of length `l` at local `s`: values, `d/dx`, `d2/dx2`.
 #[inline]
 pub fn hermite(s: f64, l: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
@@ -350,10 +359,25 @@ impl AncfCable {
         self.visit_element_matrices(q, damping, &mut |i, j, v| out.add(i, j, v));
     }
 
+    /// `1/2 v^T K_m v` with the material stiffness `K_m = EA grad eps grad eps^T +
+    /// EI grad K grad K^T` at `q` (the tangent stiffness without its stress terms): the strain
+    /// energy of the first-order strains of the motion `v` (zero for a rigid motion, whatever
+    /// the axial force).
+    pub fn material_energy(&self, q: &[f64], v: &[f64]) -> f64 {
+        let mut e = 0.0;
+        self.visit_matrices(q, Part::Material, &mut |i, j, k| e += v[i] * k * v[j]);
+        0.5 * e
+    }
+
     /// The element stiffness (or damping) matrices at `q`, entry by entry: `put(i, j, v)` in body
     /// coordinates (repeated indices add up). Allocation free.
     pub fn visit_element_matrices(&self, q: &[f64], damping: bool, put: &mut impl FnMut(usize, usize, f64)) {
-        let scale = if damping { self.damping } else { 1.0 };
+        self.visit_matrices(q, if damping { Part::Damping } else { Part::Tangent }, put)
+    }
+
+    fn visit_matrices(&self, q: &[f64], part: Part, put: &mut impl FnMut(usize, usize, f64)) {
+        let damping = part != Part::Tangent;
+        let scale = if part == Part::Damping { self.damping } else { 1.0 };
         for el in 0..self.elements {
             let e = &q[4 * el..4 * el + 8];
             let mut ke = [[0.0; 8]; 8];

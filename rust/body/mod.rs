@@ -124,6 +124,17 @@ impl Body {
         }
     }
 
+    /// Half-bandwidth, in body coordinates, of the body's own blocks of `M`, `K = -dQ/dq` and
+    /// `C = -dQ/dqd` (entries `(i, j)` with `|i - j|` above it are zero): an ANCF cable's are
+    /// element-coupled (`ancf_cable::HB`), every other kind's dense. The structural pattern of
+    /// the implicit methods' sparse Newton matrices (`sparse_newton`).
+    pub fn coupling_halfwidth(&self) -> usize {
+        match &self.kind {
+            BodyKind::AncfBeam(_) => ancf_cable::HB.min(self.n_coords.saturating_sub(1)),
+            _ => self.n_coords.saturating_sub(1),
+        }
+    }
+
     /// Number of elastic coordinates.
     pub fn n_f(&self) -> usize {
         self.elastic_range().len()
@@ -297,6 +308,20 @@ impl Body {
         }
     }
 
+    /// `1/2 v^T K_m v`: the strain energy of the first-order strains of a motion `v` (whole
+    /// `n`-vector) at `q`, with the material stiffness alone (no stress terms: a rigid motion of a
+    /// stressed cable stores none; zero for rigid kinds). Tells elastic modes from rigid ones
+    /// alike for every flexible kind (`System.material_energies`).
+    pub fn material_energy(&self, q: &[f64], v: &[f64]) -> f64 {
+        let vb = self.seg(v);
+        match &self.kind {
+            BodyKind::Beam(k) => 0.5 * k.k_ff.bilinear(&vb[3..], &vb[3..]),
+            BodyKind::Flexible(k) => 0.5 * k.k_ff.bilinear(&vb[3..3 + k.n_f], &vb[3..3 + k.n_f]),
+            BodyKind::AncfBeam(k) => k.material_energy(self.seg(q), vb),
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) => 0.0,
+        }
+    }
+
     /// Potential of gravity `-g . int rho r dV`.
     pub fn gravity_energy(&self, q: &[f64], g: [f64; 2]) -> f64 {
         let qb = self.seg(q);
@@ -416,6 +441,18 @@ impl Marker {
     /// A marker fixed in the world frame.
     pub fn ground(point: [f64; 2], angle: f64) -> Marker {
         Marker { body: None, angle, shape: MarkerShape::Ground(point) }
+    }
+
+    /// The body and the range of its body coordinates this marker's position, angle and their
+    /// rates depend on (`None`: the ground): an ANCF cable marker its element's eight
+    /// coordinates, a marker on any other kind all of its body's. The structural pattern of the
+    /// constraint rows and forces that use it (`sparse_newton`).
+    pub fn coords(&self, bodies: &[Body]) -> Option<(usize, std::ops::Range<usize>)> {
+        let bi = self.body?;
+        Some(match &self.shape {
+            MarkerShape::Cable(p) => (bi, p.first..p.first + 8),
+            _ => (bi, 0..bodies[bi].n_coords),
+        })
     }
 
     /// Whether the marker frame can rotate with its body (false for the ground and particles,

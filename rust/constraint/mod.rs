@@ -174,6 +174,21 @@ impl Constraint {
         }
     }
 
+    /// The markers of this constraint's rows (`None`: an unused slot). Each row is a function
+    /// of their states only, so its entries lie in their coordinates (`Marker::coords`): the
+    /// structural pattern of `A` and `db/dqd` (`sparse_newton`).
+    pub fn markers(&self) -> [Option<&Marker>; 2] {
+        match &self.kind {
+            ConstraintKind::Revolute(c) => [Some(&c.a), Some(&c.b)],
+            ConstraintKind::PointOnLine(c) => [Some(&c.point), Some(&c.line)],
+            ConstraintKind::Prismatic(c) => [Some(&c.a), Some(&c.b)],
+            ConstraintKind::Weld(c) => [Some(&c.a), Some(&c.b)],
+            ConstraintKind::Distance(c) => [Some(&c.a), Some(&c.b)],
+            ConstraintKind::AngleDriver(c) => [Some(&c.a), Some(&c.b)],
+            ConstraintKind::CoordinateDriver(c) => [Some(&c.point), None],
+        }
+    }
+
     /// Name suffix of each row (`""` for single-row kinds).
     pub fn row_suffixes(&self) -> &'static [&'static str] {
         match &self.kind {

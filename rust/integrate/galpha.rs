@@ -47,7 +47,7 @@
 //! positions `h^2 |beta - 1/6| |a_{n+1} - a_n|` (Zienkiewicz & Xie 1991) against
 //! `atol + rtol |q|`. Dense output: the cubic Hermite interpolant of `(q, qd)` at both ends.
 
-use super::lu::{inv_solve, inverse_from_lu_cm, lu_cm, lu_cm_solve};
+use super::newton::NewtonMatrices;
 use super::{acc_and_multipliers, fixed_step_count, initial_step_second_order, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::correct::ProjectionTolerance;
 use crate::error::{Error, Result};
@@ -85,12 +85,6 @@ impl Default for GenAlphaOptions {
 /// Keep the factored iteration matrix for the next step while Newton contracts at least this
 /// well with it (the stiff directions turn with the bodies, so it ages within a few steps).
 const REUSE_CONTRACTION: f64 = 0.2;
-/// The Newton solve at which a factorization's inverse is formed (see `GenAlpha::solve_newton`),
-/// for iteration matrices up to `INVERSE_MAX` square: the inverse wins by latency on small
-/// matrices; on large ones both solves are n^2 memory passes and the inverse would only add
-/// its n^3 and its n^2 of memory.
-const INVERSE_AFTER: usize = 3;
-const INVERSE_MAX: usize = 64;
 /// Re-read the slowly varying velocity terms (`C`, `db/dqd`) of the iteration matrix when Newton
 /// contracts worse than `REFRESH_CONTRACTION`, or at the latest after this many steps (a read
 /// is a finite-difference pass costing ~12 UK calls; every 64 steps it took 5 % of a run).
@@ -139,21 +133,11 @@ pub struct GenAlpha {
     lam: Vec<f64>,
     lam_prev: Vec<f64>,
     r2: Vec<f64>,
-    /// Structure at the last refresh: `M` (n x n), `K`, `C`, `A` (m x n), `db/dqd` (m x n).
-    mm: Vec<f64>,
-    kk: Vec<f64>,
-    cc: Vec<f64>,
-    aa: Vec<f64>,
-    bv: Vec<f64>,
-    /// Factored iteration matrix ((n+m) x (n+m)) and its pivots; the `h` it was built for;
-    /// its inverse (row-major), formed once the factorization has served `INVERSE_AFTER`
-    /// solves (then each Newton correction is one product with it); the solves so far.
-    lu: Vec<f64>,
-    inv: Vec<f64>,
-    lu_solves: usize,
-    piv: Vec<usize>,
+    /// The structure at the last refresh (`M`, `K`, `C`, `A`, `db/dqd`) and the factored
+    /// iteration matrix, dense or sparse (`newton.rs`; made in `init`, when the system is known);
+    /// the `h` it was built for.
+    newton: Option<NewtonMatrices>,
     lu_h: f64,
-    have_structure: bool,
     /// Re-read the velocity terms before the next attempt; steps since they were read.
     refresh: bool,
     age: usize,
@@ -222,17 +206,8 @@ impl GenAlpha {
             lam: z(m),
             lam_prev: z(m),
             r2: z(m),
-            mm: z(n * n),
-            kk: z(n * n),
-            cc: z(n * n),
-            aa: z(m * n),
-            bv: z(m * n),
-            lu: z(nm * nm),
-            inv: z(if nm <= INVERSE_MAX { nm * nm } else { 0 }),
-            lu_solves: 0,
-            piv: vec![0; nm],
+            newton: None,
             lu_h: 0.0,
-            have_structure: false,
             refresh: true,
             age: 0,
             reuse: false,
@@ -252,10 +227,9 @@ impl GenAlpha {
     fn read_structure<S: SecondOrderSystem>(&mut self, sys: &mut S, t: f64, at_iterate: bool) -> Result<()> {
         let n = self.n;
         let (q, qd) = if at_iterate { (&self.q_new[..], &self.qd_new[..]) } else { (&self.st.y[..n], &self.st.y[n..]) };
-        if !sys.structure(t, q, qd, &mut self.mm, &mut self.kk, &mut self.cc, &mut self.aa, &mut self.bv)? {
+        if !self.newton.as_mut().expect("GENALPHA: init first").read(sys, t, q, qd)? {
             return Err(Error::argument("method", "GENALPHA needs a system with a structured Jacobian (mass, stiffness, constraints)"));
         }
-        self.have_structure = true;
         self.st.stats.njev += 1;
         Ok(())
     }
@@ -263,73 +237,35 @@ impl GenAlpha {
     /// Read `M`, `K`, `A` where the system's last residual evaluation left them and factor the
     /// iteration matrix for step `h`.
     fn refresh_matrix<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64) -> Result<()> {
-        if !sys.stiff_structure(&self.q_new, &self.qd_new, &mut self.mm, &mut self.kk, &mut self.aa)? {
+        if !self.newton.as_mut().expect("GENALPHA: init first").read_stiff(sys, &self.q_new, &self.qd_new)? {
             return Err(Error::argument("method", "GENALPHA needs a system with a structured Jacobian (mass, stiffness, constraints)"));
         }
         self.factor(h)
     }
 
-    /// Assemble and factor `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]` for step `h`
-    /// (column-major: the solves run down contiguous columns).
+    /// Assemble and factor `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]` for step `h`.
     fn factor(&mut self, h: f64) -> Result<()> {
         self.st.stats.nlu += 1;
         self.lu_h = h;
-        self.assemble(h, 0.0);
-        let nm = self.n + self.m;
-        self.lu_solves = 0;
-        if lu_cm(&mut self.lu, &mut self.piv, nm) {
+        let (bp, gp) = self.primes(h);
+        let nw = self.newton.as_mut().expect("GENALPHA: init first");
+        if nw.factor_real(bp, gp, 0.0) {
             return Ok(());
         }
         // redundant constraint rows make the saddle-point matrix singular: regularize the
         // multiplier block (the correction dx is unaffected where A has full row rank)
-        let scale = self.mm.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300);
-        self.assemble(h, -1e-12 * scale);
+        let scale = nw.mass_scale();
         self.st.stats.nlu += 1;
-        if !lu_cm(&mut self.lu, &mut self.piv, nm) {
+        if !nw.factor_real(bp, gp, -1e-12 * scale) {
             return Err(Error::Solver(format!("GENALPHA: iteration matrix singular at t = {}", self.st.t)));
         }
         Ok(())
     }
 
-    /// The iteration matrix for step `h` into `lu` (column-major), `reg` on the diagonal of
-    /// the multiplier block.
-    fn assemble(&mut self, h: f64, reg: f64) {
-        let (n, m) = (self.n, self.m);
-        let nm = n + m;
-        let (bp, gp) = self.primes(h);
-        for j in 0..n {
-            let col = &mut self.lu[j * nm..(j + 1) * nm];
-            for i in 0..n {
-                col[i] = self.mm[i * n + j] + gp * self.cc[i * n + j] + bp * self.kk[i * n + j];
-            }
-            for r in 0..m {
-                col[n + r] = self.aa[r * n + j] - gp * self.bv[r * n + j];
-            }
-        }
-        for r in 0..m {
-            let col = &mut self.lu[(n + r) * nm..(n + r + 1) * nm];
-            col[..n].copy_from_slice(&self.aa[r * n..(r + 1) * n]);
-            for s in 0..m {
-                col[n + s] = if r == s { reg } else { 0.0 };
-            }
-        }
-    }
-
-    /// `rhs = (iteration matrix)^-1 res`: with the LU factors for the first solves of a
-    /// factorization, with its inverse from then on (formed once: a matrix that serves many
-    /// steps pays it back many times, one refreshed every step does not pay it).
+    /// `rhs = (iteration matrix)^-1 res` (on a small dense matrix with its inverse from the
+    /// third solve of a factorization on: `NewtonMatrices::solve_real_reusing`).
     fn solve_newton(&mut self) {
-        let nm = self.n + self.m;
-        self.lu_solves += 1;
-        if self.lu_solves < INVERSE_AFTER || nm > INVERSE_MAX {
-            self.rhs.copy_from_slice(&self.res);
-            lu_cm_solve(&self.lu, &self.piv, nm, &mut self.rhs);
-            return;
-        }
-        if self.lu_solves == INVERSE_AFTER {
-            inverse_from_lu_cm(&self.lu, &self.piv, nm, &mut self.inv);
-        }
-        inv_solve(&self.inv, nm, &self.res, &mut self.rhs);
+        self.newton.as_mut().expect("GENALPHA: init first").solve_real_reusing(&self.res, &mut self.rhs);
     }
 
     /// Positions and velocities of the step for the unknown `x = qdd_{n+1}`.
@@ -496,6 +432,7 @@ impl Stepper for GenAlpha {
         self.reject = false;
         self.le_prev = 0.0;
         let (q, qd) = y0.split_at(n);
+        self.newton = Some(NewtonMatrices::for_system(sys, self.opts.linear_solver, false, true, "GENALPHA")?);
         sys.acc(t0, q, qd, &mut self.qdd)?;
         self.st.stats.nfev += 1;
         sys.multipliers(&mut self.lam);

@@ -24,12 +24,14 @@
 mod dopri5;
 mod galpha;
 pub(crate) mod lu;
+pub mod newton;
 mod radau5;
 mod radau_m;
 pub mod singular;
 
 pub use dopri5::{Dopri5, PROJECTION_MOVE_LIMIT};
 pub use galpha::{GenAlpha, GenAlphaOptions};
+pub use newton::{LinearSolver, NewtonMatrices};
 pub use radau5::Radau5;
 pub use radau_m::{RadauM, RadauMOptions};
 
@@ -40,6 +42,7 @@ use crate::dynamics;
 use crate::error::{Error, Result};
 use crate::jacobian::{uk_jacobian, Differences, JacobianWorkspace};
 use crate::model::Model;
+use crate::sparse_newton::{self, Pattern, Structure};
 use crate::uk;
 
 /// `qdd = g(t, q, qd)` with its Jacobians.
@@ -136,6 +139,28 @@ pub trait SecondOrderSystem {
     /// computed).
     fn stiff_structure(&mut self, _q: &[f64], _qd: &[f64], _m: &mut [f64], _k: &mut [f64], _a: &mut [f64]) -> Result<bool> {
         Ok(false)
+    }
+    /// The structure in sparse form (`sparse_newton::Structure`: its pattern, values zero), or
+    /// `None` when the system has none (the implicit methods then use the dense `structure`).
+    fn sparse_structure(&mut self) -> Result<Option<Structure>> {
+        Ok(None)
+    }
+    /// `structure` into the values of a `sparse_structure`.
+    fn structure_sparse(&mut self, _t: f64, _q: &[f64], _qd: &[f64], _s: &mut Structure) -> Result<bool> {
+        Ok(false)
+    }
+    /// `stiff_structure` into the values of a `sparse_structure`.
+    fn stiff_structure_sparse(&mut self, _q: &[f64], _qd: &[f64], _s: &mut Structure) -> Result<bool> {
+        Ok(false)
+    }
+    /// Refuse an allocation of `bytes` above the system's memory limit (`Error::Memory`).
+    fn check_memory(&self, _what: &str, _bytes: u64) -> Result<()> {
+        Ok(())
+    }
+    /// Whether `jac` is the structured linearization (saddle-point solves with `structure`):
+    /// RADAU5 may then solve its iteration matrices as saddle points, sparse.
+    fn structured_jacobian(&self) -> bool {
+        false
     }
 }
 
@@ -432,6 +457,29 @@ impl SecondOrderSystem for UkSystem<'_> {
         a.copy_from_slice(&data.jac);
         Ok(true)
     }
+    fn sparse_structure(&mut self) -> Result<Option<Structure>> {
+        let p = Pattern::new(self.model, &self.data.ajac, false, self.data.memory_limit)?;
+        Ok(Some(Structure::new(p)))
+    }
+    fn structure_sparse(&mut self, t: f64, q: &[f64], qd: &[f64], s: &mut Structure) -> Result<bool> {
+        self.ready = false;
+        sparse_newton::fill_structure(self.model, &mut self.data, t, q, qd, s);
+        Ok(true)
+    }
+    fn stiff_structure_sparse(&mut self, q: &[f64], qd: &[f64], s: &mut Structure) -> Result<bool> {
+        // `uk::acceleration` / `augmented_residual` left the body blocks and A of (q, qd) in `data`
+        self.ready = false;
+        sparse_newton::fill_mass(self.model, &self.data, s);
+        sparse_newton::fill_stiffness(self.model, &self.data, q, qd, s);
+        sparse_newton::fill_a(&self.data, s);
+        Ok(true)
+    }
+    fn check_memory(&self, what: &str, bytes: u64) -> Result<()> {
+        Error::check_memory(what, bytes, self.data.memory_limit, "raise memory_limit")
+    }
+    fn structured_jacobian(&self) -> bool {
+        self.jws.scheme == Differences::Structured
+    }
     fn structure(&mut self, t: f64, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], c: &mut [f64], a: &mut [f64], bv: &mut [f64]) -> Result<bool> {
         self.ready = false;
         let (model, data) = (self.model, &mut self.data);
@@ -471,13 +519,16 @@ pub struct Options {
     pub stop_on_drift: bool,
     /// Watch the conditioning of the constraints for singular passages (`Solution::singular`).
     pub monitor_singular: bool,
+    /// How the implicit methods factor their Newton matrices (`newton::LinearSolver`).
+    pub linear_solver: LinearSolver,
 }
 
 impl Default for Options {
     fn default() -> Self {
         Options {
             rtol: 1e-6, atol: vec![1e-9], first_step: None, max_step: f64::INFINITY, max_steps: 1_000_000, max_nfev: usize::MAX,
-            max_wall_time: f64::INFINITY, min_step: 0.0, drift_limit: f64::INFINITY, stop_on_drift: true, monitor_singular: true,
+            max_wall_time: f64::INFINITY, min_step: 0.0, linear_solver: LinearSolver::Auto, drift_limit: f64::INFINITY,
+            stop_on_drift: true, monitor_singular: true,
         }
     }
 }

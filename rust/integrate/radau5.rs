@@ -5,6 +5,9 @@
 //! of `integrate`).
 
 use super::lu::{lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
+use super::newton::NewtonMatrices;
+use crate::band_lu::C64;
+use crate::sparse_newton::BandNewton;
 use super::{initial_step, rhs, rms_norm, weigh_error, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
 use crate::error::{Error, Result};
 
@@ -98,6 +101,10 @@ pub struct Radau5 {
     need_jac: bool,
     need_dec: bool,
     nsing: usize,
+    /// With the structured Jacobian of a system that has the sparse structure: the saddle-point
+    /// form of both iteration matrices in band storage (`BandNewton::solve_first_order_*`;
+    /// `jq`, `jv`, `e1`, `e2r`, `e2i` then stay empty). Chosen in `init`.
+    band: Option<Box<BandNewton>>,
 }
 
 pub(super) const NIT: usize = 7;
@@ -136,11 +143,11 @@ impl Radau5 {
             tmp: z(),
             tmp2: z(),
             ystage: z(),
-            jq: vec![0.0; n * n],
-            jv: vec![0.0; n * n],
-            e1: vec![0.0; n * n],
-            e2r: vec![0.0; n * n],
-            e2i: vec![0.0; n * n],
+            jq: Vec::new(),
+            jv: Vec::new(),
+            e1: Vec::new(),
+            e2r: Vec::new(),
+            e2i: Vec::new(),
             piv1: vec![0; n],
             piv2: vec![0; n],
             br: vec![0.0; n],
@@ -163,6 +170,7 @@ impl Radau5 {
             need_jac: true,
             need_dec: true,
             nsing: 0,
+            band: None,
         })
     }
 
@@ -179,6 +187,14 @@ impl Radau5 {
         self.alphn = self.alph / self.st.h;
         self.betan = self.beta / self.st.h;
         let (f, a, b) = (self.fac1, self.alphn, self.betan);
+        if let Some(band) = self.band.as_mut() {
+            // the saddle-point forms [M + C/g + K/g^2, A^T; A - Bv/g, reg I] for g = f, a + i b
+            self.st.stats.nlu += 2;
+            let g = C64::new(a, b);
+            let gi = C64::new(1.0, 0.0) / g;
+            let scale = band.s.mass_scale();
+            return [0.0, -1e-12 * scale].into_iter().any(|reg| band.factor_real(1.0 / (f * f), 1.0 / f, reg) && band.factor_complex(gi * gi, gi, reg));
+        }
         // E1 = f^2 I - f Jv - Jq ; E2 = g^2 I - g Jv - Jq, g = a + i b
         let (g2r, g2i) = (a * a - b * b, 2.0 * a * b);
         for i in 0..n {
@@ -200,6 +216,10 @@ impl Radau5 {
     fn solve_real(&mut self, x: &mut [f64]) {
         let n = self.n;
         let f = self.fac1;
+        if let Some(band) = self.band.as_mut() {
+            band.solve_first_order_real(f, x);
+            return;
+        }
         let (r1, r2) = x.split_at_mut(n);
         // rhs = f r2 + Jq r1
         for i in 0..n {
@@ -217,6 +237,10 @@ impl Radau5 {
     fn solve_cplx(&mut self, xr: &mut [f64], xi: &mut [f64]) {
         let n = self.n;
         let (a, b) = (self.alphn, self.betan);
+        if let Some(band) = self.band.as_mut() {
+            band.solve_first_order_complex(C64::new(a, b), xr, xi);
+            return;
+        }
         let (r1r, r2r) = xr.split_at_mut(n);
         let (r1i, r2i) = xi.split_at_mut(n);
         for i in 0..n {
@@ -301,6 +325,14 @@ impl Stepper for Radau5 {
         self.faccon = 1.0;
         self.theta = THET;
         self.nsing = 0;
+        // the structured Jacobian is a saddle-point solve: sparse where it pays
+        self.band = if sys.structured_jacobian() { NewtonMatrices::band_for_system(sys, self.opts.linear_solver, true, "RADAU5")?.map(Box::new) } else { None };
+        if self.band.is_none() && self.jq.len() != self.n * self.n {
+            let nn = self.n * self.n;
+            for v in [&mut self.jq, &mut self.jv, &mut self.e1, &mut self.e2r, &mut self.e2i] {
+                *v = vec![0.0; nn];
+            }
+        }
         rhs(sys, t0, &self.st.y, &mut self.f0)?;
         self.kappa_ref = sys.conditioning_ratio();
         self.st.stats.nfev += 1;
@@ -337,7 +369,12 @@ impl Stepper for Radau5 {
             if self.need_jac {
                 let n = self.n;
                 let (q, qd) = self.st.y.split_at(n);
-                sys.jac(self.st.t, q, qd, &mut self.jq, &mut self.jv)?;
+                match self.band.as_mut() {
+                    Some(band) => {
+                        sys.structure_sparse(self.st.t, q, qd, &mut band.s)?;
+                    }
+                    None => sys.jac(self.st.t, q, qd, &mut self.jq, &mut self.jv)?,
+                }
                 self.st.stats.njev += 1;
                 self.caljac = true;
                 self.need_jac = false;

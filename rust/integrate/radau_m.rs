@@ -43,10 +43,11 @@
 //! **Dense output.** The quintic Hermite interpolant of `q` from `q`, `qd`, `qdd` at both ends
 //! (error O(h^6)); `qd` its derivative.
 
-use super::lu::{lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
+use super::newton::NewtonMatrices;
 // Hairer's Newton iterations per attempt and step-size control constants, as RADAU5 has them
 use super::radau5::{rc, FACL, FACR, NIT, QUOT1, QUOT2, SAFE};
 use super::{acc_and_multipliers, fixed_step_count, initial_step_second_order, weigh_error, DenseParts, Options, SecondOrderSystem, StepState, Stepper};
+use crate::band_lu::C64;
 use crate::correct::ProjectionTolerance;
 use crate::error::{Error, Result};
 
@@ -113,18 +114,9 @@ pub struct RadauM {
     tmp: Vec<f64>,
     eq: Vec<f64>,
     ev: Vec<f64>,
-    /// Structure: `M`, `K`, `C` (n x n), `A`, `db/dqd` (m x n), row-major.
-    mm: Vec<f64>,
-    kk: Vec<f64>,
-    cc: Vec<f64>,
-    aa: Vec<f64>,
-    bv: Vec<f64>,
-    /// Real iteration matrix (column-major LU) and complex one (row-major LU, parts).
-    lu_r: Vec<f64>,
-    piv_r: Vec<usize>,
-    lu_cr: Vec<f64>,
-    lu_ci: Vec<f64>,
-    piv_c: Vec<usize>,
+    /// The structure (`M`, `K`, `C`, `A`, `db/dqd`) and the real and complex iteration
+    /// matrices, dense or sparse (`newton.rs`; made in `init`, when the system is known).
+    newton: Option<NewtonMatrices>,
     lu_h: f64,
     reuse: bool,
     refresh: bool,
@@ -217,16 +209,7 @@ impl RadauM {
             tmp: z(nm),
             eq: z(n),
             ev: z(n),
-            mm: z(n * n),
-            kk: z(n * n),
-            cc: z(n * n),
-            aa: z(m * n),
-            bv: z(m * n),
-            lu_r: z(nm * nm),
-            piv_r: vec![0; nm],
-            lu_cr: z(nm * nm),
-            lu_ci: z(nm * nm),
-            piv_c: vec![0; nm],
+            newton: None,
             lu_h: 0.0,
             reuse: false,
             refresh: true,
@@ -245,7 +228,7 @@ impl RadauM {
     fn read_structure<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
         let t = self.st.t;
         let (q, qd) = self.st.y.split_at(self.n);
-        if !sys.structure(t, q, qd, &mut self.mm, &mut self.kk, &mut self.cc, &mut self.aa, &mut self.bv)? {
+        if !self.newton.as_mut().expect("RADAU5M: init first").read(sys, t, q, qd)? {
             return Err(Error::argument("method", "RADAU5M needs a system with a structured Jacobian (mass, stiffness, constraints)"));
         }
         self.st.stats.njev += 1;
@@ -257,54 +240,25 @@ impl RadauM {
     /// `M`, `K`, `A` where the last residual evaluation left them, and both factorizations for `h`.
     fn refresh_matrices<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64) -> Result<()> {
         let (q, qd) = (&self.qs[2], &self.vs[2]);
-        if !sys.stiff_structure(q, qd, &mut self.mm, &mut self.kk, &mut self.aa)? {
+        if !self.newton.as_mut().expect("RADAU5M: init first").read_stiff(sys, q, qd)? {
             return Err(Error::argument("method", "RADAU5M needs a system with a structured Jacobian (mass, stiffness, constraints)"));
         }
         self.factor(h)
     }
 
-    /// Assemble and factor the real and the complex iteration matrices for step `h`.
+    /// Assemble and factor the real and the complex iteration matrices for step `h`:
+    /// `[M + g C + g^2 K, A^T; A - g Bv, reg I]` with `g = h lambda` and `g = h mu`.
     fn factor(&mut self, h: f64) -> Result<()> {
-        let (n, m) = (self.n, self.m);
-        let nm = n + m;
         self.lu_h = h;
         self.st.stats.nlu += 2;
-        let scale = self.mm.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300);
+        let nw = self.newton.as_mut().expect("RADAU5M: init first");
+        let scale = nw.mass_scale();
+        let g = h * self.lambda;
+        let (p, q) = (h * self.mu.0, h * self.mu.1);
+        let (g2r, gr, gi) = (p * p - q * q, p, q);
+        let g2i = 2.0 * gr * gi;
         for reg in [0.0, -1e-12 * scale] {
-            // real: [M + g C + g^2 K, A^T; A - g Bv, reg I], g = h lambda (column-major)
-            let g = h * self.lambda;
-            let (g2r, gr, gi) = {
-                let (p, q) = (h * self.mu.0, h * self.mu.1);
-                (p * p - q * q, p, q)
-            };
-            let g2i = 2.0 * gr * gi;
-            for j in 0..n {
-                for i in 0..n {
-                    let (mij, cij, kij) = (self.mm[i * n + j], self.cc[i * n + j], self.kk[i * n + j]);
-                    self.lu_r[i + j * nm] = mij + g * cij + g * g * kij;
-                    self.lu_cr[i * nm + j] = mij + gr * cij + g2r * kij;
-                    self.lu_ci[i * nm + j] = gi * cij + g2i * kij;
-                }
-                for r in 0..m {
-                    let (arj, brj) = (self.aa[r * n + j], self.bv[r * n + j]);
-                    self.lu_r[(n + r) + j * nm] = arj - g * brj;
-                    self.lu_cr[(n + r) * nm + j] = arj - gr * brj;
-                    self.lu_ci[(n + r) * nm + j] = -gi * brj;
-                    // A^T block
-                    self.lu_r[j + (n + r) * nm] = arj;
-                    self.lu_cr[j * nm + n + r] = arj;
-                    self.lu_ci[j * nm + n + r] = 0.0;
-                }
-            }
-            for r in 0..m {
-                for s in 0..m {
-                    let v = if r == s { reg } else { 0.0 };
-                    self.lu_r[(n + r) + (n + s) * nm] = v;
-                    self.lu_cr[(n + r) * nm + n + s] = v;
-                    self.lu_ci[(n + r) * nm + n + s] = 0.0;
-                }
-            }
-            if lu_cm(&mut self.lu_r, &mut self.piv_r, nm) && lu_cplx(&mut self.lu_cr, &mut self.lu_ci, &mut self.piv_c, nm) {
+            if nw.factor_real(g * g, g, reg) && nw.factor_complex(C64::new(g2r, g2i), C64::new(gr, gi), reg) {
                 return Ok(());
             }
             // redundant constraint rows make the saddle-point matrices singular: regularize
@@ -410,8 +364,9 @@ impl RadauM {
                 self.xc[k2] = -(self.ti[1][0] * r0 + self.ti[1][1] * r1 + self.ti[1][2] * r2);
                 self.xi[k2] = -(self.ti[2][0] * r0 + self.ti[2][1] * r1 + self.ti[2][2] * r2);
             }
-            lu_cm_solve(&self.lu_r, &self.piv_r, nm, &mut self.xr);
-            lu_cplx_solve(&self.lu_cr, &self.lu_ci, &self.piv_c, nm, &mut self.xc, &mut self.xi);
+            let nw = self.newton.as_mut().expect("RADAU5M: init first");
+            nw.solve_real(&mut self.xr);
+            nw.solve_complex(&mut self.xc, &mut self.xi);
             self.st.stats.newton += 1;
             // back: (T (x) I) X; the norm of the position and velocity corrections of all stages
             let mut dyno = 0.0;
@@ -508,24 +463,11 @@ impl RadauM {
     /// `x_q` of the filtered estimate for the bracket in `eq`, `ev` (into `tmp[..n]`) and its
     /// weighted RMS norm.
     fn filtered_norm<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64, tangent: bool) -> f64 {
-        let (n, m) = (self.n, self.m);
-        let nm = n + m;
+        let n = self.n;
         let g = h * self.lambda;
-        let g2 = g * g;
-        for i in 0..n {
-            let mrow = &self.mm[i * n..(i + 1) * n];
-            let crow = &self.cc[i * n..(i + 1) * n];
-            let mut s = 0.0;
-            for j in 0..n {
-                s += g2 * (mrow[j] * self.ev[j] + crow[j] * self.eq[j]) + g * mrow[j] * self.eq[j];
-            }
-            self.tmp[i] = s;
-        }
-        for r in 0..m {
-            let arow = &self.aa[r * n..(r + 1) * n];
-            self.tmp[n + r] = (0..n).map(|j| arow[j] * (g2 * self.ev[j] + g * self.eq[j])).sum();
-        }
-        lu_cm_solve(&self.lu_r, &self.piv_r, nm, &mut self.tmp);
+        let nw = self.newton.as_mut().expect("RADAU5M: init first");
+        nw.filtered_rhs(g, &self.eq, &self.ev, &mut self.tmp);
+        nw.solve_real(&mut self.tmp);
         if tangent {
             weigh_error(sys, &mut self.tmp[..n], n, self.kappa_ref);
         }
@@ -549,6 +491,7 @@ impl Stepper for RadauM {
         self.faccon = 1.0;
         self.theta = 1.0;
         let (q, qd) = y0.split_at(n);
+        self.newton = Some(NewtonMatrices::for_system(sys, self.opts.linear_solver, true, false, "RADAU5M")?);
         sys.acc(t0, q, qd, &mut self.qdd)?;
         self.st.stats.nfev += 1;
         sys.multipliers(&mut self.lam);

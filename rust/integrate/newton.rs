@@ -1,0 +1,387 @@
+//! The implicit methods' Newton matrices, dense or sparse, behind one interface: GENALPHA's
+//! `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]` and RADAU5M's real and complex ones
+//! (`g_k = (h lambda)^2`, `g_c = h lambda`).
+//!
+//! * **Dense**: `M`, `K`, `C` (n x n), `A`, `db/dqd` (m x n) from the system's `structure`, the
+//!   (n+m) matrices factored by dense LU (`lu.rs`); GENALPHA solves with the inverse once a
+//!   factorization has served `INVERSE_AFTER` solves (small matrices only). The fastest for
+//!   small systems.
+//! * **Sparse**: the same matrices from `structure_sparse` in the pattern of `sparse_newton`,
+//!   ordered once (RCM) and factored in band storage (`band_lu`): O(n) per read, factorization
+//!   and solve for chains, ropes, cables.
+//!
+//! `LinearSolver::Auto` takes the sparse form where it is measured to win
+//! (`prefer_sparse`, docs/scale.md). Both give the same matrices to the bit; their solutions
+//! agree to rounding (different pivot orders).
+
+use super::lu::{inv_solve, inverse_from_lu_cm, lu_cm, lu_cm_solve, lu_cplx, lu_cplx_solve};
+use super::SecondOrderSystem;
+use crate::band_lu::C64;
+use crate::error::{Error, Result};
+use crate::data::Data;
+use crate::model::Model;
+use crate::sparse_newton::{BandLayout, BandNewton, Pattern, Structure};
+
+/// How an implicit method factors its Newton matrices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LinearSolver {
+    /// Sparse where it pays (`prefer_sparse`), dense otherwise.
+    #[default]
+    Auto,
+    Dense,
+    Sparse,
+}
+
+impl LinearSolver {
+    pub fn parse(s: &str) -> Result<LinearSolver> {
+        match s {
+            "auto" => Ok(LinearSolver::Auto),
+            "dense" => Ok(LinearSolver::Dense),
+            "sparse" => Ok(LinearSolver::Sparse),
+            other => Err(Error::argument("linear_solver", format!("unknown linear solver '{other}' (use 'auto', 'dense' or 'sparse')"))),
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            LinearSolver::Auto => "auto",
+            LinearSolver::Dense => "dense",
+            LinearSolver::Sparse => "sparse",
+        }
+    }
+}
+
+/// Below this size `n + m` of the Newton matrix `Auto` stays dense: measured on the ANCF wire
+/// pendulum and the chain (`benches/crossover.py`, two runs, docs/scale.md "Crossovers"):
+/// GENALPHA's dense path (with its inverse solves on small matrices) wins or ties up to
+/// n + m ~ 70 on the wire, the band LU wins in both runs from ~100 (1.1-1.7x) ...
+pub const SPARSE_NEWTON_MIN: usize = 100;
+/// ... while RADAU5M (and RADAU5), with a real and a complex matrix, wins with the band LU in
+/// both runs from n + m ~ 54 (1.6-1.9x; at ~40 the runs disagree, 0.4-3.5x).
+pub const SPARSE_NEWTON_MIN_COMPLEX: usize = 50;
+
+/// `Auto`: sparse when the matrix is large enough (`complex`: with the complex one of Radau
+/// IIA) and its band after RCM covers at most half of it (a scene whose flexible bodies are
+/// dense FFRF blocks, or a hub that couples everything, has a band as wide as the matrix: the
+/// band LU would do the dense work with more bookkeeping).
+pub fn prefer_sparse(layout: &BandLayout, complex: bool) -> bool {
+    let min = if complex { SPARSE_NEWTON_MIN_COMPLEX } else { SPARSE_NEWTON_MIN };
+    layout.size >= min && 2 * (2 * layout.hb + 1) <= layout.size
+}
+
+/// The solve with a factorization at which GENALPHA forms its inverse (dense, small only).
+pub(crate) const INVERSE_AFTER: usize = 3;
+pub(crate) const INVERSE_MAX: usize = 64;
+
+/// Dense structure and factors.
+#[derive(Debug, Clone)]
+struct Dense {
+    n: usize,
+    m: usize,
+    mm: Vec<f64>,
+    kk: Vec<f64>,
+    cc: Vec<f64>,
+    aa: Vec<f64>,
+    bv: Vec<f64>,
+    /// Real matrix, column-major LU, pivots; its inverse (row-major) when `inverse`.
+    lu: Vec<f64>,
+    piv: Vec<usize>,
+    inv: Vec<f64>,
+    solves: usize,
+    /// Complex matrix (row-major LU, real and imaginary parts).
+    lu_cr: Vec<f64>,
+    lu_ci: Vec<f64>,
+    piv_c: Vec<usize>,
+}
+
+#[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)]
+enum Inner {
+    Dense(Dense),
+    Sparse(Box<BandNewton>),
+}
+
+/// The Newton matrices of one implicit run.
+#[derive(Debug, Clone)]
+pub struct NewtonMatrices {
+    inner: Inner,
+}
+
+impl NewtonMatrices {
+    /// Bytes of the dense form (`complex`: RADAU5M's second matrix; `inverse`: GENALPHA's).
+    pub fn dense_bytes(n: usize, m: usize, complex: bool, inverse: bool) -> u64 {
+        let (n, m) = (n as u64, m as u64);
+        let nm = n + m;
+        8 * (3 * n * n + 2 * m * n + nm * nm + if complex { 2 * nm * nm } else { 0 } + if inverse && nm <= INVERSE_MAX as u64 { nm * nm } else { 0 })
+    }
+
+    pub fn dense(n: usize, m: usize, complex: bool, inverse: bool) -> Self {
+        let nm = n + m;
+        let z = |k: usize| vec![0.0; k];
+        let c = |k: usize| if complex { z(k) } else { Vec::new() };
+        NewtonMatrices {
+            inner: Inner::Dense(Dense {
+                n,
+                m,
+                mm: z(n * n),
+                kk: z(n * n),
+                cc: z(n * n),
+                aa: z(m * n),
+                bv: z(m * n),
+                lu: z(nm * nm),
+                piv: vec![0; nm],
+                inv: z(if inverse && nm <= INVERSE_MAX { nm * nm } else { 0 }),
+                solves: 0,
+                lu_cr: c(nm * nm),
+                lu_ci: c(nm * nm),
+                piv_c: if complex { vec![0; nm] } else { Vec::new() },
+            }),
+        }
+    }
+
+    pub fn sparse(structure: Structure, complex: bool) -> Self {
+        let layout = BandLayout::new(&structure.pattern);
+        NewtonMatrices { inner: Inner::Sparse(Box::new(BandNewton::new(structure, layout, complex))) }
+    }
+
+    /// The Newton matrices `method` runs on with `system` (n coordinates, m rows), for the
+    /// linear solver `asked`: the sparse form when asked for or when `Auto` prefers it (and the
+    /// system has the sparse structure), the dense one otherwise.
+    pub fn for_system<S: SecondOrderSystem>(sys: &mut S, asked: LinearSolver, complex: bool, inverse: bool, method: &str) -> Result<Self> {
+        let (n, m) = (sys.n(), sys.n_constraints());
+        Ok(match Self::band_for_system(sys, asked, complex, method)? {
+            Some(b) => NewtonMatrices { inner: Inner::Sparse(Box::new(b)) },
+            None => Self::dense(n, m, complex, inverse),
+        })
+    }
+
+    /// The sparse form alone: `Some` when `asked` is `Sparse`, or `Auto` and it pays
+    /// (`prefer_sparse`); `None` for the dense form. `Sparse` on a system without a sparse
+    /// structure is an error.
+    pub fn band_for_system<S: SecondOrderSystem>(sys: &mut S, asked: LinearSolver, complex: bool, method: &str) -> Result<Option<BandNewton>> {
+        if asked == LinearSolver::Dense {
+            return Ok(None);
+        }
+        let structure = match sys.sparse_structure() {
+            // `Auto`: a pattern above the memory limit (a dense body of many coordinates) means the
+            // dense form, whose own check then speaks
+            Err(Error::Memory { .. }) if asked == LinearSolver::Auto => return Ok(None),
+            r => r?,
+        };
+        match structure {
+            Some(s) => {
+                let layout = BandLayout::new(&s.pattern);
+                if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) {
+                    sys.check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex))?;
+                    return Ok(Some(BandNewton::new(s, layout, complex)));
+                }
+                Ok(None)
+            }
+            None if asked == LinearSolver::Sparse => Err(Error::argument("linear_solver", format!("{method}: this system has no sparse structure (use 'dense' or 'auto')"))),
+            None => Ok(None),
+        }
+    }
+
+    /// What `for_system` will take for the UK system of `model` (its workspace `data`):
+    /// `Sparse` or `Dense` (checks the sparse form's memory; the caller checks the dense one's).
+    pub fn resolve(model: &Model, data: &Data, asked: LinearSolver, complex: bool) -> Result<LinearSolver> {
+        if asked == LinearSolver::Dense {
+            return Ok(LinearSolver::Dense);
+        }
+        let p = match Pattern::new(model, &data.ajac, false, data.memory_limit) {
+            Err(Error::Memory { .. }) if asked == LinearSolver::Auto => return Ok(LinearSolver::Dense),
+            r => r?,
+        };
+        let layout = BandLayout::new(&p);
+        if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) {
+            Error::check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex), data.memory_limit, "raise memory_limit")?;
+            return Ok(LinearSolver::Sparse);
+        }
+        Ok(LinearSolver::Dense)
+    }
+
+    pub fn is_sparse(&self) -> bool {
+        matches!(self.inner, Inner::Sparse(_))
+    }
+
+    /// Band half-width of the sparse form (`None`: dense).
+    pub fn bandwidth(&self) -> Option<usize> {
+        match &self.inner {
+            Inner::Sparse(b) => Some(b.layout.hb),
+            Inner::Dense(_) => None,
+        }
+    }
+
+    /// `M`, `K`, `C`, `A`, `db/dqd` at `(t, q, qd)`.
+    pub fn read<S: SecondOrderSystem>(&mut self, sys: &mut S, t: f64, q: &[f64], qd: &[f64]) -> Result<bool> {
+        match &mut self.inner {
+            Inner::Dense(d) => sys.structure(t, q, qd, &mut d.mm, &mut d.kk, &mut d.cc, &mut d.aa, &mut d.bv),
+            Inner::Sparse(b) => sys.structure_sparse(t, q, qd, &mut b.s),
+        }
+    }
+
+    /// `M`, `K`, `A` where the system's last evaluation left them.
+    pub fn read_stiff<S: SecondOrderSystem>(&mut self, sys: &mut S, q: &[f64], qd: &[f64]) -> Result<bool> {
+        match &mut self.inner {
+            Inner::Dense(d) => sys.stiff_structure(q, qd, &mut d.mm, &mut d.kk, &mut d.aa),
+            Inner::Sparse(b) => sys.stiff_structure_sparse(q, qd, &mut b.s),
+        }
+    }
+
+    /// Largest `|M_ij|`: the scale of the multiplier block's regularization.
+    pub fn mass_scale(&self) -> f64 {
+        match &self.inner {
+            Inner::Dense(d) => d.mm.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300),
+            Inner::Sparse(b) => b.s.mass_scale(),
+        }
+    }
+
+    /// Assemble and factor `[M + gc C + gk K, A^T; A - gc db/dqd, reg I]`. `false`: singular.
+    pub fn factor_real(&mut self, gk: f64, gc: f64, reg: f64) -> bool {
+        match &mut self.inner {
+            Inner::Dense(d) => {
+                let (n, m) = (d.n, d.m);
+                let nm = n + m;
+                for j in 0..n {
+                    let col = &mut d.lu[j * nm..(j + 1) * nm];
+                    for i in 0..n {
+                        col[i] = d.mm[i * n + j] + gc * d.cc[i * n + j] + gk * d.kk[i * n + j];
+                    }
+                    for r in 0..m {
+                        col[n + r] = d.aa[r * n + j] - gc * d.bv[r * n + j];
+                    }
+                }
+                for r in 0..m {
+                    let col = &mut d.lu[(n + r) * nm..(n + r + 1) * nm];
+                    col[..n].copy_from_slice(&d.aa[r * n..(r + 1) * n]);
+                    for s in 0..m {
+                        col[n + s] = if r == s { reg } else { 0.0 };
+                    }
+                }
+                d.solves = 0;
+                lu_cm(&mut d.lu, &mut d.piv, nm)
+            }
+            Inner::Sparse(b) => b.factor_real(gk, gc, reg),
+        }
+    }
+
+    /// The same with complex `gk`, `gc` (RADAU5M's complex eigenvalue).
+    pub fn factor_complex(&mut self, gk: C64, gc: C64, reg: f64) -> bool {
+        match &mut self.inner {
+            Inner::Dense(d) => {
+                let (n, m) = (d.n, d.m);
+                let nm = n + m;
+                let (g2r, g2i, gr, gi) = (gk.re, gk.im, gc.re, gc.im);
+                for j in 0..n {
+                    for i in 0..n {
+                        let (mij, cij, kij) = (d.mm[i * n + j], d.cc[i * n + j], d.kk[i * n + j]);
+                        d.lu_cr[i * nm + j] = mij + gr * cij + g2r * kij;
+                        d.lu_ci[i * nm + j] = gi * cij + g2i * kij;
+                    }
+                    for r in 0..m {
+                        let (arj, brj) = (d.aa[r * n + j], d.bv[r * n + j]);
+                        d.lu_cr[(n + r) * nm + j] = arj - gr * brj;
+                        d.lu_ci[(n + r) * nm + j] = -gi * brj;
+                        d.lu_cr[j * nm + n + r] = arj;
+                        d.lu_ci[j * nm + n + r] = 0.0;
+                    }
+                }
+                for r in 0..m {
+                    for s in 0..m {
+                        d.lu_cr[(n + r) * nm + n + s] = if r == s { reg } else { 0.0 };
+                        d.lu_ci[(n + r) * nm + n + s] = 0.0;
+                    }
+                }
+                lu_cplx(&mut d.lu_cr, &mut d.lu_ci, &mut d.piv_c, nm)
+            }
+            Inner::Sparse(b) => b.factor_complex(gk, gc, reg),
+        }
+    }
+
+    /// `x <- H^-1 x` with the real factors.
+    pub fn solve_real(&mut self, x: &mut [f64]) {
+        match &mut self.inner {
+            Inner::Dense(d) => lu_cm_solve(&d.lu, &d.piv, d.n + d.m, x),
+            Inner::Sparse(b) => b.solve_real(x),
+        }
+    }
+
+    /// `out = H^-1 res` with the real factors; on the dense form of a small matrix, with its
+    /// inverse from the `INVERSE_AFTER`-th solve of a factorization on (GENALPHA: a matrix that
+    /// serves many steps pays the inverse back many times; the solve is then independent dot
+    /// products instead of two chains of dependent updates).
+    pub fn solve_real_reusing(&mut self, res: &[f64], out: &mut [f64]) {
+        match &mut self.inner {
+            Inner::Dense(d) => {
+                let nm = d.n + d.m;
+                d.solves += 1;
+                if d.solves < INVERSE_AFTER || d.inv.is_empty() {
+                    out.copy_from_slice(res);
+                    lu_cm_solve(&d.lu, &d.piv, nm, out);
+                    return;
+                }
+                if d.solves == INVERSE_AFTER {
+                    inverse_from_lu_cm(&d.lu, &d.piv, nm, &mut d.inv);
+                }
+                inv_solve(&d.inv, nm, res, out);
+            }
+            Inner::Sparse(b) => {
+                out.copy_from_slice(res);
+                b.solve_real(out);
+            }
+        }
+    }
+
+    /// `(xr + i xi) <- H^-1 (xr + i xi)` with the complex factors.
+    pub fn solve_complex(&mut self, xr: &mut [f64], xi: &mut [f64]) {
+        match &mut self.inner {
+            Inner::Dense(d) => lu_cplx_solve(&d.lu_cr, &d.lu_ci, &d.piv_c, d.n + d.m, xr, xi),
+            Inner::Sparse(b) => b.solve_complex(xr, xi),
+        }
+    }
+
+    /// RADAU5M's filtered error estimate's right-hand side into `tmp` (n + m):
+    /// `[g^2 (M ev + C eq) + g M eq; A (g^2 ev + g eq)]`.
+    pub fn filtered_rhs(&mut self, g: f64, eq: &[f64], ev: &[f64], tmp: &mut [f64]) {
+        let g2 = g * g;
+        match &mut self.inner {
+            Inner::Dense(d) => {
+                let (n, m) = (d.n, d.m);
+                for i in 0..n {
+                    let mrow = &d.mm[i * n..(i + 1) * n];
+                    let crow = &d.cc[i * n..(i + 1) * n];
+                    let mut s = 0.0;
+                    for j in 0..n {
+                        s += g2 * (mrow[j] * ev[j] + crow[j] * eq[j]) + g * mrow[j] * eq[j];
+                    }
+                    tmp[i] = s;
+                }
+                for r in 0..m {
+                    let arow = &d.aa[r * n..(r + 1) * n];
+                    tmp[n + r] = (0..n).map(|j| arow[j] * (g2 * ev[j] + g * eq[j])).sum();
+                }
+            }
+            Inner::Sparse(b) => {
+                let s = &mut b.s;
+                let (n, m) = (s.pattern.n, s.pattern.m);
+                // tmp[..n] = g^2 M ev + g M eq + g^2 C eq; scratch: s.v
+                for j in 0..n {
+                    s.v[j] = g2 * ev[j] + g * eq[j];
+                }
+                let v = std::mem::take(&mut s.v);
+                s.mul(&s.m, &v, &mut tmp[..n]);
+                s.mul_a(&v, &mut tmp[n..n + m]);
+                s.v = v;
+                let (pat, c) = (&s.pattern, &s.c);
+                for j in 0..n {
+                    let x = g2 * eq[j];
+                    if x != 0.0 {
+                        for e in pat.col_ptr[j]..pat.col_ptr[j + 1] {
+                            tmp[pat.row[e]] += c[e] * x;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
