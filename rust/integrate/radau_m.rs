@@ -64,6 +64,9 @@ pub struct RadauMOptions {
 /// Keep the factored matrices for the next step when Newton contracted at least this well and
 /// the step size did not change.
 const REUSE_CONTRACTION: f64 = 0.1;
+/// With a fixed step: steps taken at a reduced size (after a Newton failure) before the size
+/// doubles back towards the fixed one.
+const FIXED_STEP_PATIENCE: usize = 8;
 /// Re-read the velocity terms (`C`, `db/dqd`) at the latest after this many steps (and after a
 /// failed Newton iteration): as in GENALPHA.
 const VELOCITY_TERMS_AGE: usize = 1024;
@@ -130,6 +133,8 @@ pub struct RadauM {
     reject: bool,
     /// The best conditioning of the constraints over the run's steps (`normal_weight`).
     kappa_ref: f64,
+    /// Steps taken below the fixed step since the last change of size (`FIXED_STEP_PATIENCE`).
+    short_steps: usize,
 }
 
 /// 3 x 3 matrix product.
@@ -221,6 +226,7 @@ impl RadauM {
             first: true,
             reject: false,
             kappa_ref: 0.0,
+            short_steps: 0,
         })
     }
 
@@ -610,8 +616,18 @@ impl Stepper for RadauM {
             self.have_old = true;
             self.age += 1;
             if fixed {
-                self.st.h = self.ro.step.expect("fixed");
-                self.reuse = self.theta <= REUSE_CONTRACTION;
+                // a step that Newton could not take at the fixed size is kept at the size it
+                // took for FIXED_STEP_PATIENCE steps before it doubles back (a spinning ANCF cable
+                // wasted 70 % of its attempts retrying the full step after every failure)
+                let full = self.ro.step.expect("fixed");
+                if h < full * (1.0 - 1e-12) && !last {
+                    self.short_steps += 1;
+                    self.st.h = if self.short_steps >= FIXED_STEP_PATIENCE { self.short_steps = 0; (2.0 * h).min(full) } else { h };
+                } else {
+                    self.short_steps = 0;
+                    self.st.h = full;
+                }
+                self.reuse = self.theta <= REUSE_CONTRACTION && self.st.h == h;
                 return Ok(());
             }
             // Gustafsson's predictive control
