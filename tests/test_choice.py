@@ -26,12 +26,15 @@ def test_the_paper_scene_is_stiff_and_gets_radau_with_a_step_from_its_frequencie
     c = choose_method(sys_, 0.0, 0.1, 1e-6)
     assert c.method == "RADAU5M"
     assert c.omega_elastic == pytest.approx(w[0]) and c.omega_max == pytest.approx(w[-1])
-    # the amplitude budget 0.1 over the run is loose here: the cap of 0.3 rad per step decides
-    assert c.step == pytest.approx(choice.RADAU_MAX_STEP_OMEGA / w[0])
-    # a long run or a tight tolerance spends the budget: y = (phi / (RADAU_DECAY omega_1 T))^(1/5)
+    # the amplitude budget 20 rtol over the run: y = (phi / (RADAU_DECAY omega_1 T))^(1/5) (0.28 here)
+    y = (20 * 1e-6 / (choice.RADAU_DECAY * w[0] * 0.1)) ** 0.2
+    assert y < choice.RADAU_MAX_STEP_OMEGA and c.step == pytest.approx(y / w[0])
+    # the step follows rtol: tighter, shorter; looser, up to the cap of 1 rad per step
     tight = choose_method(sys_, 0.0, 0.1, 1e-10)
-    assert tight.step == pytest.approx((1e-5 / (choice.RADAU_DECAY * w[0] * 0.1)) ** 0.2 / w[0])
+    assert tight.step == pytest.approx((20 * 1e-10 / (choice.RADAU_DECAY * w[0] * 0.1)) ** 0.2 / w[0])
     assert tight.step < c.step and tight.method == "RADAU5M"
+    loose = choose_method(sys_, 0.0, 0.1, 1e-3)
+    assert loose.step == pytest.approx(choice.RADAU_MAX_STEP_OMEGA / w[0]) and loose.step > c.step
     assert c.step * c.omega_max > choice.EXPLICIT_STEP_OMEGA * choice.RADAU_COST_RATIO
     res = simulate(sys_, 0.1)
     assert res.method == "RADAU5M" and res.success

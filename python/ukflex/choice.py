@@ -10,17 +10,21 @@ The stiff choice is ``RADAU5M`` (Radau IIA, order 5, L-stable, on the constraine
 equations) with a fixed step.  On a resolved mode ``omega`` its amplitude falls by about
 ``RADAU_DECAY (omega h)^6`` per step (the phase lags by less), so over the run ``omega_c`` loses
 ``RADAU_DECAY y^5 omega_c T`` of its amplitude, ``y = omega_c h``.  The chooser gives that the
-budget ``phi = min(1, 1e5 rtol)`` (``rtol = 1e-6``: 0.1 over the whole run) and caps ``y`` at
-``RADAU_MAX_STEP_OMEGA`` (0.3: ~20 steps per period of ``omega_c``; coarser steps made Newton
-fail on ANCF couplers and cost accuracy on the cantilever), so
+budget ``phi = min(1, PHASE_PER_RTOL rtol)`` (20 rtol: 2e-5 over the whole run at the default
+``rtol = 1e-6``) and caps ``y`` at ``RADAU_MAX_STEP_OMEGA`` (1: ~6 steps per period of
+``omega_c``), so
 
-    y = min(0.3, (phi / (RADAU_DECAY omega_c T))^(1/5)),   h = y / omega_c   (at most T / 20).
+    y = min(1, (phi / (RADAU_DECAY omega_c T))^(1/5)),   h = y / omega_c   (at most T / 20):
+
+the step follows rtol (``y`` ~ ``rtol^(1/5)``): 0.2-0.33 on the built-in scenes at the default
+rtol (where the former rule, budget ``1e5 rtol`` and cap 0.3, sat at its cap at every rtol, so
+that tightening rtol did not tighten the answer), 0.8-1 at rtol 1e-3, 0.08-0.13 at 1e-8.
 
 DOPRI5 has to resolve the fastest mode instead: on these scenes its own step control settles at
 ``h omega_max ~ 0.5`` on average (measured 0.2-0.7 at rtol 1e-6..1e-8, paper scene and flexible
 four-bar), and a RADAU5M step costs about ``RADAU_COST_RATIO`` = 1.6 DOPRI5 steps.  So when
 ``h omega_max > 0.5 x 1.6`` RADAU5M is the cheaper way to the requested accuracy: the chooser
-takes it with that fixed step (projection on; Newton to ``max(rtol, 1e-3 phi)``), which damps
+takes it with that fixed step (projection on; Newton to ``min(100 rtol, 1e-3)``), which damps
 the fast modes instead of resolving them.  Otherwise (rigid systems, soft or slow flexible ones)
 it takes native DOPRI5 at the user's tolerances.  GENALPHA (second order) runs when the user
 gives its own options (``rho_inf``, ``newton_local_error``).  See docs/integrators.md.
@@ -35,20 +39,22 @@ from typing import Any, Dict, Optional
 import numpy as np
 
 #: the chooser's constants (one place): amplitude budget per rtol and its cap, fewest steps per run
-PHASE_PER_RTOL = 1e5
+PHASE_PER_RTOL = 20.0
 PHASE_CAP = 1.0
 MIN_STEPS = 20
 #: RADAU5M on a resolved mode: amplitude loss per step ``RADAU_DECAY (omega h)^6`` (|R(i y)| of
 #: Radau IIA: 1.3e-10 at y = 0.1, 1.3e-4 at y = 1; the phase lag is 2.3e-5 y^6)
 RADAU_DECAY = 1.3e-4
-#: ... its largest step in radians of omega_c: at y = 0.5 Newton failed on 109 of 337 attempts
-#: on the ANCF coupler (N = 4; 7 of 300 at 0.3) and the cantilever's history error rose 4x
-RADAU_MAX_STEP_OMEGA = 0.3
-#: RADAU5M's Newton tolerance (its ``rtol`` with a fixed step) relative to the budget ``phi``:
-#: 1e-4 at the default rtol; measured on five built-in scenes at auto's step, Newton at 1e-4
-#: instead of 1e-6 keeps every error within 10 % (20-30 % less time), at 1e-3 the ANCF coupler's
-#: history error doubles
-NEWTON_PER_BUDGET = 1e-3
+#: ... its largest step in radians of omega_c (reached at loose rtol: ~1e-3). Newton's failures
+#: at such steps on ANCF couplers (109 of 337 attempts at 0.5) cost little since a fixed step
+#: that Newton could not take stays short for a few steps
+RADAU_MAX_STEP_OMEGA = 1.0
+#: RADAU5M's Newton tolerance (its ``rtol`` with a fixed step) per rtol: 1e-4 at the default rtol,
+#: as the former rule set it (measured on five built-in scenes at auto's step: Newton at 1e-4
+#: instead of 1e-6 keeps every error within 10 %, 20-30 % less time)
+NEWTON_PER_RTOL = 100.0
+#: ... and at most this (the former rule's value at rtol 1e-3 .. 1e-5)
+NEWTON_MAX_RTOL = 1e-3
 #: DOPRI5's average h omega_max on stiff flexible scenes, and a RADAU5M step's cost in DOPRI5
 #: steps (nonlinear FFRF coupler N = 4: 17 us against 6 UK calls of ~1.7 us)
 EXPLICIT_STEP_OMEGA = 0.5
@@ -206,7 +212,7 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
     if h * omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:
         return MethodChoice(
             "RADAU5M", options={"step": h}, omega_elastic=omega_c, omega_max=omega_max, step=h,
-            rtol=max(rtol, NEWTON_PER_BUDGET * phase),
+            rtol=min(NEWTON_PER_RTOL * rtol, NEWTON_MAX_RTOL),
             reason=(f"stiff: the step {h:.3g} s ({omega_c * h:.2g} rad of the lowest elastic mode, {omega_c:.4g} rad/s, "
                     f"amplitude loss {RADAU_DECAY * (omega_c * h) ** 5 * omega_c * span:.1e} over the run) is "
                     f"{h * omega_max:.3g}/omega_max ({omega_max:.4g} rad/s), beyond what an explicit method may take "
