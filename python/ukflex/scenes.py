@@ -22,7 +22,7 @@ from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from ._deprecation import renamed_parameters
 from .errors import InvalidSceneError
-from .scene import Circular, ConstantSpeed, Harmonic, Polynomial, Rectangular, Scene
+from .scene import Circular, ConstantSpeed, CustomSection, Harmonic, Polynomial, Rectangular, Scene
 
 __all__ = [
     "slider_crank",
@@ -31,6 +31,8 @@ __all__ = [
     "four_bar",
     "cantilever",
     "pinned_beam",
+    "spin_up",
+    "flexible_pendulum",
     "every_joint",
     "chain",
     "rope",
@@ -40,6 +42,7 @@ __all__ = [
     "scene_parameters",
     "SCENES",
     "PAPER",
+    "SPIN_UP",
 ]
 
 #: Data of the paper's slider-crank (Pennestri, Valentini, de Falco 2010), docs/paper.md.
@@ -120,13 +123,28 @@ def gravity_vector(gravity: Any) -> Optional[Tuple[float, float]]:
     return (g[0], g[1])
 
 
+def _beam_kind(formulation: str, theory: Optional[str], strain: Optional[str], poisson_ratio: float,
+               shear_factor: float, frame: str = "pinned-pinned") -> Dict[str, Any]:
+    """The :meth:`Scene.beam` options of a scene's beam of ``formulation``: an FFRF beam with
+    ``frame`` and ``strain`` (``None``: the core's default), Timoshenko's material constants where
+    the theory needs them; the ANCF cable (Euler-Bernoulli, no frame, geometrically exact: no
+    strain option; ``theory=None`` means its one theory)."""
+    if formulation == "ancf":
+        return {"formulation": "ancf", "theory": theory}
+    kw: Dict[str, Any] = {"formulation": formulation, "theory": theory, "frame": frame, "strain": strain}
+    if theory in (None, "timoshenko"):  # None: the FFRF beam's default theory, Timoshenko
+        kw.update(poisson_ratio=poisson_ratio, shear_factor=shear_factor)
+    return kw
+
+
 def _round_beam(s: Scene, name: str, length: float, elements: int, theory: str, diameter: float, density: float,
-                youngs_modulus: float, poisson_ratio: float, shear_factor: float, **options: Any):
+                youngs_modulus: float, poisson_ratio: float, shear_factor: float, formulation: str = "ffrf",
+                strain: Optional[str] = None, **options: Any):
     """A beam of circular section (the paper's coupler; FFRF: pinned-pinned frame);
     ``poisson_ratio`` and ``shear_factor`` go to Timoshenko beams only."""
-    kw = {"poisson_ratio": poisson_ratio, "shear_factor": shear_factor} if theory == "timoshenko" else {}
-    return s.beam(name, length=length, elements=elements, theory=theory, section=Circular(diameter), density=density,
-                  youngs_modulus=youngs_modulus, frame="pinned-pinned", **options, **kw)
+    return s.beam(name, length=length, elements=elements, section=Circular(diameter), density=density,
+                  youngs_modulus=youngs_modulus, **options,
+                  **_beam_kind(formulation, theory, strain, poisson_ratio, shear_factor))
 
 
 @renamed_parameters(beam="theory")
@@ -207,10 +225,9 @@ def slider_crank(
     )
     coupler = _round_beam(
         s, "coupler", Lb, elements, theory, d, density, youngs_modulus, poisson_ratio, shear_factor,
+        formulation=formulation, strain=strain,
         rotary_inertia=rotary_inertia,
         damping=damping,
-        formulation=formulation,
-        **({"strain": strain} if formulation == "ffrf" else {}),
         position=(L, 0.0),
         angle=0.0,
         velocity=(0.0, L * omega),
@@ -290,6 +307,7 @@ def four_bar(
     gravity: Any = True,
     theory: Optional[str] = None,
     elements: int = 2,
+    formulation: Optional[str] = None,
 ) -> Scene:
     """Four-bar linkage (Grashof crank-rocker for the defaults), rigid or with a flexible coupler.
 
@@ -306,6 +324,10 @@ def four_bar(
         ``None``: rigid coupler; else the coupler is a pinned-pinned steel beam (rectangular
         10 x 5 mm section) with ``elements`` elements of this theory (deprecated alias:
         ``flexible_coupler``).
+    formulation : {None, "ffrf", "ancf"}
+        The flexible coupler's formulation: ``"ffrf"`` (the default when ``theory`` is given) or
+        ``"ancf"`` (the ANCF cable, Euler-Bernoulli: ``theory`` may stay ``None``).  ``None`` with
+        ``theory=None``: the rigid coupler.
     """
     s = Scene(gravity=gravity_vector(gravity))
     a, b, c, d = crank_length, coupler_length, rocker_length, ground_length
@@ -330,25 +352,22 @@ def four_bar(
         angle=crank_angle,
         angular_velocity=omega or 0.0,
     )
-    if theory is None:
+    if theory is None and formulation is None:
         cp = s.rigid_body(
             "coupler", mass=m_per_length * b, inertia=m_per_length * b**3 / 12, com=(b / 2, 0), position=A, angle=th_b
         )
         cp_start, cp_end = cp.point(0, 0), cp.point(b, 0)
     else:
-        kw = {"poisson_ratio": STEEL["poisson_ratio"], "shear_factor": STEEL["shear_factor"]}
         cp = s.beam(
             "coupler",
             length=b,
             elements=elements,
-            theory=theory,
             section=Rectangular(0.01, 0.005),
             density=STEEL["density"],
             youngs_modulus=STEEL["youngs_modulus"],
-            frame="pinned-pinned",
             position=A,
             angle=th_b,
-            **(kw if theory == "timoshenko" else {}),
+            **_beam_kind(formulation or "ffrf", theory, None, STEEL["poisson_ratio"], STEEL["shear_factor"]),
         )
         cp_start, cp_end = cp.at(0.0), cp.at(1.0)
     rk = s.rigid_body(
@@ -373,13 +392,15 @@ def cantilever(
     tip_force: Tuple[float, float] = (0.0, 0.0),
     damping: float = 0.0,
     strain: Optional[str] = None,
+    formulation: str = "ffrf",
     *,
     density: float = STEEL["density"],
     youngs_modulus: float = STEEL["youngs_modulus"],
     poisson_ratio: float = STEEL["poisson_ratio"],
     shear_factor: float = STEEL["shear_factor"],
 ) -> Scene:
-    """Horizontal cantilever: a beam along +X, clamped frame, welded to the ground at ``xi = 0``.
+    """Horizontal cantilever: a beam along +X, welded to the ground at ``xi = 0`` (FFRF: clamped
+    frame; ``formulation="ancf"``: the geometrically exact ANCF cable, Euler-Bernoulli).
 
     Loaded by its weight (``gravity``) and a constant ``tip_force`` [N] at ``xi = 1``.  Default
     section: rectangular 20 x 10 mm steel (``density``, ``youngs_modulus``, ``poisson_ratio``,
@@ -390,21 +411,15 @@ def cantilever(
     mat = {"density": density, "youngs_modulus": youngs_modulus, "poisson_ratio": poisson_ratio,
            "shear_factor": shear_factor}
     s = Scene(gravity=gravity_vector(gravity))
-    kw = {}
-    if theory == "timoshenko":
-        kw = {"poisson_ratio": mat["poisson_ratio"], "shear_factor": mat["shear_factor"]}
     b = s.beam(
         "beam",
         length=length,
         elements=elements,
-        theory=theory,
         section=section if section is not None else Rectangular(0.02, 0.01),
         density=mat["density"],
         youngs_modulus=mat["youngs_modulus"],
-        frame="clamped",
         damping=damping,
-        strain=strain,
-        **kw,
+        **_beam_kind(formulation, theory, strain, mat["poisson_ratio"], mat["shear_factor"], frame="clamped"),
     )
     s.weld(s.ground.frame(), b.at(0.0), name="clamp")
     if tuple(tip_force) != (0.0, 0.0):
@@ -424,18 +439,100 @@ def pinned_beam(
     shear_factor: float = PAPER["shear_factor"],
     rotary_inertia: Optional[bool] = None,
     gravity: Any = False,
+    formulation: str = "ffrf",
 ) -> Scene:
     """The paper's coupler alone, simply supported: pinned at ``xi = 0`` (revolute to ground) and
-    its ``xi = 1`` end on the ground X axis (point-on-line), frame pinned-pinned.
+    its ``xi = 1`` end on the ground X axis (point-on-line); FFRF frame pinned-pinned, or the
+    ANCF cable (``formulation="ancf"``).
 
     The supports fix the frame's ``x``, ``y`` and ``theta`` at the undeformed state, so the
     elastic block ``M_ff``, ``K_ff`` gives the simply supported beam's natural frequencies.
     """
     s = Scene(gravity=gravity_vector(gravity))
     b = _round_beam(s, "beam", length, elements, theory, diameter, density, youngs_modulus, poisson_ratio,
-                    shear_factor, rotary_inertia=rotary_inertia)
+                    shear_factor, formulation=formulation, rotary_inertia=rotary_inertia)
     s.revolute(s.ground.point(0, 0), b.at(0.0), name="pin")
     s.point_on_line(b.at(1.0), s.ground.line((0, 0), angle=0.0), name="roller")
+    return s
+
+
+#: Kane, Ryan and Banerjee's spin-up beam (J. Guidance 10 (1987) 139-151), the classic test of
+#: geometric stiffening: EA = 2.8e7 N, EI = 1.4e4 N m^2, rho A = 1.2 kg/m, L = 10 m
+SPIN_UP = {"length": 10.0, "density": 3000.0, "youngs_modulus": 7e10, "area": 4e-4, "second_moment": 2e-7}
+
+
+@_checked
+def spin_up(
+    formulation: str = "ffrf",
+    elements: int = 4,
+    omega: float = 6.0,
+    spin_up_time: float = 15.0,
+    length: float = SPIN_UP["length"],
+    theory: str = "euler-bernoulli",
+    strain: Optional[str] = None,
+    gravity: Any = False,
+) -> Scene:
+    """A beam clamped to a hub whose angle is prescribed: Kane's spin-up manoeuvre.
+
+    The hub turns as ``theta(t) = (omega / T) (t^2 / 2 + (T / 2 pi)^2 (cos(2 pi t / T) - 1))``
+    for ``t < T = spin_up_time``, then at the constant speed ``omega`` (``theta = omega (t -
+    T / 2)``): a smooth spin-up (the acceleration rises from zero and returns to it).  The beam
+    (data :data:`SPIN_UP`: ``EA = 2.8e7 N``, ``EI = 1.4e4 N m^2``, ``rho A = 1.2 kg/m``, 10 m) lies
+    along the hub's X axis, welded to it at ``xi = 0``, in the horizontal plane (no gravity).
+
+    A linear FFRF beam (``strain="linear"``) has no geometric stiffening and its deflection
+    grows without bound at speeds like these (Kane et al.); the default ``strain`` (the core's,
+    nonlinear) and the ANCF cable (``formulation="ancf"``) stiffen as they should.
+
+    Returns
+    -------
+    Scene
+        Bodies ``hub`` (rigid, driven) and ``beam``; the hub's driver is ``spin``.
+    """
+    T, w = spin_up_time, omega
+    if not T > 0.0:
+        raise ValueError(f"spin_up: spin_up_time must be positive, got {T!r}")
+    s = Scene(gravity=gravity_vector(gravity))
+    hub = s.rigid_body("hub", mass=1.0, inertia=1.0)
+    s.revolute(s.ground.point(0.0, 0.0), hub.point(0.0, 0.0), name="axle")
+    # u = min(t, T) = (t + T - |t - T|) / 2 carries the profile past T exactly
+    u = f"((t + {T!r} - abs(t - {T!r})) / 2)"
+    c = (T / (2.0 * math.pi)) ** 2
+    s.angle_driver(hub.frame(), f"{w / T!r} * ({u}^2 / 2 + {c!r} * (cos({2.0 * math.pi / T!r} * {u}) - 1)) + {w!r} * (t - {u})",
+                   name="spin")
+    beam = s.beam("beam", length=length, elements=elements, density=SPIN_UP["density"],
+                  youngs_modulus=SPIN_UP["youngs_modulus"],
+                  section=CustomSection(SPIN_UP["area"], SPIN_UP["second_moment"]),
+                  **_beam_kind(formulation, theory, strain, STEEL["poisson_ratio"], STEEL["shear_factor"], frame="clamped"))
+    s.weld(hub.frame(), beam.at(0.0), name="clamp")
+    return s
+
+
+@_checked
+def flexible_pendulum(
+    formulation: str = "ffrf",
+    elements: int = 4,
+    length: float = 1.0,
+    diameter: float = 0.004,
+    angle: float = 0.0,
+    theory: str = "euler-bernoulli",
+    strain: Optional[str] = None,
+    gravity: Any = True,
+    density: float = STEEL["density"],
+    youngs_modulus: float = STEEL["youngs_modulus"],
+) -> Scene:
+    """A slender steel rod pinned at one end, released from rest at ``angle`` (0: horizontal)
+    under gravity: it swings and bends (first bending mode of the pinned-free rod ~80 rad/s at
+    the defaults, the swing ~4 rad/s).
+
+    FFRF (default; frame clamped to the root, so its elastic modes are the cantilever's) or the
+    ANCF cable (``formulation="ancf"``).  Body ``rod``; joint ``pivot`` at ``xi = 0``.
+    """
+    s = Scene(gravity=gravity_vector(gravity))
+    rod = s.beam("rod", length=length, elements=elements, section=Circular(diameter), density=density,
+                 youngs_modulus=youngs_modulus, angle=angle,
+                 **_beam_kind(formulation, theory, strain, STEEL["poisson_ratio"], STEEL["shear_factor"], frame="clamped"))
+    s.revolute(s.ground.point(0.0, 0.0), rod.at(0.0), name="pivot")
     return s
 
 
@@ -671,6 +768,8 @@ SCENES: Dict[str, Callable[..., Scene]] = {
     "four_bar": four_bar,
     "cantilever": cantilever,
     "pinned_beam": pinned_beam,
+    "spin_up": spin_up,
+    "flexible_pendulum": flexible_pendulum,
     "every_joint": every_joint,
     "chain": chain,
     "rope": rope,

@@ -1,0 +1,234 @@
+"""Is ``method="auto"`` the fast way to the physical answer on scenes nobody tuned it for?
+
+Every built-in flexible scene, each built as an FFRF and as an ANCF model of 4 elements, run by
+``simulate()`` on a freshly built System (the whole call timed: auto's modal analysis, the run
+and the result at 401 outputs), side by side with the other ways ukflex can run it: auto at
+looser tolerances, RADAU5M at fixed steps around auto's and error-controlled, GENALPHA at fixed
+steps, DOPRI5.  Medians of interleaved repetitions, one run.
+
+Errors are measured against the **physical** answer: a converged, independent model of the same
+scene (the ANCF cable of 32 elements at a fine fixed step; for the paper's slider-crank, Exudyn's
+converged ANCF cable, benches/data/exudyn_ref_ancf.csv); the largest deviation of the scene's
+output over the run, relative to the output's largest value.  The integration error (against the
+same model at a fine step) is given beside it.
+
+For each model: auto's time and error, and the fastest configuration whose physical error is
+within 1.1 x auto's (the same error, to the digit that matters) and whose next finer setting is
+too (reliable); the ratio auto / fastest (target: at most 2).
+
+    python benches/auto_speed.py             # ~5 min: the table of docs/integrators.md, benches/data/auto_speed.csv
+    python benches/auto_speed.py --quick     # ~2 min: 2 repetitions, fewer configurations
+
+The references are computed once and kept in benches/data/auto_speed_refs.npz (delete it to
+recompute: ~3 min more).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import os
+import statistics
+import time
+import warnings
+
+import numpy as np
+
+import ukflex
+from ukflex import scenes
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DATA = os.path.join(HERE, "data")
+REFS = os.path.join(DATA, "auto_speed_refs.npz")
+NOUT = 401
+N_MODEL, N_REF = 4, 32
+SAME = 1.1  # "the same error": within this factor of auto's
+BUDGET = 5.0  # seconds per run: slower configurations are out of the race
+
+
+# ---------------------------------------------------------------------------- outputs
+def _v_mid(body, length):
+    return lambda system, res: res.beam_displacement(body, 0.5)[1] / length
+
+
+def _tip_y(system, res):
+    return res.beam_position("beam", 1.0)[1]
+
+
+def _tip_off_hub_axis(system, res):
+    x, y = res.beam_position("beam", 1.0)
+    th = res.q[system.coordinate_index("hub.theta")]
+    return -np.sin(th) * x + np.cos(th) * y
+
+
+def _tip_off_root_tangent(system, res):
+    """The rod's tip off the line along its root tangent (the bending; the swing taken out)."""
+    q = res.q
+    p0 = system.beam_point("rod", 0.0, q)
+    p1 = system.beam_point("rod", 1.0, q)
+    if system.body_kind("rod") == "ancf_beam":
+        frame = np.arctan2(p1[1] - p0[1], p1[0] - p0[0])  # the chord frame
+    else:
+        frame = q[system.coordinate_index("rod.theta")]
+    tangent = frame + p0[4]
+    dx, dy = p1[0] - p0[0], p1[1] - p0[1]
+    return -np.sin(tangent) * dx + np.cos(tangent) * dy
+
+
+def _scene(kind, formulation, elements):
+    """(Scene, t_end, output) of one built-in scene as a model of ``formulation``, ``elements``."""
+    f = formulation
+    if kind == "slider_crank":
+        kw = {"strain": "nonlinear"} if f == "ffrf" else {}
+        return (scenes.slider_crank(theory="euler-bernoulli", elements=elements, formulation=f, **kw), 0.1,
+                _v_mid("coupler", scenes.PAPER["coupler_length"]))
+    if kind == "four_bar":
+        return (scenes.four_bar(theory="euler-bernoulli", elements=elements, formulation=f), 0.63,
+                _v_mid("coupler", 0.3))
+    if kind == "cantilever":
+        return scenes.cantilever(elements=elements, formulation=f), 0.8, _tip_y
+    if kind == "pinned_beam":
+        return (scenes.pinned_beam(elements=elements, formulation=f, gravity=True), 0.02,
+                _v_mid("beam", scenes.PAPER["coupler_length"]))
+    if kind == "spin_up":
+        return scenes.spin_up(elements=elements, formulation=f), 20.0, _tip_off_hub_axis
+    if kind == "flexible_pendulum":
+        return scenes.flexible_pendulum(elements=elements, formulation=f), 1.5, _tip_off_root_tangent
+    raise ValueError(kind)
+
+
+KINDS = ("slider_crank", "four_bar", "cantilever", "pinned_beam", "spin_up", "flexible_pendulum")
+
+
+def _run(kind, formulation, elements, method, budget=BUDGET, **kw):
+    scene, T, output = _scene(kind, formulation, elements)
+    te = np.linspace(0.0, T, NOUT)
+    system = scene.build()
+    tic = time.perf_counter()
+    res = ukflex.simulate(system, T, method=method, t_eval=te, max_wall_time=budget, **kw)
+    wall = time.perf_counter() - tic
+    y = output(system, res) if res.status == 0 else None
+    return wall, y, res
+
+
+def _exudyn_reference(te):
+    rows = [ln for ln in open(os.path.join(DATA, "exudyn_ref_ancf.csv")) if not ln.startswith("#")]
+    data = np.array([[float(v) for v in ln.split(",")] for ln in rows[1:]])
+    return np.interp(te, data[:, 0], data[:, 1])
+
+
+def references(kinds):
+    """{kind: (physical reference, {formulation: same-model fine run})}, computed once (cached)."""
+    cached = dict(np.load(REFS)) if os.path.exists(REFS) else {}
+    out = {}
+    for kind in kinds:
+        keys = [f"{kind}/physical", f"{kind}/ffrf", f"{kind}/ancf"]
+        if not all(k in cached for k in keys):
+            print(f"# reference of {kind} ...", flush=True)
+            T = _scene(kind, "ancf", N_MODEL)[1]
+            te = np.linspace(0.0, T, NOUT)
+            if kind == "slider_crank":
+                cached[keys[0]] = _exudyn_reference(te)
+            else:
+                h = ukflex.simulate(_scene(kind, "ancf", N_REF)[0].build(), T).extra["auto"]["step"]
+                _, y, res = _run(kind, "ancf", N_REF, "RADAU5M", budget=None, step=h / 8, rtol=1e-9)
+                assert res.status == 0, res.message
+                cached[keys[0]] = y
+            for f in ("ffrf", "ancf"):
+                h = ukflex.simulate(_scene(kind, f, N_MODEL)[0].build(), T).extra["auto"]["step"]
+                _, y, res = _run(kind, f, N_MODEL, "RADAU5M", budget=None, step=h / 16, rtol=1e-10)
+                assert res.status == 0, res.message
+                cached[f"{kind}/{f}"] = y
+            np.savez(REFS, **cached)
+        out[kind] = (cached[keys[0]], {f: cached[f"{kind}/{f}"] for f in ("ffrf", "ancf")})
+    return out
+
+
+def configurations(h, quick):
+    """(series, label, method, options); a series lists its settings coarse to fine."""
+    cfg = [("auto", "auto (default)", "auto", {})]
+    for r in ((1e-3, 1e-4, 1e-5) if not quick else (1e-4,)):
+        cfg.append(("auto rtol", f"auto rtol {r:g}", "auto", {"rtol": r}))
+    for k in ((4, 2, 1, 0.5, 0.25) if not quick else (2, 1, 0.5)):
+        cfg.append(("RADAU5M h", f"RADAU5M h = {k:g} h_auto", "RADAU5M", {"step": k * h, "rtol": 1e-4}))
+    for r in ((1e-2, 1e-3, 1e-4, 1e-5) if not quick else (1e-3, 1e-4)):
+        cfg.append(("RADAU5M rtol", f"RADAU5M rtol {r:g}", "RADAU5M", {"rtol": r}))
+    for k in ((1, 0.5, 0.25, 0.125, 0.0625) if not quick else (0.5, 0.25, 0.125)):
+        cfg.append(("GENALPHA h", f"GENALPHA h = {k:g} h_auto", "GENALPHA", {"step": k * h}))
+    for r in ((1e-3, 1e-5, 1e-7) if not quick else (1e-4,)):
+        cfg.append(("DOPRI5", f"DOPRI5 rtol {r:g}", "DOPRI5", {"rtol": r}))
+    return cfg
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--kinds", default=",".join(KINDS))
+    args = ap.parse_args()
+    warnings.simplefilter("ignore")
+    kinds = args.kinds.split(",")
+    repeat = 2 if args.quick else args.repeat
+    refs = references(kinds)
+    rows = []
+    summary = []
+    for kind in kinds:
+        phys, same = refs[kind]
+        peak = np.abs(phys).max()
+        for f in ("ffrf", "ancf"):
+            scene, T, _ = _scene(kind, f, N_MODEL)
+            h = ukflex.simulate(scene.build(), T).extra["auto"].get("step") or T / 200
+            cfg = configurations(h, args.quick)
+            walls = {c[1]: [] for c in cfg}
+            result = {}
+            for rep in range(repeat):
+                for series, label, method, kw in (cfg if rep % 2 == 0 else cfg[::-1]):
+                    if label in result and result[label] is None:
+                        continue  # failed or over budget once: out
+                    wall, y, res = _run(kind, f, N_MODEL, method, **kw)
+                    if y is None:
+                        result[label] = None
+                        continue
+                    walls[label].append(wall)
+                    err = float(np.abs(y - phys).max() / peak)
+                    ierr = float(np.abs(y - same[f]).max() / peak)
+                    a = res.extra.get("auto") or {}
+                    result[label] = (series, err, ierr, res.method, a.get("floor"), a.get("step"),
+                                     res.extra.get("naccept"), res.extra.get("nreject"))
+            table = []
+            for series, label, method, kw in cfg:
+                r = result.get(label)
+                if r is None:
+                    rows.append([kind, f, label, "", "", "", "failed or over budget"])
+                    continue
+                t = statistics.median(walls[label])
+                table.append((series, label, t, r))
+                rows.append([kind, f, label, f"{1e3 * t:.2f}", f"{r[1]:.3e}", f"{r[2]:.3e}",
+                             f"{r[3]} steps {r[6]} rejected {r[7]}" + (f" floor {r[4]:.2e}" if r[4] else "")])
+            auto = next(x for x in table if x[1] == "auto (default)")
+            level = SAME * auto[3][1]
+            best = None
+            for i, (series, label, t, r) in enumerate(table):
+                finer = next((x for x in table[i + 1:] if x[0] == series), None)
+                reliable = r[1] <= level and (finer is None or finer[3][1] <= level or series.startswith("auto"))
+                if reliable and (best is None or t < best[2]):
+                    best = (series, label, t, r)
+            summary.append((kind, f, auto, best))
+            print(f"{kind:18} {f:5} auto {1e3 * auto[2]:8.2f} ms  err {auto[3][1]:.2e} (integration {auto[3][2]:.1e}, "
+                  f"{auto[3][3]}, {auto[3][6]} steps, {auto[3][7]} rejected)  fastest at that error: {best[1]} "
+                  f"{1e3 * best[2]:.2f} ms ({best[3][1]:.2e})  ratio {auto[2] / best[2]:.2f}", flush=True)
+    with open(os.path.join(DATA, "auto_speed.csv"), "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["scene", "formulation", "configuration", "median ms", "physical error", "integration error", "notes"])
+        w.writerows(rows)
+    print()
+    print("| scene | model | auto: ms, physical error (integration) | fastest at auto's error | ratio |")
+    print("|---|---|---|---|---|")
+    for kind, f, auto, best in summary:
+        print(f"| {kind} | {f.upper()} N = {N_MODEL} | {1e3 * auto[2]:.1f} ms, {auto[3][1]:.2e} ({auto[3][2]:.1e}) | "
+              f"{best[1]}: {1e3 * best[2]:.1f} ms, {best[3][1]:.2e} | {auto[2] / best[2]:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
