@@ -6,7 +6,8 @@
 //!   kinetic-energy norm (Gauss's principle applied to the correction). Each step is the UK
 //!   kernel with `Q = 0` and `b = -residual`.
 //! * `correct`: the same, with some coordinates held at their values (the initial-state
-//!   correction: by default every elastic coordinate, so an undeformed guess stays undeformed),
+//!   correction: by default every body's deformation, so an undeformed guess stays undeformed:
+//!   the elastic coordinates of FFRF and modal bodies, and an ANCF cable moves only rigidly),
 //!   damped Newton steps, and a report of what changed.
 
 use faer::Mat;
@@ -302,6 +303,9 @@ fn min_mass_norm_step(model: &Model, data: &mut Data, q: &[f64], zeros: &[f64]) 
 pub struct CorrectOptions {
     /// `hold[i]`: coordinate `i` keeps its value (length n).
     pub hold: Vec<bool>,
+    /// Every body moves rigidly (its deformation held, `Body::rigid_motions`): what holding the
+    /// elastic coordinates means for every kind, an ANCF cable's nodal field included.
+    pub rigid: bool,
     /// Newton stops when `max |Phi| <= position_tol` (absolute, m and rad).
     pub position_tol: f64,
     /// Accepted `max |A qd + Phi_t| <= velocity_tol * max(1, max |qd|)`.
@@ -418,7 +422,24 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
             bt[(p, i)] = col[p];
         }
     }
-    // y = (B)^+ r = U S^+ V^T r with B^T = U S V^T
+    let mut y = pseudo_solve(&bt, r)?;
+    for (&(first, kb, b, whole), &off) in blocks.iter().zip(&offsets) {
+        if whole {
+            model.bodies[b].finvt(&data.bodies[b], &mut y[first..first + kb]);
+        } else {
+            upper_solve(&mf[off..off + kb * kb], kb, &mut y[first..first + kb]);
+        }
+    }
+    for (p, &g) in idx.iter().enumerate() {
+        dx[g] = y[p];
+    }
+    Ok(dx)
+}
+
+/// `y = (B)^+ r = U S^+ V^T r` with `B^T = bt = U S V^T` (k x m), the rank cut as
+/// `scipy.linalg.pinv`'s.
+fn pseudo_solve(bt: &Mat<f64>, r: &[f64]) -> Result<Vec<f64>> {
+    let (k, m) = (bt.nrows(), bt.ncols());
     let svd = bt.thin_svd().map_err(|e| Error::Solver(format!("SVD in the state correction did not converge: {e:?}")))?;
     let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
     let smax = if s.nrows() > 0 { s[0] } else { 0.0 };
@@ -436,17 +457,121 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
             }
         }
     }
-    for (&(first, kb, b, whole), &off) in blocks.iter().zip(&offsets) {
-        if whole {
-            model.bodies[b].finvt(&data.bodies[b], &mut y[first..first + kb]);
-        } else {
-            upper_solve(&mf[off..off + kb * kb], kb, &mut y[first..first + kb]);
+    Ok(y)
+}
+
+/// The bodies' rigid motions at `q` that touch no held coordinate (`Body::rigid_motions`):
+/// per body its columns (first column index, count, the sizes of the body's full basis), and
+/// per coordinate the `(column, value)` entries of the basis `B`.
+struct RigidBasis {
+    bodies: Vec<(usize, usize)>,
+    kept: Vec<Vec<usize>>,
+    entries: Vec<Vec<(usize, f64)>>,
+    k: usize,
+}
+
+impl RigidBasis {
+    fn new(model: &Model, q: &[f64], hold: &[bool]) -> RigidBasis {
+        let n = model.n;
+        let zeros = vec![0.0; n];
+        let mut cen = vec![0.0; n];
+        let (mut bodies, mut kept, mut entries) = (Vec::new(), Vec::new(), vec![Vec::new(); n]);
+        let mut k = 0;
+        for body in &model.bodies {
+            let mut raw: Vec<(usize, usize, f64)> = Vec::new();
+            let cols = body.rigid_motions(q, &zeros, 0, &mut |i, j, x| raw.push((i, j, x)), &mut cen);
+            // a column that moves a held coordinate is left out
+            let keep: Vec<usize> = (0..cols).filter(|&c| !raw.iter().any(|&(i, j, x)| j == c && x != 0.0 && hold[i])).collect();
+            for &(i, j, x) in &raw {
+                if let Some(p) = keep.iter().position(|&c| c == j) {
+                    entries[i].push((k + p, x));
+                }
+            }
+            bodies.push((k, cols));
+            k += keep.len();
+            kept.push(keep);
+        }
+        RigidBasis { bodies, kept, entries, k }
+    }
+
+    /// `x` (the kept columns) as each body's full rigid-motion vector.
+    fn body_motion(&self, b: usize, x: &[f64]) -> [f64; 3] {
+        let mut out = [0.0; 3];
+        let (first, _) = self.bodies[b];
+        for (p, &c) in self.kept[b].iter().enumerate() {
+            out[c] = x[first + p];
+        }
+        out
+    }
+
+    /// `B x` (n).
+    fn times(&self, x: &[f64]) -> Vec<f64> {
+        self.entries.iter().map(|e| e.iter().map(|&(c, v)| v * x[c]).sum()).collect()
+    }
+}
+
+/// Minimum-norm rigid motions `x` of the bodies with `A B x = r` in the metric `B^T M B` (the
+/// Gauss projection restricted to rigid motions); `B^T M B` is block diagonal by body (at most
+/// 3 x 3, from `M_b` times the columns: O(n)). Needs the mass blocks and `A` in `data`.
+fn rigid_step(model: &Model, data: &Data, basis: &RigidBasis, r: &[f64]) -> Result<Vec<f64>> {
+    let (n, m, k) = (model.n, model.m, basis.k);
+    let mut x = vec![0.0; k];
+    if k == 0 || m == 0 {
+        return Ok(x);
+    }
+    Error::check_memory("the initial-state correction (rigid motions x constraint rows)", 8 * (k as u64 + m as u64) * m as u64 * 3, data.memory_limit,
+        "the initial-state correction solves densely in the bodies' rigid motions and the constraint rows; raise memory_limit")?;
+    // per body: the Cholesky factor of its block of B^T M B
+    let mut factors: Vec<Vec<f64>> = Vec::with_capacity(model.bodies.len());
+    for (b, body) in model.bodies.iter().enumerate() {
+        let (first, _) = basis.bodies[b];
+        let kb = basis.kept[b].len();
+        let seg = body.offset..body.offset + body.n_coords;
+        let cols: Vec<Vec<f64>> = (0..kb)
+            .map(|p| seg.clone().map(|i| basis.entries[i].iter().filter(|e| e.0 == first + p).map(|e| e.1).sum()).collect())
+            .collect();
+        let mut blk = vec![0.0; kb * kb];
+        let mut mv = vec![0.0; body.n_coords];
+        for p2 in 0..kb {
+            mv.fill(0.0);
+            body.mass_times(&data.bodies[b], &cols[p2], &mut mv);
+            for p1 in 0..kb {
+                blk[p1 * kb + p2] = cols[p1].iter().zip(&mv).map(|(a, b)| a * b).sum();
+            }
+        }
+        if kb > 0 && !cholesky(&mut blk, kb) {
+            return Err(Error::SingularMass { item: format!("body '{}': mass of its rigid motions", body.name) });
+        }
+        factors.push(blk);
+    }
+    // bt = F^-1 (A B)^T (k x m)
+    let mut bt = Mat::<f64>::zeros(k, m);
+    let mut col = vec![0.0; k];
+    for i in 0..m {
+        col.fill(0.0);
+        for sg in data.ajac.row_segs(i) {
+            for (j, &a) in data.ajac.vals[sg.val..sg.val + sg.len].iter().enumerate() {
+                for &(c, v) in &basis.entries[sg.col + j] {
+                    col[c] += a * v;
+                }
+            }
+        }
+        for (b, f) in factors.iter().enumerate() {
+            let (first, kb) = (basis.bodies[b].0, basis.kept[b].len());
+            lower_solve(f, kb, &mut col[first..first + kb]);
+        }
+        for p in 0..k {
+            bt[(p, i)] = col[p];
         }
     }
-    for (p, &g) in idx.iter().enumerate() {
-        dx[g] = y[p];
+    let _ = n;
+    let mut y = pseudo_solve(&bt, r)?;
+    for (b, f) in factors.iter().enumerate() {
+        let (first, kb) = (basis.bodies[b].0, basis.kept[b].len());
+        upper_solve(f, kb, &mut y[first..first + kb]);
     }
-    Ok(dx)
+    x.copy_from_slice(&y);
+    Ok(x)
 }
 
 /// In-place lower Cholesky of a k x k row-major matrix; `false` if not positive definite.
@@ -521,6 +646,9 @@ pub fn correct_within(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
         return Err(Error::Shape { what: "hold".into(), expected: n, got: opts.hold.len() });
     }
     let free: Vec<bool> = opts.hold.iter().map(|h| !h).collect();
+    // bodies that move only rigidly: the cables' nodal fields (the other kinds' deformation is
+    // their elastic coordinates, held by the mask)
+    let rigid = opts.rigid && model.bodies.iter().any(|b| matches!(b.kind, crate::body::BodyKind::AncfBeam(_)));
     let zeros = vec![0.0; n];
     let mut q = q.to_vec();
     constraints(model, data, t, &q, &zeros, true);
@@ -536,12 +664,29 @@ pub fn correct_within(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
         for i in 0..m {
             r[i] = -phi[i];
         }
-        let dq = metric_step(model, data, &free, &r)?;
+        let (dq, basis, x) = if rigid {
+            let basis = RigidBasis::new(model, &q, &opts.hold);
+            let x = rigid_step(model, data, &basis, &r)?;
+            (Vec::new(), Some(basis), x)
+        } else {
+            (metric_step(model, data, &free, &r)?, None, Vec::new())
+        };
         let mut step = 1.0;
         let mut q_try = q.clone();
         loop {
-            for i in 0..n {
-                q_try[i] = q[i] + step * dq[i];
+            match &basis {
+                Some(basis) => {
+                    q_try.copy_from_slice(&q);
+                    let xs: Vec<f64> = x.iter().map(|v| step * v).collect();
+                    for (b, body) in model.bodies.iter().enumerate() {
+                        body.move_rigidly(&mut q_try, &basis.body_motion(b, &xs));
+                    }
+                }
+                None => {
+                    for i in 0..n {
+                        q_try[i] = q[i] + step * dq[i];
+                    }
+                }
             }
             constraints(model, data, t, &q_try, &zeros, true);
             if max_abs(&data.phi) < res || step < 1e-6 {
@@ -591,7 +736,12 @@ pub fn correct_within(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
     for i in 0..m {
         r[i] = -vres[i];
     }
-    let dqd = metric_step(model, data, &free, &r)?;
+    let dqd = if rigid {
+        let basis = RigidBasis::new(model, &out.q, &opts.hold);
+        basis.times(&rigid_step(model, data, &basis, &r)?)
+    } else {
+        metric_step(model, data, &free, &r)?
+    };
     for i in 0..n {
         out.qd[i] += dqd[i];
     }

@@ -194,7 +194,7 @@ fn baumgarte_and_state_correction_agree_on_both_paths() {
     let dq = rel_diff(&sp.qdd, &de.qdd);
     assert!(dq <= 20.0 * cond * f64::EPSILON, "Baumgarte: {dq:e}");
     // the initial-state correction (nothing held): the sparse UK step vs the dense SVD step
-    let opts = ukflex::correct::CorrectOptions { hold: vec![false; model.n], position_tol: 1e-12, velocity_tol: 1e-12, max_iterations: 20 };
+    let opts = ukflex::correct::CorrectOptions { hold: vec![false; model.n], rigid: false, position_tol: 1e-12, velocity_tol: 1e-12, max_iterations: 20 };
     let (cs, cd) = (ukflex::correct::correct(&model, &mut sp, 0.0, &q, &qd, &opts).unwrap(), ukflex::correct::correct(&model, &mut de, 0.0, &q, &qd, &opts).unwrap());
     assert!(cs.positions_ok && cs.velocities_ok && cd.positions_ok && cd.velocities_ok);
     assert!(cs.position_residual_after <= 1e-12 && cs.velocity_residual_after <= 1e-12);

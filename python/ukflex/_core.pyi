@@ -166,6 +166,8 @@ class System:
         and sigma_min / sigma_max of A M^-1/2 there."""
     def material_energies(self, q: _F64, shapes: _F64) -> _F64:
         """1/2 v^T K_m v per column v of shapes (n, k): the bodies' material stiffness and the springs."""
+    def rigid_motions(self, q: _F64, qd: _F64) -> Tuple[_F64, _F64]:
+        """Basis B (n, r) of the bodies' rigid motions at (q, qd) and the centripetal acceleration cen (n,) of that motion."""
     def singular_passages(self, t: _F64, y: _F64) -> List[Dict[str, Any]]:
         """Singular passages of a trajectory of accepted states t (k,), y (2n, k)."""
     def sensors(self, t: _F64, q: _F64, qd: _F64, reactions: bool = True) -> Dict[str, Any]:
@@ -208,9 +210,10 @@ class System:
         velocity_tol: float = 1e-10,
         max_iterations: int = 50,
         max_wall_time: Optional[float] = None,
+        rigid: bool = False,
     ) -> Dict[str, Any]:
-        """Initial-state correction with held coordinates; a report dict (BudgetError past
-        max_wall_time seconds)."""
+        """Initial-state correction with held coordinates (rigid: every body's deformation held,
+        an ANCF cable moved rigidly); a report dict (BudgetError past max_wall_time seconds)."""
 
 @final
 class SceneChecker:

@@ -107,6 +107,24 @@ def _mode_displacements(system, q: np.ndarray, shapes: np.ndarray) -> np.ndarray
     return out
 
 
+def _rigidified_acceleration(system, t0: float, q: np.ndarray, qd: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """The acceleration at ``(t0, q, qd)`` of the motion in which no body deforms: the
+    Udwadia-Kalaba acceleration restricted to the bodies' rigid motions (``core.rigid_motions``:
+    ``qdd = B x + cen``), the constraints met in the least-squares sense."""
+    B, cen = (np.asarray(a) for a in system.core.rigid_motions(q, qd))
+    A = np.asarray(system.A(q)).reshape(-1, q.size)
+    Mr = B.T @ M @ B
+    fr = B.T @ (np.asarray(system.Q(t0, q, qd)) - M @ cen)
+    if A.shape[0] == 0:
+        return B @ np.linalg.lstsq(Mr, fr, rcond=None)[0] + cen
+    Ar = A @ B
+    br = np.asarray(system.b(t0, q, qd)) - A @ cen
+    k, m = Mr.shape[0], Ar.shape[0]
+    kkt = np.block([[Mr, Ar.T], [Ar, np.zeros((m, m))]])
+    x = np.linalg.lstsq(kkt, np.concatenate([fr, br]), rcond=None)[0][:k]
+    return B @ x + cen
+
+
 def transient_floor(system, t0: float, q: np.ndarray, qd: np.ndarray, omega: np.ndarray, shapes: np.ndarray,
                     omega_c: float, h: float, span: float) -> Dict[str, Any]:
     """The error floor of RADAU5M at the fixed step ``h``: the free vibrations of the modes above
@@ -114,12 +132,13 @@ def transient_floor(system, t0: float, q: np.ndarray, qd: np.ndarray, omega: np.
     physical motion keeps them; tightening rtol does not lower it (below it the history error
     stays: docs/integrators.md, "Does auto honour rtol?").
 
-    A mode ``k`` (mass-normalized ``phi_k``, ``omega_k``) starts off its quasi-static path by its
-    modal acceleration over ``omega_k^2`` (``phi_k^T M qdd(t0) / omega_k^2``) and oscillates about
-    it with that amplitude ``a_k``.  Initial elastic *velocities* are not counted: the projection
-    ``phi_k^T M qd`` of a moving state mixes the rigid motion's velocity into the elastic modes
-    (the paper's undeformed start: a 1.7 mm "amplitude" of a mode that the run shows none of),
-    so a start with given elastic rates may have a higher floor than stated.
+    A mode ``k`` (mass-normalized ``phi_k``, ``omega_k``) starts off its quasi-static path by the
+    modal acceleration that sets it off over ``omega_k^2`` and oscillates about it with that
+    amplitude ``a_k``: ``phi_k^T M (qdd(t0) - qdd_r) / omega_k^2``, ``qdd_r`` the acceleration the
+    mechanism would have with no body deforming (:func:`_rigidified_acceleration`; the
+    difference is what the deformation feels: on the paper's undeformed start the coupler's ends
+    are pulled apart, the axial mode rings at ~4e-6 m). Initial elastic *velocities* are not
+    counted: a start with given elastic rates may have a higher floor than stated.
     After ``j`` steps the method has ``R(z)^j`` of it where the motion has ``exp(z j)``, ``z = h
     lambda_k``, ``lambda_k = omega_k (-zeta_k + i sqrt(1 - zeta_k^2))`` with the mode's damping
     ratio ``zeta_k`` (:func:`radau_stability`): the error ``a_k max_j |R^j - e^{z j}|`` over the
@@ -127,17 +146,18 @@ def transient_floor(system, t0: float, q: np.ndarray, qd: np.ndarray, omega: np.
 
     Returns ``{"floor": metres (largest displacement error of a beam point), "floor_modes": [(omega,
     amplitude of the body point, error), ...] of the three largest contributions}``."""
-    M = np.asarray(system.M(q))
-    qdd = np.asarray(system.qdd(t0, q, qd))
     fast = omega > omega_c * (1.0 + 1e-9)
     if not fast.any():
         return {"floor": 0.0, "floor_modes": []}
+    M = np.asarray(system.M(q))
+    excite = np.asarray(system.qdd(t0, q, qd)) - _rigidified_acceleration(system, t0, q, qd, M)
     w, phi = omega[fast], shapes[:, fast]
-    amp = np.abs(phi.T @ (M @ qdd)) / w ** 2
+    amp = np.abs(phi.T @ (M @ excite)) / w ** 2
     # each mode's damping ratio: -phi^T M dqdd/dqd phi / (2 omega), by a difference along the mode
-    # (gyroscopic terms, skew, drop out); the physical motion decays as exp(lambda t)
+    # (gyroscopic terms, skew, drop out); the physical motion decays as exp(lambda t). Undamped
+    # scenes leave it out.
     zeta = np.zeros(w.size)
-    for k in range(w.size):
+    for k in (range(w.size) if _has_damping(system) else ()):
         eps = 1e-6 * max(1.0, float(np.abs(qd).max())) / max(float(np.abs(phi[:, k]).max()), 1e-300)
         dq = (np.asarray(system.qdd(t0, q, qd + eps * phi[:, k])) - np.asarray(system.qdd(t0, q, qd - eps * phi[:, k]))) / (2 * eps)
         zeta[k] = max(0.0, -float(phi[:, k] @ (M @ dq)) / (2.0 * w[k]))
@@ -223,6 +243,15 @@ def _lowest_per_body(system, omega, shapes, elastic, q) -> Dict[str, Optional[fl
     return out
 
 
+def _has_damping(system) -> bool:
+    """Whether any body or force of the scene dissipates (a damping coefficient, a modal body's
+    damping matrix ``d_ff``)."""
+    d = system.description
+    items = list(d.get("bodies", [])) + list(d.get("forces", []))
+    return any(np.any(np.asarray(it.get(k) if it.get(k) is not None else 0.0, dtype=float) != 0.0)
+               for it in items for k in ("damping", "d_ff"))
+
+
 def _has_elastic_potential(system) -> bool:
     """Whether any mode can store strain or spring energy: a flexible body or a spring."""
     if any(system.body_kind(b) not in ("rigid", "point_mass") for b in system.body_names):
@@ -295,6 +324,11 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
         if omega.size >= system.n_dof:  # every mode known (small systems): the floor
             qd0 = system.qd0 if qd is None else np.asarray(qd, dtype=float)
             floor = transient_floor(system, t0, q, qd0, omega, shapes, omega_c, h, span)
+        said = ""
+        if floor.get("floor"):
+            said = (f"; the fast modes the start sets off (largest at {floor['floor_modes'][0][0]:.4g} rad/s) are "
+                    f"damped: the history stays ~{floor['floor']:.1e} m off at a body point whatever rtol "
+                    "(method='DOPRI5' keeps them)")
         return MethodChoice(
             "RADAU5M", options={"step": h}, omega_elastic=omega_c, omega_max=omega_max, step=h,
             rtol=min(NEWTON_PER_RTOL * rtol, NEWTON_MAX_RTOL), **floor,
@@ -302,7 +336,7 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
                     f"amplitude loss {RADAU_DECAY * (omega_c * h) ** 5 * omega_c * span:.1e} over the run) is "
                     f"{h * omega_max:.3g}/omega_max ({omega_max:.4g} rad/s), beyond what an explicit method may take "
                     f"(~{EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:g}/omega_max at equal cost): Radau IIA (order 5, "
-                    "L-stable) damps the fast modes instead of resolving them"))
+                    "L-stable) damps the fast modes instead of resolving them" + said))
     return MethodChoice(
         "DOPRI5", omega_elastic=omega_c, omega_max=omega_max,
         reason=(f"not stiff at this tolerance: the step {h:.3g} s that resolves the lowest elastic mode "

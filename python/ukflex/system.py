@@ -136,7 +136,8 @@ class System:
         ``qd0`` are the guess itself.
     hold : "elastic", None or sequence of str
         Coordinates held at their guessed values during the correction: ``"elastic"`` (default)
-        holds every elastic coordinate (so an undeformed guess stays undeformed), ``None`` holds
+        holds every body's deformation (so an undeformed guess stays undeformed: the elastic
+        coordinates of FFRF and modal bodies; an ANCF cable is moved rigidly), ``None`` holds
         none, or give coordinate names such as ``"crank.theta"``; ``"elastic"`` may be combined
         with names in a list.
     position_tol : float
@@ -852,8 +853,10 @@ class System:
 
     def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations, max_wall_time=None):
         held = self._held_mask(hold)
+        rigid = hold is not None and "elastic" in ([hold] if isinstance(hold, str) else list(hold))
         c = self.core.correct(self.t0, q_guess, qd_guess, [bool(h) for h in held], position_tol=position_tol,
-                              velocity_tol=velocity_tol, max_iterations=max_iterations, max_wall_time=max_wall_time)
+                              velocity_tol=velocity_tol, max_iterations=max_iterations, max_wall_time=max_wall_time,
+                              rigid=rigid)
         if not c["positions_ok"]:
             phi = np.asarray(c["phi"])
             raise InconsistentInitialStateError(

@@ -875,6 +875,29 @@ impl PySystem {
         Ok(PyArray1::from_vec(py, out))
     }
 
+    /// The rigid motions of every body at `(q, qd)` (`Body::rigid_motions`): a basis `B`
+    /// (n, r) and the centripetal acceleration `cen` (n,) of the rigid motion at that velocity;
+    /// `B x + cen` is the acceleration of a motion in which no body deforms.
+    fn rigid_motions<'py>(&self, py: Python<'py>, q: Vector<'py>, qd: Vector<'py>) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+        let n = self.model.n;
+        let (mut qv, mut vv) = (vec![0.0; n], vec![0.0; n]);
+        read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
+        read_into("qd", &qd.as_array(), &mut vv).map_err(to_py)?;
+        let mut entries = Vec::new();
+        let mut cen = vec![0.0; n];
+        let mut cols = 0;
+        for b in &self.model.bodies {
+            cols += b.rigid_motions(&qv, &vv, cols, &mut |i, j, x| entries.push((i, j, x)), &mut cen);
+        }
+        let mut basis = vec![0.0; n * cols];
+        for (i, j, x) in entries {
+            basis[i * cols + j] = x;
+        }
+        finite_out("rigid_motions", &basis).map_err(to_py)?;
+        finite_out("rigid_motions", &cen).map_err(to_py)?;
+        Ok((mat(py, basis, n, cols)?, PyArray1::from_vec(py, cen)))
+    }
+
     /// The singular passages of a trajectory of accepted states (times `t` (k,), states `y`
     /// (2n, k)), as the native runs report them (`integrate(...)["singular"]`): for runs made
     /// elsewhere (the scipy methods, the NumPy references). One factorization per state.
@@ -1361,13 +1384,14 @@ impl PySystem {
     }
 
     /// Correct (q, qd) onto Phi(q, t) = 0 and A qd + Phi_t = 0 in the mass metric, holding the
-    /// coordinates where `hold` is true: damped Newton on the positions, then one velocity
-    /// projection (the initial-state correction). Returns a dict: q, qd, iterations,
+    /// coordinates where `hold` is true (and with `rigid`, every body's deformation: an ANCF
+    /// cable moves rigidly): damped Newton on the positions, then one velocity projection (the
+    /// initial-state correction). Returns a dict: q, qd, iterations,
     /// position_residual_before/after, velocity_residual_before/after (NaN when the positions
     /// failed), phi (m,), velocity (m,), positions_ok, velocities_ok.
-    #[pyo3(signature = (t, q, qd, hold, position_tol=1e-12, velocity_tol=1e-10, max_iterations=50, max_wall_time=None))]
+    #[pyo3(signature = (t, q, qd, hold, position_tol=1e-12, velocity_tol=1e-10, max_iterations=50, max_wall_time=None, rigid=false))]
     #[allow(clippy::too_many_arguments)]
-    fn correct<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize, max_wall_time: Option<f64>) -> PyResult<Bound<'py, PyDict>> {
+    fn correct<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize, max_wall_time: Option<f64>, rigid: bool) -> PyResult<Bound<'py, PyDict>> {
         let max_wall_time = max_wall_time.unwrap_or(f64::INFINITY);
         if !(max_wall_time > 0.0) {
             return Err(PyValueError::new_err(format!("max_wall_time must be positive, got {max_wall_time}")));
@@ -1377,7 +1401,7 @@ impl PySystem {
                 return Err(PyValueError::new_err(format!("{what} must be positive and finite, got {v}")));
             }
         }
-        let opts = CorrectOptions { hold, position_tol, velocity_tol, max_iterations };
+        let opts = CorrectOptions { hold, rigid, position_tol, velocity_tol, max_iterations };
         let c = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;

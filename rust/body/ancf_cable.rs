@@ -640,3 +640,58 @@ pub fn add_angle_jacobian(p: &CablePoint, ms: &MarkerState, w: f64, row: &mut [f
         row[p.first + 2 * a + 1] += w * p.d[a] * ms.dphi_dslope[1];
     }
 }
+
+/// The rigid motions of a cable's nodal field (`Body::rigid_motions`): translations along X and
+/// Y and the rotation about the nodes' centre `c` (positions `k x (r - c)`, slopes `k x r'`); the
+/// centripetal part `-w^2 (r - c)`, `-w^2 r'` at the angular velocity `w` that fits the nodes'
+/// velocities best (least squares on the positions). `q`, `qd`, `cen`: the body's segment.
+pub fn rigid_motions(q: &[f64], qd: &[f64], offset: usize, col0: usize, put: &mut impl FnMut(usize, usize, f64), cen: &mut [f64]) -> usize {
+    let nodes = q.len() / 4;
+    let (mut c, mut v) = ([0.0f64; 2], [0.0f64; 2]);
+    for i in 0..nodes {
+        for d in 0..2 {
+            c[d] += q[4 * i + d] / nodes as f64;
+            v[d] += qd[4 * i + d] / nodes as f64;
+        }
+    }
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..nodes {
+        let (rx, ry) = (q[4 * i] - c[0], q[4 * i + 1] - c[1]);
+        num += rx * (qd[4 * i + 1] - v[1]) - ry * (qd[4 * i] - v[0]);
+        den += rx * rx + ry * ry;
+    }
+    let w = if den > 0.0 { num / den } else { 0.0 };
+    for i in 0..nodes {
+        let k = 4 * i;
+        let (rx, ry, sx, sy) = (q[k] - c[0], q[k + 1] - c[1], q[k + 2], q[k + 3]);
+        put(offset + k, col0, 1.0);
+        put(offset + k + 1, col0 + 1, 1.0);
+        for (j, val) in [(k, -ry), (k + 1, rx), (k + 2, -sy), (k + 3, sx)] {
+            put(offset + j, col0 + 2, val);
+        }
+        for (j, val) in [(k, rx), (k + 1, ry), (k + 2, sx), (k + 3, sy)] {
+            cen[j] = -w * w * val;
+        }
+    }
+    3
+}
+
+/// Translate a cable's nodal field by `(x[0], x[1])` and turn it by `x[2]` about its nodes'
+/// centre (`rigid_motions`' columns, exactly: positions `c + t + R (r - c)`, slopes `R r'`).
+pub fn move_rigidly(q: &mut [f64], x: &[f64]) {
+    let nodes = q.len() / 4;
+    let mut c = [0.0f64; 2];
+    for i in 0..nodes {
+        c[0] += q[4 * i] / nodes as f64;
+        c[1] += q[4 * i + 1] / nodes as f64;
+    }
+    let (s, co) = x[2].sin_cos();
+    for i in 0..nodes {
+        let k = 4 * i;
+        let (rx, ry, sx, sy) = (q[k] - c[0], q[k + 1] - c[1], q[k + 2], q[k + 3]);
+        q[k] = c[0] + x[0] + co * rx - s * ry;
+        q[k + 1] = c[1] + x[1] + s * rx + co * ry;
+        q[k + 2] = co * sx - s * sy;
+        q[k + 3] = s * sx + co * sy;
+    }
+}

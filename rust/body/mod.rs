@@ -322,6 +322,54 @@ impl Body {
         }
     }
 
+    /// The body's rigid motions at `(q, qd)`: a basis of them (columns `col0..`, entries given
+    /// to `put(coordinate, column, value)` in whole-`n` coordinates) and the centripetal part of
+    /// the rigid acceleration at the body's angular velocity (`cen`, whole `n`, this body's
+    /// segment written); returns the number of columns. Rigid bodies, point masses and the
+    /// floating frames of FFRF and modal bodies: their own coordinates; an ANCF cable: the
+    /// translations and the rotation of its nodal field about its nodes' centre. The "rigidified"
+    /// motion from which `method="auto"` reads what an initial state sets off in the fast modes.
+    pub fn rigid_motions(&self, q: &[f64], qd: &[f64], col0: usize, put: &mut impl FnMut(usize, usize, f64), cen: &mut [f64]) -> usize {
+        let o = self.offset;
+        match &self.kind {
+            BodyKind::AncfBeam(_) => {
+                let (qb, vb) = (self.seg(q), self.seg(qd));
+                ancf_cable::rigid_motions(qb, vb, o, col0, put, &mut cen[o..o + self.n_coords])
+            }
+            BodyKind::PointMass(_) => {
+                put(o, col0, 1.0);
+                put(o + 1, col0 + 1, 1.0);
+                2
+            }
+            BodyKind::Rigid(_) | BodyKind::Beam(_) | BodyKind::Flexible(_) => {
+                for k in 0..3 {
+                    put(o + k, col0 + k, 1.0);
+                }
+                3
+            }
+        }
+    }
+
+    /// Move the body rigidly by `x` (its `rigid_motions` columns: the same order): the
+    /// reference coordinates of rigid, point-mass, FFRF and modal bodies take `x` added; an ANCF
+    /// cable's nodal field is translated and turned about its nodes' centre exactly (the
+    /// linear field `k x (r - c)` would stretch it by `x^2 / 2`).
+    pub fn move_rigidly(&self, q: &mut [f64], x: &[f64]) {
+        let o = self.offset;
+        match &self.kind {
+            BodyKind::AncfBeam(_) => ancf_cable::move_rigidly(&mut q[o..o + self.n_coords], x),
+            BodyKind::PointMass(_) => {
+                q[o] += x[0];
+                q[o + 1] += x[1];
+            }
+            BodyKind::Rigid(_) | BodyKind::Beam(_) | BodyKind::Flexible(_) => {
+                for k in 0..3 {
+                    q[o + k] += x[k];
+                }
+            }
+        }
+    }
+
     /// Potential of gravity `-g . int rho r dV`.
     pub fn gravity_energy(&self, q: &[f64], g: [f64; 2]) -> f64 {
         let qb = self.seg(q);

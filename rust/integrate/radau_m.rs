@@ -68,7 +68,7 @@ pub struct RadauMOptions {
 /// the step size did not change.
 const REUSE_CONTRACTION: f64 = 0.1;
 /// With a fixed step: steps taken at a reduced size (after a Newton failure) before the size
-/// doubles back towards the fixed one.
+/// doubles back towards the fixed one (doubled after each doubling that fails).
 const FIXED_STEP_PATIENCE: usize = 8;
 /// Re-read the velocity terms (`C`, `db/dqd`) at the latest after this many steps (and after a
 /// failed Newton iteration): as in GENALPHA.
@@ -139,8 +139,11 @@ pub struct RadauM {
     reject: bool,
     /// The best conditioning of the constraints over the run's steps (`normal_weight`).
     kappa_ref: f64,
-    /// Steps taken below the fixed step since the last change of size (`FIXED_STEP_PATIENCE`).
+    /// Fixed step: steps taken below it since the last change of size, the steps to wait
+    /// before doubling back, and whether the last change was a doubling.
     short_steps: usize,
+    patience: usize,
+    doubled: bool,
 }
 
 /// 3 x 3 matrix product.
@@ -254,6 +257,8 @@ impl RadauM {
             reject: false,
             kappa_ref: 0.0,
             short_steps: 0,
+            patience: FIXED_STEP_PATIENCE,
+            doubled: false,
         })
     }
 
@@ -582,6 +587,12 @@ impl Stepper for RadauM {
                         return Err(Error::Solver(format!("RADAU5M: Newton did not converge at t = {} even with h = {h:e} (1/1000 of the fixed step)", self.st.t)));
                     }
                     self.st.h = 0.5 * h;
+                    if self.doubled {
+                        // the step it doubled back to failed: wait twice as long next time
+                        self.doubled = false;
+                        self.patience = (2 * self.patience).min(1 << 16);
+                    }
+                    self.short_steps = 0;
                 } else {
                     self.st.h = self.st.h.min(0.5 * h);
                 }
@@ -650,15 +661,31 @@ impl Stepper for RadauM {
             self.age += 1;
             if fixed {
                 // a step that Newton could not take at the fixed size is kept at the size it
-                // took for FIXED_STEP_PATIENCE steps before it doubles back (a spinning ANCF cable
-                // wasted 70 % of its attempts retrying the full step after every failure)
+                // took for `patience` steps before it doubles back; a doubling that fails again
+                // doubles the patience (an ANCF cable spinning fast: its stiff axial directions
+                // turn between the stages, and the step Newton can take shrinks like
+                // (omega_axial^2 omega_spin)^(-1/3): it retried the full step after every failure
+                // on 70 % of its attempts, then every 8 steps on 11 %)
                 let full = self.ro.step.expect("fixed");
-                if h < full * (1.0 - 1e-12) && !last {
-                    self.short_steps += 1;
-                    self.st.h = if self.short_steps >= FIXED_STEP_PATIENCE { self.short_steps = 0; (2.0 * h).min(full) } else { h };
-                } else {
-                    self.short_steps = 0;
-                    self.st.h = full;
+                if !last {
+                    if self.doubled {
+                        // the step it doubled back to held: back to the first patience
+                        self.doubled = false;
+                        self.patience = FIXED_STEP_PATIENCE;
+                    }
+                    if h < full * (1.0 - 1e-12) {
+                        self.short_steps += 1;
+                        if self.short_steps >= self.patience {
+                            self.short_steps = 0;
+                            self.doubled = true;
+                            self.st.h = (2.0 * h).min(full);
+                        } else {
+                            self.st.h = h;
+                        }
+                    } else {
+                        self.short_steps = 0;
+                        self.st.h = full;
+                    }
                 }
                 self.reuse = self.theta <= REUSE_CONTRACTION && self.st.h == h;
                 return Ok(());
