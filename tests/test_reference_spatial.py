@@ -295,6 +295,44 @@ def test_uk_routes_and_coordinate_partitioning_agree(name):
         assert np.abs(T["A"] @ ref - T["b"]).max() <= 1e-9 * max(1.0, np.abs(T["b"]).max())
 
 
+def test_forces_along_p_and_the_regularization_constant_do_not_change_accelerations():
+    """A generalized force along p_i (per body) is taken by the normalization row's multiplier:
+    the accelerations ignore it. So the right-hand side shift -4 k (pd.pd) p, the value of k and
+    the choice between 8 Gd^T J Gd p and -2 G^T (w' x J w') (equal up to a multiple of p on
+    consistent states) leave qdd alone; a force off p does not."""
+    m = scenes.double_pendulum()
+    rng = np.random.default_rng(17)
+    q, qd = _moving_state(m, rng)
+    T = m.terms(0.0, q, qd)
+    ref = sp.qdd_block(m, 0.0, q, qd, terms=T)
+    scale = np.abs(ref).max()
+    rig = m.rigid_bodies()
+    Qp = T["Q"].copy()
+    Qe = T["Q"].copy()
+    for b in rig:
+        s_ = slice(b.offset + 3, b.offset + 7)
+        p, pd = b.p(q), b.p(qd)
+        Qp[s_] += rng.normal() * 10 * p
+        w = b.omega_body(q, qd)
+        Qe[s_] += -2 * sp.rot_G(p).T @ np.cross(w, b.inertia @ w) - b.quadratic_velocity(q, qd)[3:]
+    for Q in (Qp, Qe):
+        v = sp.qdd_block(m, 0.0, q, qd, terms={**T, "Q": Q})
+        assert np.abs(v - ref).max() < 1e-11 * scale
+    k0 = [b.k_reg for b in rig]
+    try:
+        for f in (1e-3, 1e3):
+            for b, k in zip(rig, k0):
+                b.k_reg = f * k
+            v = sp.qdd_block(m, 0.0, q, qd, terms=T)
+            assert np.abs(v - ref).max() < 1e-10 * scale, f
+    finally:
+        for b, k in zip(rig, k0):
+            b.k_reg = k
+    Qx = T["Q"].copy()
+    Qx[rig[0].offset + 3:rig[0].offset + 7] += rng.normal(size=4)
+    assert np.abs(sp.qdd_block(m, 0.0, q, qd, terms={**T, "Q": Qx}) - ref).max() > 1e-3 * scale
+
+
 def test_flyball_point_masses_and_composite_bodies_move_alike():
     """A 5 kg point mass on a spherical joint at the rod's end is the composite rigid body with
     its centre of mass offset: the shared coordinates accelerate alike."""
