@@ -145,19 +145,26 @@ class RigidBody:
         return Q
 
     # -- sensors ------------------------------------------------------------------------
+    # Sensors read the rotation that p represents, p / |p|: with p = c u (|u| = 1),
+    # G(p) pd = c^2 G(u) ud, so w' = 2 G(p) pd / |p|^2 and R = A(p) / |p|^2. On |p| = 1 these
+    # are the usual formulas; off it (drift) they stay the physical ones.
     def kinetic_energy(self, q, qd):
-        w = 2.0 * rot_G(self.p(q)) @ self.p(qd)
+        w = self.omega_body(q, qd)
         rd = self.r(qd)
         return 0.5 * self.mass * rd @ rd + 0.5 * w @ self.inertia @ w
 
     def omega_body(self, q, qd):
-        return 2.0 * rot_G(self.p(q)) @ self.p(qd)
+        p = self.p(q)
+        return 2.0 * rot_G(p) @ self.p(qd) / (p @ p)
+
+    def rotation(self, q):
+        p = self.p(q)
+        return rot_A(p) / (p @ p)
 
     def angular_momentum(self, q, qd, about):
         """World components, about the world point ``about``."""
-        p = self.p(q)
         w = self.omega_body(q, qd)
-        return self.mass * np.cross(self.r(q) - about, self.r(qd)) + rot_A(p) @ (self.inertia @ w)
+        return self.mass * np.cross(self.r(q) - about, self.r(qd)) + self.rotation(q) @ (self.inertia @ w)
 
     def frame_origin(self, q):
         return self.r(q) - rot_A(self.p(q)) @ self.com

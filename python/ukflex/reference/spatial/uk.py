@@ -153,24 +153,25 @@ def _body_wrench(model, body, Qc, q):
 
 def reaction_map(model, t, q, joint, frame="world"):
     """Linear map ``R`` (6, m): ``[force; torque] = R lam`` -- the force and the torque (about
-    the second marker's point) that the joint applies to the body of its second marker (to the
-    first marker's body, sign reversed, if the second is the ground); components in world axes
-    (``frame="world"``) or in the second marker's axes (``frame="joint"``)."""
+    the first marker's point) that the joint exerts on the body of its **first** marker, the
+    convention of the Rust core's ``Reaction`` (the second marker's body receives the opposite
+    wrench); for a first marker on the ground, the wrench the ground receives. Components in
+    world axes (``frame="world"``) or in the first marker's axes (``frame="joint"``)."""
     A = model.A(t, q)
     m = A.shape[0]
     R = np.zeros((6, m))
-    on_j = joint.mj.body is not None
-    body = joint.mj.body if on_j else joint.mi.body
-    P = model.marker_position(joint.mj, q)
-    sign = 1.0 if on_j else -1.0
+    on_i = joint.mi.body is not None
+    body = joint.mi.body if on_i else joint.mj.body
+    X = model.marker_position(joint.mi, q)
+    sign = 1.0 if on_i else -1.0
+    rc = body.r(q)
     for r in range(joint.rows.start, joint.rows.stop):
         Qc = -A[r]                        # generalized constraint force of lam_r = 1
         F, n_c = _body_wrench(model, body, Qc, q)
-        rc = body.r(q)
         R[:3, r] = sign * F
-        R[3:, r] = sign * (n_c - np.cross(P - rc, F))
+        R[3:, r] = sign * (n_c - np.cross(X - rc, F))
     if frame == "joint":
-        C = model.marker_axes(joint.mj, q)
+        C = model.marker_axes(joint.mi, q)
         R = np.vstack([C.T @ R[:3], C.T @ R[3:]])
     return R
 
@@ -192,7 +193,7 @@ def joint_reactions(model, t, q, qd, lam=None, rtol=None, frame="world"):
 
 
 def reaction_uniqueness(model, t, q, rtol=1e-8, rank_rtol=1e-8):
-    """Which reaction components (joint frame: force, then torque, along the second marker's
+    """Which reaction components (joint frame: force, then torque, along the first marker's
     x, y, z) are the same for every admissible ``lam``: component ``c`` of joint ``j`` is
     unique iff its row of ``R_j`` is orthogonal to ``null(A^T)``.
     Returns ``(null_dim, {name: bool (6,)})``."""
