@@ -9,14 +9,14 @@ frame sits at ``s' = s - c'`` from the centre of mass, and the body frame origin
     M_i = diag(m I_3, 4 G^T J G),        J = inertia about the centre of mass, body axes,
 
 and the velocity-dependent generalized force (Lagrange's equations with
-``T = 1/2 m rd.rd + 2 pd^T G^T J G pd``; the docs derive it) is
+``T = 1/2 m rd.rd + 2 pd^T G^T J G pd``; docs/spatial-design.md derives it) is
 
     Q_v = [0; 8 Gd^T J Gd p],            Gd = G(pd).
 
 ``M_pp = 4 G^T J G`` has rank 3 (``G p = 0``). The regularized block that the recommended UK
 route factors is ``4 G^T J G + 4 k p p^T`` with ``k = trace(J)/3``; with ``N = [G; p^T]``
 (``N N^T = |p|^2 I``) it is ``4 N^T diag(J, k) N`` and has the explicit factor
-``F = 2 N^T diag(L_J, sqrt(k)) / |p|`` (``J = L_J L_J^T``), so
+``F = 2 N^T diag(L_J, sqrt(k))`` (``J = L_J L_J^T``), so
 ``F^-T = N^T diag(L_J^-T, 1/sqrt(k)) / (2 |p|^2)``.
 
 A point mass has coordinates ``r`` (3) and ``M = m I_3``; its markers carry no orientation
@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .rotations import rot_A, rot_G, p_from_matrix, pd_from_omega_world, skew
+from .rotations import rot_A, rot_G, p_from_matrix, pd_from_omega_world
 
 __all__ = ["RigidBody", "PointMass", "check_inertia", "box_inertia", "InvalidBody"]
 

@@ -1,7 +1,8 @@
 """Applied forces as generalized forces ``Q`` (virtual work ``Q . dq``).
 
 * gravity ``m g`` at the centre of mass: ``Q_r = m g`` (rigid bodies and point masses);
-* a point force ``F`` at a marker (world components, or body components ``F'``, ``F = A F'``):
+* a point force ``F`` at a marker (world components, or components ``F'`` in the marker's axes,
+  which turn with the body: ``F = A C F'``):
   ``Q = J_P^T F`` with ``J_P = dP/dq = [I, B(p, s')]``;
 * a torque (world ``n`` or body ``n'``): ``Q_p = 2 G^T n'`` (virtual rotation
   ``d pi' = 2 G dp``);

@@ -182,9 +182,7 @@ class Joint:
         """Rows ``Phi`` (a Kin) of this joint."""
         mi, mj, k = self.mi, self.mj, self.kind
         ax = lambda m, c: m.axis(c, n, q, qd)  # noqa: E731
-        if k in ("spherical", "revolute", "universal", "fixed", "cylindrical", "prismatic",
-                 "planar", "distance", "point_on_line", "point_on_plane"):
-            d = mj.point(n, q, qd) - mi.point(n, q, qd)
+        d = mj.point(n, q, qd) - mi.point(n, q, qd)
         rows = []
         if k in ("spherical", "revolute", "universal", "fixed"):
             rows.append(d)
