@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import sys
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -132,7 +133,7 @@ CASES = [(k, c) for k in JOINTS + DRIVERS for c in ("pair", "ground", "point")
 
 @pytest.mark.parametrize("kind,case", CASES, ids=[f"{k}-{c}" for k, c in CASES])
 def test_jacobian_and_gamma_against_finite_differences(kind, case):
-    m, rng = _pair_model(kind, case, seed=hash((kind, case)) % 2**32)
+    m, rng = _pair_model(kind, case, seed=zlib.crc32(f"{kind}-{case}".encode()))
     for _ in range(3):
         q, qd = _random_state(m, rng)
         t = rng.uniform(0, 2)
@@ -273,7 +274,7 @@ def _moving_state(m, rng):
 @pytest.mark.parametrize("name", list(SCENES))
 def test_uk_routes_and_coordinate_partitioning_agree(name):
     m = SCENES[name]()
-    rng = np.random.default_rng(abs(hash(name)) % 2**32)
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
     for q, qd in (_start(m), _moving_state(m, rng)):
         q, qd, _ = sp.correct_initial_state(m, q, qd)
         t = 0.3
