@@ -10,7 +10,7 @@ mod system;
 use numpy::ndarray::ArrayView1;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::exceptions::{PyException, PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyType;
@@ -110,7 +110,18 @@ pub(crate) fn to_py(e: Error) -> PyErr {
             err
         }),
         Error::Memory { .. } => MemoryLimitError::new_err(msg),
+        Error::UnknownName { what, name, valid } => unknown_name(&what, &name, &valid).unwrap_or_else(|_| PyKeyError::new_err(msg)),
     }
+}
+
+/// `ukflex.UnknownNameError` (a `UkflexError` and a `KeyError`, defined in `ukflex.errors`,
+/// which writes its message) for an unknown `name` of kind `what`, listing the valid ones.
+fn unknown_name(what: &str, name: &str, valid: &[String]) -> PyResult<PyErr> {
+    Python::attach(|py| {
+        let cls = py.import("ukflex.errors")?.getattr("UnknownNameError")?;
+        let exc = cls.call_method1("of", (what, name, valid.to_vec()))?;
+        Ok(PyErr::from_value(exc))
+    })
 }
 
 /// Copy a (possibly strided) NumPy vector into `dst`, checking length and finiteness.
@@ -139,7 +150,7 @@ pub(crate) fn read_into(what: &str, src: &ArrayView1<f64>, dst: &mut [f64]) -> R
 /// never as NaN handed back to the caller.
 pub(crate) fn finite_out(stage: &str, v: &[f64]) -> Result<(), Error> {
     match v.iter().position(|x| !x.is_finite()) {
-        Some(index) => Err(Error::NonFinite { what: format!("{stage} result (inputs out of double-precision range?)"), index }),
+        Some(index) => Err(Error::NonFinite { what: format!("{stage} result (inputs out of double-precision range, or a degenerate state?)"), index }),
         None => Ok(()),
     }
 }
@@ -154,28 +165,32 @@ pub(crate) fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -
 
 /// Evaluate the dense output recorded by `System.integrate(..., dense=True)` of a run of
 /// `method` at the times `t` (k,): returns (dim, k). Each time uses the step whose interval
-/// holds it (outside the run: the first or last step's polynomial, extrapolated).
+/// holds it (outside the run: the first or last step's polynomial, extrapolated). The record is
+/// checked against the method's layout first (`DenseView::check`: a `ValueError` naming what
+/// is inconsistent); a value that does not fit a double (extrapolated far out) is a
+/// `NonFiniteError`.
 #[pyfunction]
 fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<'py, f64>, data: numpy::PyReadonlyArray2<'py, f64>, part_len: Vec<usize>, t: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    use crate::integrate::{DenseRecord, Method};
-    let method = Method::from_name(method).ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}'")))?;
+    use crate::integrate::{DenseView, Method};
+    let method = Method::from_name(method).ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5', 'GENALPHA' or 'RADAU5M')")))?;
     let (meta, data) = (meta.as_array(), data.as_array());
-    let width: usize = part_len.iter().sum();
-    if meta.ncols() != 3 || data.ncols() != width || meta.nrows() != data.nrows() || part_len.len() > 5 || meta.nrows() == 0 {
-        return Err(PyValueError::new_err("dense_eval: inconsistent dense record (meta (nseg, 3), data (nseg, sum(part_len)))"));
+    if meta.ncols() != 3 || meta.nrows() != data.nrows() {
+        return Err(PyValueError::new_err(format!(
+            "dense_eval: inconsistent dense record: meta must be (nseg, 3) and data (nseg, width), got {:?} and {:?}", meta.shape(), data.shape())));
     }
-    let dim = match method {
-        Method::GenAlpha(_) => part_len.last().copied().unwrap_or(0),
-        _ => part_len.first().copied().unwrap_or(0),
-    };
-    let rec = DenseRecord { meta: meta.iter().copied().collect(), data: data.iter().copied().collect(), part_len };
+    // row-major views of the arrays (copied only when they are not C-contiguous)
+    let meta_v: std::borrow::Cow<[f64]> = match meta.as_slice() { Some(s) => s.into(), None => meta.iter().copied().collect::<Vec<_>>().into() };
+    let data_v: std::borrow::Cow<[f64]> = match data.as_slice() { Some(s) => s.into(), None => data.iter().copied().collect::<Vec<_>>().into() };
+    let rec = DenseView { meta: &meta_v, data: &data_v, part_len: &part_len };
+    let dim = rec.check(&method).map_err(to_py)?;
     let ts: Vec<f64> = t.as_array().iter().copied().collect();
     crate::error::check_finite("t", &ts).map_err(to_py)?;
     let k = ts.len();
-    let mut out = vec![0.0; dim * k];
+    let mut out = vec![0.0; dim.checked_mul(k).ok_or_else(|| PyValueError::new_err("dense_eval: too many values"))?];
     let mut buf = vec![0.0; dim];
     for (j, tj) in ts.iter().enumerate() {
         rec.eval(&method, *tj, &mut buf);
+        finite_out("dense_eval", &buf).map_err(to_py)?;
         for i in 0..dim {
             out[i * k + j] = buf[i];
         }

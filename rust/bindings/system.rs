@@ -4,7 +4,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
-use pyo3::exceptions::{PyKeyError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -107,7 +107,7 @@ impl PySystem {
     fn body(&self, name: &str) -> PyResult<usize> {
         self.model
             .body_index(name)
-            .ok_or_else(|| PyKeyError::new_err(format!("unknown body '{name}' (bodies: {:?})", self.body_names())))
+            .ok_or_else(|| to_py(Error::UnknownName { what: "body".into(), name: name.to_string(), valid: self.body_names() }))
     }
 
     fn body_names(&self) -> Vec<String> {
@@ -206,6 +206,18 @@ impl PySystem {
         self.model.constraint_row_names.clone()
     }
 
+    /// Names of the joints and drivers (one per item, joints first), as sensors report them.
+    #[getter]
+    fn constraint_items(&self) -> Vec<String> {
+        self.model.constraints.iter().map(|c| c.name.clone()).collect()
+    }
+
+    /// Names of the drivers.
+    #[getter]
+    fn driver_names(&self) -> Vec<String> {
+        self.model.constraints.iter().filter(|c| c.is_driver()).map(|c| c.name.clone()).collect()
+    }
+
     /// (q0, qd0) as given by the description (not corrected).
     fn initial_guess<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>) {
         (PyArray1::from_slice(py, &self.model.q0), PyArray1::from_slice(py, &self.model.qd0))
@@ -294,6 +306,10 @@ impl PySystem {
                 fill_linearized_stiffness(model, &mut ws.data, t, &ws.q, &ws.qd, &qdd, &lambda, &s.pattern, &mut qv, &mut f, &mut k);
                 finite_out("the linearized stiffness", &k)?;
             }
+            finite_out("linearization M", &s.m)?;
+            finite_out("linearization A", &s.a)?;
+            finite_out("linearization qdd", &qdd)?;
+            finite_out("linearization lambda", &lambda)?;
             Ok((s, k, qdd, lambda))
         })?;
         let (s, k, qdd, lambda) = out;
@@ -363,6 +379,7 @@ impl PySystem {
             ws.q.copy_from_slice(&model.q0);
             ws.qd.fill(0.0);
             dynamics::constraints(model, &mut ws.data, t, &ws.q, &ws.qd, false);
+            finite_out("phi_t(t)", &ws.data.phi_t)?;
             Ok(ws.data.phi_t.clone())
         })?;
         Ok(PyArray1::from_vec(py, v))
@@ -456,7 +473,7 @@ impl PySystem {
 
     /// Euclidean norms of the position, velocity and acceleration residuals along a trajectory:
     /// t (nt,), q and qd (n, nt) -> (3, nt), in one call with the GIL released (a result's
-    /// residual histories; a state with NaN or infinity gets NaN norms).
+    /// residual histories). A non-finite input or norm is a `NonFiniteError` naming the state.
     fn residual_norms<'py>(&self, py: Python<'py>, t: Vector<'py>, q: PyReadonlyArray2<'py, f64>, qd: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let (n, m) = (self.model.n, self.model.m);
         let tv: Vec<f64> = t.as_array().to_vec();
@@ -478,15 +495,15 @@ impl PySystem {
                         qdc[i] = qda[[i, k]];
                     }
                     if !tv[k].is_finite() || qc.iter().chain(qdc.iter()).any(|x| !x.is_finite()) {
-                        out[k] = f64::NAN;
-                        out[nt + k] = f64::NAN;
-                        out[2 * nt + k] = f64::NAN;
-                        continue;
+                        return Err(Error::NonFinite { what: "residual_norms: t, q or qd of the state".into(), index: k });
                     }
                     uk::residuals(model, &mut ws.data, tv[k], &qc, &qdc, &mut p, &mut v, &mut a)?;
                     out[k] = norm(&p);
                     out[nt + k] = norm(&v);
                     out[2 * nt + k] = norm(&a);
+                    if !(out[k].is_finite() && out[nt + k].is_finite() && out[2 * nt + k].is_finite()) {
+                        return Err(Error::NonFinite { what: "residual_norms result (inputs out of double-precision range?) at the state".into(), index: k });
+                    }
                 }
                 Ok(out)
             })
@@ -546,6 +563,7 @@ impl PySystem {
             }
             let path = ws.data.uk_path();
             let info = if exact { uk::exact_rank_info(model, &mut ws.data)? } else { ws.data.rank_info };
+            finite_out("rank_info", &[info.sigma_max, info.sigma_min_kept, info.sigma_max_dropped, info.tolerance])?;
             Ok((info, path))
         })?;
         let d = PyDict::new(py);
@@ -952,6 +970,7 @@ impl PySystem {
             }
         }
         finite_out("tangent_project", &out).map_err(to_py)?;
+        finite_out("tangent_project ratio", &[ratio]).map_err(to_py)?;
         Ok((mat(py, out, n, k)?, ratio))
     }
 
@@ -974,6 +993,7 @@ impl PySystem {
             let out = correct::project_in_place(model, &mut ws.data, &mut pws, t, &mut qn, &mut qdn, tol)?;
             finite_out("project_step", &qn)?;
             finite_out("project_step", &qdn)?;
+            finite_out("project_step ||Phi||", &[out.phi_norm])?;
             Ok((qn, qdn, out.phi_norm, out.converged))
         })?;
         Ok((PyArray1::from_vec(py, qn), PyArray1::from_vec(py, qdn), phi0, phi1))
@@ -1013,6 +1033,9 @@ impl PySystem {
             Self::load(ws, &q, Some(&qd))?;
             let (mut qn, mut qdn) = (ws.q.clone(), ws.qd.clone());
             let rep = correct::project(model, &mut ws.data, t, &mut qn, &mut qdn, tol, max_iter)?;
+            finite_out("project q", &qn)?;
+            finite_out("project qd", &qdn)?;
+            finite_out("project residuals", &[rep.position_residual, rep.velocity_residual, rep.position_correction, rep.velocity_correction])?;
             Ok((qn, qdn, rep))
         })?;
         let d = PyDict::new(py);
@@ -1096,7 +1119,10 @@ impl PySystem {
         let v = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
             dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
-            let crate::body::BodyData::Beam(bd) = &ws.data.bodies[bi] else { unreachable!("beam data") };
+            let crate::body::BodyData::Beam(bd) = &ws.data.bodies[bi] else {
+                return Err(Error::Solver("axial_forces: the workspace of a beam is not a beam's".into()));
+            };
+            finite_out("axial_forces", &bd.axial_force)?;
             Ok(bd.axial_force.clone())
         })?;
         Ok(PyArray1::from_vec(py, v))
@@ -1133,6 +1159,7 @@ impl PySystem {
             }
             _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam or a flexible body"))),
         };
+        finite_out("tangent_stiffness", &k).map_err(to_py)?;
         mat(py, k, nb, nb)
     }
 
@@ -1166,7 +1193,10 @@ impl PySystem {
         crate::error::check_finite("q", &flat).map_err(to_py)?;
         let mut out = vec![0.0; 5 * cols];
         for k in 0..cols {
-            let p = b.beam_point(xi, &flat[k * n..(k + 1) * n]).expect("checked: a beam");
+            let Some(p) = b.beam_point(xi, &flat[k * n..(k + 1) * n]) else {
+                return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+            };
+            finite_out("beam_point", &p).map_err(to_py)?;
             for (r, v) in p.iter().enumerate() {
                 out[r * cols + k] = *v;
             }
@@ -1210,6 +1240,10 @@ impl PySystem {
                 dp[k] = sensors::dissipation_power(model, &mut ws.data, qk, qdk, &mut v, &mut f);
             }
             sensors::unwrap_torque_potentials(model, &mut fp, nt);
+            finite_out("sensors reactions", &rx)?;
+            finite_out("sensors body energies", &be)?;
+            finite_out("sensors force potentials", &fp)?;
+            finite_out("sensors dissipation power", &dp)?;
             Ok(())
         })?;
         let d = PyDict::new(py);
@@ -1250,7 +1284,11 @@ impl PySystem {
         let mut out = Vec::with_capacity(nt * nx * 5);
         for k in 0..nt {
             for &x in &xs {
-                out.extend_from_slice(&b.internal_forces(x, &qs[k * n..(k + 1) * n]).expect("checked: a beam"));
+                let Some(f) = b.internal_forces(x, &qs[k * n..(k + 1) * n]) else {
+                    return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+                };
+                finite_out("beam_internal_forces", &f).map_err(to_py)?;
+                out.extend_from_slice(&f);
             }
         }
         Ok(PyArray1::from_vec(py, out).reshape([nt, nx, 5])?.into_any())
