@@ -57,6 +57,29 @@ def _indices(name: str, value: Any, n: int, what: str) -> np.ndarray:
     return raw.astype(np.int64)
 
 
+def _eigh(k: np.ndarray, m: np.ndarray, **options: Any) -> Any:
+    """``scipy.linalg.eigh(k, m, **options)`` whose results must be finite and complete: masses or
+    stiffnesses beyond what double precision can resolve (a density of 1e-300 kg/m^3) are an
+    :class:`InvalidArgumentError`, not an empty or NaN basis further on."""
+    expected = None
+    if "subset_by_index" in options:
+        lo, hi = options["subset_by_index"]
+        expected = hi - lo + 1
+    scales = f"max |K| = {np.max(np.abs(k)) if k.size else 0.0:.3g}, max |M| = {np.max(np.abs(m)) if m.size else 0.0:.3g}"
+    try:
+        with np.errstate(all="ignore"):
+            out = sla.eigh(k, m, **options)
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise InvalidArgumentError("stiffness_matrix", f"the eigenproblem of the part cannot be solved ({exc}; {scales}): "
+                                   "masses or stiffnesses out of double-precision range? check the units") from None
+    lam = out if options.get("eigvals_only") else out[0]
+    arrays = (out,) if options.get("eigvals_only") else out
+    if (expected is not None and lam.size != expected) or lam.size == 0 or not all(np.all(np.isfinite(a)) for a in arrays):
+        raise InvalidArgumentError("stiffness_matrix", f"the eigenproblem of the part has no finite solution ({scales}): "
+                                   "masses or stiffnesses out of double-precision range? check the units")
+    return out
+
+
 def _interface_rows(nodes: np.ndarray, spec: Interface) -> Tuple[Tuple[float, float], np.ndarray, Optional[np.ndarray]]:
     """Point, displacement rows (2, 2N) and rotation row (2N,) of an interface (one node or the
     rigid average of several)."""
@@ -128,7 +151,7 @@ def from_nodal(
     m_scalar = _scalar_mass(mm)
     iface = {name: _interface_rows(x, spec) for name, spec in interfaces.items()}
     if frame == "mean-axis":
-        lam, vec = sla.eigh(kk, mm)
+        lam, vec = _eigh(kk, mm)
         if modes + 3 > n:
             raise InvalidArgumentError("modes", f"{modes} modes do not fit a model with {n} dofs")
         lam_rigid = lam[:3]
@@ -163,7 +186,7 @@ def from_nodal(
             b = np.zeros((0, n))
         phi = _constrained_basis(kk, mm, c, b, modes)
         kr, mr = phi.T @ kk @ phi, phi.T @ mm @ phi
-        lam = sla.eigh(kr, mr, eigvals_only=True)
+        lam = _eigh(kr, mr, eigvals_only=True)
         if lam[0] <= 1e-9 * abs(lam[-1]):
             raise InvalidArgumentError("stiffness_matrix", f"the stiffness with the reference conditions {list(fixed)} is "
                                        f"not positive definite (lowest eigenvalue {lam[0]:.3e}): rigid-body motions left "
@@ -186,7 +209,7 @@ def _data_from_basis(x: np.ndarray, mm: np.ndarray, kk: np.ndarray, m_scalar: np
     d_ff = None
     if damping_ratio > 0.0:
         m_ff = inv["m_ff"]
-        lam_r, v = sla.eigh(k_ff, m_ff)
+        lam_r, v = _eigh(k_ff, m_ff)
         w = np.sqrt(np.maximum(lam_r, 0.0))
         mv = m_ff @ v
         d_ff = mv @ np.diag(2.0 * damping_ratio * w) @ mv.T
@@ -206,7 +229,7 @@ def _constrained_basis(kk: np.ndarray, mm: np.ndarray, c: np.ndarray, b: np.ndar
     kz, mz = z.T @ kk @ z, z.T @ mm @ z
     if modes > kz.shape[0]:
         raise InvalidArgumentError("modes", f"{modes} modes do not fit: only {kz.shape[0]} interior dofs")
-    lam, v = sla.eigh(kz, mz, subset_by_index=[0, modes - 1])
+    lam, v = _eigh(kz, mz, subset_by_index=[0, modes - 1])
     normal = z @ v
     if not nb:
         return normal
@@ -280,6 +303,18 @@ def _mesh_arrays(points: Any, cells: Any) -> Tuple[np.ndarray, np.ndarray]:
     repeated = np.flatnonzero(np.any(s[:, 1:] == s[:, :-1], axis=1))
     if repeated.size:
         raise InvalidArgumentError("cells", f"cell {int(repeated[0])} {t[repeated[0]].tolist()} repeats a vertex")
+    # every corner of a cell must turn the same way (area > 0 at each, counterclockwise or not):
+    # a collinear or folded cell has no valid element map (scikit-fem: "Zero Jacobian determinant")
+    xy = p[:, :2][t]  # (E, k, 2)
+    e1 = np.roll(xy, -1, axis=1) - xy
+    e0 = xy - np.roll(xy, 1, axis=1)
+    turn = e0[..., 0] * e1[..., 1] - e0[..., 1] * e1[..., 0]  # (E, k)
+    size = np.max(np.abs(xy - xy.mean(axis=1, keepdims=True)), axis=(1, 2)) ** 2
+    flat = ~((np.all(turn > 1e-12 * size[:, None], axis=1)) | np.all(turn < -1e-12 * size[:, None], axis=1))
+    if np.any(flat):
+        k = int(np.flatnonzero(flat)[0])
+        raise InvalidArgumentError("cells", f"cell {k} {t[k].tolist()} at {xy[k].tolist()} is degenerate or folded "
+                                   "(collinear vertices, zero area or a non-convex corner)")
     return np.ascontiguousarray(p[:, :2].T), np.ascontiguousarray(t.T)
 
 
@@ -413,7 +448,7 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
                 raise InvalidArgumentError("modal_derivatives", f"the number of modes differentiated must be in "
                                            f"1..{phi.shape[1]}, got {nd}")
             # the lowest nd normal modes (Craig-Bampton: its reduced model's modes)
-            lam_r, v = sla.eigh(phi.T @ kk @ phi, phi.T @ mm @ phi)
+            lam_r, v = _eigh(phi.T @ kk @ phi, phi.T @ mm @ phi)
             low = phi @ v[:, :nd]
             loads = _green_lagrange_md_loads(basis, perm, low, thickness, lam_ps, mu)
             iface = {name: _interface_rows(nodes, spec) for name, spec in resolved.items()}
@@ -421,7 +456,7 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             kkt = np.block([[kk, c.T], [c, np.zeros((3, 3))]])
             theta = np.linalg.solve(kkt, np.vstack([loads, np.zeros((3, loads.shape[1]))]))[:kk.shape[0]]
             p = _enrich(np.zeros((kk.shape[0], 0)), np.hstack([phi, theta]), mm, 1e-9)
-            lam_e, v = sla.eigh(p.T @ kk @ p, p.T @ mm @ p)
+            lam_e, v = _eigh(p.T @ kk @ p, p.T @ mm @ p)
             phi = p @ v
             freq = np.sqrt(np.maximum(lam_e, 0.0))
             data = _data_from_basis(nodes, mm, kk, _scalar_mass(mm), iface, phi, damping_ratio)
@@ -519,7 +554,7 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_
     k, m = np.asarray(data.k_ff, dtype=float), np.asarray(data.m_ff, dtype=float)
     if not 1 <= modes <= k.shape[0]:
         raise InvalidArgumentError("modes", f"modes must be in 1..{k.shape[0]}, got {modes}")
-    lam, p = sla.eigh(k, m, subset_by_index=[0, modes - 1])
+    lam, p = _eigh(k, m, subset_by_index=[0, modes - 1])
     if modal_derivatives is not False:
         if data.k3 is None:
             raise InvalidArgumentError("modal_derivatives", "modal derivatives need the third-order stiffness k3 "
@@ -532,7 +567,7 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_
         extra = [k3p[:, a, b] for a in range(nd) for b in range(a, nd)]
         loads = np.array(extra).T  # (n, n_extra)
         p = _enrich(p, sla.cho_solve(sla.cho_factor(k), loads), m, tol)
-        lam, v = sla.eigh(p.T @ k @ p, p.T @ m @ p)
+        lam, v = _eigh(p.T @ k @ p, p.T @ m @ p)
         p = p @ v
     n_r = p.shape[1]
     proj = lambda a: None if a is None else p.T @ np.asarray(a, dtype=float) @ p  # noqa: E731

@@ -58,6 +58,11 @@ PAPER = {
 STEEL = {"density": 7850.0, "youngs_modulus": 2.1e11, "poisson_ratio": 0.3, "shear_factor": 5.0 / 6.0}
 
 
+#: Largest count argument of a built-in scene (links, elements, rows, ...): a million items take
+#: minutes to build and gigabytes to run.
+MAX_ITEMS = 10 ** 6
+
+
 def _checked(fn: Callable[..., Scene]) -> Callable[..., Scene]:
     """Check a built-in scene's numeric arguments (real, finite; integers where the default is one)
     before the function computes with them, and name the scene and arguments when its arithmetic
@@ -77,6 +82,8 @@ def _checked(fn: Callable[..., Scene]) -> Callable[..., Scene]:
                 continue
             if isinstance(default, int) and not isinstance(value, numbers.Integral) or isinstance(value, bool):
                 raise TypeError(f"{fn.__name__}: {name} must be an integer, got {value!r}")
+            if isinstance(default, int) and abs(value) > MAX_ITEMS:
+                raise ValueError(f"{fn.__name__}: {name} = {value!r:.40} is beyond what a scene can hold (at most {MAX_ITEMS:,})")
             if not isinstance(value, numbers.Real):
                 raise TypeError(f"{fn.__name__}: {name} must be a real number, got {value!r}")
             try:

@@ -864,9 +864,10 @@ class DenseSolution:
 
     def __init__(self, method: str, meta: np.ndarray, data: np.ndarray, part_len: Sequence[int]):
         self.method = method
-        self.meta = np.ascontiguousarray(meta, dtype=float)
-        self.data = np.ascontiguousarray(data, dtype=float)
-        self.part_len = [int(k) for k in part_len]
+        # real numbers only (complex values are not cast to their real parts); the layout is the core's
+        self.meta = np.ascontiguousarray(_real_array("meta", meta))
+        self.data = np.ascontiguousarray(_real_array("data", data))
+        self.part_len = list(part_len)
         # the core checks the record against the method's layout (a ValueError naming what is
         # inconsistent; NonFiniteError for NaN in it), here once and at every evaluation
         _core.dense_eval(self.method, self.meta, self.data, self.part_len, np.zeros(0))
@@ -875,8 +876,10 @@ class DenseSolution:
         self.t_max = float(self.ts[-1]) if self.ts.size else float("nan")
 
     def __call__(self, t: ArrayLike) -> np.ndarray:
-        tt = np.asarray(t, dtype=float)
-        out = _core.dense_eval(self.method, self.meta, self.data, self.part_len, np.atleast_1d(tt).ravel())
+        tt = np.asarray(t)  # the core converts numbers and refuses the rest (strings, complex, ...)
+        if tt.ndim > 1:
+            raise InvalidArgumentError("t", f"expected a time or a 1-D array of times, got shape {tt.shape}")
+        out = _core.dense_eval(self.method, self.meta, self.data, self.part_len, np.atleast_1d(tt))
         return out[:, 0] if tt.ndim == 0 else out
 
     def truncated(self, t_stop: float) -> "DenseSolution":

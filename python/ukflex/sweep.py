@@ -164,7 +164,7 @@ def run_case(build: Callable[..., Any], outputs: Callable[[Any], Mapping[str, An
         row["solver_status"] = int(res.status)
     except Exception as exc:  # a failed case is a row, never the end of the sweep
         row["status"] = "failed"
-        row["error"] = f"{type(exc).__name__}: {exc}".splitlines()[0] if str(exc) else type(exc).__name__
+        row["error"] = _describe(exc)
         row["method"] = ""
         row["solver_status"] = None
     row["wall_time"] = time.perf_counter() - tic
@@ -185,9 +185,20 @@ def _run_chunk(payload: bytes, chunk: List[Tuple[int, Dict[str, Any]]], defaults
     return [(i, run_case(funcs[0], funcs[1], case, defaults, blas)) for i, case in chunk]
 
 
+def _describe(exc: BaseException) -> str:
+    """``Type: first line of the message`` of a case's exception (one whose ``__str__`` fails
+    too: a failed case never ends the sweep)."""
+    try:
+        text = str(exc)
+    except Exception:  # noqa: BLE001 - the user's exception class
+        text = "(its message cannot be shown: __str__ raised)"
+    line = text.splitlines()[0] if text.strip() else ""
+    return f"{type(exc).__name__}: {line}" if line else type(exc).__name__
+
+
 def _failed_row(case: Dict[str, Any], exc: BaseException) -> Dict[str, Any]:
     row = dict(case)
-    row.update(status="failed", error=f"{type(exc).__name__}: {exc}".splitlines()[0], method="",
+    row.update(status="failed", error=_describe(exc), method="",
                solver_status=None, wall_time=float("nan"))
     return row
 

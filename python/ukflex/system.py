@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import json
 import math
-import numbers
+import reprlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
+from .arguments import real
 from .description import normalize
 from .errors import (InconsistentInitialStateError, InvalidArgumentError, InvalidSceneError, NonFiniteError,
                      UnknownNameError, core as _core)
@@ -374,11 +375,13 @@ class System:
         settings = dict(state["settings"])
         for name, args in settings.items():
             if name not in self.SETTINGS or not isinstance(args, tuple):
-                raise bad("settings", f"expected {{name: args tuple}} with names in {list(self.SETTINGS)}, got {name!r}: {args!r:.80}")
+                raise bad("settings", f"expected {{name: args tuple}} with names in {list(self.SETTINGS)}, got "
+                                      f"{reprlib.repr(name)}: {reprlib.repr(args)}")
         _, description = normalize(state["description"])
-        t0 = state["t0"]
-        if isinstance(t0, bool) or not isinstance(t0, numbers.Real) or not math.isfinite(float(t0)):
-            raise bad("t0", f"expected a finite number, got {t0!r:.80}")
+        try:
+            t0 = real("t0", state["t0"])
+        except InvalidArgumentError as exc:
+            raise bad("t0", str(exc)) from None
         if not isinstance(state["initial_correction"], InitialCorrection):
             raise bad("initial_correction", f"expected an InitialCorrection, got {type(state['initial_correction']).__name__}")
         try:
@@ -388,7 +391,7 @@ class System:
         for key in ("q_guess", "qd_guess", "q0", "qd0"):
             try:
                 v = np.array(state[key], dtype=float)
-            except (TypeError, ValueError) as exc:
+            except (TypeError, ValueError, OverflowError) as exc:
                 raise bad(key, f"expected an array of {self.n_coords} floats ({exc})") from None
             if v.shape != (self.n_coords,) or not np.all(np.isfinite(v)):
                 raise bad(key, f"expected {self.n_coords} finite floats (the scene's coordinates), got shape {v.shape}")
@@ -446,14 +449,14 @@ class System:
 
     def body_slice(self, body: str) -> slice:
         """Slice of ``q`` holding body ``body``'s coordinates ``[x, y, theta, q_f...]``."""
-        if body not in self.body_slices:
+        if not isinstance(body, str) or body not in self.body_slices:
             raise UnknownNameError.of("body", body, self.body_names)
         start, stop = self.body_slices[body]
         return slice(start, stop)
 
     def elastic_slice(self, body: str) -> slice:
         """Slice of ``q`` holding body ``body``'s elastic coordinates ``q_f``."""
-        if body not in self.body_slices:
+        if not isinstance(body, str) or body not in self.body_slices:
             raise UnknownNameError.of("body", body, self.body_names)
         start, stop = self.core.elastic_range(body)
         if start == stop:

@@ -10,7 +10,7 @@ mod system;
 use numpy::ndarray::ArrayView1;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyKeyError, PyValueError};
+use pyo3::exceptions::{PyException, PyKeyError, PyOverflowError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyType;
@@ -92,6 +92,26 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Vector<'py> {
     }
 }
 
+/// A real scalar argument (a time, an axis coordinate, a tolerance): what `float()` takes, with a
+/// number beyond the double range (a 400-digit integer) a `ValueError` saying so instead of
+/// Python's bare `OverflowError` (PyO3 names the argument in the exception note).
+pub struct Real(pub f64);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Real {
+    type Error = PyErr;
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        match obj.extract::<f64>() {
+            Ok(v) => Ok(Real(v)),
+            Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => {
+                let text = obj.repr().map(|r| r.to_string()).unwrap_or_default();
+                let shown: String = text.chars().take(40).collect();
+                Err(PyValueError::new_err(format!("expected a real number within the double-precision range, got {shown}{}", if text.chars().count() > 40 { "..." } else { "" })))
+            }
+            Err(e) => Err(e),
+        }
+    }
+}
+
 pub(crate) fn to_py(e: Error) -> PyErr {
     let msg = e.to_string();
     match e {
@@ -170,8 +190,15 @@ pub(crate) fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -
 /// is inconsistent); a value that does not fit a double (extrapolated far out) is a
 /// `NonFiniteError`.
 #[pyfunction]
-fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<'py, f64>, data: numpy::PyReadonlyArray2<'py, f64>, part_len: Vec<usize>, t: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<'py, f64>, data: numpy::PyReadonlyArray2<'py, f64>, part_len: &Bound<'py, PyAny>, t: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     use crate::integrate::{DenseView, Method};
+    // whole numbers >= 0 (a negative or huge one is a ValueError naming it, not an OverflowError)
+    let bad = || PyValueError::new_err("dense_eval: part_len must be a list of whole numbers >= 0 (the lengths of the record's parts)");
+    let mut lens = Vec::new();
+    for x in part_len.try_iter().map_err(|_| bad())? {
+        lens.push(x.map_err(|_| bad())?.extract::<u64>().map_err(|_| bad())?.try_into().map_err(|_| bad())?);
+    }
+    let part_len: Vec<usize> = lens;
     let method = Method::from_name(method).ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5', 'GENALPHA' or 'RADAU5M')")))?;
     let (meta, data) = (meta.as_array(), data.as_array());
     if meta.ncols() != 3 || meta.nrows() != data.nrows() {

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use super::sensors::read_states;
-use super::{check_time, finite_out, mat, read_into, to_py, SolverError, Vector};
+use super::{check_time, finite_out, mat, read_into, to_py, Real, SolverError, Vector};
 use crate::body::{ancf_cable, BodyKind};
 use crate::linalg::Banded;
 use crate::correct::{self, CorrectOptions};
@@ -274,7 +274,8 @@ impl PySystem {
     /// iterate); `stiffness=False` skips K (then all zero): M and A alone, one evaluation.
     #[pyo3(signature = (t, q, qd, qdd=None, lam=None, stiffness=true))]
     #[allow(clippy::too_many_arguments)]
-    fn linearization<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, qdd: Option<Vector<'py>>, lam: Option<Vector<'py>>, stiffness: bool) -> PyResult<Bound<'py, PyDict>> {
+    fn linearization<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, qdd: Option<Vector<'py>>, lam: Option<Vector<'py>>, stiffness: bool) -> PyResult<Bound<'py, PyDict>> {
+        let t = t.0;
         use crate::sparse_newton::{fill_a, fill_linearized_stiffness, fill_mass, Pattern, Structure};
         let (n, m) = (self.model.n, self.model.m);
         let mut held = (vec![0.0; n], vec![0.0; m]);
@@ -332,7 +333,8 @@ impl PySystem {
 
     /// Generalized forces Q(t, q, qd) = applied + quadratic velocity + elastic, shape (n,).
     #[allow(non_snake_case)]
-    fn Q<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn Q<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
@@ -361,7 +363,8 @@ impl PySystem {
     }
 
     /// Constraint values Phi(q, t), shape (m,).
-    fn phi<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn phi<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, None)?;
@@ -373,7 +376,8 @@ impl PySystem {
     }
 
     /// Partial time derivative Phi_t(t), shape (m,) (nonzero only for drivers).
-    fn phi_t<'py>(&self, py: Python<'py>, t: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn phi_t<'py>(&self, py: Python<'py>, t: Real) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             ws.q.copy_from_slice(&model.q0);
@@ -386,7 +390,8 @@ impl PySystem {
     }
 
     /// b = gamma(t, q, qd) (paper eq. 43), shape (m,).
-    fn b<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn b<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
@@ -398,7 +403,8 @@ impl PySystem {
     }
 
     /// UK acceleration qdd(t, q, qd), shape (n,).
-    fn qdd<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn qdd<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let out = PyArray1::<f64>::zeros(py, self.model.n, false);
         self.with_ws(|model, ws| {
             check_time(t)?;
@@ -413,7 +419,8 @@ impl PySystem {
     }
 
     /// Right-hand side for integrators: y = [q, qd] -> [qd, qdd], shape (2n,).
-    fn rhs<'py>(&self, py: Python<'py>, t: f64, y: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn rhs<'py>(&self, py: Python<'py>, t: Real, y: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let n = self.model.n;
         let out = PyArray1::<f64>::zeros(py, 2 * n, false);
         self.with_ws(|model, ws| {
@@ -439,7 +446,8 @@ impl PySystem {
     /// (t, q, qd), the minimum over `batches` batches of `reps` calls, GIL released. Lets a
     /// Python benchmark separate the core's time from the binding's overhead in one run.
     #[pyo3(signature = (t, q, qd, reps=1000, batches=21))]
-    fn time_acceleration(&self, py: Python<'_>, t: f64, q: Vector<'_>, qd: Vector<'_>, reps: usize, batches: usize) -> PyResult<f64> {
+    fn time_acceleration(&self, py: Python<'_>, t: Real, q: Vector<'_>, qd: Vector<'_>, reps: usize, batches: usize) -> PyResult<f64> {
+        let t = t.0;
         let n = self.model.n;
         let (mut qv, mut qdv) = (vec![0.0; n], vec![0.0; n]);
         read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
@@ -460,7 +468,8 @@ impl PySystem {
     }
 
     /// Lagrange multipliers (M qdd + A^T lambda = Q), shape (m,).
-    fn multipliers<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn multipliers<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
@@ -513,7 +522,8 @@ impl PySystem {
 
     /// (position Phi, velocity A qd + Phi_t, acceleration A qdd - b), each shape (m,).
     #[allow(clippy::type_complexity)]
-    fn residuals<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn residuals<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        let t = t.0;
         let m = self.model.m;
         let (p, v, a) = self.with_ws(|model, ws| {
             check_time(t)?;
@@ -549,7 +559,8 @@ impl PySystem {
     /// `exact=False` skips the on-demand singular values: after a certified full-rank solve the
     /// report then holds the certificate's bounds (`exact` says which), at no extra cost.
     #[pyo3(signature = (t=None, q=None, qd=None, exact=true))]
-    fn rank_info<'py>(&self, py: Python<'py>, t: Option<f64>, q: Option<Vector<'py>>, qd: Option<Vector<'py>>, exact: bool) -> PyResult<Bound<'py, PyDict>> {
+    fn rank_info<'py>(&self, py: Python<'py>, t: Option<Real>, q: Option<Vector<'py>>, qd: Option<Vector<'py>>, exact: bool) -> PyResult<Bound<'py, PyDict>> {
+        let t = t.map(|t| t.0);
         let state = match (t, &q, &qd) {
             (Some(t), Some(q), Some(qd)) => Some((t, q, qd)),
             (None, None, None) => None,
@@ -617,7 +628,8 @@ impl PySystem {
     /// columns reuse the mass factor and the pseudoinverse of the base point. Runs with the GIL
     /// released. `scheme="forward"` halves the cost.
     #[pyo3(signature = (t, y, scheme="central"))]
-    fn jac<'py>(&self, py: Python<'py>, t: f64, y: Vector<'py>, scheme: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn jac<'py>(&self, py: Python<'py>, t: Real, y: Vector<'py>, scheme: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let t = t.0;
         let n = self.model.n;
         let scheme = match scheme {
             "central" => Differences::Central,
@@ -678,9 +690,9 @@ impl PySystem {
     fn integrate<'py>(
         &self,
         py: Python<'py>,
-        t0: f64,
+        t0: Real,
         y0: Vector<'py>,
-        t_end: f64,
+        t_end: Real,
         method: &str,
         rtol: f64,
         atol: Option<Vector<'py>>,
@@ -702,6 +714,7 @@ impl PySystem {
         on_drift: &str,
         monitor_singular: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let (t0, t_end) = (t0.0, t_end.0);
         let linear_solver = LinearSolver::parse(linear_solver).map_err(to_py)?;
         let jacobian = match jacobian {
             "central" => Differences::Central,
@@ -929,7 +942,8 @@ impl PySystem {
     /// the tangent space of the constraints in the mass metric (the filter of the explicit
     /// methods' error estimates, docs/integrators.md).
     /// Returns (the projected V, sigma_min / sigma_max of `A M^-1/2` at q).
-    fn tangent_project<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, v: PyReadonlyArray2<'py, f64>) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
+    fn tangent_project<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, v: PyReadonlyArray2<'py, f64>) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
+        let t = t.0;
         let n = self.model.n;
         let va = v.as_array();
         if va.shape().len() != 2 || va.shape()[0] != n {
@@ -980,7 +994,8 @@ impl PySystem {
     /// Returns (q, qd, ||Phi|| at the new q, whether Newton converged).
     #[pyo3(signature = (t, q, qd, position_tol, max_iter=3))]
     #[allow(clippy::type_complexity)]
-    fn project_step<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, position_tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64, bool)> {
+    fn project_step<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, position_tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64, bool)> {
+        let t = t.0;
         if !(position_tol >= 0.0) || !position_tol.is_finite() {
             return Err(PyValueError::new_err(format!("position_tol must be >= 0 and finite, got {position_tol}")));
         }
@@ -1024,7 +1039,8 @@ impl PySystem {
     /// position_correction, velocity_correction).
     #[pyo3(signature = (t, q, qd, tol=1e-12, max_iter=20))]
     #[allow(clippy::type_complexity)]
-    fn project<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+    fn project<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+        let t = t.0;
         if !tol.is_finite() || tol <= 0.0 {
             return Err(PyValueError::new_err(format!("tol must be positive and finite, got {tol}")));
         }
@@ -1052,7 +1068,8 @@ impl PySystem {
     /// (S (2, n_b), S' (2, n_b)) over the body's n_b = 4 (N + 1) coordinates e, with the world
     /// position r = S e and the slope r' = S' e (d/dx) of the axis point.
     #[allow(clippy::type_complexity)]
-    fn beam_shape<'py>(&self, py: Python<'py>, body: &str, xi: f64) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyAny>)> {
+    fn beam_shape<'py>(&self, py: Python<'py>, body: &str, xi: Real) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyAny>)> {
+        let xi = xi.0;
         let bi = self.body(body)?;
         if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
             return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {xi}")));
@@ -1169,7 +1186,8 @@ impl PySystem {
     /// in the beam frame from the undeformed (xi L, 0)) and psi (section rotation relative to
     /// that frame). The beam frame is an FFRF beam's floating frame (pinned-pinned: the chord
     /// of the ends) and an ANCF beam's chord frame of the ends, so the two compare one to one.
-    fn beam_point<'py>(&self, py: Python<'py>, body: &str, xi: f64, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn beam_point<'py>(&self, py: Python<'py>, body: &str, xi: Real, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let xi = xi.0;
         let bi = self.body(body)?;
         if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
             return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {xi}")));
@@ -1405,7 +1423,8 @@ impl PySystem {
     /// failed), phi (m,), velocity (m,), positions_ok, velocities_ok.
     #[pyo3(signature = (t, q, qd, hold, position_tol=1e-12, velocity_tol=1e-10, max_iterations=50, max_wall_time=None))]
     #[allow(clippy::too_many_arguments)]
-    fn correct<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize, max_wall_time: Option<f64>) -> PyResult<Bound<'py, PyDict>> {
+    fn correct<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize, max_wall_time: Option<f64>) -> PyResult<Bound<'py, PyDict>> {
+        let t = t.0;
         let max_wall_time = max_wall_time.unwrap_or(f64::INFINITY);
         if !(max_wall_time > 0.0) {
             return Err(PyValueError::new_err(format!("max_wall_time must be positive, got {max_wall_time}")));

@@ -132,9 +132,17 @@ const NONE: NodeId = NodeId::MAX;
 /// Nodes of the rule of one node's derivative, at most (the size check of `derivative`).
 const RULE_NODES: usize = 10;
 
+/// The variables a node depends on, one bit per slot (slots from 64 on share the last bits:
+/// conservatively "depends on all of them").
+fn var_bit(k: usize) -> u64 {
+    if k < 63 { 1 << k } else { !((1u64 << 63) - 1) }
+}
+
 #[derive(Debug, Clone)]
 pub struct Graph {
     nodes: Vec<Node>,
+    /// `deps[i]`: the variables node `i` depends on (`var_bit`s).
+    deps: Vec<u64>,
     index: HashMap<Node, NodeId>,
     n_vars: usize,
     /// `memo[v][i]`: the node of `d(node i)/d(variable v)` (`NONE`: not formed yet).
@@ -144,7 +152,7 @@ pub struct Graph {
 impl Graph {
     /// An empty graph over `n_vars` variables (slots `0..n_vars`).
     pub fn new(n_vars: usize) -> Graph {
-        Graph { nodes: Vec::new(), index: HashMap::new(), n_vars, memo: vec![Vec::new(); n_vars] }
+        Graph { nodes: Vec::new(), deps: Vec::new(), index: HashMap::new(), n_vars, memo: vec![Vec::new(); n_vars] }
     }
 
     pub fn n_vars(&self) -> usize {
@@ -176,7 +184,13 @@ impl Graph {
             return id;
         }
         let id = self.nodes.len() as NodeId;
+        let deps = match n {
+            Node::Const(_) => 0,
+            Node::Var(k) => var_bit(k as usize),
+            _ => n.children().into_iter().flatten().fold(0, |d, c| d | self.deps[c as usize]),
+        };
         self.nodes.push(n);
+        self.deps.push(deps);
         self.index.insert(n, id);
         id
     }
@@ -303,6 +317,11 @@ impl Graph {
     /// (`(a/b)' = a'/b - (a/b)(b'/b)`, `(log a)' = a'/a`), so operands scaled by 1e-170 do not
     /// underflow in between (`(a'b - ab')/b^2` did).
     fn rule(&mut self, i: usize, var: usize) -> NodeId {
+        // a part that does not depend on the variable has derivative 0, whatever its value
+        // (`pi/0` is infinite, its derivative is still 0, not the NaN the quotient rule gives)
+        if self.deps[i] & var_bit(var) == 0 {
+            return self.num(0.0);
+        }
         let me = i as NodeId;
         let d = |g: &Graph, a: NodeId| g.memo_get(var, a as usize);
         match self.nodes[i] {

@@ -190,6 +190,18 @@ mod tests {
     }
 
     #[test]
+    fn constant_parts_have_zero_derivatives() {
+        // pi/0 is infinite and tanh(0.5)/inf is 0: f = 2, a constant, whose derivatives are 0
+        // (the quotient rule on the constant pi/0 gave 0/0 = NaN)
+        assert_eq!(ev("tanh(0.5) / (pi / 0) + 2 + t - t", 0.5), (2.0, 0.0, 0.0));
+        assert!(ev("t * log(-1)", 0.3).1.is_nan()); // a NaN constant still multiplies
+        let f = Function::parse("x * exp(2) + y^2", &["x", "y"]).unwrap();
+        let (mut buf, mut g) = (vec![0.0; f.scratch_len()], [0.0; 2]);
+        f.eval_gradient(&[1.0, 3.0], &mut buf, &mut g);
+        assert_eq!(g, [2f64.exp(), 6.0]);
+    }
+
+    #[test]
     fn shared_subexpressions_are_one_node() {
         let mut g = Graph::new(1);
         let a = parse(&mut g, "sin(t)*sin(t) + sin(t)", &["t"]).unwrap();
