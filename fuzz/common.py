@@ -4,7 +4,6 @@ finiteness and hostile-input tests, and the compiled systems the per-call catego
 from __future__ import annotations
 
 import contextlib
-import math
 import warnings
 from dataclasses import dataclass
 from typing import Any, Callable, Dict, List, Sequence, Tuple

@@ -462,6 +462,8 @@ def _against_sympy(case: Dict[str, Any], ts: np.ndarray, v: np.ndarray) -> List[
             return float("nan")
 
     for j, tv in enumerate(ts):
+        if math.isinf(_naive(case["sympy"], float(tv), "ieee")):
+            continue  # beyond doubles as written (cosh(cosh(t^30))): 40 digits of it would take SymPy ages
         for k, name in enumerate(("f", "f'", "f''")):
             ours = float(v[k][j])
             kind, exact = _exact(derivs[k], t, float(tv))

@@ -297,9 +297,12 @@ def simulate(
     budget = _Budget(_count("max_steps", max_steps), _count("max_nfev", max_nfev),
                      None if max_wall_time is None else _positive("max_wall_time", max_wall_time),
                      0.0 if min_step == 0 else _positive("min_step", min_step), call_start)
+    if options.get("first_step") is not None:  # every method's: a positive number (scipy's compare it as given)
+        options = dict(options, first_step=_positive("first_step", options["first_step"]))
     for key in ("max_step", "step"):  # a step size that cannot reach t_end within the step budget
         if options.get(key) is not None:
             h = _positive(key, options[key])
+            options = dict(options, **{key: h})
             if (t_end_f - t0) / h > budget.max_steps:
                 raise InvalidArgumentError(
                     key, f"{key} = {h:g} needs {(t_end_f - t0) / h:.3g} steps to reach t_end, more than max_steps = "
@@ -320,9 +323,9 @@ def simulate(
                 raise InvalidArgumentError("events", f"entry {k} is not callable: {ev!r}")
             terminal = getattr(ev, "terminal", None)
             if terminal is not None and not (isinstance(terminal, (bool, np.bool_)) or (
-                    isinstance(terminal, numbers.Integral) and terminal >= 0)):
+                    isinstance(terminal, numbers.Integral) and 0 <= terminal <= 2 ** 53)):
                 raise InvalidArgumentError("events", f"entry {k}: terminal must be a boolean or a whole number of "
-                                           f"occurrences (solve_ivp's rule), got {terminal!r:.60}")
+                                           f"occurrences up to 2**53 (solve_ivp's rule), got {terminal!r:.60}")
             direction = getattr(ev, "direction", None)
             if direction is not None:
                 _real(f"events[{k}].direction", direction)
