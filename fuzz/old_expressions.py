@@ -114,6 +114,20 @@ class OldExpr:
             return a
         return self._node("*", a, b)
 
+    def exact_mul(self, a: Node, b: Node) -> Node:
+        """``a * b`` as written (the parser's, as the core's now: no 0 * x = 0)."""
+        x, y = self._num(a), self._num(b)
+        if x is not None and y is not None:
+            return self.num(np.float64(x) * y)
+        return b if x == 1.0 else a if y == 1.0 else self._node("*", a, b)
+
+    def exact_div(self, a: Node, b: Node) -> Node:
+        """``a / b`` as written (no 0 / x = 0)."""
+        x, y = self._num(a), self._num(b)
+        if x is not None and y is not None and y != 0.0:
+            return self.num(np.float64(x) / y)
+        return a if y == 1.0 else self._node("/", a, b)
+
     def div(self, a: Node, b: Node) -> Node:
         x, y = self._num(a), self._num(b)
         if x is not None and y is not None and y != 0.0:
@@ -280,10 +294,10 @@ class OldExpr:
             c = self._peek()
             if c == "*" and self.chars[self.pos + 1:self.pos + 2] != "*":
                 self.pos += 1
-                a = self.mul(a, self._unary())
+                a = self.exact_mul(a, self._unary())
             elif c == "/":
                 self.pos += 1
-                a = self.div(a, self._unary())
+                a = self.exact_div(a, self._unary())
             else:
                 return a
 

@@ -202,6 +202,19 @@ mod tests {
     }
 
     #[test]
+    fn products_and_quotients_as_written_keep_ieee_values() {
+        // 0 * x and 0 / x are not folded where x can be infinite or NaN: 0 * (t/0) is NaN, not 0
+        assert!(ev("t/0*(1*0)", 1.0).0.is_nan());
+        assert!(ev("0/(t - t)", 1.0).0.is_nan());
+        assert_eq!(ev("1/(0*sin(t))", -2.0).0, f64::NEG_INFINITY); // 0 * sin(-2) = -0, as IEEE has it
+        // in derivatives the zeros are structural: d/dt (0 * t) = 0
+        assert_eq!(ev("0*t + t", 2.0), (2.0, 1.0, 0.0));
+        // pow within an ulp: tan of 1.7e12 amplifies every ulp of the argument
+        let x = 2f64.tan().powf(3.0).powf(3.0).powf(4.0);
+        assert_eq!(ev("tan(((tan(2)^3)^3)^4)", 0.0).0, x.tan());
+    }
+
+    #[test]
     fn shared_subexpressions_are_one_node() {
         let mut g = Graph::new(1);
         let a = parse(&mut g, "sin(t)*sin(t) + sin(t)", &["t"]).unwrap();

@@ -119,8 +119,8 @@ impl Parser<'_> {
                 match op {
                     Op::Add => self.g.add(a, b),
                     Op::Sub => self.g.sub(a, b),
-                    Op::Mul => self.g.mul(a, b),
-                    Op::Div => self.g.div(a, b),
+                    Op::Mul => self.g.product(a, b),
+                    Op::Div => self.g.quotient(a, b),
                     _ => self.g.pow(a, b),
                 }
             }
