@@ -53,7 +53,11 @@ def _tree(draw, depth: int = 4):
     return ("pow", draw(_tree(depth - 1)), exponent)
 
 
-def _render(node, sympy: bool, style: Tuple[bool, bool]) -> str:
+def _has_t(n) -> bool:
+    return n[0] == "t" or any(_has_t(c) for c in n[1:] if isinstance(c, tuple))
+
+
+def _render(node, sympy: bool, style: Tuple[bool, bool], fold: bool = True) -> str:
     """Text of a tree with the fewest parentheses the grammar allows (``style``: ``**`` for ``^``,
     spaces around operators); ``sympy``: SymPy's spelling (``**``, ``Abs``, ``E``)."""
     stars, spaces = style
@@ -70,6 +74,16 @@ def _render(node, sympy: bool, style: Tuple[bool, bool]) -> str:
         k = n[0]
         if k == "t":
             return "t"
+        if sympy and fold and k not in ("num",) and not _has_t(n):
+            # a part without t is computed once, in doubles, as the core folds it: SymPy gets that
+            # double (sin(sinh(15)^3) is the sine of the double 4.3e18, not of the real number)
+            text = _render(n, True, style, fold=False)
+            v = _naive(text, 0.0, "ieee")
+            if math.isfinite(v):
+                import decimal
+
+                return f"Float('{decimal.Decimal(v)}', 60)"
+            return text
         if k == "num":
             if sympy:
                 # the doubles the core uses (sin(pi) is 1.2e-16, not 0), as SymPy floats of 60
