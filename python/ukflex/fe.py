@@ -26,6 +26,7 @@ rotation about it).  Reduction (``frame``):
 
 from __future__ import annotations
 
+import reprlib
 from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -46,11 +47,12 @@ def _indices(name: str, value: Any, n: int, what: str) -> np.ndarray:
     try:
         raw = np.asarray(value)
     except (TypeError, ValueError) as exc:
-        raise InvalidArgumentError(name, f"expected {what} (whole numbers), got {value!r:.80} ({exc})") from None
+        raise InvalidArgumentError(name, f"expected {what} (whole numbers), got {reprlib.repr(value)} ({exc})") from None
     if raw.dtype.kind not in "iuf" or raw.size == 0:
-        raise InvalidArgumentError(name, f"expected {what} (whole numbers), got {raw.dtype} values {value!r:.80}")
+        raise InvalidArgumentError(name, f"expected {what} (whole numbers), got {raw.dtype} values {reprlib.repr(value)}")
     if raw.dtype.kind == "f" and not np.all(np.isfinite(raw) & (raw == np.round(raw))):
-        raise InvalidArgumentError(name, f"{what} must be whole numbers, got {value!r:.80}")
+        bad = raw[~(np.isfinite(raw) & (raw == np.round(raw)))]
+        raise InvalidArgumentError(name, f"{what} must be whole numbers, got {bad[:8].tolist()}")
     outside = raw[(raw < 0) | (raw >= n)]
     if outside.size:
         raise InvalidArgumentError(name, f"{what} {outside[:8].tolist()} are not nodes of the mesh (0..{n - 1})")
