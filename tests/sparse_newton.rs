@@ -150,11 +150,17 @@ fn sparse_and_dense_newton_runs_give_the_same_answer_to_rounding() {
             let d = rel_diff(&ys, &yd);
             let du = rel_diff(&yu, &yd);
             println!("{name:20} {method:8} step {step:?}: steps {} / {}, Newton {} / {}, relative difference {d:.1e} (dense, 1 ulp: {du:.1e})", sd.naccept, ss.naccept, sd.newton, ss.newton);
-            if method != "RADAU5" {
+            if method == "GENALPHA" || step.is_some() {
                 // the same matrices, factored differently: the same step sequence (RADAU5's
                 // saddle-point form is another route to its iteration matrices' solutions, whose
-                // rounding may move an error estimate across 1: a few steps differ)
+                // rounding may move an error estimate across 1: a few steps differ; so may
+                // RADAU5M's controlled steps since its error test covers the velocities,
+                // x_v = x_q / (h lambda) - e_q, which amplifies the same rounding: the ANCF
+                // coupler's 6188 steps rejected 397 / 393 attempts -- on 667e66b too)
                 assert_eq!((sd.naccept, sd.nreject), (ss.naccept, ss.nreject), "{name} {method} {step:?}: the same steps");
+            } else if method == "RADAU5M" {
+                let (a, b) = (sd.naccept + sd.nreject, ss.naccept + ss.nreject);
+                assert!(a.abs_diff(b) * 100 <= a, "{name} {method} {step:?}: {a} / {b} attempts");
             }
             // rounding: within what one ulp of the initial state changes (stiff runs amplify it)
             assert!(d <= (5.0 * du).max(1e-11), "{name} {method} {step:?}: sparse and dense differ by {d:e} (1 ulp: {du:e})");
