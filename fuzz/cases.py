@@ -25,90 +25,19 @@ import contextlib
 import io
 import math
 import os
+import shutil
 import tempfile
 import threading
-import warnings
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
-from typing import Any, Callable, Dict, List, Sequence, Tuple
+from typing import Any, Dict, List, Tuple
 
 import numpy as np
 from hypothesis import strategies as st
 
+from .common import (Category, Finding, _exc, _finite, _is_bad_input, _max_abs, _named, _quiet, _short, _system,
+                     _ukflex)
+from .surfaces import SURFACE_WEIGHTS, SURFACES
 from .values import WRONG_TYPES, hostile, hostile_array, maybe_hostile, scaled
-
-Finding = Tuple[str, str]
-
-
-@dataclass(frozen=True)
-class Category:
-    name: str
-    strategy: Callable[[], st.SearchStrategy]
-    check: Callable[[Any], List[Finding]]
-    doc: str
-
-
-# ----------------------------------------------------------------------------------- helpers
-def _ukflex():
-    import ukflex
-
-    return ukflex
-
-
-def _named(exc: BaseException, names: Sequence[str]) -> bool:
-    """A ukflex error, or a TypeError/ValueError whose message names one of ``names``."""
-    uk = _ukflex()
-    if isinstance(exc, uk.UkflexError):
-        return True
-    if isinstance(exc, (TypeError, ValueError, OverflowError)):
-        # pyo3 names the argument in an exception note ("while processing 'q'")
-        msg = " ".join([str(exc)] + [str(n) for n in getattr(exc, "__notes__", [])])
-        return any(n and n in msg for n in names)
-    return False
-
-
-def _exc(exc: BaseException) -> str:
-    return f"{type(exc).__name__}: {str(exc)[:300]}"
-
-
-def _finite(*arrays: Any) -> bool:
-    for a in arrays:
-        a = np.asarray(a)
-        if a.dtype.kind in "fc" and not np.all(np.isfinite(a)):
-            return False
-    return True
-
-
-def _is_bad_input(v: Any) -> bool:
-    """Input that a careful API must refuse (non-finite, masked, complex, wrong type)."""
-    if isinstance(v, np.ma.MaskedArray):
-        return True
-    if isinstance(v, (str, bytes, dict)) or v is None or isinstance(v, bool):
-        return True
-    if isinstance(v, int):  # a Python int is a number; only one beyond the double range is bad
-        return abs(v) > 1.7e308
-    try:
-        a = np.asarray(v)
-    except Exception:  # noqa: BLE001 - ragged etc.
-        return True
-    if a.dtype.kind == "c" or a.dtype.kind in "OUSV":
-        return True
-    if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
-        return True
-    return False
-
-
-@contextlib.contextmanager
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        with np.errstate(all="ignore"):
-            yield
-
-
-def _max_abs(a: Any) -> float:
-    a = np.asarray(a, dtype=float)
-    return float(np.max(np.abs(a))) if a.size else 0.0
 
 
 # ----------------------------------------------------------------------------------- scenes
@@ -410,29 +339,6 @@ def _check_core(case: Dict[str, Any]) -> List[Finding]:
 
 
 # ----------------------------------------------------------------------------------- arrays
-_SYSTEMS: Dict[str, Any] = {}
-
-
-def _ancf_cantilever():
-    uk = _ukflex()
-    s = uk.Scene(gravity=(0.0, -9.81))
-    b = s.beam("beam", length=1.0, section=uk.Rectangular(0.02, 0.01), density=7850.0, youngs_modulus=2.1e11,
-               elements=2, formulation="ancf")
-    s.weld(s.ground.frame(), b.at(0.0), name="clamp")
-    return s
-
-
-def _system(name: str):
-    if name not in _SYSTEMS:
-        uk = _ukflex()
-        scene = {"slider_crank": lambda: uk.scenes.slider_crank(elements=2),
-                 "pendulum": lambda: uk.scenes.pendulum(),
-                 "cantilever_ancf": _ancf_cantilever,
-                 "every_joint": lambda: uk.scenes.every_joint()}[name]()
-        _SYSTEMS[name] = uk.System(scene)
-    return _SYSTEMS[name]
-
-
 _METHODS = {  # method -> argument names (t: scalar, q/qd: (n,), y: (2n,))
     "qdd": ("t", "q", "qd"), "rhs": ("t", "y"), "M": ("q",), "Q": ("t", "q", "qd"), "phi": ("t", "q"),
     "A": ("q",), "b": ("t", "q", "qd"), "multipliers": ("t", "q", "qd"), "residuals": ("t", "q", "qd"),
@@ -493,11 +399,6 @@ def _check_array(case: Dict[str, Any]) -> List[Finding]:
             if err > 1e-6 * scale:
                 return [("wrong", f"qdd differs from the NumPy reference by {err:.3g} (scale {scale:.3g})")]
     return []
-
-
-def _short(v: Any) -> str:
-    r = repr(v)
-    return r if len(r) < 120 else r[:117] + "..."
 
 
 # ----------------------------------------------------------------------------------- simulate options
@@ -571,10 +472,38 @@ def _cli_case(draw):
     target = draw(st.sampled_from(["pendulum", "examples/pendulum.toml", "fifo", "devzero", "dir", "missing",
                                    "spaces", "deep", "bigint", "empty", "binary", "dotdot_name", "kind_list"]))
     command = draw(st.sampled_from(["run", "run", "run", "export", "list"]))
-    out = draw(st.sampled_from(["tmp", "tmp", "file", "proc", "dotdot"]))
+    out = draw(st.sampled_from(["tmp", "tmp", "file", "proc", "dotdot", "dotdot_rel"]))
     samples = draw(st.sampled_from(["11", "11", "1e11", "-3", "0", "abc", "99999999999"]))
     t_end = draw(st.sampled_from(["0.01", "0.01", "-1", "nan", "1e300", "x"]))
-    return dict(target=target, command=command, out=out, samples=samples, t_end=t_end)
+    # output expressions: unknown joints and drivers must be refused before the run
+    plot = draw(st.sampled_from([None, None, None, "reaction(nope).fx", "work(nope)", "reaction(pivot).fx", "rod.theta",
+                                 "energy(nope).kinetic"]))
+    param = draw(st.sampled_from([None, None, None, "gravity=nan", "gravity=inf", "gravity=abc", "mass=-1", "length=1e300"]))
+    # a few runs plot in a separate process with an empty $HOME: nothing may be written there
+    fresh = draw(st.sampled_from([False] * 9 + [True]))
+    if draw(st.booleans()):  # half the runs are plausible but for the output, parameter and folder options
+        target, command, samples, t_end = "pendulum", "run", "11", "0.01"
+    if fresh:  # a run that plots, in its own process: what it writes outside its folder shows
+        target, command, samples, t_end, out, param = "pendulum", "run", "11", "0.01", "tmp", None
+        plot = draw(st.sampled_from([None, "rod.theta"]))
+    return dict(target=target, command=command, out=out, samples=samples, t_end=t_end, plot=plot, param=param,
+                fresh_process=fresh)
+
+
+def _cli_subprocess(argv: List[str], work: str, home: str, repo: str) -> Tuple[int, str, str]:
+    """``ukflex`` in a fresh process with an empty ``$HOME`` and no ``MPLCONFIGDIR`` (a seeded
+    regression, named in ``FUZZ_REGRESSION``, is put back there too)."""
+    import subprocess
+    import sys
+
+    os.makedirs(home, exist_ok=True)
+    env = {k: v for k, v in os.environ.items() if k not in ("MPLCONFIGDIR", "XDG_CACHE_HOME", "XDG_CONFIG_HOME")}
+    env.update(HOME=home, MPLBACKEND="Agg", PYTHONPATH=repo)
+    code = ("import os, sys\nr = os.environ.get('FUZZ_REGRESSION')\nif r:\n    from fuzz import regressions\n"
+            "    regressions.apply(r)\nfrom ukflex import cli\nsys.exit(cli.main(sys.argv[1:]))")
+    p = subprocess.run([sys.executable, "-c", code] + argv, cwd=work, env=env, capture_output=True, text=True,
+                       timeout=60)
+    return p.returncode, p.stdout, p.stderr
 
 
 def _cli_target(kind: str, work: str, repo: str) -> str:
@@ -617,16 +546,20 @@ def _check_cli(case: Dict[str, Any]) -> List[Finding]:
         os.makedirs(work)
         target = _cli_target(case["target"], work, repo)
         outs = {"tmp": os.path.join(work, "out"), "file": os.path.join(work, "in"), "proc": "/proc/ukflex-fuzz",
-                "dotdot": os.path.join(work, "..", "..")}
+                "dotdot": os.path.join(work, "..", ".."), "dotdot_rel": os.path.join(".", "x", "..", "out2")}
         out = outs[case["out"]]
         if case["out"] == "file":
             out = os.path.join(work, "a_file")
             open(out, "w").close()
         if case["command"] == "run":
-            argv = ["run", target, "--t-end", case["t_end"], "--samples", case["samples"], "--no-plot",
-                    "--method", "DOPRI5", "--no-progress"]
+            argv = ["run", target, "--t-end", case["t_end"], "--samples", case["samples"],
+                    "--method", "DOPRI5", "--no-progress"] + ([] if case.get("fresh_process") else ["--no-plot"])
             if case["out"] != "tmp" or case["target"] != "dotdot_name":
                 argv += ["--out", out]
+            if case.get("plot"):
+                argv += ["--plot", case["plot"]]
+            if case.get("param") and case["target"] == "pendulum":
+                argv += ["--param", case["param"]]
         elif case["command"] == "export":
             argv = ["export", case["target"] if case["target"] == "pendulum" else "pendulum", "-o",
                     out if case["out"] != "tmp" else os.path.join(work, "exp.toml")]
@@ -634,20 +567,38 @@ def _check_cli(case: Dict[str, Any]) -> List[Finding]:
             argv = ["list"]
         before = {d: set(os.listdir(d)) for d in (root, os.path.join(root, "a"), os.path.join(root, "a", "b"))}
         err, stdout = io.StringIO(), io.StringIO()
-        cwd = os.getcwd()
-        os.chdir(work)
-        try:
-            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(stdout), _quiet():
-                try:
-                    code = cli.main(argv)
-                except SystemExit as exc:
-                    code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
-        except Exception as exc:  # noqa: BLE001
-            return [("cli-traceback", f"{argv[:2]}: {_exc(exc)}")]
-        finally:
-            os.chdir(cwd)
+        home = tempfile.mkdtemp(prefix="fuzz-home-")  # beside the watched folders, removed below
+        if case.get("fresh_process"):
+            code, out_text, text = _cli_subprocess(argv, work, home, repo)
+            stdout.write(out_text)
+            err.write(text)
+        else:
+            cwd = os.getcwd()
+            os.chdir(work)
+            try:
+                with contextlib.redirect_stderr(err), contextlib.redirect_stdout(stdout), _quiet():
+                    try:
+                        code = cli.main(argv)
+                    except SystemExit as exc:
+                        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+            except Exception as exc:  # noqa: BLE001
+                return [("cli-traceback", f"{argv[:2]}: {_exc(exc)}")]
+            finally:
+                os.chdir(cwd)
         findings: List[Finding] = []
         text = err.getvalue()
+        written = [os.path.relpath(os.path.join(d, f), home) for d, _, fs in os.walk(home) for f in fs]
+        shutil.rmtree(home, ignore_errors=True)
+        if written:
+            findings.append(("cli-traceback", f"{argv}: wrote under $HOME: {written[:3]}"))
+        if os.path.isdir(os.path.join(work, "x")):
+            findings.append(("cli-traceback", f"{argv}: left a stray folder x/ on the way to its --out"))
+        if code == 2 and case["command"] == "run":  # a user error is found before the run: no results written
+            for d in {out, os.path.join(work, "out2")}:
+                if os.path.isdir(d):
+                    results = [f for f in os.listdir(d) if f.endswith((".csv", ".npz"))]
+                    if results:
+                        findings.append(("cli-traceback", f"{argv}: exit 2 after the run (wrote {results})"))
         failed_run = code == 1 and "status -1" in stdout.getvalue()  # ran, failed (budget, NaN), said so
         if code not in (0, 2) and not failed_run:
             findings.append(("cli-traceback", f"{argv}: exit status {code}: {text[-300:]}"))
@@ -724,10 +675,10 @@ CATEGORIES: Dict[str, Category] = {
         Category("options", _options_case, _check_options, "simulate with hostile options"),
         Category("cli", _cli_case, _check_cli, "the CLI with hostile files, paths and options"),
         Category("threads", _thread_case, _check_threads, "concurrent integrations and calls on one System"),
-    ]
+    ] + SURFACES
 }
 
 #: relative weights of the categories in a mixed run (the CLI and threads cases cost the most)
-WEIGHTS = {"scene": 3, "toml": 2, "core": 3, "arrays": 4, "options": 2, "cli": 1, "threads": 1}
+WEIGHTS = {"scene": 3, "toml": 2, "core": 3, "arrays": 4, "options": 2, "cli": 1, "threads": 1, **SURFACE_WEIGHTS}
 
 __all__ = ["CATEGORIES", "WEIGHTS", "Category", "Finding", "WRONG_TYPES"]

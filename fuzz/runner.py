@@ -48,7 +48,7 @@ class Report:
         return sum(sum(c.values()) for c in self.findings.values())
 
     def table(self) -> str:
-        kinds = ["crash", "hang", "unnamed-exception", "silent-nonfinite", "wrong", "cli-traceback"]
+        kinds = ["crash", "hang", "panic", "unnamed-exception", "silent-nonfinite", "wrong", "cli-traceback"]
         head = f"| category | cases | {' | '.join(kinds)} |\n|---|---:|" + "---:|" * len(kinds)
         rows = [head]
         for cat in sorted(self.cases):
@@ -88,6 +88,7 @@ def _worker(wid, tasks, results, started, current, reprs, counts, regression):  
     import ukflex  # noqa: F401 - imported before the first case, so the watchdog never times an import
 
     if regression:
+        os.environ["FUZZ_REGRESSION"] = regression  # for the processes a case starts (fuzz.cases._cli_subprocess)
         regressions.apply(regression)
     parent = os.getppid()
     while True:
@@ -158,14 +159,17 @@ def run(cases: Dict[str, int], *, workers: int = 2, timeout: float = 10.0, seed:
     t0 = time.time()
 
     def spawn(wid):
+        # not daemonic: a case may start processes of its own (sweep's process pool); a worker whose
+        # runner died exits by itself (it watches its parent), and the runner kills its workers at the end
         p = ctx.Process(target=_worker, args=(wid, tasks, results, started, current, reprs, counts, regression),
-                        daemon=True)
+                        daemon=False)
         p.start()
         return p
 
     procs = [spawn(w) for w in range(workers)]
     done = set()
     last_print = 0.0
+    idle_deaths = 0  # workers that died before taking a case: a broken setup, not a finding
     try:
         while len(done) < len(pending):
             try:
@@ -183,6 +187,10 @@ def run(cases: Dict[str, int], *, workers: int = 2, timeout: float = 10.0, seed:
                 dead = not p.is_alive()
                 if not (hung or dead) or (dead and task_id < 0):
                     if dead:  # finished between batches (should not happen) -> restart
+                        idle_deaths += 1
+                        if idle_deaths > 4 * workers:
+                            raise RuntimeError(f"fuzz workers die before their first case (exit code {p.exitcode}): "
+                                               "the worker setup (regression patch, import) fails")
                         procs[wid] = spawn(wid)
                     continue
                 what = _repr_of(reprs, wid)

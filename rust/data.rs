@@ -156,6 +156,8 @@ pub struct Data {
     pub phi_t: Vec<f64>,
     /// `b = gamma` (m).
     pub gamma: Vec<f64>,
+    /// Where drivers' motion expressions evaluate (the longest tape of the model's drivers).
+    pub motion_scratch: Vec<f64>,
     /// `F^-1 Q` then `F^-1 Q + B^+ (b - A a)` (n).
     pub y: Vec<f64>,
     /// Unconstrained acceleration `a = M^-1 Q` (n).
@@ -226,6 +228,7 @@ impl Data {
             dense_jac: false,
             phi_t: vec![0.0; m],
             gamma: vec![0.0; m],
+            motion_scratch: vec![0.0; model.constraints.iter().map(|c| c.scratch_len()).max().unwrap_or(0)],
             y: vec![0.0; n],
             qdd_free: vec![0.0; n],
             qdd: vec![0.0; n],

@@ -70,6 +70,7 @@ pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]
             layout,
             phi_t: &mut data.phi_t[r0..r0 + rows],
             gamma: &mut data.gamma[r0..r0 + rows],
+            scratch: &mut data.motion_scratch,
         };
         c.eval(&model.bodies, t, q, qd, width, out);
     }

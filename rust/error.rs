@@ -29,7 +29,7 @@ pub enum Error {
     #[error("{what}: {message}")]
     Argument { what: String, message: String },
     /// A driver's motion expression does not parse (`position`: 0-based character index).
-    #[error("{item}: cannot parse the motion expression {text:?} at position {position}: {message}")]
+    #[error("{item}: cannot parse the motion expression {} at position {position}: {message}", excerpt(text, *position))]
     Expression { item: String, text: String, message: String, position: usize },
     /// A work budget of a run ran out (`what`: `max_steps`, `max_nfev`, `max_wall_time`,
     /// `min_step`).
@@ -41,6 +41,10 @@ pub enum Error {
     /// A solver kernel could not produce a result (e.g. SVD did not converge).
     #[error("solver failure: {0}")]
     Solver(String),
+    /// A name that is not one of the valid names of its kind (a body, a joint, ...): Python's
+    /// `UnknownNameError` (a `KeyError`).
+    #[error("unknown {what} '{name}'; valid: {}", listing(valid))]
+    UnknownName { what: String, name: String, valid: Vec<String> },
     /// An allocation would exceed the configured memory limit (refused before allocating).
     #[error("{what} needs about {:.1} MiB, above the memory limit of {:.1} MiB; {hint}", *bytes as f64 / 1048576.0, *limit as f64 / 1048576.0)]
     Memory { what: String, bytes: u64, limit: u64, hint: String },
@@ -62,6 +66,27 @@ impl Error {
     pub fn invalid(item: impl Into<String>, message: impl Into<String>) -> Self {
         Error::InvalidProperty { item: item.into(), message: message.into() }
     }
+}
+
+/// Up to 20 names, then how many there are.
+pub fn listing(names: &[String]) -> String {
+    if names.len() <= 20 {
+        return format!("{names:?}");
+    }
+    format!("{:?} ... ({} in all)", &names[..20], names.len())
+}
+
+/// `text` quoted, or for a long text the part around `position` with its length.
+pub fn excerpt(text: &str, position: usize) -> String {
+    const KEEP: usize = 30;
+    let n = text.chars().count();
+    if n <= 3 * KEEP {
+        return format!("{text:?}");
+    }
+    let from = position.saturating_sub(KEEP).min(n.saturating_sub(2 * KEEP));
+    let part: String = text.chars().skip(from).take(2 * KEEP).collect();
+    let (head, tail) = (if from > 0 { "..." } else { "" }, if from + 2 * KEEP < n { "..." } else { "" });
+    format!("{head}{part:?}{tail} ({n} characters)")
 }
 
 /// Check that every entry of `values` is finite.

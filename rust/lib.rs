@@ -2,7 +2,7 @@
 //! Udwadia-Kalaba formulation.
 //!
 //! Data flows one way: description (`description`) -> model (`model`, `body`, `constraint`,
-//! `force`) -> workspace (`data`) -> kernels (`dynamics`, `uk`, `jacobian`) -> drivers
+//! `force`, the expression language `expr`) -> workspace (`data`) -> kernels (`dynamics`, `uk`, `jacobian`) -> drivers
 //! (`integrate`, `correct`) -> results. `bindings` (feature `python`) is the only module that
 //! knows Python. Each body kind owns its code in `body/`, each joint kind in `constraint/`;
 //! see `docs/architecture.md`.
@@ -19,6 +19,7 @@ pub mod data;
 pub mod description;
 pub mod dynamics;
 pub mod error;
+pub mod expr;
 pub mod force;
 pub mod integrate;
 pub mod jacobian;

@@ -15,8 +15,10 @@ from fuzz.cases import CATEGORIES  # noqa: E402
 from fuzz.regressions import REGRESSIONS  # noqa: E402
 from fuzz.runner import run  # noqa: E402
 
-#: cases per category in CI (about a minute on two shared cores)
-BOUNDED = {"scene": 150, "toml": 100, "core": 150, "arrays": 250, "options": 100, "cli": 40, "threads": 25}
+#: cases per category in CI (about two minutes on two shared cores)
+BOUNDED = {"scene": 150, "toml": 100, "core": 150, "arrays": 250, "options": 100, "cli": 40, "threads": 25,
+           "expr": 150, "spline": 100, "dense": 100, "pickle": 100, "fe": 40, "sweep": 40, "extremes": 150, "names": 100,
+           "builders": 100}
 
 
 @pytest.fixture(autouse=True)

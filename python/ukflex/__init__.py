@@ -27,6 +27,7 @@ from .errors import (
     SingularMassError,
     SolverError,
     UkflexError,
+    UnknownNameError,
     UnknownOptionError,
 )
 from .scene import (
@@ -101,5 +102,6 @@ __all__ = [
     "MissingDependencyError",
     "InvalidArgumentError",
     "UnknownOptionError",
+    "UnknownNameError",
     "SingularConfigurationWarning",
 ]

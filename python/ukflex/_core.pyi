@@ -192,6 +192,11 @@ class System:
     def coordinate_names(self) -> List[str]: ...
     @property
     def constraint_names(self) -> List[str]: ...
+    @property
+    def constraint_items(self) -> List[str]:
+        """Names of the joints and drivers (joints first), as sensors report them."""
+    @property
+    def driver_names(self) -> List[str]: ...
     def axial_forces(self, body: str, q: _F64) -> _F64:
         """Axial force of each element of a beam at q, shape (elements,)."""
     def body_kind(self, body: str) -> str:

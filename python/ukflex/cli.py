@@ -256,7 +256,10 @@ def _parse_params(items: Sequence[str]) -> Dict[str, Any]:
         try:
             params[k] = ast.literal_eval(v)
         except (ValueError, SyntaxError):
-            params[k] = v
+            try:  # nan, inf, -inf: numbers literal_eval does not know (the scene then says what it takes)
+                params[k] = float(v)
+            except ValueError:
+                params[k] = v
     return params
 
 
@@ -817,12 +820,33 @@ def _build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _private_matplotlib_cache() -> None:
+    """Unless the user chose one (``MPLCONFIGDIR``), give matplotlib a temporary configuration
+    and cache folder for this process, removed at exit: a run that plots writes nothing under
+    ``$HOME`` (matplotlib's font cache goes to ``~/.cache/matplotlib`` by default; building it
+    again takes ~0.2 s)."""
+    if "MPLCONFIGDIR" in os.environ or "matplotlib" in sys.modules:
+        return
+    import atexit
+    import shutil
+    import tempfile
+
+    folder = tempfile.mkdtemp(prefix="ukflex-matplotlib-")
+    os.environ["MPLCONFIGDIR"] = folder
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     """Entry point of the ``ukflex`` console script."""
     from .errors import UkflexError
 
     parser = _build_parser()
     args = parser.parse_args(argv)  # argument errors: one line, SystemExit(2) (--help: SystemExit(0))
+    # ./x/../y is y: os.makedirs would otherwise create a stray x/ on the way
+    for key in ("out", "output"):
+        if getattr(args, key, None) not in (None, "-"):
+            setattr(args, key, os.path.normpath(getattr(args, key)))
+    _private_matplotlib_cache()
     with warnings.catch_warnings():
         # old parameter names (--param beam=..., g=...) still work: say so on stderr
         warnings.filterwarnings("default", category=DeprecationWarning, module=r"ukflex(\.|$)")

@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import numbers
+import reprlib
 from typing import Any, Dict, List, Mapping, Optional, Tuple
 
 from .errors import InvalidSceneError, core
@@ -24,14 +25,22 @@ SECTIONS = ("bodies", "joints", "drivers", "forces")
 _WORD = {"bodies": "body", "joints": "joint", "drivers": "driver", "forces": "force"}
 
 
-def plain(item: str, path: str, value: Any) -> Any:
+#: Deepest nesting of lists and dicts in a description (a flexible body's fourth-order tensor
+#: ``k4`` sits 6 deep; the core's JSON reader stops at 128).
+MAX_NESTING = 64
+
+
+def plain(item: str, path: str, value: Any, _depth: int = 0) -> Any:
     """``value`` as JSON-compatible data (dicts, lists, str, int, float, bool, None).
 
     Objects with ``to_dict()`` (markers, sections, motions) become their dicts.  A number JSON
-    cannot carry (NaN, infinity) is refused here, naming ``item`` and ``path``.
+    cannot carry (NaN, infinity) is refused here, naming ``item`` and ``path``; so is nesting
+    deeper than :data:`MAX_NESTING` (it would exhaust the interpreter's recursion).
     """
+    if _depth > MAX_NESTING:
+        raise InvalidSceneError(f"{item}: {path or 'value'}: lists or dicts nested deeper than {MAX_NESTING} levels")
     if hasattr(value, "to_dict") and callable(value.to_dict):
-        return plain(item, path, value.to_dict())
+        return plain(item, path, value.to_dict(), _depth + 1)
     if getattr(value, "_is_body_handle", False):
         raise InvalidSceneError(
             f"{item}{' ' + path if path else ''}: expected a marker (e.g. {value.name}.point(x, y) or .at(xi)), "
@@ -47,12 +56,12 @@ def plain(item: str, path: str, value: Any) -> Any:
             raise InvalidSceneError(f"{item}: {path or 'value'} must be finite, got {x!r}")
         return x
     if isinstance(value, Mapping):
-        return {str(k): plain(item, f"{path}.{k}" if path else str(k), v) for k, v in value.items()}
+        return {str(k): plain(item, f"{path}.{k}" if path else str(k), v, _depth + 1) for k, v in value.items()}
     if hasattr(value, "tolist") and not isinstance(value, (bytes, bytearray)):
         value = value.tolist()
     if isinstance(value, (list, tuple)):
-        return [plain(item, f"{path}[{i}]", v) for i, v in enumerate(value)]
-    raise InvalidSceneError(f"{item}: {path or 'value'}: cannot be written into a scene description: {value!r}")
+        return [plain(item, f"{path}[{i}]", v, _depth + 1) for i, v in enumerate(value)]
+    raise InvalidSceneError(f"{item}: {path or 'value'}: cannot be written into a scene description: {reprlib.repr(value)}")
 
 
 class Checker:
@@ -72,7 +81,8 @@ class Checker:
     def label(self, section: str, item: Mapping[str, Any]) -> str:
         """How errors name ``item`` if it were added to ``section`` now."""
         kind, name = item.get("kind"), item.get("name")
-        return core.item_name(section, str(kind), name if isinstance(name, str) else None, len(self.items[section]))
+        kind = kind if isinstance(kind, str) else reprlib.repr(kind)
+        return core.item_name(section, kind, name if isinstance(name, str) else None, len(self.items[section]))
 
     def add(self, section: str, item: Mapping[str, Any]) -> Dict[str, Any]:
         """Validate ``item`` and append it to ``section``; returns what the core derived from it.
@@ -123,7 +133,7 @@ def normalize(description: Mapping[str, Any]) -> Tuple[Checker, Dict[str, Any]]:
         for index, item in enumerate(description.get(section) or []):
             try:
                 if not isinstance(item, Mapping):
-                    raise InvalidSceneError(f"scene: every entry of {section} must be a dict, got {item!r}")
+                    raise InvalidSceneError(f"scene: every entry of {section} must be a dict, got {reprlib.repr(item)}")
                 checker.add(section, item)
             except InvalidSceneError as exc:
                 exc.entry = (section, index)

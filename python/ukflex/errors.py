@@ -9,7 +9,7 @@ core's base class :class:`UkflexError`.
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Any, Sequence
 
 try:
     from . import _core as core  # type: ignore[attr-defined]
@@ -32,6 +32,7 @@ __all__ = [
     "MissingDependencyError",
     "InvalidArgumentError",
     "UnknownOptionError",
+    "UnknownNameError",
     "StabilityWarning",
     "RankDeficiencyWarning",
     "DriftWarning",
@@ -106,6 +107,37 @@ class UnknownOptionError(InvalidArgumentError):
     def __init__(self, argument: str, message: str, valid: Sequence[str] = ()):
         super().__init__(argument, message)
         self.valid = list(valid)
+
+
+class UnknownNameError(UkflexError, KeyError):  # type: ignore[misc, valid-type]
+    """A name that is not one of its kind's valid names: a body, coordinate, joint or driver,
+    residual kind, ... (``System.body_info("nope")``, ``res.coordinate("nope")``,
+    ``res.sensors.reaction("nope")``).  A ``KeyError`` too, so ``except KeyError`` keeps
+    working; its message is the text, not the quoted repr a plain ``KeyError`` prints.
+
+    Attributes
+    ----------
+    what : str
+        The kind of name (``"body"``, ``"coordinate"``, ``"joint"``, ...).
+    name : str
+        The name that was asked for.
+    valid : list of str
+        The valid names.
+    """
+
+    def __init__(self, message: str, what: str = "", name: str = "", valid: Sequence[str] = ()):
+        super().__init__(message)
+        self.what, self.name, self.valid = what, name, list(valid)
+
+    __str__ = BaseException.__str__
+
+    @classmethod
+    def of(cls, what: str, name: Any, valid: Sequence[str]) -> "UnknownNameError":
+        """The error for an unknown ``name`` of kind ``what``; the message lists (up to 20 of)
+        the valid names."""
+        names = [str(v) for v in valid]
+        listed = repr(names) if len(names) <= 20 else f"{names[:20]!r} ... ({len(names)} in all)"
+        return cls(f"unknown {what} {name!r}; valid: {listed}", what, str(name), names)
 
 
 # ------------------------------------------------------------------------------------ warnings

@@ -26,11 +26,13 @@ rotation about it).  Reduction (``frame``):
 
 from __future__ import annotations
 
+import reprlib
 from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import scipy.linalg as sla
 
+from .arguments import count, non_negative, positive, real
 from .errors import InvalidArgumentError
 from .flexible import FlexibleData, InterfacePoint
 
@@ -39,14 +41,52 @@ __all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices", "reduce"]
 Interface = Union[int, Sequence[int]]
 
 
+def _indices(name: str, value: Any, n: int, what: str) -> np.ndarray:
+    """``value`` as an array of whole numbers in ``0..n-1`` (integral floats accepted; 2.5, -1,
+    strings and out-of-range indices refused, naming ``name``)."""
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise InvalidArgumentError(name, f"expected {what} (whole numbers), got {reprlib.repr(value)} ({exc})") from None
+    if raw.dtype.kind not in "iuf" or raw.size == 0:
+        raise InvalidArgumentError(name, f"expected {what} (whole numbers), got {raw.dtype} values {reprlib.repr(value)}")
+    if raw.dtype.kind == "f" and not np.all(np.isfinite(raw) & (raw == np.round(raw))):
+        bad = raw[~(np.isfinite(raw) & (raw == np.round(raw)))]
+        raise InvalidArgumentError(name, f"{what} must be whole numbers, got {bad[:8].tolist()}")
+    outside = raw[(raw < 0) | (raw >= n)]
+    if outside.size:
+        raise InvalidArgumentError(name, f"{what} {outside[:8].tolist()} are not nodes of the mesh (0..{n - 1})")
+    return raw.astype(np.int64)
+
+
+def _eigh(k: np.ndarray, m: np.ndarray, **options: Any) -> Any:
+    """``scipy.linalg.eigh(k, m, **options)`` whose results must be finite and complete: masses or
+    stiffnesses beyond what double precision can resolve (a density of 1e-300 kg/m^3) are an
+    :class:`InvalidArgumentError`, not an empty or NaN basis further on."""
+    expected = None
+    if "subset_by_index" in options:
+        lo, hi = options["subset_by_index"]
+        expected = hi - lo + 1
+    scales = f"max |K| = {np.max(np.abs(k)) if k.size else 0.0:.3g}, max |M| = {np.max(np.abs(m)) if m.size else 0.0:.3g}"
+    try:
+        with np.errstate(all="ignore"):
+            out = sla.eigh(k, m, **options)
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise InvalidArgumentError("stiffness_matrix", f"the eigenproblem of the part cannot be solved ({exc}; {scales}): "
+                                   "masses or stiffnesses out of double-precision range? check the units") from None
+    lam = out if options.get("eigvals_only") else out[0]
+    arrays = (out,) if options.get("eigvals_only") else out
+    if (expected is not None and lam.size != expected) or lam.size == 0 or not all(np.all(np.isfinite(a)) for a in arrays):
+        raise InvalidArgumentError("stiffness_matrix", f"the eigenproblem of the part has no finite solution ({scales}): "
+                                   "masses or stiffnesses out of double-precision range? check the units")
+    return out
+
+
 def _interface_rows(nodes: np.ndarray, spec: Interface) -> Tuple[Tuple[float, float], np.ndarray, Optional[np.ndarray]]:
     """Point, displacement rows (2, 2N) and rotation row (2N,) of an interface (one node or the
     rigid average of several)."""
     ndof = 2 * nodes.shape[0]
-    idx = np.atleast_1d(np.asarray(spec, dtype=int))
-    if idx.size == 0 or idx.min() < 0 or idx.max() >= nodes.shape[0]:
-        raise InvalidArgumentError("interfaces",
-                                   f"interface nodes {idx.tolist()} are not nodes of the mesh (0..{nodes.shape[0] - 1})")
+    idx = np.atleast_1d(_indices("interfaces", spec, nodes.shape[0], "interface nodes")).ravel()
     c = nodes[idx].mean(axis=0)
     d = np.zeros((2, ndof))
     for i in idx:
@@ -89,10 +129,14 @@ def from_nodal(
     The returned data carries ``info["frequencies"]`` (rad/s, the kept normal modes; for
     Craig-Bampton those of the reduced model) and ``info["modes"]`` (2N, n_f), the nodal shapes.
     """
-    x = np.asarray(nodes, dtype=float)
-    mm = np.asarray(mass_matrix, dtype=float)
-    kk = np.asarray(stiffness_matrix, dtype=float)
-    n = 2 * x.shape[0]
+    x = _real_array("nodes", nodes)
+    mm = _real_array("mass_matrix", mass_matrix)
+    kk = _real_array("stiffness_matrix", stiffness_matrix)
+    modes = count("modes", modes)
+    damping_ratio = non_negative("damping_ratio", damping_ratio)
+    if not isinstance(interfaces, Mapping):
+        raise InvalidArgumentError("interfaces", f"expected a dict name -> node index or indices, got {type(interfaces).__name__}")
+    n = 2 * x.shape[0] if x.ndim == 2 else 0
     if x.ndim != 2 or x.shape[1] != 2 or mm.shape != (n, n) or kk.shape != (n, n):
         raise InvalidArgumentError("nodes",
                                    f"nodes must be (N, 2) and the matrices (2N, 2N); got {x.shape}, {mm.shape}, {kk.shape}")
@@ -109,7 +153,7 @@ def from_nodal(
     m_scalar = _scalar_mass(mm)
     iface = {name: _interface_rows(x, spec) for name, spec in interfaces.items()}
     if frame == "mean-axis":
-        lam, vec = sla.eigh(kk, mm)
+        lam, vec = _eigh(kk, mm)
         if modes + 3 > n:
             raise InvalidArgumentError("modes", f"{modes} modes do not fit a model with {n} dofs")
         lam_rigid = lam[:3]
@@ -119,7 +163,11 @@ def from_nodal(
         phi = vec[:, 3:3 + modes]
         freq = np.sqrt(np.maximum(lam[3:3 + modes], 0.0))
     elif frame in ("fixed", "craig-bampton"):
-        if fixed is None or len(fixed) != 3:
+        try:
+            fixed = [tuple(e) for e in fixed]  # type: ignore[union-attr]
+        except TypeError:
+            fixed = None
+        if fixed is None or len(fixed) != 3 or any(len(e) != 2 for e in fixed):
             raise InvalidArgumentError("fixed",
                                        "frame 'fixed' and 'craig-bampton' need fixed = three (interface, 'x'|'y') reference conditions")
         ref = []
@@ -140,7 +188,7 @@ def from_nodal(
             b = np.zeros((0, n))
         phi = _constrained_basis(kk, mm, c, b, modes)
         kr, mr = phi.T @ kk @ phi, phi.T @ mm @ phi
-        lam = sla.eigh(kr, mr, eigvals_only=True)
+        lam = _eigh(kr, mr, eigvals_only=True)
         if lam[0] <= 1e-9 * abs(lam[-1]):
             raise InvalidArgumentError("stiffness_matrix", f"the stiffness with the reference conditions {list(fixed)} is "
                                        f"not positive definite (lowest eigenvalue {lam[0]:.3e}): rigid-body motions left "
@@ -163,7 +211,7 @@ def _data_from_basis(x: np.ndarray, mm: np.ndarray, kk: np.ndarray, m_scalar: np
     d_ff = None
     if damping_ratio > 0.0:
         m_ff = inv["m_ff"]
-        lam_r, v = sla.eigh(k_ff, m_ff)
+        lam_r, v = _eigh(k_ff, m_ff)
         w = np.sqrt(np.maximum(lam_r, 0.0))
         mv = m_ff @ v
         d_ff = mv @ np.diag(2.0 * damping_ratio * w) @ mv.T
@@ -183,7 +231,7 @@ def _constrained_basis(kk: np.ndarray, mm: np.ndarray, c: np.ndarray, b: np.ndar
     kz, mz = z.T @ kk @ z, z.T @ mm @ z
     if modes > kz.shape[0]:
         raise InvalidArgumentError("modes", f"{modes} modes do not fit: only {kz.shape[0]} interior dofs")
-    lam, v = sla.eigh(kz, mz, subset_by_index=[0, modes - 1])
+    lam, v = _eigh(kz, mz, subset_by_index=[0, modes - 1])
     normal = z @ v
     if not nb:
         return normal
@@ -220,10 +268,9 @@ def _mesh_basis(points: np.ndarray, cells: np.ndarray, order: int) -> Tuple[Any,
     from .plotting import require
 
     skfem = require("skfem", "ukflex.fe.from_mesh", extra="fe")
-    if order not in (1, 2):
+    if order not in (1, 2) or isinstance(order, bool):
         raise InvalidArgumentError("order", f"order must be 1 (P1/Q1) or 2 (P2/Q2), got {order!r}")
-    p = np.asarray(points, dtype=float)[:, :2].T
-    t = np.asarray(cells, dtype=int).T
+    p, t = _mesh_arrays(points, cells)
     if t.shape[0] == 3:
         mesh = skfem.MeshTri(p, t)
         scalar = skfem.ElementTriP1() if order == 1 else skfem.ElementTriP2()
@@ -245,11 +292,55 @@ def _mesh_basis(points: np.ndarray, cells: np.ndarray, order: int) -> Tuple[Any,
     return basis, per_node.T.ravel(), nodes
 
 
+def _mesh_arrays(points: Any, cells: Any) -> Tuple[np.ndarray, np.ndarray]:
+    """The mesh as scikit-fem takes it: points (2, N) and cells (3|4, E), checked: finite points
+    (N, 2) or (N, 3), cells of whole-number indices of the points, each cell's vertices distinct."""
+    p = _real_array("points", points)
+    if p.ndim != 2 or p.shape[1] not in (2, 3) or p.shape[0] < 3:
+        raise InvalidArgumentError("points", f"expected an array (N, 2) or (N, 3) of N >= 3 points, got shape {p.shape}")
+    t = _indices("cells", cells, p.shape[0], "cell vertices")
+    if t.ndim != 2 or t.shape[1] not in (3, 4):
+        raise InvalidArgumentError("cells", f"cells must be triangles (E, 3) or quadrilaterals (E, 4), got shape {t.shape}")
+    s = np.sort(t, axis=1)
+    repeated = np.flatnonzero(np.any(s[:, 1:] == s[:, :-1], axis=1))
+    if repeated.size:
+        raise InvalidArgumentError("cells", f"cell {int(repeated[0])} {t[repeated[0]].tolist()} repeats a vertex")
+    # every corner of a cell must turn the same way (area > 0 at each, counterclockwise or not):
+    # a collinear or folded cell has no valid element map (scikit-fem: "Zero Jacobian determinant")
+    xy = p[:, :2][t]  # (E, k, 2)
+    e1 = np.roll(xy, -1, axis=1) - xy
+    e0 = xy - np.roll(xy, 1, axis=1)
+    turn = e0[..., 0] * e1[..., 1] - e0[..., 1] * e1[..., 0]  # (E, k)
+    size = np.max(np.abs(xy - xy.mean(axis=1, keepdims=True)), axis=(1, 2)) ** 2
+    flat = ~((np.all(turn > 1e-12 * size[:, None], axis=1)) | np.all(turn < -1e-12 * size[:, None], axis=1))
+    if np.any(flat):
+        k = int(np.flatnonzero(flat)[0])
+        raise InvalidArgumentError("cells", f"cell {k} {t[k].tolist()} at {xy[k].tolist()} is degenerate or folded "
+                                   "(collinear vertices, zero area or a non-convex corner)")
+    return np.ascontiguousarray(p[:, :2].T), np.ascontiguousarray(t.T)
+
+
+def _real_array(name: str, value: Any) -> np.ndarray:
+    from .arguments import real_array
+
+    return real_array(name, value)
+
+
+def _material(thickness: Any, density: Any, youngs_modulus: Any, poisson_ratio: Any) -> Tuple[float, float, float, float]:
+    """A plane-stress material, checked: positive thickness, density and modulus, Poisson's ratio
+    in (-1, 0.5] (0.5: incompressible, which plane stress allows)."""
+    nu = real("poisson_ratio", poisson_ratio)
+    if not -1.0 < nu <= 0.5:
+        raise InvalidArgumentError("poisson_ratio", f"must lie in (-1, 0.5] for an isotropic material, got {poisson_ratio!r}")
+    return positive("thickness", thickness), positive("density", density), positive("youngs_modulus", youngs_modulus), nu
+
+
 def _plane_stress_lame(youngs_modulus: float, poisson_ratio: float) -> Tuple[float, float]:
-    """Plane-stress Lame parameters ``(lambda*, mu)``, ``lambda* = 2 lambda mu / (lambda + 2 mu)``."""
+    """Plane-stress Lame parameters ``(lambda*, mu)``: ``lambda* = E nu / (1 - nu^2)`` (the 3-D
+    ``2 lambda mu / (lambda + 2 mu)`` without the 3-D ``lambda``, which is singular at 0.5) and
+    ``mu = E / (2 (1 + nu))``."""
     mu = youngs_modulus / (2.0 * (1.0 + poisson_ratio))
-    lam = youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio))
-    return 2.0 * lam * mu / (lam + 2.0 * mu), mu
+    return youngs_modulus * poisson_ratio / (1.0 - poisson_ratio * poisson_ratio), mu
 
 
 def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickness: float, density: float,
@@ -267,6 +358,7 @@ def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickne
     from skfem.helpers import dot
     from skfem.models.elasticity import linear_elasticity
 
+    thickness, density, youngs_modulus, poisson_ratio = _material(thickness, density, youngs_modulus, poisson_ratio)
     basis, perm, nodes = _mesh_basis(points, cells, order)
     lam_ps, mu = _plane_stress_lame(youngs_modulus, poisson_ratio)
     kk = (thickness * skfem.asm(linear_elasticity(lam_ps, mu), basis)).toarray()
@@ -315,20 +407,31 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
         if isinstance(mesh, str):
             import meshio
 
-            mesh = meshio.read(mesh)
+            try:
+                mesh = meshio.read(mesh)
+            except Exception as exc:  # meshio's ReadError, a missing file, ...
+                raise InvalidArgumentError("mesh", f"cannot read the mesh file {mesh!r}: {type(exc).__name__}: {exc}") from exc
+        if not hasattr(mesh, "cells") or not hasattr(mesh, "points"):
+            raise InvalidArgumentError("mesh", f"expected a mesh file, a meshio.Mesh or points with cells=, got {type(mesh).__name__}")
         blocks = [c for c in mesh.cells if c.type in ("triangle", "quad")]
         if not blocks:
             raise InvalidArgumentError("mesh", "the mesh has no triangle or quad cells")
-        points, cells = np.asarray(mesh.points)[:, :2], blocks[0].data
+        points, cells = mesh.points, blocks[0].data
     else:
-        points = np.asarray(mesh, dtype=float)[:, :2]
+        points = mesh
+    if not isinstance(interfaces, Mapping):
+        raise InvalidArgumentError("interfaces", f"expected a dict name -> node index, indices or selector, got {type(interfaces).__name__}")
     mm, kk, nodes = plane_stress_mesh_matrices(points, cells, thickness=thickness, density=density,
                                                youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, order=order)
     resolved = {}
     for name, spec in interfaces.items():
         if callable(spec):
             sel = np.asarray(spec(nodes))
-            idx = np.flatnonzero(sel) if sel.dtype == bool else sel.astype(int).ravel()
+            if sel.dtype == bool and sel.shape != (nodes.shape[0],):
+                raise InvalidArgumentError("interfaces", f"interface {name!r}: a boolean selection needs one entry per node "
+                                           f"({nodes.shape[0]}), got shape {sel.shape}")
+            idx = np.flatnonzero(sel) if sel.dtype == bool else (
+                _indices("interfaces", sel, nodes.shape[0], f"interface {name!r} nodes").ravel() if sel.size else sel.ravel())
             if idx.size == 0:
                 raise InvalidArgumentError("interfaces",
                                            f"interface {name!r}: the selection matches no node of the mesh")
@@ -342,12 +445,12 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
         lam_ps, mu = _plane_stress_lame(youngs_modulus, poisson_ratio)
         phi = data.info["modes"]
         if modal_derivatives is not False:
-            nd = modes if modal_derivatives is True else int(modal_derivatives)
+            nd = modes if modal_derivatives is True else count("modal_derivatives", modal_derivatives)
             if not 1 <= nd <= phi.shape[1]:
                 raise InvalidArgumentError("modal_derivatives", f"the number of modes differentiated must be in "
                                            f"1..{phi.shape[1]}, got {nd}")
             # the lowest nd normal modes (Craig-Bampton: its reduced model's modes)
-            lam_r, v = sla.eigh(phi.T @ kk @ phi, phi.T @ mm @ phi)
+            lam_r, v = _eigh(phi.T @ kk @ phi, phi.T @ mm @ phi)
             low = phi @ v[:, :nd]
             loads = _green_lagrange_md_loads(basis, perm, low, thickness, lam_ps, mu)
             iface = {name: _interface_rows(nodes, spec) for name, spec in resolved.items()}
@@ -355,7 +458,7 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             kkt = np.block([[kk, c.T], [c, np.zeros((3, 3))]])
             theta = np.linalg.solve(kkt, np.vstack([loads, np.zeros((3, loads.shape[1]))]))[:kk.shape[0]]
             p = _enrich(np.zeros((kk.shape[0], 0)), np.hstack([phi, theta]), mm, 1e-9)
-            lam_e, v = sla.eigh(p.T @ kk @ p, p.T @ mm @ p)
+            lam_e, v = _eigh(p.T @ kk @ p, p.T @ mm @ p)
             phi = p @ v
             freq = np.sqrt(np.maximum(lam_e, 0.0))
             data = _data_from_basis(nodes, mm, kk, _scalar_mass(mm), iface, phi, damping_ratio)
@@ -444,15 +547,21 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_
     bending mode needs: without them a basis of bending modes cannot shorten and the quartic
     membrane energy locks it (docs/flexible-bodies.md: 21 % too stiff on the paper's coupler).
     """
+    if not isinstance(data, FlexibleData):
+        raise InvalidArgumentError("data", f"expected a FlexibleData (from fe.from_nodal, fe.from_mesh or FlexibleData(...)), "
+                                   f"got {type(data).__name__}")
+    modes = count("modes", modes)
+    damping_ratio = non_negative("damping_ratio", damping_ratio)
+    tol = positive("tol", tol)
     k, m = np.asarray(data.k_ff, dtype=float), np.asarray(data.m_ff, dtype=float)
     if not 1 <= modes <= k.shape[0]:
         raise InvalidArgumentError("modes", f"modes must be in 1..{k.shape[0]}, got {modes}")
-    lam, p = sla.eigh(k, m, subset_by_index=[0, modes - 1])
+    lam, p = _eigh(k, m, subset_by_index=[0, modes - 1])
     if modal_derivatives is not False:
         if data.k3 is None:
             raise InvalidArgumentError("modal_derivatives", "modal derivatives need the third-order stiffness k3 "
                                        "(nonlinear strain data)")
-        nd = modes if modal_derivatives is True else int(modal_derivatives)
+        nd = modes if modal_derivatives is True else count("modal_derivatives", modal_derivatives)
         if not 1 <= nd <= modes:
             raise InvalidArgumentError("modal_derivatives",
                                        f"the number of modes differentiated must be in 1..{modes}, got {nd}")
@@ -460,7 +569,7 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_
         extra = [k3p[:, a, b] for a in range(nd) for b in range(a, nd)]
         loads = np.array(extra).T  # (n, n_extra)
         p = _enrich(p, sla.cho_solve(sla.cho_factor(k), loads), m, tol)
-        lam, v = sla.eigh(p.T @ k @ p, p.T @ m @ p)
+        lam, v = _eigh(p.T @ k @ p, p.T @ m @ p)
         p = p @ v
     n_r = p.shape[1]
     proj = lambda a: None if a is None else p.T @ np.asarray(a, dtype=float) @ p  # noqa: E731

@@ -10,7 +10,12 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .errors import UnknownNameError
+
 __all__ = ["SimulationResult"]
+
+#: The residual histories of a result (``SimulationResult.residuals``).
+RESIDUAL_KINDS = ("position", "velocity", "acceleration")
 
 
 @dataclass
@@ -220,7 +225,10 @@ class SimulationResult:
         return np.array(acc).reshape(self.t.size, -1).T
 
     def max_residual(self, kind: str = "position") -> float:
-        """Largest residual norm of ``kind`` over the run."""
+        """Largest residual norm of ``kind`` (``"position"``, ``"velocity"`` or
+        ``"acceleration"``) over the run."""
+        if kind not in RESIDUAL_KINDS:
+            raise UnknownNameError.of("residual kind", kind, RESIDUAL_KINDS)
         r = self.residuals[kind]
         return float(np.max(r)) if r.size else 0.0
 
@@ -292,10 +300,12 @@ class _LazyResiduals(Mapping):
         return self._values
 
     def __getitem__(self, key: str) -> np.ndarray:
+        if key not in RESIDUAL_KINDS:
+            raise UnknownNameError.of("residual kind", key, RESIDUAL_KINDS)
         return self._get()[key]
 
     def __iter__(self):
-        return iter(("position", "velocity", "acceleration"))
+        return iter(RESIDUAL_KINDS)
 
     def __len__(self) -> int:
         return 3
@@ -303,20 +313,27 @@ class _LazyResiduals(Mapping):
     def __repr__(self) -> str:
         return repr(self._get())
 
-    def __reduce__(self):  # pickles as the plain dict of its values
-        return (dict, (self._get(),))
+    def __reduce__(self):  # pickles its values (evaluated now)
+        return (_residuals_of, (self._get(),))
+
+
+def _residuals_of(values: Dict[str, np.ndarray]) -> "_LazyResiduals":
+    """A :class:`_LazyResiduals` holding ``values`` (unpickling)."""
+    r = _LazyResiduals.__new__(_LazyResiduals)
+    r._args, r._values = None, {k: np.asarray(values[k]) for k in RESIDUAL_KINDS}
+    return r
 
 
 def _residual_norms(system: Any, t: np.ndarray, q: np.ndarray, qd: np.ndarray) -> Dict[str, np.ndarray]:
     """Euclidean norms of the position, velocity and acceleration residuals, each shape (nt,)."""
-    out = {k: np.zeros(t.size) for k in ("position", "velocity", "acceleration")}
+    out = {k: np.zeros(t.size) for k in RESIDUAL_KINDS}
     if system.n_constraints == 0:
         return out
     core = getattr(system, "core", None)
     if core is not None and hasattr(core, "residual_norms") and t.size:
         norms = core.residual_norms(t, np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qd, dtype=float))
-        return {k: np.asarray(norms[i]) for i, k in enumerate(("position", "velocity", "acceleration"))}
+        return {k: np.asarray(norms[i]) for i, k in enumerate(RESIDUAL_KINDS)}
     for i in range(t.size):
-        for key, r in zip(("position", "velocity", "acceleration"), system.residuals(t[i], q[:, i], qd[:, i])):
+        for key, r in zip(RESIDUAL_KINDS, system.residuals(t[i], q[:, i], qd[:, i])):
             out[key][i] = np.linalg.norm(r)
     return out

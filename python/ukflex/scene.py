@@ -166,10 +166,9 @@ class Spline:
     slopes: Optional[Sequence[float]] = None
 
     def to_dict(self) -> Dict[str, Any]:
-        d: Dict[str, Any] = {"kind": "spline", "times": [_num("times", x) for x in self.times],
-                             "values": [_num("values", x) for x in self.values]}
+        d: Dict[str, Any] = {"kind": "spline", "times": _nums("times", self.times), "values": _nums("values", self.values)}
         if self.slopes is not None:
-            d["slopes"] = [_num("slopes", x) for x in self.slopes]
+            d["slopes"] = _nums("slopes", self.slopes)
         return d
 
 
@@ -220,6 +219,13 @@ def _num(name: str, value: Any) -> float:
     except (TypeError, ValueError):
         raise InvalidArgumentError(name, f"expected a real number, got {value!r}") from None
     return v
+
+
+def _nums(name: str, values: Any) -> List[float]:
+    """A sequence of real numbers (a list, tuple or 1-D array) for a builder argument."""
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__") or getattr(values, "ndim", 1) != 1:
+        raise InvalidArgumentError(name, f"expected a sequence of real numbers, got {values!r:.80}")
+    return [_num(f"{name}[{i}]", x) for i, x in enumerate(values)]
 
 
 def _point_args(x: Any, y: Any) -> Vec2:

@@ -61,6 +61,11 @@ PAPER = {
 STEEL = {"density": 7850.0, "youngs_modulus": 2.1e11, "poisson_ratio": 0.3, "shear_factor": 5.0 / 6.0}
 
 
+#: Largest count argument of a built-in scene (links, elements, rows, ...): a million items take
+#: minutes to build and gigabytes to run.
+MAX_ITEMS = 10 ** 6
+
+
 def _checked(fn: Callable[..., Scene]) -> Callable[..., Scene]:
     """Check a built-in scene's numeric arguments (real, finite; integers where the default is one)
     before the function computes with them, and name the scene and arguments when its arithmetic
@@ -80,6 +85,8 @@ def _checked(fn: Callable[..., Scene]) -> Callable[..., Scene]:
                 continue
             if isinstance(default, int) and not isinstance(value, numbers.Integral) or isinstance(value, bool):
                 raise TypeError(f"{fn.__name__}: {name} must be an integer, got {value!r}")
+            if isinstance(default, int) and abs(value) > MAX_ITEMS:
+                raise ValueError(f"{fn.__name__}: {name} = {value!r:.40} is beyond what a scene can hold (at most {MAX_ITEMS:,})")
             if not isinstance(value, numbers.Real):
                 raise TypeError(f"{fn.__name__}: {name} must be a real number, got {value!r}")
             try:
@@ -92,7 +99,8 @@ def _checked(fn: Callable[..., Scene]) -> Callable[..., Scene]:
             return fn(*args, **kwargs)
         except (ZeroDivisionError, OverflowError) as exc:
             given = ", ".join(f"{k}={v!r}" for k, v in bound.arguments.items())
-            raise InvalidSceneError(f"{fn.__name__}({given}): {exc}") from exc
+            what = "a division by zero" if isinstance(exc, ZeroDivisionError) else "a number beyond the double-precision range"
+            raise InvalidSceneError(f"{fn.__name__}({given}): its geometry needs {what} ({exc}); check the arguments") from exc
 
     return wrapper
 
@@ -117,10 +125,13 @@ def gravity_vector(gravity: Any) -> Optional[Tuple[float, float]]:
         return None
     if isinstance(gravity, numbers.Real):
         return (0.0, -float(gravity))
-    g = tuple(float(v) for v in gravity)
-    if len(g) != 2:
-        raise ValueError(f"gravity must be True, False, a magnitude or a 2-vector, got {gravity!r}")
-    return (g[0], g[1])
+    expected = f"gravity must be True, False, a magnitude or a 2-vector of numbers, got {gravity!r:.60}"
+    if isinstance(gravity, (str, bytes)) or not hasattr(gravity, "__iter__"):
+        raise ValueError(expected)
+    g = tuple(gravity)
+    if len(g) != 2 or not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in g):
+        raise ValueError(expected)
+    return (float(g[0]), float(g[1]))
 
 
 def _beam_kind(formulation: str, theory: Optional[str], strain: Optional[str], poisson_ratio: float,
@@ -619,6 +630,7 @@ def _link_chain(s: Scene, angles: Any, link: float, mass: float, prefix: str = "
     return bodies
 
 
+@_checked
 def chain(links: int = 16, length: float = 2.0, mass: float = 1.0, angle: float = 0.0, gravity: Any = True) -> Scene:
     """Pendulum chain of rigid links under gravity.
 
@@ -634,6 +646,7 @@ def chain(links: int = 16, length: float = 2.0, mass: float = 1.0, angle: float 
     return s
 
 
+@_checked
 def rope(links: int = 64, length: float = 2.0, mass: float = 0.5, span: float = 1.6, gravity: Any = True) -> Scene:
     """A rope of short rigid links hung between two pins (a closed loop through the ground).
 

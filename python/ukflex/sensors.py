@@ -32,6 +32,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from .errors import UnknownNameError
 
 def parse_xi(expr: str, xi_text: str) -> float:
     """The axis coordinate XI of an output expression such as ``v(coupler, 0.5)``: a number in [0, 1]."""
@@ -117,7 +118,7 @@ class Sensors:
         (world), ``fx_local, fy_local`` (joint frame), ``power``, each (nt,), and ``body``."""
         names = self.joint_names
         if joint not in names:
-            raise KeyError(f"unknown joint {joint!r}; joints and drivers are {names}")
+            raise UnknownNameError.of("joint or driver", joint, names)
         k = names.index(joint)
         r = np.asarray(self._raw["reactions"])[:, k, :]
         out: Dict[str, Any] = {c: r[:, i].copy() for i, c in enumerate(REACTION_COLUMNS)}
@@ -126,6 +127,8 @@ class Sensors:
 
     def driver_work(self, driver: Optional[str] = None) -> np.ndarray:
         """Work done by one driver (or all drivers), accumulated from ``t_0``, shape (nt,)."""
+        if driver is not None and driver not in self.driver_names:
+            raise UnknownNameError.of("driver", driver, self.driver_names)
         names = [driver] if driver is not None else self.driver_names
         p = sum((self.reaction(d)["power"] for d in names), np.zeros_like(self.t))
         return cumulative_integral(self.t, p)
@@ -135,7 +138,7 @@ class Sensors:
         """``kinetic``, ``strain``, ``gravity`` energy of one body, each (nt,)."""
         names = list(self._raw["body_names"])
         if body not in names:
-            raise KeyError(f"unknown body {body!r}; bodies are {names}")
+            raise UnknownNameError.of("body", body, names)
         e = np.asarray(self._raw["body_energies"])[:, names.index(body), :]
         return {"kinetic": e[:, 0].copy(), "strain": e[:, 1].copy(), "gravity": e[:, 2].copy()}
 
@@ -258,9 +261,15 @@ class Sensors:
         if m:
             if m.group(2) not in REACTION_COLUMNS:
                 raise ValueError(f"output {expr!r}: reaction columns are {REACTION_COLUMNS}")
+            items = list(system.core.constraint_items)
+            if m.group(1) not in items:
+                raise ValueError(f"output {expr!r}: unknown joint or driver {m.group(1)!r}; joints and drivers are {items}")
             return ("reaction", m.group(1), m.group(2))
         m = cls._WORK.match(e)
         if m:
+            drivers = list(system.core.driver_names)
+            if m.group(1) not in drivers:
+                raise ValueError(f"output {expr!r}: {m.group(1)!r} is not a driver; drivers are {drivers}")
             return ("work", m.group(1))
         m = cls._BODY_ENERGY.match(e)
         if m:

@@ -22,6 +22,7 @@ from scipy.integrate._ivp.ivp import METHODS as _SCIPY_SOLVERS, find_active_even
 from . import _core
 from .errors import (DriftWarning, InvalidArgumentError, NonFiniteError, SingularConfigurationWarning, SolverError,
                      UnknownOptionError)
+from .arguments import COUNT_LIMIT, count as _count, positive as _positive, real as _real, real_array as _real_array
 from .results import SimulationResult
 from .scene import Scene
 from .system import System, length_scale
@@ -55,62 +56,6 @@ def as_system(scene_or_system: Union[Scene, System, Dict[str, Any]], **build_opt
 
 
 # ------------------------------------------------------------------------------ argument checks
-def _real(name: str, value: Any) -> float:
-    """A real scalar: int or float (NumPy's too); bool, str, complex, None and arrays refused."""
-    if isinstance(value, np.ndarray) and value.ndim == 0 and not isinstance(value, np.ma.MaskedArray):
-        value = value[()]
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise InvalidArgumentError(name, f"must be a real number, got {type(value).__name__} {value!r}")
-    try:
-        x = float(value)
-    except OverflowError:
-        raise InvalidArgumentError(name, f"{value!r:.40} is beyond the double-precision range") from None
-    if not math.isfinite(x):
-        raise InvalidArgumentError(name, f"must be finite, got {value!r}")
-    return x
-
-
-def _positive(name: str, value: Any) -> float:
-    x = _real(name, value)
-    if x <= 0.0:
-        raise InvalidArgumentError(name, f"must be positive, got {value!r}")
-    return x
-
-
-def _count(name: str, value: Any) -> int:
-    """A positive integer (an integral float such as 1e6 too); 1.5, bools and strings refused."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise InvalidArgumentError(name, f"must be a positive integer, got {type(value).__name__} {value!r}")
-    if isinstance(value, numbers.Integral):
-        if value < 1:
-            raise InvalidArgumentError(name, f"must be a positive integer, got {value!r}")
-        return int(value)
-    x = float(value)
-    if not x.is_integer() or x < 1:
-        raise InvalidArgumentError(name, f"must be a positive integer, got {value!r}")
-    return int(x)
-
-
-def _real_array(name: str, value: Any, shape: Optional[tuple] = None) -> np.ndarray:
-    """A finite float array; None, strings, masked, complex, boolean and object arrays refused."""
-    if value is None:
-        raise InvalidArgumentError(name, "must be an array of real numbers, got None")
-    if isinstance(value, np.ma.MaskedArray):
-        raise InvalidArgumentError(name, "masked arrays are not accepted (fill or compress the mask first)")
-    if isinstance(value, (str, bytes)):
-        raise InvalidArgumentError(name, f"must be an array of real numbers, got a string {value!r}")
-    raw = np.asarray(value)
-    if raw.dtype.kind not in "iuf":
-        raise InvalidArgumentError(name, f"must hold real numbers, got dtype {raw.dtype}")
-    arr = raw.astype(float)
-    if shape is not None and arr.shape != shape:
-        raise InvalidArgumentError(name, f"expected shape {shape}, got {arr.shape}")
-    bad = np.flatnonzero(~np.isfinite(arr.ravel()))
-    if bad.size:
-        raise NonFiniteError(f"{name}: contains NaN or infinity at index {int(bad[0])}")
-    return arr
-
-
 def _method_name(method: Any) -> Union[str, type]:
     if isinstance(method, str):
         key = method.upper()
@@ -352,9 +297,12 @@ def simulate(
     budget = _Budget(_count("max_steps", max_steps), _count("max_nfev", max_nfev),
                      None if max_wall_time is None else _positive("max_wall_time", max_wall_time),
                      0.0 if min_step == 0 else _positive("min_step", min_step), call_start)
+    if options.get("first_step") is not None:  # every method's: a positive number (scipy's compare it as given)
+        options = dict(options, first_step=_positive("first_step", options["first_step"]))
     for key in ("max_step", "step"):  # a step size that cannot reach t_end within the step budget
         if options.get(key) is not None:
             h = _positive(key, options[key])
+            options = dict(options, **{key: h})
             if (t_end_f - t0) / h > budget.max_steps:
                 raise InvalidArgumentError(
                     key, f"{key} = {h:g} needs {(t_end_f - t0) / h:.3g} steps to reach t_end, more than max_steps = "
@@ -373,6 +321,14 @@ def simulate(
         for k, ev in enumerate(ev_list):
             if not callable(ev):
                 raise InvalidArgumentError("events", f"entry {k} is not callable: {ev!r}")
+            terminal = getattr(ev, "terminal", None)
+            if terminal is not None and not (isinstance(terminal, (bool, np.bool_)) or (
+                    isinstance(terminal, numbers.Integral) and 0 <= terminal <= 2 ** 53)):
+                raise InvalidArgumentError("events", f"entry {k}: terminal must be a boolean or a whole number of "
+                                           f"occurrences up to 2**53 (solve_ivp's rule), got {terminal!r:.60}")
+            direction = getattr(ev, "direction", None)
+            if direction is not None:
+                _real(f"events[{k}].direction", direction)
         if args is not None:
             ev_list = [_with_args(ev, args) for ev in ev_list]
     if args is not None and callable(options.get("jac")):
@@ -911,16 +867,22 @@ class DenseSolution:
 
     def __init__(self, method: str, meta: np.ndarray, data: np.ndarray, part_len: Sequence[int]):
         self.method = method
-        self.meta = np.ascontiguousarray(meta, dtype=float)
-        self.data = np.ascontiguousarray(data, dtype=float)
-        self.part_len = [int(k) for k in part_len]
+        # real numbers only (complex values are not cast to their real parts); the layout is the core's
+        self.meta = np.ascontiguousarray(_real_array("meta", meta))
+        self.data = np.ascontiguousarray(_real_array("data", data))
+        self.part_len = list(part_len)
+        # the core checks the record against the method's layout (a ValueError naming what is
+        # inconsistent; NonFiniteError for NaN in it), here once and at every evaluation
+        _core.dense_eval(self.method, self.meta, self.data, self.part_len, np.zeros(0))
         self.ts = np.concatenate([self.meta[:1, 0], self.meta[:, 1]]) if len(self.meta) else np.zeros(0)
         self.t_min = float(self.ts[0]) if self.ts.size else float("nan")
         self.t_max = float(self.ts[-1]) if self.ts.size else float("nan")
 
     def __call__(self, t: ArrayLike) -> np.ndarray:
-        tt = np.asarray(t, dtype=float)
-        out = _core.dense_eval(self.method, self.meta, self.data, self.part_len, np.atleast_1d(tt).ravel())
+        tt = np.asarray(t)  # the core converts numbers and refuses the rest (strings, complex, ...)
+        if tt.ndim > 1:
+            raise InvalidArgumentError("t", f"expected a time or a 1-D array of times, got shape {tt.shape}")
+        out = _core.dense_eval(self.method, self.meta, self.data, self.part_len, np.atleast_1d(tt))
         return out[:, 0] if tt.ndim == 0 else out
 
     def truncated(self, t_stop: float) -> "DenseSolution":

@@ -28,7 +28,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .errors import SolverError
+from .errors import SolverError, UnknownNameError
 from .results import SimulationResult
 from .simulate import DEFAULT_MAX_STEPS, NATIVE_METHODS, as_system, simulate
 from .system import System
@@ -380,12 +380,13 @@ def beam_properties(system: System, body: str) -> Dict[str, Any]:
 
     Raises
     ------
-    KeyError
-        ``body`` is unknown or not a beam.
+    UnknownNameError
+        ``body`` is unknown or not a beam (a ``KeyError``).
     """
     info = system.body_info(body)
     if info["kind"] != "beam":
-        raise KeyError(f"body {body!r} is not a beam")
+        beams = [b for b in system.body_names if system.body_kind(b) == "beam"]
+        raise UnknownNameError(f"body {body!r} is not an FFRF beam; FFRF beams are {beams}", "beam", body, beams)
     area, second_moment = _section(system, body)
     return {"length": float(info["length"]), "E": float(info["youngs_modulus"]), "area": area, "I": second_moment,
             "elements": int(info["elements"]), "frame": info["frame"]}

@@ -25,9 +25,11 @@ import os
 import pickle
 import sys
 import time
-from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
-__all__ = ["sweep", "cases_of", "RESERVED_COLUMNS"]
+from .errors import InvalidArgumentError
+
+__all__ = ["sweep", "cases_of", "Cases", "RESERVED_COLUMNS", "MAX_CASES"]
 
 #: Columns :func:`sweep` adds to the case parameters and outputs.
 RESERVED_COLUMNS = ("status", "error", "wall_time", "method", "solver_status")
@@ -41,45 +43,75 @@ def _need(module: str, what: str) -> Any:
     return require(module, what, extra="sweep")
 
 
-def cases_of(grid: Grid) -> List[Dict[str, Any]]:
-    """The list of cases (keyword dicts for ``build``) of a grid.
+#: Default largest number of cases of one sweep (``max_cases``): a grid beyond it is refused
+#: before any case runs (its rows alone would fill memory).
+MAX_CASES = 10 ** 6
 
-    ``grid`` is a dict of lists (the full factorial, in ``itertools.product`` order: the last key
-    varies fastest; a value that is not a list/tuple/array is a fixed parameter) or a list of case
-    dicts (taken as they are).
+
+class Cases:
+    """The cases of a grid, generated lazily: ``len(cases)`` is known up front (the product of
+    the value lists' lengths, never overflowing) and iterating yields one keyword dict at a time
+    (``itertools.product`` order, the last key varying fastest), so a grid is never materialized.
+
+    ``grid`` is a dict of lists (the full factorial; a value that is not a list/tuple/range/array
+    is a fixed parameter) or a list of case dicts (taken as they are).  A grid of more than
+    ``max_cases`` cases raises :class:`ukflex.InvalidArgumentError` giving its size.
     """
-    if isinstance(grid, Mapping):
-        if not grid:
-            raise ValueError("sweep: the grid is empty (give a dict of lists or a list of case dicts)")
-        keys = list(grid)
-        values = []
-        for k in keys:
-            if not isinstance(k, str) or not k.isidentifier():
-                raise ValueError(f"sweep: grid keys must be keyword names, got {k!r}")
-            v = grid[k]
-            if isinstance(v, (list, tuple, range)) or type(v).__name__ == "ndarray":
-                v = list(v)
-                if not v:
-                    raise ValueError(f"sweep: grid[{k!r}] is an empty list")
-            else:
-                v = [v]
-            values.append(v)
-        cases = [dict(zip(keys, combo)) for combo in itertools.product(*values)]
-    elif isinstance(grid, (list, tuple)):
-        cases = []
-        for i, c in enumerate(grid):
-            if not isinstance(c, Mapping):
-                raise TypeError(f"sweep: case {i} must be a dict of keyword arguments, got {type(c).__name__}")
-            cases.append(dict(c))
-        if not cases:
-            raise ValueError("sweep: the list of cases is empty")
-    else:
-        raise TypeError(f"sweep: grid must be a dict of lists or a list of dicts, got {type(grid).__name__}")
-    for c in cases:
-        bad = [k for k in c if k in RESERVED_COLUMNS]
+
+    def __init__(self, grid: Grid, max_cases: int = MAX_CASES):
+        from .arguments import count
+
+        max_cases = count("max_cases", max_cases)
+        self._keys: List[str] = []
+        self._axes: List[Sequence[Any]] = []
+        self._list: Optional[Sequence[Mapping[str, Any]]] = None
+        if isinstance(grid, Mapping):
+            if not grid:
+                raise InvalidArgumentError("grid", "the grid is empty (give a dict of lists or a list of case dicts)")
+            size = 1
+            for k, v in grid.items():
+                if not isinstance(k, str) or not k.isidentifier():
+                    raise InvalidArgumentError("grid", f"grid keys must be keyword names, got {k!r}")
+                if isinstance(v, (list, tuple, range)) or type(v).__name__ == "ndarray":
+                    n = len(v)
+                    if not n:
+                        raise InvalidArgumentError("grid", f"grid[{k!r}] is an empty list")
+                else:
+                    v, n = (v,), 1
+                self._keys.append(k)
+                self._axes.append(v)
+                size *= n
+            bad = [k for k in self._keys if k in RESERVED_COLUMNS]
+        elif isinstance(grid, (list, tuple)):
+            if not grid:
+                raise InvalidArgumentError("grid", "the list of cases is empty")
+            for i, c in enumerate(grid):
+                if not isinstance(c, Mapping):
+                    raise InvalidArgumentError("grid", f"case {i} must be a dict of keyword arguments, got {type(c).__name__}")
+            self._list, size = grid, len(grid)
+            bad = sorted({k for c in grid for k in c if k in RESERVED_COLUMNS})
+        else:
+            raise InvalidArgumentError("grid", f"grid must be a dict of lists or a list of dicts, got {type(grid).__name__}")
         if bad:
-            raise ValueError(f"sweep: case parameter name(s) {bad} clash with the result columns {RESERVED_COLUMNS}")
-    return cases
+            raise InvalidArgumentError("grid", f"case parameter name(s) {bad} clash with the result columns {RESERVED_COLUMNS}")
+        if size > max_cases:
+            shape = " x ".join(str(len(a)) for a in self._axes) if self._list is None else str(size)
+            raise InvalidArgumentError("grid", f"the grid has {size:,} cases ({shape}), more than max_cases = {max_cases:,}; "
+                                       "split it into several sweeps or raise max_cases")
+        self.size = size
+
+    def __len__(self) -> int:
+        return self.size
+
+    def __iter__(self) -> Iterator[Dict[str, Any]]:
+        if self._list is not None:
+            return (dict(c) for c in self._list)
+        return (dict(zip(self._keys, combo)) for combo in itertools.product(*self._axes))
+
+
+def cases_of(grid: Grid, max_cases: int = MAX_CASES) -> List[Dict[str, Any]]:
+    """The list of cases (keyword dicts for ``build``) of a grid (:class:`Cases`, as a list)."""
+    return list(Cases(grid, max_cases))
 
 
 # ----------------------------------------------------------------------------------- one case
@@ -132,7 +164,7 @@ def run_case(build: Callable[..., Any], outputs: Callable[[Any], Mapping[str, An
         row["solver_status"] = int(res.status)
     except Exception as exc:  # a failed case is a row, never the end of the sweep
         row["status"] = "failed"
-        row["error"] = f"{type(exc).__name__}: {exc}".splitlines()[0] if str(exc) else type(exc).__name__
+        row["error"] = _describe(exc)
         row["method"] = ""
         row["solver_status"] = None
     row["wall_time"] = time.perf_counter() - tic
@@ -153,9 +185,20 @@ def _run_chunk(payload: bytes, chunk: List[Tuple[int, Dict[str, Any]]], defaults
     return [(i, run_case(funcs[0], funcs[1], case, defaults, blas)) for i, case in chunk]
 
 
+def _describe(exc: BaseException) -> str:
+    """``Type: first line of the message`` of a case's exception (one whose ``__str__`` fails
+    too: a failed case never ends the sweep)."""
+    try:
+        text = str(exc)
+    except Exception:  # noqa: BLE001 - the user's exception class
+        text = "(its message cannot be shown: __str__ raised)"
+    line = text.splitlines()[0] if text.strip() else ""
+    return f"{type(exc).__name__}: {line}" if line else type(exc).__name__
+
+
 def _failed_row(case: Dict[str, Any], exc: BaseException) -> Dict[str, Any]:
     row = dict(case)
-    row.update(status="failed", error=f"{type(exc).__name__}: {exc}".splitlines()[0], method="",
+    row.update(status="failed", error=_describe(exc), method="",
                solver_status=None, wall_time=float("nan"))
     return row
 
@@ -173,26 +216,41 @@ def _progress_bar(total: int, progress: Optional[bool], label: str) -> Any:
     return tqdm(total=total, desc=label, unit="case", file=sys.stderr)
 
 
-def _chunks(cases: List[Dict[str, Any]], nworkers: int, chunksize: Optional[int]) -> List[List[Tuple[int, Dict[str, Any]]]]:
+Chunk = List[Tuple[int, Dict[str, Any]]]
+
+
+def _chunks(cases: Cases, nworkers: int, chunksize: Optional[int]) -> Iterator[Chunk]:
+    """``(case index, case)`` lists of ``chunksize`` cases (default: about 8 tasks per worker, at
+    most 64 cases each), drawn from the lazy cases as they are needed."""
     if chunksize is None:
-        chunksize = min(64, max(1, -(-len(cases) // (8 * nworkers))))
-    elif int(chunksize) < 1:
-        raise ValueError(f"sweep: chunksize must be >= 1, got {chunksize!r}")
-    indexed = list(enumerate(cases))
-    return [indexed[k:k + int(chunksize)] for k in range(0, len(indexed), int(chunksize))]
+        size = min(64, max(1, -(-len(cases) // (8 * nworkers))))
+    else:
+        from .arguments import count
+
+        size = count("chunksize", chunksize)
+    it = enumerate(cases)
+    while True:
+        chunk = list(itertools.islice(it, size))
+        if not chunk:
+            return
+        yield chunk
 
 
-def _collect(rows: List[Optional[Dict[str, Any]]], chunk: List[Tuple[int, Dict[str, Any]]], fut: Any,
-             cases: List[Dict[str, Any]], bar: Any) -> None:
+def _collect(rows: List[Optional[Dict[str, Any]]], chunk: Chunk, fut: Any, bar: Any) -> None:
     """Store a finished task's rows; a lost worker (BrokenProcessPool, KilledWorker) fails its cases."""
     try:
         for i, row in fut.result():
             rows[i] = row
     except Exception as exc:
-        for i, _ in chunk:
-            rows[i] = _failed_row(cases[i], exc)
+        for i, case in chunk:
+            rows[i] = _failed_row(case, exc)
     if bar is not None:
         bar.update(len(chunk))
+
+
+#: Tasks in flight per worker: chunks are made and submitted as earlier ones finish, so a large
+#: grid never sits in the executor's queue as a whole.
+IN_FLIGHT_PER_WORKER = 4
 
 
 def _is_dask_client(executor: Any) -> bool:
@@ -222,6 +280,7 @@ def sweep(
     chunksize: Optional[int] = None,
     progress: Optional[bool] = None,
     blas_threads: Optional[int] = 1,
+    max_cases: int = MAX_CASES,
     **simulate_options: Any,
 ) -> Any:
     """Simulate every case of ``grid`` and collect scalar outputs in a DataFrame.
@@ -250,6 +309,10 @@ def sweep(
     blas_threads : int or None
         BLAS threads per case (threadpoolctl; default 1, so that workers do not oversubscribe
         the cores); ``None`` leaves BLAS alone.
+    max_cases : int
+        Largest grid accepted (default :data:`MAX_CASES`, 10**6): a larger one raises
+        :class:`ukflex.InvalidArgumentError` giving its size before any case runs.  Cases are
+        generated as they are run, never all at once.
     **simulate_options
         Defaults for :func:`ukflex.simulate` (``t_end`` is required here or from ``build``).
 
@@ -266,10 +329,10 @@ def sweep(
     pd = _need("pandas", "ukflex.sweep")
     if not callable(build) or not callable(outputs):
         raise TypeError("sweep: build and outputs must be callables")
-    cases = cases_of(grid)
-    blas = None if blas_threads is None else int(blas_threads)
-    if blas is not None and blas < 1:
-        raise ValueError(f"sweep: blas_threads must be >= 1 or None, got {blas_threads!r}")
+    cases = Cases(grid, max_cases)
+    from .arguments import count
+
+    blas = None if blas_threads is None else count("blas_threads", blas_threads)
     rows: List[Optional[Dict[str, Any]]] = [None] * len(cases)
     tic = time.perf_counter()
 
@@ -281,19 +344,26 @@ def sweep(
             if bar is not None:
                 bar.update(1)
     elif isinstance(executor, str) and executor == "processes":
-        from concurrent.futures import ProcessPoolExecutor, as_completed
+        from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
-        nworkers = int(workers) if workers is not None else (os.cpu_count() or 1)
-        if nworkers < 1:
-            raise ValueError(f"sweep: workers must be >= 1, got {workers!r}")
+        nworkers = (os.cpu_count() or 1) if workers is None else count("workers", workers)
         name = "processes"
         payload = _payload(build, outputs)
         chunks = _chunks(cases, nworkers, chunksize)
         bar = _progress_bar(len(cases), progress, f"sweep ({nworkers} processes)")
         with ProcessPoolExecutor(max_workers=nworkers) as pool:
-            futures = {pool.submit(_run_chunk, payload, chunk, simulate_options, blas): chunk for chunk in chunks}
-            for fut in as_completed(futures):
-                _collect(rows, futures[fut], fut, cases, bar)
+            pending: Dict[Any, Chunk] = {}
+
+            def submit(k: int) -> None:
+                for chunk in itertools.islice(chunks, k):
+                    pending[pool.submit(_run_chunk, payload, chunk, simulate_options, blas)] = chunk
+
+            submit(IN_FLIGHT_PER_WORKER * nworkers)
+            while pending:
+                done, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    _collect(rows, pending.pop(fut), fut, bar)
+                submit(len(done))
     elif _is_dask_client(executor):
         distributed = _need("distributed", "ukflex.sweep on Dask")
         name = "dask"
@@ -302,13 +372,24 @@ def sweep(
         [remote] = executor.scatter([payload], broadcast=True)
         chunks = _chunks(cases, max(nworkers, 1), chunksize)
         bar = _progress_bar(len(cases), progress, "sweep (dask)")
-        futures = [executor.submit(_run_chunk, remote, chunk, simulate_options, blas, pure=False) for chunk in chunks]
-        by_key = {f.key: chunk for f, chunk in zip(futures, chunks)}
+        by_key: Dict[Any, Tuple[Any, Chunk]] = {}
+
+        def submit_dask(k: int) -> List[Any]:
+            new = []
+            for chunk in itertools.islice(chunks, k):
+                f = executor.submit(_run_chunk, remote, chunk, simulate_options, blas, pure=False)
+                by_key[f.key] = (f, chunk)
+                new.append(f)
+            return new
+
+        ac = distributed.as_completed(submit_dask(IN_FLIGHT_PER_WORKER * max(nworkers, 1)))
         try:
-            for fut in distributed.as_completed(futures):
-                _collect(rows, by_key[fut.key], fut, cases, bar)
+            for fut in ac:
+                _collect(rows, by_key.pop(fut.key)[1], fut, bar)
+                for f in submit_dask(1):
+                    ac.add(f)
         finally:
-            executor.cancel([f for f in futures if not f.done()])
+            executor.cancel([f for f, _ in by_key.values() if not f.done()])
     else:
         raise ValueError(f"sweep: executor must be 'serial', 'processes' or a dask distributed Client, got {executor!r}")
     if bar is not None:

@@ -10,13 +10,17 @@ from __future__ import annotations
 
 import json
 import math
+import reprlib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
+from .arguments import real
 from .description import normalize
-from .errors import InconsistentInitialStateError, InvalidSceneError, NonFiniteError, core as _core
+from .errors import (InconsistentInitialStateError, InvalidArgumentError, InvalidSceneError, NonFiniteError,
+                     UnknownNameError, core as _core)
 
 __all__ = ["System", "InitialCorrection", "Equilibrium"]
 
@@ -344,7 +348,58 @@ class System:
             "initial_correction": self.initial_correction,
         }
 
+    #: The settings a pickled System replays (``_settings``).
+    SETTINGS = ("set_stabilization", "set_rank_tolerance", "set_pseudoinverse")
+
     def __setstate__(self, state: Dict[str, Any]) -> None:
+        """Rebuild from :meth:`__getstate__`'s dict, checking it: a state that is not one (a key
+        missing or unknown, a setting that is not one, states of the wrong shape or not finite)
+        is an :class:`InvalidArgumentError` naming the entry; the description is validated by
+        the core as any scene is."""
+        def bad(entry: str, message: str) -> InvalidArgumentError:
+            return InvalidArgumentError(f"System pickle state[{entry!r}]", message)
+
+        if not isinstance(state, Mapping):
+            raise InvalidArgumentError("System pickle state", f"expected a dict, got {type(state).__name__}")
+        keys = ("description", "build_options", "settings", "t0", "q_guess", "qd_guess", "q0", "qd0",
+                "initial_correction")
+        missing = [k for k in keys if k not in state]
+        unknown = [k for k in state if k not in keys + ("core_options",)]
+        if missing or unknown:
+            raise InvalidArgumentError("System pickle state", f"missing entries {missing}, unknown entries {unknown}")
+        for key in ("build_options", "settings", "core_options"):
+            if not isinstance(state.get(key, {}), Mapping):
+                raise bad(key, f"expected a dict, got {type(state[key]).__name__}")
+        core_options = dict(state.get("core_options", {}))
+        if set(core_options) - {"uk_solver", "memory_limit"}:
+            raise bad("core_options", f"unknown options {sorted(set(core_options) - {'uk_solver', 'memory_limit'})}")
+        settings = dict(state["settings"])
+        for name, args in settings.items():
+            if name not in self.SETTINGS or not isinstance(args, tuple):
+                raise bad("settings", f"expected {{name: args tuple}} with names in {list(self.SETTINGS)}, got "
+                                      f"{reprlib.repr(name)}: {reprlib.repr(args)}")
+        _, description = normalize(state["description"])
+        try:
+            t0 = real("t0", state["t0"])
+        except InvalidArgumentError as exc:
+            raise bad("t0", str(exc)) from None
+        if not isinstance(state["initial_correction"], InitialCorrection):
+            raise bad("initial_correction", f"expected an InitialCorrection, got {type(state['initial_correction']).__name__}")
+        try:
+            self._restore(dict(state, description=description, core_options=core_options, settings=settings, t0=float(t0)))
+        except (ValueError, TypeError) as exc:  # a setting or core option the core refuses
+            raise bad("settings", f"{type(exc).__name__}: {exc}") from exc
+        for key in ("q_guess", "qd_guess", "q0", "qd0"):
+            try:
+                v = np.array(state[key], dtype=float)
+            except (TypeError, ValueError, OverflowError) as exc:
+                raise bad(key, f"expected an array of {self.n_coords} floats ({exc})") from None
+            if v.shape != (self.n_coords,) or not np.all(np.isfinite(v)):
+                raise bad(key, f"expected {self.n_coords} finite floats (the scene's coordinates), got shape {v.shape}")
+            setattr(self, key, v)
+
+    def _restore(self, state: Dict[str, Any]) -> None:
+        """Rebuild from a state known to be one (:meth:`copy`, or checked by :meth:`__setstate__`)."""
         self.description = state["description"]
         self._build_options = dict(state["build_options"])
         self._settings = {}
@@ -352,7 +407,7 @@ class System:
         self._bind(_core.System(json.dumps(self.description), **self._core_options))
         for name, args in state["settings"].items():
             getattr(self, name)(*args)
-        for key in ("t0", "q_guess", "qd_guess", "q0", "qd0", "initial_correction"):
+        for key in ("t0", "initial_correction", "q_guess", "qd_guess", "q0", "qd0"):
             setattr(self, key, state[key])
 
     def copy(self) -> "System":
@@ -362,7 +417,7 @@ class System:
         need different settings at the same time each use their own copy (``stability.run`` and
         ``stability.rank_history`` do this for you)."""
         new = System.__new__(System)
-        new.__setstate__(self.__getstate__())
+        new._restore(self.__getstate__())
         return new
 
     # ------------------------------------------------------------------------------ info
@@ -391,22 +446,24 @@ class System:
         try:
             return self.coordinate_names.index(name)
         except ValueError:
-            raise KeyError(f"unknown coordinate {name!r}; coordinates are {self.coordinate_names}") from None
+            raise UnknownNameError.of("coordinate", name, self.coordinate_names) from None
 
     def body_slice(self, body: str) -> slice:
         """Slice of ``q`` holding body ``body``'s coordinates ``[x, y, theta, q_f...]``."""
-        if body not in self.body_slices:
-            raise KeyError(f"unknown body {body!r}; bodies are {self.body_names}")
+        if not isinstance(body, str) or body not in self.body_slices:
+            raise UnknownNameError.of("body", body, self.body_names)
         start, stop = self.body_slices[body]
         return slice(start, stop)
 
     def elastic_slice(self, body: str) -> slice:
         """Slice of ``q`` holding body ``body``'s elastic coordinates ``q_f``."""
-        if body not in self.body_slices:
-            raise KeyError(f"unknown body {body!r}; bodies are {self.body_names}")
+        if not isinstance(body, str) or body not in self.body_slices:
+            raise UnknownNameError.of("body", body, self.body_names)
         start, stop = self.core.elastic_range(body)
         if start == stop:
-            raise KeyError(f"body {body!r} is {self.body_kind(body)}: it has no elastic coordinates")
+            flexible = [b for b in self.body_names if self.core.elastic_range(b)[0] != self.core.elastic_range(b)[1]]
+            raise UnknownNameError(f"body {body!r} is {self.body_kind(body)}: it has no elastic coordinates; bodies "
+                                   f"with elastic coordinates: {flexible}", "flexible body", body, flexible)
         return slice(start, stop)
 
     def elastic_mask(self) -> np.ndarray:

@@ -10,7 +10,7 @@ mod system;
 use numpy::ndarray::ArrayView1;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::exceptions::{PyException, PyKeyError, PyOverflowError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyType;
@@ -92,6 +92,26 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Vector<'py> {
     }
 }
 
+/// A real scalar argument (a time, an axis coordinate, a tolerance): what `float()` takes, with a
+/// number beyond the double range (a 400-digit integer) a `ValueError` saying so instead of
+/// Python's bare `OverflowError` (PyO3 names the argument in the exception note).
+pub struct Real(pub f64);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Real {
+    type Error = PyErr;
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        match obj.extract::<f64>() {
+            Ok(v) => Ok(Real(v)),
+            Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => {
+                let text = obj.repr().map(|r| r.to_string()).unwrap_or_default();
+                let shown: String = text.chars().take(40).collect();
+                Err(PyValueError::new_err(format!("expected a real number within the double-precision range, got {shown}{}", if text.chars().count() > 40 { "..." } else { "" })))
+            }
+            Err(e) => Err(e),
+        }
+    }
+}
+
 pub(crate) fn to_py(e: Error) -> PyErr {
     let msg = e.to_string();
     match e {
@@ -110,7 +130,18 @@ pub(crate) fn to_py(e: Error) -> PyErr {
             err
         }),
         Error::Memory { .. } => MemoryLimitError::new_err(msg),
+        Error::UnknownName { what, name, valid } => unknown_name(&what, &name, &valid).unwrap_or_else(|_| PyKeyError::new_err(msg)),
     }
+}
+
+/// `ukflex.UnknownNameError` (a `UkflexError` and a `KeyError`, defined in `ukflex.errors`,
+/// which writes its message) for an unknown `name` of kind `what`, listing the valid ones.
+fn unknown_name(what: &str, name: &str, valid: &[String]) -> PyResult<PyErr> {
+    Python::attach(|py| {
+        let cls = py.import("ukflex.errors")?.getattr("UnknownNameError")?;
+        let exc = cls.call_method1("of", (what, name, valid.to_vec()))?;
+        Ok(PyErr::from_value(exc))
+    })
 }
 
 /// Copy a (possibly strided) NumPy vector into `dst`, checking length and finiteness.
@@ -139,7 +170,7 @@ pub(crate) fn read_into(what: &str, src: &ArrayView1<f64>, dst: &mut [f64]) -> R
 /// never as NaN handed back to the caller.
 pub(crate) fn finite_out(stage: &str, v: &[f64]) -> Result<(), Error> {
     match v.iter().position(|x| !x.is_finite()) {
-        Some(index) => Err(Error::NonFinite { what: format!("{stage} result (inputs out of double-precision range?)"), index }),
+        Some(index) => Err(Error::NonFinite { what: format!("{stage} result (inputs out of double-precision range, or a degenerate state?)"), index }),
         None => Ok(()),
     }
 }
@@ -154,28 +185,39 @@ pub(crate) fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -
 
 /// Evaluate the dense output recorded by `System.integrate(..., dense=True)` of a run of
 /// `method` at the times `t` (k,): returns (dim, k). Each time uses the step whose interval
-/// holds it (outside the run: the first or last step's polynomial, extrapolated).
+/// holds it (outside the run: the first or last step's polynomial, extrapolated). The record is
+/// checked against the method's layout first (`DenseView::check`: a `ValueError` naming what
+/// is inconsistent); a value that does not fit a double (extrapolated far out) is a
+/// `NonFiniteError`.
 #[pyfunction]
-fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<'py, f64>, data: numpy::PyReadonlyArray2<'py, f64>, part_len: Vec<usize>, t: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    use crate::integrate::{DenseRecord, Method};
-    let method = Method::from_name(method).ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}'")))?;
-    let (meta, data) = (meta.as_array(), data.as_array());
-    let width: usize = part_len.iter().sum();
-    if meta.ncols() != 3 || data.ncols() != width || meta.nrows() != data.nrows() || part_len.len() > 5 || meta.nrows() == 0 {
-        return Err(PyValueError::new_err("dense_eval: inconsistent dense record (meta (nseg, 3), data (nseg, sum(part_len)))"));
+fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<'py, f64>, data: numpy::PyReadonlyArray2<'py, f64>, part_len: &Bound<'py, PyAny>, t: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    use crate::integrate::{DenseView, Method};
+    // whole numbers >= 0 (a negative or huge one is a ValueError naming it, not an OverflowError)
+    let bad = || PyValueError::new_err("dense_eval: part_len must be a list of whole numbers >= 0 (the lengths of the record's parts)");
+    let mut lens = Vec::new();
+    for x in part_len.try_iter().map_err(|_| bad())? {
+        lens.push(x.map_err(|_| bad())?.extract::<u64>().map_err(|_| bad())?.try_into().map_err(|_| bad())?);
     }
-    let dim = match method {
-        Method::GenAlpha(_) => part_len.last().copied().unwrap_or(0),
-        _ => part_len.first().copied().unwrap_or(0),
-    };
-    let rec = DenseRecord { meta: meta.iter().copied().collect(), data: data.iter().copied().collect(), part_len };
+    let part_len: Vec<usize> = lens;
+    let method = Method::from_name(method).ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5', 'GENALPHA' or 'RADAU5M')")))?;
+    let (meta, data) = (meta.as_array(), data.as_array());
+    if meta.ncols() != 3 || meta.nrows() != data.nrows() {
+        return Err(PyValueError::new_err(format!(
+            "dense_eval: inconsistent dense record: meta must be (nseg, 3) and data (nseg, width), got {:?} and {:?}", meta.shape(), data.shape())));
+    }
+    // row-major views of the arrays (copied only when they are not C-contiguous)
+    let meta_v: std::borrow::Cow<[f64]> = match meta.as_slice() { Some(s) => s.into(), None => meta.iter().copied().collect::<Vec<_>>().into() };
+    let data_v: std::borrow::Cow<[f64]> = match data.as_slice() { Some(s) => s.into(), None => data.iter().copied().collect::<Vec<_>>().into() };
+    let rec = DenseView { meta: &meta_v, data: &data_v, part_len: &part_len };
+    let dim = rec.check(&method).map_err(to_py)?;
     let ts: Vec<f64> = t.as_array().iter().copied().collect();
     crate::error::check_finite("t", &ts).map_err(to_py)?;
     let k = ts.len();
-    let mut out = vec![0.0; dim * k];
+    let mut out = vec![0.0; dim.checked_mul(k).ok_or_else(|| PyValueError::new_err("dense_eval: too many values"))?];
     let mut buf = vec![0.0; dim];
     for (j, tj) in ts.iter().enumerate() {
         rec.eval(&method, *tj, &mut buf);
+        finite_out("dense_eval", &buf).map_err(to_py)?;
         for i in 0..dim {
             out[i * k + j] = buf[i];
         }

@@ -41,8 +41,9 @@ pub fn motion_values<'py>(py: Python<'py>, motion_json: &str, t: Vector<'py>) ->
     let t = t.as_array();
     let nt = t.len();
     let mut out = vec![0.0; 3 * nt];
+    let mut scratch = vec![0.0; m.scratch_len()];
     for (k, &tk) in t.iter().enumerate() {
-        let (f, d1, d2) = m.eval(tk);
+        let (f, d1, d2) = m.eval(tk, &mut scratch);
         out[k] = f;
         out[nt + k] = d1;
         out[2 * nt + k] = d2;

@@ -4,12 +4,12 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
-use pyo3::exceptions::{PyKeyError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use super::sensors::read_states;
-use super::{check_time, finite_out, mat, read_into, to_py, SolverError, Vector};
+use super::{check_time, finite_out, mat, read_into, to_py, Real, SolverError, Vector};
 use crate::body::{ancf_cable, BodyKind};
 use crate::linalg::Banded;
 use crate::correct::{self, CorrectOptions};
@@ -107,7 +107,7 @@ impl PySystem {
     fn body(&self, name: &str) -> PyResult<usize> {
         self.model
             .body_index(name)
-            .ok_or_else(|| PyKeyError::new_err(format!("unknown body '{name}' (bodies: {:?})", self.body_names())))
+            .ok_or_else(|| to_py(Error::UnknownName { what: "body".into(), name: name.to_string(), valid: self.body_names() }))
     }
 
     fn body_names(&self) -> Vec<String> {
@@ -206,6 +206,18 @@ impl PySystem {
         self.model.constraint_row_names.clone()
     }
 
+    /// Names of the joints and drivers (one per item, joints first), as sensors report them.
+    #[getter]
+    fn constraint_items(&self) -> Vec<String> {
+        self.model.constraints.iter().map(|c| c.name.clone()).collect()
+    }
+
+    /// Names of the drivers.
+    #[getter]
+    fn driver_names(&self) -> Vec<String> {
+        self.model.constraints.iter().filter(|c| c.is_driver()).map(|c| c.name.clone()).collect()
+    }
+
     /// (q0, qd0) as given by the description (not corrected).
     fn initial_guess<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>) {
         (PyArray1::from_slice(py, &self.model.q0), PyArray1::from_slice(py, &self.model.qd0))
@@ -262,7 +274,8 @@ impl PySystem {
     /// iterate); `stiffness=False` skips K (then all zero): M and A alone, one evaluation.
     #[pyo3(signature = (t, q, qd, qdd=None, lam=None, stiffness=true))]
     #[allow(clippy::too_many_arguments)]
-    fn linearization<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, qdd: Option<Vector<'py>>, lam: Option<Vector<'py>>, stiffness: bool) -> PyResult<Bound<'py, PyDict>> {
+    fn linearization<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, qdd: Option<Vector<'py>>, lam: Option<Vector<'py>>, stiffness: bool) -> PyResult<Bound<'py, PyDict>> {
+        let t = t.0;
         use crate::sparse_newton::{fill_a, fill_linearized_stiffness, fill_mass, Pattern, Structure};
         let (n, m) = (self.model.n, self.model.m);
         let mut held = (vec![0.0; n], vec![0.0; m]);
@@ -294,6 +307,10 @@ impl PySystem {
                 fill_linearized_stiffness(model, &mut ws.data, t, &ws.q, &ws.qd, &qdd, &lambda, &s.pattern, &mut qv, &mut f, &mut k);
                 finite_out("the linearized stiffness", &k)?;
             }
+            finite_out("linearization M", &s.m)?;
+            finite_out("linearization A", &s.a)?;
+            finite_out("linearization qdd", &qdd)?;
+            finite_out("linearization lambda", &lambda)?;
             Ok((s, k, qdd, lambda))
         })?;
         let (s, k, qdd, lambda) = out;
@@ -316,7 +333,8 @@ impl PySystem {
 
     /// Generalized forces Q(t, q, qd) = applied + quadratic velocity + elastic, shape (n,).
     #[allow(non_snake_case)]
-    fn Q<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn Q<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
@@ -345,7 +363,8 @@ impl PySystem {
     }
 
     /// Constraint values Phi(q, t), shape (m,).
-    fn phi<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn phi<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, None)?;
@@ -357,19 +376,22 @@ impl PySystem {
     }
 
     /// Partial time derivative Phi_t(t), shape (m,) (nonzero only for drivers).
-    fn phi_t<'py>(&self, py: Python<'py>, t: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn phi_t<'py>(&self, py: Python<'py>, t: Real) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             ws.q.copy_from_slice(&model.q0);
             ws.qd.fill(0.0);
             dynamics::constraints(model, &mut ws.data, t, &ws.q, &ws.qd, false);
+            finite_out("phi_t(t)", &ws.data.phi_t)?;
             Ok(ws.data.phi_t.clone())
         })?;
         Ok(PyArray1::from_vec(py, v))
     }
 
     /// b = gamma(t, q, qd) (paper eq. 43), shape (m,).
-    fn b<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn b<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
@@ -381,7 +403,8 @@ impl PySystem {
     }
 
     /// UK acceleration qdd(t, q, qd), shape (n,).
-    fn qdd<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn qdd<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let out = PyArray1::<f64>::zeros(py, self.model.n, false);
         self.with_ws(|model, ws| {
             check_time(t)?;
@@ -396,7 +419,8 @@ impl PySystem {
     }
 
     /// Right-hand side for integrators: y = [q, qd] -> [qd, qdd], shape (2n,).
-    fn rhs<'py>(&self, py: Python<'py>, t: f64, y: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn rhs<'py>(&self, py: Python<'py>, t: Real, y: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let n = self.model.n;
         let out = PyArray1::<f64>::zeros(py, 2 * n, false);
         self.with_ws(|model, ws| {
@@ -422,7 +446,8 @@ impl PySystem {
     /// (t, q, qd), the minimum over `batches` batches of `reps` calls, GIL released. Lets a
     /// Python benchmark separate the core's time from the binding's overhead in one run.
     #[pyo3(signature = (t, q, qd, reps=1000, batches=21))]
-    fn time_acceleration(&self, py: Python<'_>, t: f64, q: Vector<'_>, qd: Vector<'_>, reps: usize, batches: usize) -> PyResult<f64> {
+    fn time_acceleration(&self, py: Python<'_>, t: Real, q: Vector<'_>, qd: Vector<'_>, reps: usize, batches: usize) -> PyResult<f64> {
+        let t = t.0;
         let n = self.model.n;
         let (mut qv, mut qdv) = (vec![0.0; n], vec![0.0; n]);
         read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
@@ -443,7 +468,8 @@ impl PySystem {
     }
 
     /// Lagrange multipliers (M qdd + A^T lambda = Q), shape (m,).
-    fn multipliers<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn multipliers<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = t.0;
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
@@ -456,7 +482,7 @@ impl PySystem {
 
     /// Euclidean norms of the position, velocity and acceleration residuals along a trajectory:
     /// t (nt,), q and qd (n, nt) -> (3, nt), in one call with the GIL released (a result's
-    /// residual histories; a state with NaN or infinity gets NaN norms).
+    /// residual histories). A non-finite input or norm is a `NonFiniteError` naming the state.
     fn residual_norms<'py>(&self, py: Python<'py>, t: Vector<'py>, q: PyReadonlyArray2<'py, f64>, qd: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let (n, m) = (self.model.n, self.model.m);
         let tv: Vec<f64> = t.as_array().to_vec();
@@ -478,15 +504,15 @@ impl PySystem {
                         qdc[i] = qda[[i, k]];
                     }
                     if !tv[k].is_finite() || qc.iter().chain(qdc.iter()).any(|x| !x.is_finite()) {
-                        out[k] = f64::NAN;
-                        out[nt + k] = f64::NAN;
-                        out[2 * nt + k] = f64::NAN;
-                        continue;
+                        return Err(Error::NonFinite { what: "residual_norms: t, q or qd of the state".into(), index: k });
                     }
                     uk::residuals(model, &mut ws.data, tv[k], &qc, &qdc, &mut p, &mut v, &mut a)?;
                     out[k] = norm(&p);
                     out[nt + k] = norm(&v);
                     out[2 * nt + k] = norm(&a);
+                    if !(out[k].is_finite() && out[nt + k].is_finite() && out[2 * nt + k].is_finite()) {
+                        return Err(Error::NonFinite { what: "residual_norms result (inputs out of double-precision range?) at the state".into(), index: k });
+                    }
                 }
                 Ok(out)
             })
@@ -496,7 +522,8 @@ impl PySystem {
 
     /// (position Phi, velocity A qd + Phi_t, acceleration A qdd - b), each shape (m,).
     #[allow(clippy::type_complexity)]
-    fn residuals<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn residuals<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        let t = t.0;
         let m = self.model.m;
         let (p, v, a) = self.with_ws(|model, ws| {
             check_time(t)?;
@@ -532,7 +559,8 @@ impl PySystem {
     /// `exact=False` skips the on-demand singular values: after a certified full-rank solve the
     /// report then holds the certificate's bounds (`exact` says which), at no extra cost.
     #[pyo3(signature = (t=None, q=None, qd=None, exact=true))]
-    fn rank_info<'py>(&self, py: Python<'py>, t: Option<f64>, q: Option<Vector<'py>>, qd: Option<Vector<'py>>, exact: bool) -> PyResult<Bound<'py, PyDict>> {
+    fn rank_info<'py>(&self, py: Python<'py>, t: Option<Real>, q: Option<Vector<'py>>, qd: Option<Vector<'py>>, exact: bool) -> PyResult<Bound<'py, PyDict>> {
+        let t = t.map(|t| t.0);
         let state = match (t, &q, &qd) {
             (Some(t), Some(q), Some(qd)) => Some((t, q, qd)),
             (None, None, None) => None,
@@ -546,6 +574,7 @@ impl PySystem {
             }
             let path = ws.data.uk_path();
             let info = if exact { uk::exact_rank_info(model, &mut ws.data)? } else { ws.data.rank_info };
+            finite_out("rank_info", &[info.sigma_max, info.sigma_min_kept, info.sigma_max_dropped, info.tolerance])?;
             Ok((info, path))
         })?;
         let d = PyDict::new(py);
@@ -599,7 +628,8 @@ impl PySystem {
     /// columns reuse the mass factor and the pseudoinverse of the base point. Runs with the GIL
     /// released. `scheme="forward"` halves the cost.
     #[pyo3(signature = (t, y, scheme="central"))]
-    fn jac<'py>(&self, py: Python<'py>, t: f64, y: Vector<'py>, scheme: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn jac<'py>(&self, py: Python<'py>, t: Real, y: Vector<'py>, scheme: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let t = t.0;
         let n = self.model.n;
         let scheme = match scheme {
             "central" => Differences::Central,
@@ -660,9 +690,9 @@ impl PySystem {
     fn integrate<'py>(
         &self,
         py: Python<'py>,
-        t0: f64,
+        t0: Real,
         y0: Vector<'py>,
-        t_end: f64,
+        t_end: Real,
         method: &str,
         rtol: f64,
         atol: Option<Vector<'py>>,
@@ -684,6 +714,7 @@ impl PySystem {
         on_drift: &str,
         monitor_singular: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let (t0, t_end) = (t0.0, t_end.0);
         let linear_solver = LinearSolver::parse(linear_solver).map_err(to_py)?;
         let jacobian = match jacobian {
             "central" => Differences::Central,
@@ -934,7 +965,8 @@ impl PySystem {
     /// the tangent space of the constraints in the mass metric (the filter of the explicit
     /// methods' error estimates, docs/integrators.md).
     /// Returns (the projected V, sigma_min / sigma_max of `A M^-1/2` at q).
-    fn tangent_project<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, v: PyReadonlyArray2<'py, f64>) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
+    fn tangent_project<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, v: PyReadonlyArray2<'py, f64>) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
+        let t = t.0;
         let n = self.model.n;
         let va = v.as_array();
         if va.shape().len() != 2 || va.shape()[0] != n {
@@ -975,6 +1007,7 @@ impl PySystem {
             }
         }
         finite_out("tangent_project", &out).map_err(to_py)?;
+        finite_out("tangent_project ratio", &[ratio]).map_err(to_py)?;
         Ok((mat(py, out, n, k)?, ratio))
     }
 
@@ -984,7 +1017,8 @@ impl PySystem {
     /// Returns (q, qd, ||Phi|| at the new q, whether Newton converged).
     #[pyo3(signature = (t, q, qd, position_tol, max_iter=3))]
     #[allow(clippy::type_complexity)]
-    fn project_step<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, position_tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64, bool)> {
+    fn project_step<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, position_tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64, bool)> {
+        let t = t.0;
         if !(position_tol >= 0.0) || !position_tol.is_finite() {
             return Err(PyValueError::new_err(format!("position_tol must be >= 0 and finite, got {position_tol}")));
         }
@@ -997,6 +1031,7 @@ impl PySystem {
             let out = correct::project_in_place(model, &mut ws.data, &mut pws, t, &mut qn, &mut qdn, tol)?;
             finite_out("project_step", &qn)?;
             finite_out("project_step", &qdn)?;
+            finite_out("project_step ||Phi||", &[out.phi_norm])?;
             Ok((qn, qdn, out.phi_norm, out.converged))
         })?;
         Ok((PyArray1::from_vec(py, qn), PyArray1::from_vec(py, qdn), phi0, phi1))
@@ -1027,7 +1062,8 @@ impl PySystem {
     /// position_correction, velocity_correction).
     #[pyo3(signature = (t, q, qd, tol=1e-12, max_iter=20))]
     #[allow(clippy::type_complexity)]
-    fn project<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+    fn project<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+        let t = t.0;
         if !tol.is_finite() || tol <= 0.0 {
             return Err(PyValueError::new_err(format!("tol must be positive and finite, got {tol}")));
         }
@@ -1036,6 +1072,9 @@ impl PySystem {
             Self::load(ws, &q, Some(&qd))?;
             let (mut qn, mut qdn) = (ws.q.clone(), ws.qd.clone());
             let rep = correct::project(model, &mut ws.data, t, &mut qn, &mut qdn, tol, max_iter)?;
+            finite_out("project q", &qn)?;
+            finite_out("project qd", &qdn)?;
+            finite_out("project residuals", &[rep.position_residual, rep.velocity_residual, rep.position_correction, rep.velocity_correction])?;
             Ok((qn, qdn, rep))
         })?;
         let d = PyDict::new(py);
@@ -1052,7 +1091,8 @@ impl PySystem {
     /// (S (2, n_b), S' (2, n_b)) over the body's n_b = 4 (N + 1) coordinates e, with the world
     /// position r = S e and the slope r' = S' e (d/dx) of the axis point.
     #[allow(clippy::type_complexity)]
-    fn beam_shape<'py>(&self, py: Python<'py>, body: &str, xi: f64) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyAny>)> {
+    fn beam_shape<'py>(&self, py: Python<'py>, body: &str, xi: Real) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyAny>)> {
+        let xi = xi.0;
         let bi = self.body(body)?;
         if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
             return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {xi}")));
@@ -1119,7 +1159,10 @@ impl PySystem {
         let v = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
             dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
-            let crate::body::BodyData::Beam(bd) = &ws.data.bodies[bi] else { unreachable!("beam data") };
+            let crate::body::BodyData::Beam(bd) = &ws.data.bodies[bi] else {
+                return Err(Error::Solver("axial_forces: the workspace of a beam is not a beam's".into()));
+            };
+            finite_out("axial_forces", &bd.axial_force)?;
             Ok(bd.axial_force.clone())
         })?;
         Ok(PyArray1::from_vec(py, v))
@@ -1156,6 +1199,7 @@ impl PySystem {
             }
             _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam or a flexible body"))),
         };
+        finite_out("tangent_stiffness", &k).map_err(to_py)?;
         mat(py, k, nb, nb)
     }
 
@@ -1165,7 +1209,8 @@ impl PySystem {
     /// in the beam frame from the undeformed (xi L, 0)) and psi (section rotation relative to
     /// that frame). The beam frame is an FFRF beam's floating frame (pinned-pinned: the chord
     /// of the ends) and an ANCF beam's chord frame of the ends, so the two compare one to one.
-    fn beam_point<'py>(&self, py: Python<'py>, body: &str, xi: f64, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn beam_point<'py>(&self, py: Python<'py>, body: &str, xi: Real, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let xi = xi.0;
         let bi = self.body(body)?;
         if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
             return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {xi}")));
@@ -1189,7 +1234,10 @@ impl PySystem {
         crate::error::check_finite("q", &flat).map_err(to_py)?;
         let mut out = vec![0.0; 5 * cols];
         for k in 0..cols {
-            let p = b.beam_point(xi, &flat[k * n..(k + 1) * n]).expect("checked: a beam");
+            let Some(p) = b.beam_point(xi, &flat[k * n..(k + 1) * n]) else {
+                return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+            };
+            finite_out("beam_point", &p).map_err(to_py)?;
             for (r, v) in p.iter().enumerate() {
                 out[r * cols + k] = *v;
             }
@@ -1233,6 +1281,10 @@ impl PySystem {
                 dp[k] = sensors::dissipation_power(model, &mut ws.data, qk, qdk, &mut v, &mut f);
             }
             sensors::unwrap_torque_potentials(model, &mut fp, nt);
+            finite_out("sensors reactions", &rx)?;
+            finite_out("sensors body energies", &be)?;
+            finite_out("sensors force potentials", &fp)?;
+            finite_out("sensors dissipation power", &dp)?;
             Ok(())
         })?;
         let d = PyDict::new(py);
@@ -1273,7 +1325,11 @@ impl PySystem {
         let mut out = Vec::with_capacity(nt * nx * 5);
         for k in 0..nt {
             for &x in &xs {
-                out.extend_from_slice(&b.internal_forces(x, &qs[k * n..(k + 1) * n]).expect("checked: a beam"));
+                let Some(f) = b.internal_forces(x, &qs[k * n..(k + 1) * n]) else {
+                    return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+                };
+                finite_out("beam_internal_forces", &f).map_err(to_py)?;
+                out.extend_from_slice(&f);
             }
         }
         Ok(PyArray1::from_vec(py, out).reshape([nt, nx, 5])?.into_any())
@@ -1391,7 +1447,8 @@ impl PySystem {
     /// failed), phi (m,), velocity (m,), positions_ok, velocities_ok.
     #[pyo3(signature = (t, q, qd, hold, position_tol=1e-12, velocity_tol=1e-10, max_iterations=50, max_wall_time=None, rigid=false))]
     #[allow(clippy::too_many_arguments)]
-    fn correct<'py>(&self, py: Python<'py>, t: f64, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize, max_wall_time: Option<f64>, rigid: bool) -> PyResult<Bound<'py, PyDict>> {
+    fn correct<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, hold: Vec<bool>, position_tol: f64, velocity_tol: f64, max_iterations: usize, max_wall_time: Option<f64>, rigid: bool) -> PyResult<Bound<'py, PyDict>> {
+        let t = t.0;
         let max_wall_time = max_wall_time.unwrap_or(f64::INFINITY);
         if !(max_wall_time > 0.0) {
             return Err(PyValueError::new_err(format!("max_wall_time must be positive, got {max_wall_time}")));

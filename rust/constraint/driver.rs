@@ -33,7 +33,8 @@ impl AngleDriver {
     #[inline]
     pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
         let (sa, sb) = (self.a.state(bodies, q, qd), self.b.state(bodies, q, qd));
-        rows::angle(bodies, &self.a, &self.b, &sa, &sb, self.motion.eval(t), n, out, 0);
+        let f = self.motion.eval(t, out.scratch);
+        rows::angle(bodies, &self.a, &self.b, &sa, &sb, f, n, out, 0);
     }
 
     /// Reaction on `a`'s body: the driving torque `-lambda`; joint frame: marker `a`.
@@ -68,7 +69,7 @@ impl CoordinateDriver {
             Axis::X => 0,
             Axis::Y => 1,
         };
-        let f = self.motion.eval(t);
+        let f = self.motion.eval(t, out.scratch);
         if let Some(phi) = out.phi.as_deref_mut() {
             phi[0] = sp.r[k] - f.0;
         }

@@ -9,7 +9,6 @@
 
 pub mod distance;
 pub mod driver;
-pub mod expr;
 pub mod jac;
 pub mod motion;
 pub mod point_on_line;
@@ -76,6 +75,8 @@ pub struct ConstraintOut<'a> {
     pub phi_t: &'a mut [f64],
     /// `gamma` rows.
     pub gamma: &'a mut [f64],
+    /// Evaluation buffer of a driver's motion (`Data::motion_scratch`, `scratch_len()` long).
+    pub scratch: &'a mut [f64],
 }
 
 /// What a constraint needs from the model while it is built: the bodies, their names and the
@@ -205,6 +206,15 @@ impl Constraint {
     #[inline]
     pub fn rows(&self) -> usize {
         self.row_suffixes().len()
+    }
+
+    /// Length of the buffer a driver's motion evaluates in (0 for joints).
+    pub fn scratch_len(&self) -> usize {
+        match &self.kind {
+            ConstraintKind::AngleDriver(c) => c.motion.scratch_len(),
+            ConstraintKind::CoordinateDriver(c) => c.motion.scratch_len(),
+            _ => 0,
+        }
     }
 
     pub fn is_driver(&self) -> bool {

@@ -1,15 +1,15 @@
 //! Prescribed motions `f(t)` of drivers, with exact first and second derivatives.
 
-use super::expr::Expr;
 use crate::description::MotionDesc;
 use crate::error::{check_finite_item, Error, Result};
+use crate::expr::TimeFunction;
 
 #[derive(Debug, Clone)]
 pub enum Motion {
     ConstantSpeed { initial: f64, speed: f64 },
     Polynomial { coefficients: Vec<f64> },
     Harmonic { offset: f64, amplitude: f64, frequency: f64, phase: f64 },
-    Expression(Box<Expr>),
+    Expression(Box<TimeFunction>),
     Spline(Box<Spline>),
 }
 
@@ -26,13 +26,13 @@ impl Motion {
             MotionDesc::Harmonic { offset, amplitude, frequency, phase } => {
                 Motion::Harmonic { offset: *offset, amplitude: *amplitude, frequency: *frequency, phase: *phase }
             }
-            MotionDesc::Expression { expression } => Motion::Expression(Box::new(Expr::parse(item, expression)?)),
+            MotionDesc::Expression { expression } => Motion::Expression(Box::new(TimeFunction::parse(item, expression)?)),
             MotionDesc::Spline { times, values, slopes } => Motion::Spline(Box::new(Spline::new(item, times, values, *slopes)?)),
         };
         check_finite_item(item, "motion", &m.parameters())?;
         // an expression may leave its domain (sqrt of a negative, log of 0): refuse it where
         // the run starts rather than let NaN reach the integrator
-        let (f, d1, d2) = m.eval(0.0);
+        let (f, d1, d2) = m.eval(0.0, &mut vec![0.0; m.scratch_len()]);
         if !(f.is_finite() && d1.is_finite() && d2.is_finite()) {
             return Err(Error::invalid(item, format!("motion is not finite at t = 0: f = {f}, f' = {d1}, f'' = {d2}")));
         }
@@ -49,9 +49,18 @@ impl Motion {
         }
     }
 
-    /// `(f, f', f'')` at time `t`.
+    /// Length of the evaluation buffer `eval` needs (an expression's tape; 0 for the others).
+    pub fn scratch_len(&self) -> usize {
+        match self {
+            Motion::Expression(e) => e.scratch_len(),
+            _ => 0,
+        }
+    }
+
+    /// `(f, f', f'')` at time `t`; `scratch` is at least `scratch_len()` long (the workspace's
+    /// `Data::motion_scratch` on the hot path: no allocation).
     #[inline]
-    pub fn eval(&self, t: f64) -> (f64, f64, f64) {
+    pub fn eval(&self, t: f64, scratch: &mut [f64]) -> (f64, f64, f64) {
         match self {
             Motion::ConstantSpeed { initial, speed } => (initial + speed * t, *speed, 0.0),
             Motion::Polynomial { coefficients } => {
@@ -68,7 +77,7 @@ impl Motion {
                 let (s, c) = (frequency * t + phase).sin_cos();
                 (offset + amplitude * s, amplitude * frequency * c, -amplitude * frequency * frequency * s)
             }
-            Motion::Expression(e) => e.eval(t),
+            Motion::Expression(e) => e.eval(t, scratch),
             Motion::Spline(s) => s.eval(t),
         }
     }

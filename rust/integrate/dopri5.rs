@@ -318,6 +318,13 @@ impl Stepper for Dopri5 {
             out[i] = r0[i] + theta * (r1[i] + theta1 * (r2[i] + theta * (r3[i] + theta1 * r4[i])));
         }
     }
+    /// Five parts `r0..r4` of the state's dimension.
+    fn dense_dim(part_len: &[usize]) -> Option<usize> {
+        match part_len {
+            [d, rest @ ..] if rest.len() == 4 && rest.iter().all(|r| r == d) => Some(*d),
+            _ => None,
+        }
+    }
     fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
         rhs(sys, self.st.t, &self.st.y, &mut self.k[0])?;
         self.st.stats.nfev += 1;

@@ -581,6 +581,14 @@ impl Stepper for GenAlpha {
         }
     }
 
+    /// `q0`, `qd0` (n each) and the state `y` (2n).
+    fn dense_dim(part_len: &[usize]) -> Option<usize> {
+        match *part_len {
+            [n, m, y] if n == m && n.checked_mul(2) == Some(y) => Some(y),
+            _ => None,
+        }
+    }
+
     fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
         acc_and_multipliers(sys, &mut self.st, &mut self.qdd, &mut self.lam)
     }

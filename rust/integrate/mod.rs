@@ -39,7 +39,7 @@ use crate::correct::{self, ProjectOutcome, ProjectWorkspace, ProjectionTolerance
 use crate::data::RankInfo;
 use crate::data::Data;
 use crate::dynamics;
-use crate::error::{Error, Result};
+use crate::error::{check_finite, Error, Result};
 use crate::jacobian::{uk_jacobian, Differences, JacobianWorkspace};
 use crate::model::Model;
 use crate::sparse_newton::{self, Pattern, Structure};
@@ -660,6 +660,9 @@ pub trait Stepper {
     fn dense_parts(&self) -> DenseParts<'_>;
     /// The dense output defined by `meta` and `parts` (as `dense_parts` gives them) at `t`.
     fn dense_eval(meta: [f64; 3], parts: &[&[f64]], t: f64, out: &mut [f64]);
+    /// The dimension of the states `dense_eval` writes when `part_len` (the lengths of
+    /// `dense_parts`) is this method's layout; `None` otherwise (`DenseView::check`).
+    fn dense_dim(part_len: &[usize]) -> Option<usize>;
     /// State at `t` in `[t_old, t]` from the dense output of the last step.
     fn dense(&self, t: f64, out: &mut [f64]) {
         let d = self.dense_parts();
@@ -789,8 +792,59 @@ impl DenseRecord {
         self.part_len.iter().sum()
     }
 
-    /// Evaluate the record of a run of `method` at `t` (the segment whose interval holds `t`;
-    /// before the first or after the last segment: that segment's polynomial extrapolated).
+    pub fn view(&self) -> DenseView<'_> {
+        DenseView { meta: &self.meta, data: &self.data, part_len: &self.part_len }
+    }
+}
+
+/// A dense record to evaluate (a run's own, or arrays handed back by Python: `dense_eval`),
+/// checked against its method's layout before any evaluation.
+#[derive(Debug, Clone, Copy)]
+pub struct DenseView<'a> {
+    pub meta: &'a [f64],
+    pub data: &'a [f64],
+    pub part_len: &'a [usize],
+}
+
+impl DenseView<'_> {
+    /// Check the record as a run of `method` writes it: at least one segment, `meta` 3 per
+    /// segment, the parts of the method's layout (`Stepper::dense_dim`), `data` the width per
+    /// segment, every value finite, each segment forward in time and the segments in order (the
+    /// search in `eval` relies on it). Returns the dimension of an evaluated state.
+    pub fn check(&self, method: &Method) -> Result<usize> {
+        let bad = |m: String| Err(Error::argument("dense output", m));
+        let dim = match method {
+            Method::Dopri5 => Dopri5::dense_dim(self.part_len),
+            Method::Radau5 => Radau5::dense_dim(self.part_len),
+            Method::GenAlpha(_) => GenAlpha::dense_dim(self.part_len),
+            Method::RadauM(_) => RadauM::dense_dim(self.part_len),
+        };
+        let Some(dim) = dim else {
+            return bad(format!("part lengths {:?} are not the layout of a {} record", self.part_len, method.name()));
+        };
+        let nseg = self.meta.len() / 3;
+        if nseg == 0 || self.meta.len() % 3 != 0 {
+            return bad(format!("meta must hold 3 values per segment (at least one), got {}", self.meta.len()));
+        }
+        let width = self.part_len.iter().try_fold(0usize, |a, &b| a.checked_add(b));
+        if width.filter(|w| nseg.checked_mul(*w) == Some(self.data.len())).is_none() {
+            return bad(format!("data must hold {nseg} segments of {:?} values, got {} values", self.part_len, self.data.len()));
+        }
+        check_finite("dense output meta", self.meta)?;
+        check_finite("dense output data", self.data)?;
+        for k in 0..nseg {
+            let (t_old, t) = (self.meta[3 * k], self.meta[3 * k + 1]);
+            let next = if k + 1 < nseg { self.meta[3 * k + 3] } else { t };
+            if !(t_old <= t) || !(next >= t) {
+                return bad(format!("segment {k} [{t_old}, {t}] runs backwards or out of order"));
+            }
+        }
+        Ok(dim)
+    }
+
+    /// Evaluate at `t` into `out` (`check`ed record, `out` of its dimension): the segment whose
+    /// interval holds `t`; before the first or after the last segment, that segment's polynomial
+    /// extrapolated.
     pub fn eval(&self, method: &Method, t: f64, out: &mut [f64]) {
         let nseg = self.meta.len() / 3;
         if nseg == 0 {
@@ -807,16 +861,16 @@ impl DenseRecord {
                 hi = mid;
             }
         }
-        let w = self.width();
+        let w: usize = self.part_len.iter().sum();
         let seg = &self.data[lo * w..(lo + 1) * w];
         let mut parts: [&[f64]; 5] = [&[]; 5];
         let mut at = 0;
-        for (k, len) in self.part_len.iter().enumerate() {
+        for (k, len) in self.part_len.iter().enumerate().take(5) {
             parts[k] = &seg[at..at + len];
             at += len;
         }
         let meta = [self.meta[3 * lo], self.meta[3 * lo + 1], self.meta[3 * lo + 2]];
-        let parts = &parts[..self.part_len.len()];
+        let parts = &parts[..self.part_len.len().min(5)];
         match method {
             Method::Dopri5 => Dopri5::dense_eval(meta, parts, t, out),
             Method::Radau5 => Radau5::dense_eval(meta, parts, t, out),
@@ -1083,6 +1137,14 @@ impl Method {
         }
     }
 
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Dopri5 => "DOPRI5",
+            Method::Radau5 => "RADAU5",
+            Method::GenAlpha(_) => "GENALPHA",
+            Method::RadauM(_) => "RADAU5M",
+        }
+    }
 }
 
 /// Convenience: run `method` on the UK system of `model` with a workspace `data`.

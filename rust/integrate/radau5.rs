@@ -617,6 +617,13 @@ impl Stepper for Radau5 {
             out[i] = c0[i] + s * (c1[i] + (s - C2M1) * (c2[i] + (s - C1M1) * c3[i]));
         }
     }
+    /// Four parts `c0..c3` of the state's dimension.
+    fn dense_dim(part_len: &[usize]) -> Option<usize> {
+        match part_len {
+            [d, rest @ ..] if rest.len() == 3 && rest.iter().all(|r| r == d) => Some(*d),
+            _ => None,
+        }
+    }
     fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
         // the post-step hook moved y: the collocation polynomial follows by (1 + s) (y - c0),
         // so the dense output still ends at the state

@@ -753,6 +753,14 @@ impl Stepper for RadauM {
         }
     }
 
+    /// The state `y` (2n), then `q0`, `v0`, `a0`, `a1` (n each).
+    fn dense_dim(part_len: &[usize]) -> Option<usize> {
+        match *part_len {
+            [y, n, b, c, d] if [b, c, d].iter().all(|x| *x == n) && n.checked_mul(2) == Some(y) => Some(y),
+            _ => None,
+        }
+    }
+
     fn restart_at<S: SecondOrderSystem>(&mut self, sys: &mut S) -> Result<()> {
         acc_and_multipliers(sys, &mut self.st, &mut self.qdd, &mut self.lam)
     }

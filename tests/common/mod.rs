@@ -42,8 +42,9 @@ pub fn ancf_paper_scene(elements: usize, gravity: bool) -> String {
     paper_scene("euler-bernoulli", elements, gravity).replace(r#""kind": "beam","#, r#""kind": "beam", "formulation": "ancf","#)
 }
 
-/// A scene that uses every joint, driver and force kind on rigid bodies and beams (not
-/// consistent: for term-by-term checks at random states).
+/// A scene that uses every joint, driver and force kind on rigid bodies and beams, and motions
+/// of every kind but the spline (an expression among them; not consistent: for term-by-term
+/// checks at random states).
 pub fn every_kind_scene() -> String {
     r#"{"gravity": [0.3, -9.81],
       "bodies": [
@@ -69,7 +70,7 @@ pub fn every_kind_scene() -> String {
         {"kind": "angle", "a": {"body": "crank"}, "motion": {"kind": "harmonic", "offset": 0.1, "amplitude": 0.5, "frequency": 7.0, "phase": 0.2}},
         {"kind": "coordinate", "point": {"body": "slider", "point": [0.01, 0.0]}, "axis": "x", "motion": {"kind": "polynomial", "coefficients": [0.1, 0.2, -0.3, 0.4]}},
         {"kind": "angle", "a": {"body": "link", "xi": 0.6}, "b": {"body": "arm", "angle": 0.1}, "motion": {"kind": "constant_speed", "initial": 0.2, "speed": 3.0}},
-        {"kind": "coordinate", "point": {"body": "coupler", "xi": 0.25}, "axis": "y", "motion": {"kind": "harmonic", "amplitude": 0.01, "frequency": 30.0}}],
+        {"kind": "coordinate", "point": {"body": "coupler", "xi": 0.25}, "axis": "y", "motion": {"kind": "expression", "expression": "0.01*sin(30*t) + 0.002*t^2/(1 + t)"}}],
       "forces": [
         {"kind": "point_force", "point": {"body": "coupler", "xi": 0.3}, "force": [1.0, -2.0]},
         {"kind": "torque", "frame": {"body": "link", "xi": 0.7}, "torque": 0.4},

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from .. import Circular, ConstantSpeed, Scene
+from ..errors import UnknownNameError
 from ..scenes import PAPER, double_pendulum, gravity_vector, slider_crank
 
 __all__ = [
@@ -340,4 +341,4 @@ def case(name: str) -> Case:
     for c in CASES:
         if c.name == name:
             return c
-    raise KeyError(f"unknown case {name!r}; cases are {[c.name for c in CASES]}")
+    raise UnknownNameError.of("case", name, [c.name for c in CASES])

@@ -1,0 +1,90 @@
+//! A compiled list of the nodes some outputs need, children first: evaluation is one forward
+//! pass writing each node's value into a caller's buffer (sized once: [`Tape::len`]).
+
+use super::graph::{pow, Func, Graph, Node, NodeId};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Instr {
+    Const(f64),
+    Var(u32),
+    Neg(u32),
+    Add(u32, u32),
+    Sub(u32, u32),
+    Mul(u32, u32),
+    Div(u32, u32),
+    Pow(u32, u32),
+    Call(Func, u32),
+}
+
+#[derive(Debug, Clone)]
+pub struct Tape {
+    code: Vec<Instr>,
+    outputs: Vec<u32>,
+    n_vars: usize,
+}
+
+impl Tape {
+    /// The nodes `roots` depend on, renumbered in order; output `k` is `roots[k]`.
+    pub fn new(graph: &Graph, roots: &[NodeId]) -> Tape {
+        let reach = graph.reachable(roots);
+        let mut slot = vec![u32::MAX; reach.len()];
+        let mut code = Vec::new();
+        for (i, _) in reach.iter().enumerate().filter(|(_, r)| **r) {
+            let s = |c: NodeId| slot[c as usize];
+            let ins = match graph.node(i as NodeId) {
+                Node::Const(bits) => Instr::Const(f64::from_bits(bits)),
+                Node::Var(k) => Instr::Var(k),
+                Node::Neg(a) => Instr::Neg(s(a)),
+                Node::Add(a, b) => Instr::Add(s(a), s(b)),
+                Node::Sub(a, b) => Instr::Sub(s(a), s(b)),
+                Node::Mul(a, b) => Instr::Mul(s(a), s(b)),
+                Node::Div(a, b) => Instr::Div(s(a), s(b)),
+                Node::Pow(a, b) => Instr::Pow(s(a), s(b)),
+                Node::Call(f, a) => Instr::Call(f, s(a)),
+            };
+            slot[i] = code.len() as u32;
+            code.push(ins);
+        }
+        let outputs = roots.iter().map(|&r| slot[r as usize]).collect();
+        Tape { code, outputs, n_vars: graph.n_vars() }
+    }
+
+    /// Instructions, and the length of the evaluation buffer.
+    pub fn len(&self) -> usize {
+        self.code.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.code.is_empty()
+    }
+
+    pub fn n_vars(&self) -> usize {
+        self.n_vars
+    }
+
+    /// Evaluate every instruction at the variables `vars` (slot order, at least `n_vars`) into
+    /// `buf` (at least [`Tape::len`]); read outputs with [`Tape::output`].
+    #[inline]
+    pub fn eval(&self, vars: &[f64], buf: &mut [f64]) {
+        let buf = &mut buf[..self.code.len()];
+        for k in 0..self.code.len() {
+            buf[k] = match self.code[k] {
+                Instr::Const(c) => c,
+                Instr::Var(j) => vars[j as usize],
+                Instr::Neg(a) => -buf[a as usize],
+                Instr::Add(a, b) => buf[a as usize] + buf[b as usize],
+                Instr::Sub(a, b) => buf[a as usize] - buf[b as usize],
+                Instr::Mul(a, b) => buf[a as usize] * buf[b as usize],
+                Instr::Div(a, b) => buf[a as usize] / buf[b as usize],
+                Instr::Pow(a, b) => pow(buf[a as usize], buf[b as usize]),
+                Instr::Call(f, a) => f.apply(buf[a as usize]),
+            };
+        }
+    }
+
+    /// Output `k` of the last [`Tape::eval`] into `buf`.
+    #[inline]
+    pub fn output(&self, k: usize, buf: &[f64]) -> f64 {
+        buf[self.outputs[k] as usize]
+    }
+}
