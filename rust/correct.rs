@@ -15,6 +15,7 @@ use faer::Mat;
 use crate::dynamics::{constraints, mass_and_forces};
 use crate::data::Data;
 use crate::error::{Error, Result};
+use crate::linalg::dense::{cholesky, pinv_solve, solve_lower, solve_upper};
 use crate::model::Model;
 use crate::uk::{evaluate, solve};
 
@@ -390,7 +391,7 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
                 blk[(pos[gi] - first) * kb + pos[gj] - first] = v;
             }
         });
-        if !cholesky(&mut blk, kb) {
+        if cholesky(&mut blk, kb, 0.0).is_err() {
             return Err(Error::SingularMass { item: format!("body '{}': mass block of the corrected coordinates", body.name) });
         }
         blocks.push((first, kb, b, false));
@@ -415,7 +416,7 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
             if whole {
                 model.bodies[b].finv(&data.bodies[b], &mut col[first..first + kb]);
             } else {
-                lower_solve(&mf[off..off + kb * kb], kb, &mut col[first..first + kb]);
+                solve_lower(&mf[off..off + kb * kb], kb, &mut col[first..first + kb]);
             }
         }
         for p in 0..k {
@@ -427,7 +428,7 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
         if whole {
             model.bodies[b].finvt(&data.bodies[b], &mut y[first..first + kb]);
         } else {
-            upper_solve(&mf[off..off + kb * kb], kb, &mut y[first..first + kb]);
+            solve_upper(&mf[off..off + kb * kb], kb, &mut y[first..first + kb]);
         }
     }
     for (p, &g) in idx.iter().enumerate() {
@@ -436,28 +437,9 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
     Ok(dx)
 }
 
-/// `y = (B)^+ r = U S^+ V^T r` with `B^T = bt = U S V^T` (k x m), the rank cut as
-/// `scipy.linalg.pinv`'s.
+/// `B^+ r` with `B^T = bt` (`linalg::dense::pinv_solve`, the rank cut of `scipy.linalg.pinv`).
 fn pseudo_solve(bt: &Mat<f64>, r: &[f64]) -> Result<Vec<f64>> {
-    let (k, m) = (bt.nrows(), bt.ncols());
-    let svd = bt.thin_svd().map_err(|e| Error::Solver(format!("SVD in the state correction did not converge: {e:?}")))?;
-    let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
-    let smax = if s.nrows() > 0 { s[0] } else { 0.0 };
-    let tol = (k.max(m) as f64) * f64::EPSILON * smax;
-    let mut y = vec![0.0; k];
-    for j in 0..s.nrows() {
-        if s[j] > tol && s[j] > 0.0 {
-            let mut c = 0.0;
-            for i in 0..m {
-                c += v[(i, j)] * r[i];
-            }
-            c /= s[j];
-            for p in 0..k {
-                y[p] += u[(p, j)] * c;
-            }
-        }
-    }
-    Ok(y)
+    pinv_solve(bt, r).map_err(|e| Error::Solver(format!("SVD in the state correction did not converge: {e:?}")))
 }
 
 /// The bodies' rigid motions at `q` that touch no held coordinate (`Body::rigid_motions`):
@@ -539,7 +521,7 @@ fn rigid_step(model: &Model, data: &Data, basis: &RigidBasis, r: &[f64]) -> Resu
                 blk[p1 * kb + p2] = cols[p1].iter().zip(&mv).map(|(a, b)| a * b).sum();
             }
         }
-        if kb > 0 && !cholesky(&mut blk, kb) {
+        if kb > 0 && cholesky(&mut blk, kb, 0.0).is_err() {
             return Err(Error::SingularMass { item: format!("body '{}': mass of its rigid motions", body.name) });
         }
         factors.push(blk);
@@ -558,7 +540,7 @@ fn rigid_step(model: &Model, data: &Data, basis: &RigidBasis, r: &[f64]) -> Resu
         }
         for (b, f) in factors.iter().enumerate() {
             let (first, kb) = (basis.bodies[b].0, basis.kept[b].len());
-            lower_solve(f, kb, &mut col[first..first + kb]);
+            solve_lower(f, kb, &mut col[first..first + kb]);
         }
         for p in 0..k {
             bt[(p, i)] = col[p];
@@ -568,56 +550,10 @@ fn rigid_step(model: &Model, data: &Data, basis: &RigidBasis, r: &[f64]) -> Resu
     let mut y = pseudo_solve(&bt, r)?;
     for (b, f) in factors.iter().enumerate() {
         let (first, kb) = (basis.bodies[b].0, basis.kept[b].len());
-        upper_solve(f, kb, &mut y[first..first + kb]);
+        solve_upper(f, kb, &mut y[first..first + kb]);
     }
     x.copy_from_slice(&y);
     Ok(x)
-}
-
-/// In-place lower Cholesky of a k x k row-major matrix; `false` if not positive definite.
-fn cholesky(a: &mut [f64], k: usize) -> bool {
-    for j in 0..k {
-        let mut d = a[j * k + j];
-        for p in 0..j {
-            d -= a[j * k + p] * a[j * k + p];
-        }
-        if !(d > 0.0) || !d.is_finite() {
-            return false;
-        }
-        let d = d.sqrt();
-        a[j * k + j] = d;
-        for i in j + 1..k {
-            let mut s = a[i * k + j];
-            for p in 0..j {
-                s -= a[i * k + p] * a[j * k + p];
-            }
-            a[i * k + j] = s / d;
-        }
-        for i in 0..j {
-            a[i * k + j] = 0.0;
-        }
-    }
-    true
-}
-
-fn lower_solve(l: &[f64], k: usize, x: &mut [f64]) {
-    for i in 0..k {
-        let mut s = x[i];
-        for p in 0..i {
-            s -= l[i * k + p] * x[p];
-        }
-        x[i] = s / l[i * k + i];
-    }
-}
-
-fn upper_solve(l: &[f64], k: usize, x: &mut [f64]) {
-    for i in (0..k).rev() {
-        let mut s = x[i];
-        for p in i + 1..k {
-            s -= l[p * k + i] * x[p];
-        }
-        x[i] = s / l[i * k + i];
-    }
 }
 
 /// Correct `(q, qd)` onto the constraints at time `t`, holding the coordinates marked in

@@ -10,7 +10,7 @@ use crate::body::BodyData;
 use crate::constraint::jac::SegJac;
 use crate::model::Model;
 use crate::error::{Error, Result};
-use crate::small_svd::QrJacobi;
+use crate::linalg::small_svd::QrJacobi;
 use crate::sparse_uk::SparseUk;
 
 /// Which UK correction path a `Data` uses (a build option of the System).

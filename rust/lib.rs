@@ -11,7 +11,6 @@
 // form of a positivity check; kernels take the state slices and the outputs they write.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord, clippy::too_many_arguments)]
 
-pub mod band_lu;
 pub mod body;
 pub mod constraint;
 pub mod correct;
@@ -25,7 +24,6 @@ pub mod jacobian;
 pub mod linalg;
 pub mod model;
 pub mod sensors;
-pub mod small_svd;
 pub mod sparse_newton;
 pub mod sparse_uk;
 pub mod uk;
@@ -35,4 +33,6 @@ mod bindings;
 
 pub use data::{Data, RankInfo, RankTolerance, SvdBackend, UkSolver};
 pub use error::{Error, Result};
+/// The band LU's old path (`crate::band_lu`), still used by the implicit methods.
+pub use linalg::band_lu;
 pub use model::Model;

@@ -96,7 +96,7 @@ fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
                 faer_svd(data)?;
             } else if jacobi_of_r(model, data).is_err() {
                 if backend == SvdBackend::QrJacobi {
-                    return Err(Error::Solver(format!("Jacobi SVD of A F^-T did not converge in {} sweeps", crate::small_svd::MAX_SWEEPS)));
+                    return Err(Error::Solver(format!("Jacobi SVD of A F^-T did not converge in {} sweeps", crate::linalg::small_svd::MAX_SWEEPS)));
                 }
                 // The one-sided Jacobi sweeps can stall on a rank-deficient B (redundant
                 // constraint rows: columns of rounding-level norm keep being rotated); faer's
@@ -142,7 +142,7 @@ fn jacobi_of_r(model: &Model, data: &mut Data) -> Result<()> {
     let k = model.n.min(model.m);
     let qrj = data.qrj.as_mut().expect("QR workspace");
     if !qrj.svd_of_r() {
-        return Err(Error::Solver(format!("Jacobi SVD of A F^-T did not converge in {} sweeps", crate::small_svd::MAX_SWEEPS)));
+        return Err(Error::Solver(format!("Jacobi SVD of A F^-T did not converge in {} sweeps", crate::linalg::small_svd::MAX_SWEEPS)));
     }
     let mut s = data.svd_s.column_vector_mut();
     for j in 0..k {

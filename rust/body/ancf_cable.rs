@@ -445,44 +445,16 @@ impl AncfCable {
         true
     }
 
-    /// `v <- (L_s (x) I_2)^-1 v`: forward substitution on the x and y components together,
-    /// from the first non-zero entry on (a constraint column touches one element).
+    /// `v <- (L_s (x) I_2)^-1 v` (forward substitution on the x and y components together).
     #[inline]
     pub fn finv(&self, _bd: &AncfCableData, v: &mut [f64]) {
-        let (n, hb) = (self.l_s.n, self.l_s.hb);
-        let w = hb + 1;
-        let start = v.chunks_exact(2).position(|p| p[0] != 0.0 || p[1] != 0.0).unwrap_or(n);
-        for i in start..n {
-            let lo = i.saturating_sub(hb);
-            let row = &self.l_s.data[i * w + (lo + hb - i)..i * w + hb];
-            let (mut s0, mut s1) = (0.0, 0.0);
-            for (lk, k) in row.iter().zip(lo..i) {
-                s0 += lk * v[2 * k];
-                s1 += lk * v[2 * k + 1];
-            }
-            let inv = self.l_s.inv_diag[i];
-            v[2 * i] = (v[2 * i] - s0) * inv;
-            v[2 * i + 1] = (v[2 * i + 1] - s1) * inv;
-        }
+        self.l_s.solve_lower_pairs(v);
     }
 
-    /// `v <- (L_s^T (x) I_2)^-1 v`: back substitution (column sweep) on both components.
+    /// `v <- (L_s^T (x) I_2)^-1 v`.
     #[inline]
     pub fn finvt(&self, _bd: &AncfCableData, v: &mut [f64]) {
-        let (n, hb) = (self.l_s.n, self.l_s.hb);
-        let w = hb + 1;
-        for i in (0..n).rev() {
-            let inv = self.l_s.inv_diag[i];
-            let (x0, x1) = (v[2 * i] * inv, v[2 * i + 1] * inv);
-            v[2 * i] = x0;
-            v[2 * i + 1] = x1;
-            let lo = i.saturating_sub(hb);
-            let row = &self.l_s.data[i * w + (lo + hb - i)..i * w + hb];
-            for (lk, k) in row.iter().zip(lo..i) {
-                v[2 * k] -= lk * x0;
-                v[2 * k + 1] -= lk * x1;
-            }
-        }
+        self.l_s.solve_upper_pairs(v);
     }
 
     /// `out += (M_s (x) I_2) x` (`x`, `out`: the body's segments).

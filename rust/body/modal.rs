@@ -16,6 +16,7 @@ use super::ffrf_beam::{dot, frame_dense_block, frame_factor, frame_finv, frame_f
 use super::{add_frame_gravity, finite_vec2, frame_mass_block, frame_mass_moment, InitialState};
 use crate::description::{FlexibleDesc, MarkerDesc, Strain};
 use crate::error::{check_finite_item, positive, Error, Result};
+use crate::linalg::dense::cholesky;
 use crate::linalg::{Banded, BandedCholesky};
 
 /// Largest number of elastic coordinates of one flexible body (its matrices are stored by
@@ -98,31 +99,6 @@ fn banded(a: &[f64], n: usize, hb: usize) -> Banded {
     b
 }
 
-/// Dense Cholesky (lower, in place) of a symmetric `n x n`; `Err(pivot)` if a pivot is not
-/// above `tol` (relative to the largest diagonal entry).
-fn dense_cholesky(a: &mut [f64], n: usize, tol: f64) -> std::result::Result<(), (usize, f64)> {
-    let dmax = (0..n).fold(0.0f64, |m, i| m.max(a[i * n + i].abs()));
-    for j in 0..n {
-        let mut d = a[j * n + j];
-        for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k];
-        }
-        if !(d > tol * dmax) {
-            return Err((j, d));
-        }
-        let d = d.sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / d;
-        }
-    }
-    Ok(())
-}
-
 /// Check a tensor of order `order` (n^order entries, row-major) for length, finiteness and full
 /// symmetry under index permutations (pairwise transpositions suffice).
 fn check_tensor(item: &str, what: &str, t: &[f64], n: usize, order: u32) -> Result<f64> {
@@ -188,7 +164,7 @@ impl Modal {
         check_finite_item(item, "s_bar", &d.s_bar.concat())?;
         // M_ff positive definite, and the whole body block at q_f = 0
         let mut mc = m.clone();
-        if let Err((p, v)) = dense_cholesky(&mut mc, n, 1e-13) {
+        if let Err((p, v)) = cholesky(&mut mc, n, 1e-13) {
             return Err(Error::SingularMass { item: format!("{item}: m_ff is not positive definite (pivot {p} = {v:e})") });
         }
         let s_t = [mass * com[0], mass * com[1]];
@@ -212,14 +188,14 @@ impl Modal {
                 full[(3 + i) * nb + 3 + j] = m[i * n + j];
             }
         }
-        if let Err((p, v)) = dense_cholesky(&mut full, nb, 1e-13) {
+        if let Err((p, v)) = cholesky(&mut full, nb, 1e-13) {
             return Err(Error::SingularMass {
                 item: format!("{item}: the body's mass matrix at q_f = 0 is not positive definite (pivot {p} = {v:e}): mass, inertia, com, s_bar, s_ju0 and m_ff do not belong to one mass distribution"),
             });
         }
         // K_ff positive definite: a null vector is a rigid-body motion the frame already carries
         let mut kc = k.clone();
-        if let Err((p, v)) = dense_cholesky(&mut kc, n, 1e-12) {
+        if let Err((p, v)) = cholesky(&mut kc, n, 1e-12) {
             return Err(Error::invalid(
                 item,
                 format!("k_ff must be positive definite (pivot {p} = {v:e}): a singular k_ff has rigid-body modes that were not removed (the floating frame already carries the rigid motion: fix the frame by reference conditions, mean axes or interface modes), a negative one is not a stiffness"),
@@ -231,7 +207,7 @@ impl Modal {
             for i in 0..n {
                 dc[i * n + i] += 1e-12 * tr.abs() + f64::MIN_POSITIVE;
             }
-            if dense_cholesky(&mut dc, n, 0.0).is_err() {
+            if cholesky(&mut dc, n, 0.0).is_err() {
                 return Err(Error::invalid(item, "d_ff must be positive semi-definite"));
             }
         }
