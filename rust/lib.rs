@@ -25,14 +25,14 @@ pub mod linalg;
 pub mod model;
 pub mod sensors;
 pub mod sparse_newton;
-pub mod sparse_uk;
 pub mod uk;
 
 #[cfg(feature = "python")]
 mod bindings;
 
-pub use data::{Data, RankInfo, RankTolerance, SvdBackend, UkSolver};
+pub use data::Data;
 pub use error::{Error, Result};
 /// The band LU's old path (`crate::band_lu`), still used by the implicit methods.
 pub use linalg::band_lu;
 pub use model::Model;
+pub use uk::{RankInfo, RankTolerance, SvdBackend, UkSolver};

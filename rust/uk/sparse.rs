@@ -35,12 +35,12 @@
 //! wide trees) gives no selected inverse, so its full-rank certificate would be a pivot-ratio
 //! heuristic, not a bound; faer's sparse QR of `B^T` avoids squaring but `1/|R^-1|_F` needs
 //! `R^-1` (O(m^2) and dense). A chain, rope or track has a narrow band after RCM; a lattice of
-//! width `w` has `hb ~ 2 w`, and `uk::prefer_sparse` keeps the dense path where the band is
+//! width `w` has `hb ~ 2 w`, and `data::prefer_sparse` keeps the dense path where the band is
 //! too wide to pay.
 
 use crate::body::BodyData;
 use crate::constraint::jac::SegJac;
-use crate::data::{RankInfo, RankTolerance};
+use super::settings::{RankInfo, RankTolerance};
 use crate::linalg::banded::{count_eigenvalues_below, BandedCholesky};
 use crate::model::Model;
 
