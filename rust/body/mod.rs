@@ -9,13 +9,15 @@
 //! one arm per `match` below (the compiler lists them).
 
 pub mod ancf_cable;
+pub mod ffrf;
 pub mod ffrf_beam;
 pub mod modal;
 pub mod point_mass;
 pub mod rigid;
 
 pub use ancf_cable::{AncfCable, AncfCableData, CablePoint};
-pub use ffrf_beam::{Beam, BeamData, PointShape};
+pub use ffrf::{Ffrf, FfrfData, PointShape};
+pub use ffrf_beam::{Beam, BeamData};
 pub use modal::Modal;
 pub use point_mass::{PointMass, PointMassData};
 pub use rigid::{Rigid, RigidData};
@@ -43,7 +45,7 @@ pub enum BodyData {
     Beam(BeamData),
     PointMass(PointMassData),
     AncfBeam(AncfCableData),
-    Flexible(BeamData),
+    Flexible(FfrfData),
 }
 
 #[derive(Debug, Clone)]
@@ -408,7 +410,7 @@ impl Body {
         match &self.kind {
             BodyKind::Beam(k) => {
                 let ps = k.point_shape(xi);
-                let ms = ffrf_beam::marker_state(&ps, 0.0, qb, qb);
+                let ms = ffrf::marker_state(&ps, 0.0, qb, qb);
                 let (mut u, mut v) = (0.0, 0.0);
                 for &(i, su, sv, _) in &ps.entries {
                     u += su * qb[3 + i];
@@ -520,7 +522,7 @@ impl Marker {
         let (qb, qdb) = (body.seg(q), body.seg(qd));
         match &self.shape {
             MarkerShape::Rigid(p) => rigid::marker_state(p, self.angle, qb, qdb),
-            MarkerShape::Beam(ps) => ffrf_beam::marker_state(ps, self.angle, qb, qdb),
+            MarkerShape::Beam(ps) => ffrf::marker_state(ps, self.angle, qb, qdb),
             MarkerShape::Particle => point_mass::marker_state(self.angle, qb, qdb),
             MarkerShape::Cable(p) => ancf_cable::marker_state(p, self.angle, qb, qdb),
             MarkerShape::Ground(_) => unreachable!("ground marker on a body"),
@@ -541,7 +543,7 @@ impl Marker {
         let rb = body_slice(bodies, bi, row, layout);
         match &self.shape {
             MarkerShape::Rigid(_) => rigid::add_point_jacobian(ms, w, rb),
-            MarkerShape::Beam(ps) => ffrf_beam::add_point_jacobian(ps, ms, w, rb),
+            MarkerShape::Beam(ps) => ffrf::add_point_jacobian(ps, ms, w, rb),
             MarkerShape::Particle => point_mass::add_point_jacobian(w, rb),
             MarkerShape::Cable(p) => ancf_cable::add_point_jacobian(p, w, rb),
             MarkerShape::Ground(_) => {}
@@ -561,7 +563,7 @@ impl Marker {
         let rb = body_slice(bodies, bi, row, layout);
         match &self.shape {
             MarkerShape::Rigid(_) => rigid::add_angle_jacobian(w, rb),
-            MarkerShape::Beam(ps) => ffrf_beam::add_angle_jacobian(ps, w, rb),
+            MarkerShape::Beam(ps) => ffrf::add_angle_jacobian(ps, w, rb),
             MarkerShape::Cable(p) => ancf_cable::add_angle_jacobian(p, ms, w, rb),
             MarkerShape::Particle | MarkerShape::Ground(_) => {}
         }
