@@ -25,7 +25,8 @@
 //! velocity terms; gravity is a constant generalized force.
 
 use super::ffrf_beam::{beam_section, BeamSection};
-use super::{axis_marker_xi, finite_vec2, InitialState, MarkerState};
+use super::marker::axis_marker_xi;
+use super::{finite_vec2, InitialState, MarkerState};
 use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions};
 use crate::error::{Error, Result};
 use crate::linalg::{Banded, BandedCholesky, GAUSS4};
@@ -338,6 +339,15 @@ impl AncfCable {
         }
     }
 
+    /// Stiffness `K_t` (`visit_element_matrices`) into `k` and, with damping, the strain-rate
+    /// damping matrix into `c` (body coordinates; repeated entries add up).
+    pub fn tangent(&self, q: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
+        self.visit_element_matrices(q, false, k);
+        if self.damping > 0.0 {
+            self.visit_element_matrices(q, true, c);
+        }
+    }
+
     /// `out += K_t = -dQ_el/dq = d2U/dq2` (the undamped elastic force's tangent stiffness,
     /// symmetric) at `q`, element by element: axial `EA (t t^T + eps (I - t t^T)/|r'|)`,
     /// bending `EI (grad K grad K^T + K d2K)` in `(r', r'')`, mapped through the shape
@@ -458,7 +468,7 @@ impl AncfCable {
     }
 
     /// `out += (M_s (x) I_2) x` (`x`, `out`: the body's segments).
-    pub fn mass_times(&self, x: &[f64], out: &mut [f64]) {
+    pub fn mass_times(&self, _bd: &AncfCableData, x: &[f64], out: &mut [f64]) {
         let n = self.m_s.n;
         for i in 0..n {
             let (mut a, mut b) = (0.0, 0.0);

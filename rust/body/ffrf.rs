@@ -19,7 +19,8 @@
 //! * the initial state, the first moment of mass, and the kinematics of a marker at a point of
 //!   the body (`PointShape`: an axis point of a beam, an interface point of a modal body).
 
-use super::{add_frame_gravity, add_frame_point_jacobian, finite_vec2, frame_mass_block, frame_mass_moment, frame_point_state, frame_sin_cos, InitialState, MarkerState};
+use super::frame::{add_frame_gravity, add_frame_point_jacobian, frame_mass_block, frame_mass_moment, frame_point_state, frame_sin_cos};
+use super::{finite_vec2, InitialState, MarkerState};
 use crate::error::{check_finite_item, Error, Result};
 use crate::linalg::{cholesky3, dot4 as dot, solve_lower3, solve_upper3, Banded, BandedCholesky};
 

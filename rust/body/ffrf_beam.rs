@@ -8,7 +8,8 @@
 //! internal forces, and the shape of its axis points.
 
 use super::ffrf::{Ffrf, FfrfData, PointShape};
-use super::{axis_marker_xi, InitialState};
+use super::marker::axis_marker_xi;
+use super::InitialState;
 use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions, SectionDesc, Strain};
 use crate::error::{non_negative, positive, Error, Result};
 use crate::linalg::{Banded, BandedCholesky, GAUSS4};
@@ -494,6 +495,16 @@ impl Beam {
         }
     }
 
+    /// Stiffness `K_t` of the elastic forces (`elastic_tangent`) into `k` and the damping
+    /// `beta K_t` into `c` (body coordinates: the elastic block).
+    pub fn tangent(&self, q: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
+        let qf = &q[3..];
+        self.elastic_tangent(qf, &mut |i, j, v| k(3 + i, 3 + j, v));
+        if self.damping > 0.0 {
+            self.elastic_tangent(qf, &mut |i, j, v| c(3 + i, 3 + j, self.damping * v));
+        }
+    }
+
     /// Tangent stiffness of the elastic forces, `K_t = -dQ_el/dq_f` (n_f x n_f): `K_ff` plus,
     /// with nonlinear strain, `E a l (b b^T - B B^T) + N G` per element (`b = B + G d / l`).
     /// `put(i, j, v)` receives entries in elastic-coordinate indices (repeated indices add up).
@@ -592,6 +603,11 @@ impl Beam {
             }
         }
         u
+    }
+
+    /// `1/2 v_f^T K_ff v_f`: the material strain energy of the motion `v` (body segments).
+    pub fn material_energy(&self, _q: &[f64], v: &[f64]) -> f64 {
+        self.frame.linear_strain_energy(&v[3..])
     }
 
     /// Internal forces and strains of the elastic law at the axis point `xi` (body

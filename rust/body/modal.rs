@@ -445,6 +445,19 @@ impl Modal {
         }
     }
 
+    /// Stiffness `K_t` (`elastic_tangent`) into `k` and `D_ff` into `c` (body coordinates: the
+    /// elastic block).
+    pub fn tangent(&self, q: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
+        let qf = &q[3..];
+        self.elastic_tangent(qf, &mut |i, j, v| k(3 + i, 3 + j, v));
+        self.damping_tangent(&mut |i, j, v| c(3 + i, 3 + j, v));
+    }
+
+    /// `1/2 v_f^T K_ff v_f`: the material strain energy of the motion `v` (body segments).
+    pub fn material_energy(&self, _q: &[f64], v: &[f64]) -> f64 {
+        self.frame.linear_strain_energy(&v[3..3 + self.frame.n_f])
+    }
+
     /// Damping `-dQ/dqd_f = D_ff`.
     pub fn damping_tangent(&self, put: &mut impl FnMut(usize, usize, f64)) {
         if let Some(dm) = &self.d_ff {
