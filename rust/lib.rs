@@ -4,8 +4,10 @@
 //! Data flows one way: description (`description`) -> model (`model`, `body`, `constraint`,
 //! `force`) -> workspace (`data`) -> kernels (`dynamics`, `uk`, `jacobian`) -> drivers
 //! (`integrate`, `correct`) -> results. `bindings` (feature `python`) is the only module that
-//! knows Python. Each body kind owns its code in `body/`, each joint kind in `constraint/`;
-//! see `docs/architecture.md`.
+//! knows Python. Each body kind owns its code in `body/` (the floating-frame kinds share
+//! `body/ffrf.rs`), each joint kind in `constraint/`; the numerics (dense, banded, LU, SVD,
+//! orderings) live in `linalg/`, the UK solves and their settings in `uk/`. See
+//! `docs/architecture.md`.
 
 // Numeric kernels index like the papers they follow; `!(x > 0.0)` is the deliberate NaN-rejecting
 // form of a positivity check; kernels take the state slices and the outputs they write.
