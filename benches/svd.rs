@@ -13,7 +13,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::svd::{svd, svd_scratch, ComputeSvdVectors};
 use faer::{diag::Diag, Mat, Par};
-use ukflex::small_svd::QrJacobi;
+use ukflex::linalg::small_svd::QrJacobi;
 use ukflex::{uk, SvdBackend};
 
 mod scenes;

@@ -214,7 +214,7 @@ impl StructuredJacobian {
     /// `jq`, `jv` (n x n row-major) at `(t, q, qd)`.
     pub fn evaluate(&mut self, model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], jq: &mut [f64], jv: &mut [f64]) -> Result<()> {
         use crate::dynamics;
-        use crate::integrate::lu::{lu_cm, lu_cm_solve}; // the saddle-point matrix is symmetric: row- and column-major alike
+        use crate::linalg::lu::{lu_cm, lu_cm_solve}; // the saddle-point matrix is symmetric: row- and column-major alike
         let (n, m) = (model.n, model.m);
         let nm = n + m;
         dynamics::mass_and_forces(model, data, q, qd);

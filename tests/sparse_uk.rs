@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use ukflex::data::Factored;
+use ukflex::uk::Factored;
 use ukflex::{uk, Data, Model, UkSolver};
 
 /// A consistent state of `chain_scene(k)`: random link angles and rates, the reference points

@@ -25,7 +25,8 @@
 //! velocity terms; gravity is a constant generalized force.
 
 use super::ffrf_beam::{beam_section, BeamSection};
-use super::{axis_marker_xi, finite_vec2, InitialState, MarkerState};
+use super::marker::axis_marker_xi;
+use super::{finite_vec2, InitialState, MarkerState};
 use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions};
 use crate::error::{Error, Result};
 use crate::linalg::{Banded, BandedCholesky, GAUSS4};
@@ -338,6 +339,15 @@ impl AncfCable {
         }
     }
 
+    /// Stiffness `K_t` (`visit_element_matrices`) into `k` and, with damping, the strain-rate
+    /// damping matrix into `c` (body coordinates; repeated entries add up).
+    pub fn tangent(&self, q: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
+        self.visit_element_matrices(q, false, k);
+        if self.damping > 0.0 {
+            self.visit_element_matrices(q, true, c);
+        }
+    }
+
     /// `out += K_t = -dQ_el/dq = d2U/dq2` (the undamped elastic force's tangent stiffness,
     /// symmetric) at `q`, element by element: axial `EA (t t^T + eps (I - t t^T)/|r'|)`,
     /// bending `EI (grad K grad K^T + K d2K)` in `(r', r'')`, mapped through the shape
@@ -445,48 +455,20 @@ impl AncfCable {
         true
     }
 
-    /// `v <- (L_s (x) I_2)^-1 v`: forward substitution on the x and y components together,
-    /// from the first non-zero entry on (a constraint column touches one element).
+    /// `v <- (L_s (x) I_2)^-1 v` (forward substitution on the x and y components together).
     #[inline]
     pub fn finv(&self, _bd: &AncfCableData, v: &mut [f64]) {
-        let (n, hb) = (self.l_s.n, self.l_s.hb);
-        let w = hb + 1;
-        let start = v.chunks_exact(2).position(|p| p[0] != 0.0 || p[1] != 0.0).unwrap_or(n);
-        for i in start..n {
-            let lo = i.saturating_sub(hb);
-            let row = &self.l_s.data[i * w + (lo + hb - i)..i * w + hb];
-            let (mut s0, mut s1) = (0.0, 0.0);
-            for (lk, k) in row.iter().zip(lo..i) {
-                s0 += lk * v[2 * k];
-                s1 += lk * v[2 * k + 1];
-            }
-            let inv = self.l_s.inv_diag[i];
-            v[2 * i] = (v[2 * i] - s0) * inv;
-            v[2 * i + 1] = (v[2 * i + 1] - s1) * inv;
-        }
+        self.l_s.solve_lower_pairs(v);
     }
 
-    /// `v <- (L_s^T (x) I_2)^-1 v`: back substitution (column sweep) on both components.
+    /// `v <- (L_s^T (x) I_2)^-1 v`.
     #[inline]
     pub fn finvt(&self, _bd: &AncfCableData, v: &mut [f64]) {
-        let (n, hb) = (self.l_s.n, self.l_s.hb);
-        let w = hb + 1;
-        for i in (0..n).rev() {
-            let inv = self.l_s.inv_diag[i];
-            let (x0, x1) = (v[2 * i] * inv, v[2 * i + 1] * inv);
-            v[2 * i] = x0;
-            v[2 * i + 1] = x1;
-            let lo = i.saturating_sub(hb);
-            let row = &self.l_s.data[i * w + (lo + hb - i)..i * w + hb];
-            for (lk, k) in row.iter().zip(lo..i) {
-                v[2 * k] -= lk * x0;
-                v[2 * k + 1] -= lk * x1;
-            }
-        }
+        self.l_s.solve_upper_pairs(v);
     }
 
     /// `out += (M_s (x) I_2) x` (`x`, `out`: the body's segments).
-    pub fn mass_times(&self, x: &[f64], out: &mut [f64]) {
+    pub fn mass_times(&self, _bd: &AncfCableData, x: &[f64], out: &mut [f64]) {
         let n = self.m_s.n;
         for i in 0..n {
             let (mut a, mut b) = (0.0, 0.0);

@@ -9,14 +9,16 @@
 //! * `K_ff`, `D_ff`, and with `strain = nonlinear` the tensors `k3` (and `k4`) of the strain
 //!   energy `U = q K q / 2 + k3 q q q / 6 + k4 q q q q / 24`.
 //!
-//! The equations are those of the FFRF beam (`ffrf_beam.rs`) with these constants: the block
-//! factor with the constant `M_ff` and the marker kinematics are shared with it.
+//! This file validates the description and builds these invariants (`ffrf::Ffrf`); the
+//! equations on them are the floating-frame core's (`ffrf.rs`, shared with the FFRF beam), to
+//! which the body adds `-D_ff qd_f` and the forces of `k3`, `k4`.
 
-use super::ffrf_beam::{dot, frame_dense_block, frame_factor, frame_finv, frame_finvt, frame_kinetic_energy, frame_mass_times, BeamData, PointShape};
-use super::{add_frame_gravity, finite_vec2, frame_mass_block, frame_mass_moment, InitialState};
+use super::ffrf::{Ffrf, FfrfData, PointShape};
+use super::{finite_vec2, InitialState};
 use crate::description::{FlexibleDesc, MarkerDesc, Strain};
 use crate::error::{check_finite_item, positive, Error, Result};
-use crate::linalg::{Banded, BandedCholesky};
+use crate::linalg::dense::cholesky;
+use crate::linalg::{dot4 as dot, Banded, BandedCholesky};
 
 /// Largest number of elastic coordinates of one flexible body (its matrices are stored by
 /// their band, up to dense).
@@ -28,19 +30,9 @@ const SYM_TOL: f64 = 1e-9;
 /// One flexible body with its constant invariants (see the module docs).
 #[derive(Debug, Clone)]
 pub struct Modal {
-    pub n_f: usize,
-    pub mass: f64,
-    pub s_t: [f64; 2],
-    pub j0: f64,
-    pub s_bar: [Vec<f64>; 2],
-    pub s_u0: Vec<f64>,
-    pub s_ju0: Vec<f64>,
-    pub s_tilde: Banded,
-    pub m_ff: Banded,
-    pub m_ff_tr: Banded,
-    pub k_ff: Banded,
+    /// The floating-frame invariants (read through `Deref` as `modal.n_f`, ...).
+    pub frame: Ffrf,
     pub d_ff: Option<Banded>,
-    pub l_ff: BandedCholesky,
     pub strain: Strain,
     /// `k3[i][j][k]` row-major (n_f^3), empty unless nonlinear.
     pub k3: Vec<f64>,
@@ -98,31 +90,6 @@ fn banded(a: &[f64], n: usize, hb: usize) -> Banded {
     b
 }
 
-/// Dense Cholesky (lower, in place) of a symmetric `n x n`; `Err(pivot)` if a pivot is not
-/// above `tol` (relative to the largest diagonal entry).
-fn dense_cholesky(a: &mut [f64], n: usize, tol: f64) -> std::result::Result<(), (usize, f64)> {
-    let dmax = (0..n).fold(0.0f64, |m, i| m.max(a[i * n + i].abs()));
-    for j in 0..n {
-        let mut d = a[j * n + j];
-        for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k];
-        }
-        if !(d > tol * dmax) {
-            return Err((j, d));
-        }
-        let d = d.sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / d;
-        }
-    }
-    Ok(())
-}
-
 /// Check a tensor of order `order` (n^order entries, row-major) for length, finiteness and full
 /// symmetry under index permutations (pairwise transpositions suffice).
 fn check_tensor(item: &str, what: &str, t: &[f64], n: usize, order: u32) -> Result<f64> {
@@ -152,15 +119,17 @@ fn check_tensor(item: &str, what: &str, t: &[f64], n: usize, order: u32) -> Resu
     Ok(big)
 }
 
-impl Modal {
-    pub fn from_desc(d: &FlexibleDesc, item: &str) -> Result<Modal> {
-        let n = d.k_ff.len();
-        if n == 0 || n > MAX_ELASTIC {
-            return Err(Error::invalid(item, format!("k_ff must be n_f x n_f with n_f in 1..={MAX_ELASTIC} elastic coordinates, got n_f = {n} (a body without elastic coordinates is a rigid body)")));
-        }
-        let mass = positive(item, "mass", d.mass)?;
-        let inertia = positive(item, "inertia", d.inertia)?;
-        let com = finite_vec2(item, "com", d.com)?;
+/// The description's square matrices, row-major and checked (sizes, finite, symmetric).
+struct Matrices {
+    k: Vec<f64>,
+    m: Vec<f64>,
+    st: Vec<f64>,
+    mtr: Vec<f64>,
+    dmp: Option<Vec<f64>>,
+}
+
+impl Matrices {
+    fn read(d: &FlexibleDesc, item: &str, n: usize) -> Result<Matrices> {
         let (k, kbig) = square(item, "k_ff", &d.k_ff, n)?;
         let (m, mbig) = square(item, "m_ff", &d.m_ff, n)?;
         let (st, stbig) = square(item, "s_tilde", &d.s_tilde, n)?;
@@ -176,23 +145,22 @@ impl Modal {
         if let Some((dd, dbig)) = &dmp {
             check_symmetry(item, "d_ff", dd, n, *dbig, 1.0)?;
         }
-        if d.s_bar.len() != 2 || d.s_bar.iter().any(|r| r.len() != n) {
-            return Err(Error::invalid(item, format!("s_bar must be 2 x {n} (rows x and y), got {} rows of lengths {:?}", d.s_bar.len(), d.s_bar.iter().map(|r| r.len()).collect::<Vec<_>>())));
-        }
-        for (what, v) in [("s_u0", &d.s_u0), ("s_ju0", &d.s_ju0)] {
-            if v.len() != n {
-                return Err(Error::invalid(item, format!("{what} must have length n_f = {n}, got {}", v.len())));
-            }
-            check_finite_item(item, what, v)?;
-        }
-        check_finite_item(item, "s_bar", &d.s_bar.concat())?;
-        // M_ff positive definite, and the whole body block at q_f = 0
-        let mut mc = m.clone();
-        if let Err((p, v)) = dense_cholesky(&mut mc, n, 1e-13) {
+        Ok(Matrices { k, m, st, mtr, dmp: dmp.map(|(dd, _)| dd) })
+    }
+
+    /// The common half-bandwidth of the banded copies.
+    fn bandwidth(&self, n: usize) -> usize {
+        let hb = bandwidth(&self.m, n).max(bandwidth(&self.k, n)).max(bandwidth(&self.st, n)).max(bandwidth(&self.mtr, n));
+        self.dmp.as_ref().map_or(hb, |dd| hb.max(bandwidth(dd, n)))
+    }
+
+    /// Definiteness: `M_ff` and the whole body block at `q_f = 0` positive definite (one mass
+    /// distribution), `K_ff` positive definite (no rigid-body modes left), `D_ff` semi-definite.
+    fn check_definite(&self, d: &FlexibleDesc, item: &str, n: usize, mass: f64, s_t: [f64; 2], j0: f64) -> Result<()> {
+        let mut mc = self.m.clone();
+        if let Err((p, v)) = cholesky(&mut mc, n, 1e-13) {
             return Err(Error::SingularMass { item: format!("{item}: m_ff is not positive definite (pivot {p} = {v:e})") });
         }
-        let s_t = [mass * com[0], mass * com[1]];
-        let j0 = inertia + mass * (com[0] * com[0] + com[1] * com[1]);
         let nb = n + 3;
         let mut full = vec![0.0; nb * nb];
         let put = |a: &mut Vec<f64>, i: usize, j: usize, v: f64| {
@@ -209,93 +177,135 @@ impl Modal {
             put(&mut full, 1, 3 + j, d.s_bar[1][j]);
             put(&mut full, 2, 3 + j, d.s_ju0[j]);
             for i in 0..n {
-                full[(3 + i) * nb + 3 + j] = m[i * n + j];
+                full[(3 + i) * nb + 3 + j] = self.m[i * n + j];
             }
         }
-        if let Err((p, v)) = dense_cholesky(&mut full, nb, 1e-13) {
+        if let Err((p, v)) = cholesky(&mut full, nb, 1e-13) {
             return Err(Error::SingularMass {
                 item: format!("{item}: the body's mass matrix at q_f = 0 is not positive definite (pivot {p} = {v:e}): mass, inertia, com, s_bar, s_ju0 and m_ff do not belong to one mass distribution"),
             });
         }
         // K_ff positive definite: a null vector is a rigid-body motion the frame already carries
-        let mut kc = k.clone();
-        if let Err((p, v)) = dense_cholesky(&mut kc, n, 1e-12) {
+        let mut kc = self.k.clone();
+        if let Err((p, v)) = cholesky(&mut kc, n, 1e-12) {
             return Err(Error::invalid(
                 item,
                 format!("k_ff must be positive definite (pivot {p} = {v:e}): a singular k_ff has rigid-body modes that were not removed (the floating frame already carries the rigid motion: fix the frame by reference conditions, mean axes or interface modes), a negative one is not a stiffness"),
             ));
         }
-        if let Some((dd, _)) = &dmp {
+        if let Some(dd) = &self.dmp {
             let tr: f64 = (0..n).map(|i| dd[i * n + i]).sum();
             let mut dc = dd.clone();
             for i in 0..n {
                 dc[i * n + i] += 1e-12 * tr.abs() + f64::MIN_POSITIVE;
             }
-            if dense_cholesky(&mut dc, n, 0.0).is_err() {
+            if cholesky(&mut dc, n, 0.0).is_err() {
                 return Err(Error::invalid(item, "d_ff must be positive semi-definite"));
             }
         }
-        let strain = d.strain.unwrap_or(Strain::Linear);
-        let (k3, k4) = match strain {
-            Strain::Linear => {
-                if d.k3.is_some() || d.k4.is_some() {
-                    return Err(Error::invalid(item, "k3 and k4 need strain = \"nonlinear\""));
-                }
-                (Vec::new(), Vec::new())
-            }
-            Strain::Nonlinear => {
-                let Some(k3) = &d.k3 else {
-                    return Err(Error::invalid(item, "strain = \"nonlinear\" needs k3, the third-order stiffness tensor (n_f^3 entries)"));
-                };
-                check_tensor(item, "k3", k3, n, 3)?;
-                let k4 = match &d.k4 {
-                    Some(t) => {
-                        check_tensor(item, "k4", t, n, 4)?;
-                        t.clone()
-                    }
-                    None => Vec::new(),
-                };
-                (k3.clone(), k4)
-            }
-        };
-        let mut hb = bandwidth(&m, n).max(bandwidth(&k, n)).max(bandwidth(&st, n)).max(bandwidth(&mtr, n));
-        if let Some((dd, _)) = &dmp {
-            hb = hb.max(bandwidth(dd, n));
+        Ok(())
+    }
+}
+
+/// `s_bar` (2 x n), `s_u0` and `s_ju0` (n): sizes and finite.
+fn check_vectors(d: &FlexibleDesc, item: &str, n: usize) -> Result<()> {
+    if d.s_bar.len() != 2 || d.s_bar.iter().any(|r| r.len() != n) {
+        return Err(Error::invalid(item, format!("s_bar must be 2 x {n} (rows x and y), got {} rows of lengths {:?}", d.s_bar.len(), d.s_bar.iter().map(|r| r.len()).collect::<Vec<_>>())));
+    }
+    for (what, v) in [("s_u0", &d.s_u0), ("s_ju0", &d.s_ju0)] {
+        if v.len() != n {
+            return Err(Error::invalid(item, format!("{what} must have length n_f = {n}, got {}", v.len())));
         }
-        let m_ff = banded(&m, n, hb);
+        check_finite_item(item, what, v)?;
+    }
+    check_finite_item(item, "s_bar", &d.s_bar.concat())
+}
+
+/// The strain law and its tensors `(strain, k3, k4)` (empty unless nonlinear / given).
+fn strain_tensors(d: &FlexibleDesc, item: &str, n: usize) -> Result<(Strain, Vec<f64>, Vec<f64>)> {
+    let strain = d.strain.unwrap_or(Strain::Linear);
+    match strain {
+        Strain::Linear => {
+            if d.k3.is_some() || d.k4.is_some() {
+                return Err(Error::invalid(item, "k3 and k4 need strain = \"nonlinear\""));
+            }
+            Ok((strain, Vec::new(), Vec::new()))
+        }
+        Strain::Nonlinear => {
+            let Some(k3) = &d.k3 else {
+                return Err(Error::invalid(item, "strain = \"nonlinear\" needs k3, the third-order stiffness tensor (n_f^3 entries)"));
+            };
+            check_tensor(item, "k3", k3, n, 3)?;
+            let k4 = match &d.k4 {
+                Some(t) => {
+                    check_tensor(item, "k4", t, n, 4)?;
+                    t.clone()
+                }
+                None => Vec::new(),
+            };
+            Ok((strain, k3.clone(), k4))
+        }
+    }
+}
+
+/// The interface points: names unique, points distinct, displacement (2 x n) and rotation (n)
+/// rows finite; their sparse shapes.
+fn interface_points(d: &FlexibleDesc, item: &str, n: usize) -> Result<Vec<(String, PointShape)>> {
+    let mut markers: Vec<(String, PointShape)> = Vec::with_capacity(d.markers.len());
+    for md in &d.markers {
+        let what = format!("marker '{}'", md.name);
+        if md.name.is_empty() || markers.iter().any(|(nm, _)| nm == &md.name) {
+            return Err(Error::invalid(item, format!("marker names must be non-empty and unique, got '{}' twice or empty", md.name)));
+        }
+        let p = finite_vec2(item, &format!("{what} point"), md.point)?;
+        if md.displacement.len() != 2 || md.displacement.iter().any(|r| r.len() != n) {
+            return Err(Error::invalid(item, format!("{what}: displacement must be 2 x n_f = 2 x {n}, got {} rows of lengths {:?}", md.displacement.len(), md.displacement.iter().map(|r| r.len()).collect::<Vec<_>>())));
+        }
+        check_finite_item(item, &format!("{what} displacement"), &md.displacement.concat())?;
+        if let Some(r) = &md.rotation {
+            if r.len() != n {
+                return Err(Error::invalid(item, format!("{what}: rotation must have length n_f = {n}, got {}", r.len())));
+            }
+            check_finite_item(item, &format!("{what} rotation"), r)?;
+        }
+        if let Some((other, _)) = markers.iter().find(|(_, s)| s.x == p[0] && s.y == p[1]) {
+            return Err(Error::invalid(item, format!("{what} and marker '{other}' sit at the same point {p:?}")));
+        }
+        let mut entries = Vec::new();
+        for i in 0..n {
+            let (su, sv) = (md.displacement[0][i], md.displacement[1][i]);
+            let sp = md.rotation.as_ref().map_or(0.0, |r| r[i]);
+            if su != 0.0 || sv != 0.0 || sp != 0.0 {
+                entries.push((i, su, sv, sp));
+            }
+        }
+        markers.push((md.name.clone(), PointShape { x: p[0], y: p[1], entries }));
+    }
+    Ok(markers)
+}
+
+impl Modal {
+    /// Validate the description (in this order: sizes, mass data, matrices, vectors,
+    /// definiteness, strain tensors, interface points) and build the invariants.
+    pub fn from_desc(d: &FlexibleDesc, item: &str) -> Result<Modal> {
+        let n = d.k_ff.len();
+        if n == 0 || n > MAX_ELASTIC {
+            return Err(Error::invalid(item, format!("k_ff must be n_f x n_f with n_f in 1..={MAX_ELASTIC} elastic coordinates, got n_f = {n} (a body without elastic coordinates is a rigid body)")));
+        }
+        let mass = positive(item, "mass", d.mass)?;
+        let inertia = positive(item, "inertia", d.inertia)?;
+        let com = finite_vec2(item, "com", d.com)?;
+        let mats = Matrices::read(d, item, n)?;
+        check_vectors(d, item, n)?;
+        let s_t = [mass * com[0], mass * com[1]];
+        let j0 = inertia + mass * (com[0] * com[0] + com[1] * com[1]);
+        mats.check_definite(d, item, n, mass, s_t, j0)?;
+        let (strain, k3, k4) = strain_tensors(d, item, n)?;
+        let hb = mats.bandwidth(n);
+        let m_ff = banded(&mats.m, n, hb);
         let l_ff = BandedCholesky::factor(&m_ff).map_err(|i| Error::SingularMass { item: format!("{item}: m_ff, pivot {i}") })?;
-        // interface points
-        let mut markers: Vec<(String, PointShape)> = Vec::with_capacity(d.markers.len());
-        for md in &d.markers {
-            let what = format!("marker '{}'", md.name);
-            if md.name.is_empty() || markers.iter().any(|(nm, _)| nm == &md.name) {
-                return Err(Error::invalid(item, format!("marker names must be non-empty and unique, got '{}' twice or empty", md.name)));
-            }
-            let p = finite_vec2(item, &format!("{what} point"), md.point)?;
-            if md.displacement.len() != 2 || md.displacement.iter().any(|r| r.len() != n) {
-                return Err(Error::invalid(item, format!("{what}: displacement must be 2 x n_f = 2 x {n}, got {} rows of lengths {:?}", md.displacement.len(), md.displacement.iter().map(|r| r.len()).collect::<Vec<_>>())));
-            }
-            check_finite_item(item, &format!("{what} displacement"), &md.displacement.concat())?;
-            if let Some(r) = &md.rotation {
-                if r.len() != n {
-                    return Err(Error::invalid(item, format!("{what}: rotation must have length n_f = {n}, got {}", r.len())));
-                }
-                check_finite_item(item, &format!("{what} rotation"), r)?;
-            }
-            if let Some((other, _)) = markers.iter().find(|(_, s)| s.x == p[0] && s.y == p[1]) {
-                return Err(Error::invalid(item, format!("{what} and marker '{other}' sit at the same point {p:?}")));
-            }
-            let mut entries = Vec::new();
-            for i in 0..n {
-                let (su, sv) = (md.displacement[0][i], md.displacement[1][i]);
-                let sp = md.rotation.as_ref().map_or(0.0, |r| r[i]);
-                if su != 0.0 || sv != 0.0 || sp != 0.0 {
-                    entries.push((i, su, sv, sp));
-                }
-            }
-            markers.push((md.name.clone(), PointShape { x: p[0], y: p[1], entries }));
-        }
-        Ok(Modal {
+        let markers = interface_points(d, item, n)?;
+        let frame = Ffrf {
             n_f: n,
             mass,
             s_t,
@@ -303,45 +313,28 @@ impl Modal {
             s_bar: [d.s_bar[0].clone(), d.s_bar[1].clone()],
             s_u0: d.s_u0.clone(),
             s_ju0: d.s_ju0.clone(),
-            s_tilde: banded(&st, n, hb),
-            m_ff_tr: banded(&mtr, n, hb),
-            k_ff: banded(&k, n, hb),
-            d_ff: dmp.map(|(dd, _)| banded(&dd, n, hb)),
+            s_tilde: banded(&mats.st, n, hb),
+            m_ff_tr: banded(&mats.mtr, n, hb),
+            k_ff: banded(&mats.k, n, hb),
             m_ff,
             l_ff,
-            strain,
-            k3,
-            k4,
-            markers,
-        })
+        };
+        Ok(Modal { frame, d_ff: mats.dmp.map(|dd| banded(&dd, n, hb)), strain, k3, k4, markers })
     }
 
     /// Initial guess: frame state from the description, elastic coordinates (default zero).
     pub fn initial_state(&self, d: &FlexibleDesc, item: &str) -> Result<InitialState> {
-        let p = finite_vec2(item, "position", d.position)?;
-        let v = finite_vec2(item, "velocity", d.velocity)?;
-        let mut q = vec![p[0], p[1], d.angle];
-        let mut qd = vec![v[0], v[1], d.angular_velocity];
-        for (what, given, out) in [("elastic", &d.elastic, &mut q), ("elastic_rates", &d.elastic_rates, &mut qd)] {
-            match given {
-                Some(v) if v.len() != self.n_f => return Err(Error::invalid(item, format!("{what} must have length {}, got {}", self.n_f, v.len()))),
-                Some(v) => out.extend_from_slice(v),
-                None => out.resize(out.len() + self.n_f, 0.0),
-            }
-        }
-        let mut names: Vec<String> = ["x", "y", "theta"].map(String::from).to_vec();
-        names.extend((0..self.n_f).map(|i| format!("qf{i}")));
-        Ok(InitialState { q, qd, names })
+        self.frame.initial_state(item, d.position, d.velocity, d.angle, d.angular_velocity, &d.elastic, &d.elastic_rates)
     }
 
-    pub fn new_data(&self) -> BeamData {
-        BeamData::new(&self.s_bar, &self.l_ff, 0)
+    pub fn new_data(&self) -> FfrfData {
+        self.frame.new_data()
     }
 
     /// Nonlinear elastic force `-dU_nl/dq_f` added to `ff`: `-k3 q q / 2 - k4 q q q / 6`.
     #[inline]
     fn add_nonlinear_force(&self, qf: &[f64], ff: &mut [f64]) {
-        let n = self.n_f;
+        let n = self.frame.n_f;
         if !self.k3.is_empty() {
             for (i, fi) in ff.iter_mut().enumerate().take(n) {
                 let t = &self.k3[i * n * n..(i + 1) * n * n];
@@ -367,88 +360,50 @@ impl Modal {
         }
     }
 
-    /// Mass blocks and generalized forces (the FFRF beam's equations with this body's
-    /// invariants), `Sigma = s_t + S_bar q_f`, `w = s_u0 + M_ff^tr q_f`:
-    /// * `m_thetatheta = j0 + q_f . (s_u0 + w)`, `m_thetaf = s_ju0 - S_tilde q_f`
-    /// * `Q_v,R = thd^2 A Sigma - 2 thd A J S_bar qd_f`, `Q_v,theta = -2 thd qd_f . w`
-    /// * `Q_f = thd^2 w + 2 thd S_tilde qd_f - K_ff q_f - D_ff qd_f - dU_nl/dq_f`
-    /// * gravity: `Q_R = m g`, `Q_theta = g . A J Sigma`, `Q_f = S_bar^T A^T g`
+    /// Mass blocks and generalized forces: the floating-frame core's (`Ffrf::mass_and_forces`)
+    /// with this body's elastic terms `-D_ff qd_f - dU_nl/dq_f`.
     #[inline]
-    pub fn mass_and_forces(&self, bd: &mut BeamData, q: &[f64], qd: &[f64], gravity: Option<[f64; 2]>, f: &mut [f64]) {
-        let nf = self.n_f;
-        let thd = qd[2];
-        let (s, c) = super::frame_sin_cos(q[2]);
-        let (qf, qfd) = (&q[3..3 + nf], &qd[3..3 + nf]);
-        let sig = [self.s_t[0] + dot(&self.s_bar[0], qf), self.s_t[1] + dot(&self.s_bar[1], qf)];
-        let sigd = [dot(&self.s_bar[0], qfd), dot(&self.s_bar[1], qfd)];
-        let asig = [c * sig[0] - s * sig[1], s * sig[0] + c * sig[1]];
-        let asigd = [c * sigd[0] - s * sigd[1], s * sigd[0] + c * sigd[1]];
-        bd.w.copy_from_slice(&self.s_u0);
-        self.m_ff_tr.mul_add(1.0, qf, &mut bd.w);
-        bd.m_thf.copy_from_slice(&self.s_ju0);
-        self.s_tilde.mul_add(-1.0, qf, &mut bd.m_thf);
-        let mut m_thth = self.j0;
-        let mut qd_w = 0.0;
-        for j in 0..nf {
-            m_thth += qf[j] * (self.s_u0[j] + bd.w[j]);
-            qd_w += qfd[j] * bd.w[j];
-        }
-        bd.m_rr = frame_mass_block(self.mass, sig, m_thth, c, s);
-        bd.cs = [c, s];
-        f[0] = thd * thd * asig[0] + 2.0 * thd * asigd[1];
-        f[1] = thd * thd * asig[1] - 2.0 * thd * asigd[0];
-        f[2] = -2.0 * thd * qd_w;
-        let ff = &mut f[3..3 + nf];
-        for (o, w) in ff.iter_mut().zip(&bd.w) {
-            *o = thd * thd * w;
-        }
-        self.s_tilde.mul_add(2.0 * thd, qfd, ff);
-        self.k_ff.mul_add(-1.0, qf, ff);
-        if let Some(dm) = &self.d_ff {
-            dm.mul_add(-1.0, qfd, ff);
-        }
-        self.add_nonlinear_force(qf, ff);
-        if let Some(g) = gravity {
-            add_frame_gravity(self.mass, &bd.m_rr, g, f);
-            let atg = [c * g[0] + s * g[1], -s * g[0] + c * g[1]];
-            for j in 0..nf {
-                f[3 + j] += self.s_bar[0][j] * atg[0] + self.s_bar[1][j] * atg[1];
+    pub fn mass_and_forces(&self, bd: &mut FfrfData, q: &[f64], qd: &[f64], gravity: Option<[f64; 2]>, f: &mut [f64]) {
+        self.frame.mass_and_forces(bd, q, qd, gravity, f, |qf, qfd, ff| {
+            if let Some(dm) = &self.d_ff {
+                dm.mul_add(-1.0, qfd, ff);
             }
-        }
+            self.add_nonlinear_force(qf, ff);
+        });
     }
 
     #[inline]
-    pub fn factor(&self, bd: &mut BeamData) -> bool {
-        frame_factor(&self.l_ff, bd)
+    pub fn factor(&self, bd: &mut FfrfData) -> bool {
+        self.frame.factor(bd)
     }
 
     #[inline]
-    pub fn finv(&self, bd: &BeamData, v: &mut [f64]) {
-        frame_finv(&self.l_ff, bd, v)
+    pub fn finv(&self, bd: &FfrfData, v: &mut [f64]) {
+        self.frame.finv(bd, v)
     }
 
     #[inline]
-    pub fn finvt(&self, bd: &BeamData, v: &mut [f64]) {
-        frame_finvt(&self.l_ff, bd, v)
+    pub fn finvt(&self, bd: &FfrfData, v: &mut [f64]) {
+        self.frame.finvt(bd, v)
     }
 
-    pub fn mass_times(&self, bd: &BeamData, x: &[f64], out: &mut [f64]) {
-        frame_mass_times(&self.s_bar, &self.m_ff, bd, x, out)
+    pub fn mass_times(&self, bd: &FfrfData, x: &[f64], out: &mut [f64]) {
+        self.frame.mass_times(bd, x, out)
     }
 
-    pub fn dense_block(&self, bd: &BeamData, put: &mut impl FnMut(usize, usize, f64)) {
-        frame_dense_block(&self.s_bar, &self.m_ff, bd, put)
+    pub fn dense_block(&self, bd: &FfrfData, put: &mut impl FnMut(usize, usize, f64)) {
+        self.frame.dense_block(bd, put)
     }
 
-    pub fn kinetic_energy(&self, bd: &BeamData, qd: &[f64]) -> f64 {
-        frame_kinetic_energy(&self.s_bar, &self.m_ff, bd, qd)
+    pub fn kinetic_energy(&self, bd: &FfrfData, qd: &[f64]) -> f64 {
+        self.frame.kinetic_energy(bd, qd)
     }
 
     /// `q_f K q_f / 2 + k3 q q q / 6 + k4 q q q q / 24`.
     pub fn strain_energy(&self, q: &[f64]) -> f64 {
-        let qf = &q[3..3 + self.n_f];
-        let mut u = 0.5 * self.k_ff.bilinear(qf, qf);
-        let n = self.n_f;
+        let n = self.frame.n_f;
+        let qf = &q[3..3 + n];
+        let mut u = self.frame.linear_strain_energy(qf);
         if !self.k3.is_empty() {
             let mut e = 0.0;
             for (ij, t) in self.k3.chunks_exact(n).enumerate() {
@@ -468,10 +423,10 @@ impl Modal {
 
     /// Tangent stiffness `-dQ_el/dq_f`: `K_ff + k3 q + k4 q q / 2` (entries to `put`).
     pub fn elastic_tangent(&self, qf: &[f64], put: &mut impl FnMut(usize, usize, f64)) {
-        let n = self.n_f;
+        let n = self.frame.n_f;
         for i in 0..n {
             for j in 0..n {
-                let mut v = self.k_ff.get(i, j);
+                let mut v = self.frame.k_ff.get(i, j);
                 if !self.k3.is_empty() {
                     v += dot(&self.k3[(i * n + j) * n..(i * n + j + 1) * n], qf);
                 }
@@ -490,20 +445,28 @@ impl Modal {
         }
     }
 
+    /// Stiffness `K_t` (`elastic_tangent`) into `k` and `D_ff` into `c` (body coordinates: the
+    /// elastic block).
+    pub fn tangent(&self, q: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
+        let qf = &q[3..];
+        self.elastic_tangent(qf, &mut |i, j, v| k(3 + i, 3 + j, v));
+        self.damping_tangent(&mut |i, j, v| c(3 + i, 3 + j, v));
+    }
+
+    /// `1/2 v_f^T K_ff v_f`: the material strain energy of the motion `v` (body segments).
+    pub fn material_energy(&self, _q: &[f64], v: &[f64]) -> f64 {
+        self.frame.linear_strain_energy(&v[3..3 + self.frame.n_f])
+    }
+
     /// Damping `-dQ/dqd_f = D_ff`.
     pub fn damping_tangent(&self, put: &mut impl FnMut(usize, usize, f64)) {
-        let Some(dm) = &self.d_ff else { return };
-        let n = self.n_f;
-        for i in 0..n {
-            for j in i.saturating_sub(dm.hb)..(i + dm.hb + 1).min(n) {
-                put(i, j, dm.get(i, j));
-            }
+        if let Some(dm) = &self.d_ff {
+            dm.visit(put);
         }
     }
 
     pub fn mass_moment(&self, q: &[f64]) -> [f64; 2] {
-        let qf = &q[3..3 + self.n_f];
-        frame_mass_moment(self.mass, [self.s_t[0] + dot(&self.s_bar[0], qf), self.s_t[1] + dot(&self.s_bar[1], qf)], q)
+        self.frame.mass_moment(q)
     }
 
     /// A marker on a flexible body is one of its interface points, given by its undeformed
@@ -521,5 +484,14 @@ impl Modal {
             Some((_, s)) => Ok(s.clone()),
             None => Err(Error::invalid(item, format!("no interface point of flexible body '{body}' at ({}, {}): markers on it must sit at one of [{}]", p[0], p[1], known()))),
         }
+    }
+}
+
+impl std::ops::Deref for Modal {
+    type Target = Ffrf;
+
+    /// A flexible body is a floating-frame body with invariants given by its description.
+    fn deref(&self) -> &Ffrf {
+        &self.frame
     }
 }

@@ -62,6 +62,12 @@ impl PointMass {
         put(1, 1, self.mass);
     }
 
+    /// `out += m x`.
+    pub fn mass_times(&self, _bd: &PointMassData, x: &[f64], out: &mut [f64]) {
+        out[0] += self.mass * x[0];
+        out[1] += self.mass * x[1];
+    }
+
     pub fn kinetic_energy(&self, _bd: &PointMassData, qd: &[f64]) -> f64 {
         0.5 * self.mass * (qd[0] * qd[0] + qd[1] * qd[1])
     }

@@ -1,7 +1,8 @@
 //! Rigid body: coordinates `(x, y, theta)` of a reference point and the body angle; the centre
 //! of mass sits at `com` in the body frame. Mass block `[[m I, A J m com], [., J_ref]]`.
 
-use super::{add_frame_gravity, add_frame_point_jacobian, finite_vec2, frame_mass_block, frame_mass_moment, frame_point_state, InitialState, MarkerState};
+use super::frame::{add_frame_gravity, add_frame_point_jacobian, frame_mass_block, frame_mass_moment, frame_point_state, frame_sin_cos};
+use super::{finite_vec2, InitialState, MarkerState};
 use crate::description::{MarkerDesc, RigidDesc};
 use crate::error::{positive, Error, Result};
 use crate::linalg::{cholesky3, solve_lower3, solve_upper3};
@@ -62,7 +63,7 @@ impl Rigid {
     #[inline]
     pub fn mass_and_forces(&self, bd: &mut RigidData, q: &[f64], qd: &[f64], gravity: Option<[f64; 2]>, f: &mut [f64]) {
         let thd = qd[2];
-        let (s, c) = super::frame_sin_cos(q[2]);
+        let (s, c) = frame_sin_cos(q[2]);
         bd.m_rr = frame_mass_block(self.mass, self.sig(), self.j_ref, c, s);
         // A sig = (m_rr[1][2], -m_rr[0][2])
         f[0] = thd * thd * bd.m_rr[1][2];
@@ -94,6 +95,13 @@ impl Rigid {
             for j in 0..3 {
                 put(i, j, bd.m_rr[i][j]);
             }
+        }
+    }
+
+    /// `out += M_b x`.
+    pub fn mass_times(&self, bd: &RigidData, x: &[f64], out: &mut [f64]) {
+        for i in 0..3 {
+            out[i] += bd.m_rr[i][0] * x[0] + bd.m_rr[i][1] * x[1] + bd.m_rr[i][2] * x[2];
         }
     }
 

@@ -23,7 +23,7 @@
 
 mod dopri5;
 mod galpha;
-pub(crate) mod lu;
+pub(crate) use crate::linalg::lu;
 pub mod newton;
 mod radau5;
 mod radau_m;

@@ -35,12 +35,13 @@
 //! wide trees) gives no selected inverse, so its full-rank certificate would be a pivot-ratio
 //! heuristic, not a bound; faer's sparse QR of `B^T` avoids squaring but `1/|R^-1|_F` needs
 //! `R^-1` (O(m^2) and dense). A chain, rope or track has a narrow band after RCM; a lattice of
-//! width `w` has `hb ~ 2 w`, and `uk::prefer_sparse` keeps the dense path where the band is
+//! width `w` has `hb ~ 2 w`, and `data::prefer_sparse` keeps the dense path where the band is
 //! too wide to pay.
 
 use crate::body::BodyData;
 use crate::constraint::jac::SegJac;
-use crate::data::{RankInfo, RankTolerance};
+use super::settings::{RankInfo, RankTolerance};
+use crate::linalg::banded::{count_eigenvalues_below, BandedCholesky};
 use crate::model::Model;
 
 /// One body segment of one row of `A` (and of `B`).
@@ -71,10 +72,9 @@ pub struct SparseUk {
     pairs: Vec<(usize, usize, usize, usize)>,
     /// Longest dot product that makes one entry of `S`.
     max_dot: usize,
-    /// `S`, then `L` (row `p` at `p (hb + 1)`: `[L(p, p-hb), .., L(p, p)]`).
-    band: Vec<f64>,
-    inv_diag: Vec<f64>,
-    /// Selected inverse `Z = S^-1` inside the band (same layout).
+    /// `S` (its lower band), then its factor `L` (`factor_in_place`).
+    chol: BandedCholesky,
+    /// Selected inverse `Z = S^-1` inside the band (the layout of `L`).
     z: Vec<f64>,
     /// Work vectors: m long (band order) and n long.
     x: Vec<f64>,
@@ -146,8 +146,7 @@ impl SparseUk {
             vals: vec![0.0; val],
             pairs,
             max_dot: max_dot.into_iter().max().unwrap_or(0),
-            band: vec![0.0; m * w],
-            inv_diag: vec![0.0; m],
+            chol: BandedCholesky::zeros(m, hb),
             z: vec![0.0; m * w],
             x: vec![0.0; m],
             dx: vec![0.0; m],
@@ -189,23 +188,19 @@ impl SparseUk {
             model.bodies[s.body].finv(&bodies[s.body], &mut self.vals[s.val..s.val + s.len]);
         }
         // S = B B^T in band storage
-        self.band.fill(0.0);
-        for &(idx, a, b, len) in &self.pairs {
-            let d: f64 = self.vals[a..a + len].iter().zip(&self.vals[b..b + len]).map(|(x, y)| x * y).sum();
-            self.band[idx] += d;
-        }
+        gram(&self.pairs, &self.vals, &mut self.chol.data);
         let (mut trace_s, mut max_d) = (0.0f64, 0.0f64);
         for p in 0..m {
-            let d = self.band[p * w + hb];
+            let d = self.chol.data[p * w + hb];
             trace_s += d;
             max_d = max_d.max(d);
         }
         self.trace_s = trace_s;
         self.trace_sinv = f64::INFINITY;
-        if !trace_s.is_finite() || !self.cholesky() {
+        if !trace_s.is_finite() || !self.chol.factor_in_place() {
             return None;
         }
-        let trace_sinv = self.selected_inverse_trace();
+        let trace_sinv = self.chol.selected_inverse_trace(&mut self.z);
         self.trace_sinv = trace_sinv;
         let gamma = |k: usize| {
             let ke = k as f64 * f64::EPSILON;
@@ -237,115 +232,8 @@ impl SparseUk {
     /// pivoting: a diagnostic). From the `B^T` values of the last `factor`; leaves its
     /// factorization intact (scratch: the selected-inverse band and a work vector).
     pub fn count_below(&mut self, tau2: f64) -> usize {
-        let (m, hb) = (self.m, self.hb);
-        let w = hb + 1;
-        let (l, d) = (&mut self.z, &mut self.dx);
-        l.fill(0.0);
-        for &(idx, a, b, len) in &self.pairs {
-            let v: f64 = self.vals[a..a + len].iter().zip(&self.vals[b..b + len]).map(|(x, y)| x * y).sum();
-            l[idx] += v;
-        }
-        let mut below = 0;
-        for i in 0..m {
-            let lo = i.saturating_sub(hb);
-            for j in lo..i {
-                let klo = lo.max(j.saturating_sub(hb));
-                let mut s = l[i * w + (j + hb - i)];
-                for k in klo..j {
-                    s -= l[i * w + (k + hb - i)] * l[j * w + (k + hb - j)] * d[k];
-                }
-                l[i * w + (j + hb - i)] = if d[j] != 0.0 { s / d[j] } else { 0.0 };
-            }
-            let mut s = l[i * w + hb] - tau2;
-            for k in lo..i {
-                let lik = l[i * w + (k + hb - i)];
-                s -= lik * lik * d[k];
-            }
-            d[i] = s;
-            if s < 0.0 {
-                below += 1;
-            }
-        }
-        below
-    }
-
-    /// In-place band Cholesky of `self.band`; false on a non-positive or non-finite pivot.
-    fn cholesky(&mut self) -> bool {
-        let (m, hb) = (self.m, self.hb);
-        let w = hb + 1;
-        let l = &mut self.band;
-        for i in 0..m {
-            let lo = i.saturating_sub(hb);
-            for j in lo..=i {
-                let klo = lo.max(j.saturating_sub(hb));
-                let mut s = l[i * w + (j + hb - i)];
-                for k in klo..j {
-                    s -= l[i * w + (k + hb - i)] * l[j * w + (k + hb - j)];
-                }
-                if i == j {
-                    if !(s > 0.0) || !s.is_finite() {
-                        return false;
-                    }
-                    let d = s.sqrt();
-                    l[i * w + hb] = d;
-                    self.inv_diag[i] = 1.0 / d;
-                } else {
-                    l[i * w + (j + hb - i)] = s * self.inv_diag[j];
-                }
-            }
-        }
-        true
-    }
-
-    /// `trace(S^-1)` by the Takahashi recurrence on `L` (entries of `Z = S^-1` in the band):
-    /// `Z(i, j) = -(1/L_jj) sum_{k > j} L_kj Z(i, k)`, `Z(j, j) = (1/L_jj) (1/L_jj - sum_{k>j} L_kj Z(k, j))`.
-    fn selected_inverse_trace(&mut self) -> f64 {
-        let (m, hb) = (self.m, self.hb);
-        let w = hb + 1;
-        let (l, z) = (&self.band, &mut self.z);
-        // symmetric access inside the band: (i, k), both > j, |i - k| <= hb
-        let zi = |z: &[f64], i: usize, k: usize| if k <= i { z[i * w + (k + hb - i)] } else { z[k * w + (i + hb - k)] };
-        let mut trace = 0.0;
-        for j in (0..m).rev() {
-            let hi = (j + hb).min(m - 1);
-            let inv = self.inv_diag[j];
-            for i in (j + 1..=hi).rev() {
-                let mut s = 0.0;
-                for k in j + 1..=hi {
-                    s += l[k * w + (j + hb - k)] * zi(z, i, k);
-                }
-                z[i * w + (j + hb - i)] = -s * inv;
-            }
-            let mut s = 0.0;
-            for k in j + 1..=hi {
-                s += l[k * w + (j + hb - k)] * z[k * w + (j + hb - k)];
-            }
-            let d = (inv - s) * inv;
-            z[j * w + hb] = d;
-            trace += d;
-        }
-        trace
-    }
-
-    /// `x <- S^-1 x` with the band factor (band order).
-    fn solve(l: &[f64], inv_diag: &[f64], hb: usize, x: &mut [f64]) {
-        let m = x.len();
-        let w = hb + 1;
-        for i in 0..m {
-            let lo = i.saturating_sub(hb);
-            let row = &l[i * w + (lo + hb - i)..i * w + hb];
-            let s: f64 = row.iter().zip(&x[lo..i]).map(|(a, b)| a * b).sum();
-            x[i] = (x[i] - s) * inv_diag[i];
-        }
-        for i in (0..m).rev() {
-            let xi = x[i] * inv_diag[i];
-            x[i] = xi;
-            let lo = i.saturating_sub(hb);
-            let row = &l[i * w + (lo + hb - i)..i * w + hb];
-            for (a, b) in x[lo..i].iter_mut().zip(row) {
-                *a -= b * xi;
-            }
-        }
+        gram(&self.pairs, &self.vals, &mut self.z);
+        count_eigenvalues_below(&mut self.z, &mut self.dx, self.m, self.hb, tau2)
     }
 
     /// `(B v)_i` for the row `i` (segments of `B^T`).
@@ -363,13 +251,13 @@ impl SparseUk {
     /// `x = S^-1 r` plus one refinement step with `B` (`x += S^-1 (r - B B^T x)`),
     /// `y += B^T x`, `lambda = -x`.
     pub fn correct(&mut self, gamma: &[f64], residual: &mut [f64], y: &mut [f64], lambda: &mut [f64]) {
-        let (m, hb) = (self.m, self.hb);
+        let m = self.m;
         // A a = B F^T a = B y with y = F^-1 Q (a = F^-T y): no pass over the rows of A
         for i in 0..m {
             residual[i] = gamma[i] - self.b_row_dot(i, y);
             self.x[self.perm[i]] = residual[i];
         }
-        Self::solve(&self.band, &self.inv_diag, hb, &mut self.x);
+        self.chol.solve(&mut self.x);
         // refinement: r - B (B^T x)
         self.wn.fill(0.0);
         for i in 0..m {
@@ -383,7 +271,7 @@ impl SparseUk {
         for i in 0..m {
             self.dx[self.perm[i]] = residual[i] - self.b_row_dot(i, &self.wn);
         }
-        Self::solve(&self.band, &self.inv_diag, hb, &mut self.dx);
+        self.chol.solve(&mut self.dx);
         for (x, d) in self.x.iter_mut().zip(&self.dx) {
             *x += d;
         }
@@ -396,6 +284,16 @@ impl SparseUk {
                 }
             }
         }
+    }
+}
+
+/// `S = B B^T` (its lower band, the layout of `L`) into `out` from the `B^T` values `vals`:
+/// `S[band] = sum of vals_a . vals_b` over the segment pairs of each band entry.
+fn gram(pairs: &[(usize, usize, usize, usize)], vals: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for &(idx, a, b, len) in pairs {
+        let d: f64 = vals[a..a + len].iter().zip(&vals[b..b + len]).map(|(x, y)| x * y).sum();
+        out[idx] += d;
     }
 }
 
@@ -416,5 +314,5 @@ fn rcm(m: usize, rows_of_body: &[Vec<(usize, usize)>]) -> Vec<usize> {
         a.sort_unstable();
         a.dedup();
     }
-    crate::sparse_newton::rcm(&adj)
+    crate::linalg::rcm::rcm(&adj)
 }

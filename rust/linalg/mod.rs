@@ -1,0 +1,26 @@
+//! Numerics, in one home. Nothing here knows the model: slices, banded and dense matrices.
+//!
+//! * `dense`: the dot product of the kernels, the 3x3 Cholesky of the floating-frame blocks,
+//!   the dense Cholesky and triangular solves, the pseudoinverse solve of the state correction;
+//! * `banded`: band storage, the banded Cholesky (constant FFRF and ANCF mass factors, the
+//!   Gram matrix of the sparse UK path) with its selected inverse and an inertia count;
+//! * `band_lu`: the band LU with partial pivoting of the implicit methods' sparse Newton
+//!   matrices, real and complex; `lu`: their dense LU;
+//! * `small_svd`: the QR + one-sided Jacobi SVD of the UK pseudoinverse;
+//! * `rcm`: the reverse Cuthill-McKee order that makes the sparse matrices banded;
+//! * `quadrature`: the Gauss rule of the element integrals.
+//!
+//! Everything is allocation free after construction except `dense::pinv_solve` (faer's SVD,
+//! not on a per-step path).
+
+pub mod band_lu;
+pub mod banded;
+pub mod dense;
+pub mod lu;
+pub mod quadrature;
+pub mod rcm;
+pub mod small_svd;
+
+pub use banded::{Banded, BandedCholesky};
+pub use dense::{cholesky3, dot4, solve_lower3, solve_upper3};
+pub use quadrature::GAUSS4;

@@ -1,0 +1,108 @@
+//! The settings of the UK solve and what a factorization reports: which path (`UkSolver`),
+//! which dense backend (`SvdBackend`), the rank tolerance of the pseudoinverse, the constraint
+//! stabilization, the rank found (`RankInfo`) and which factorization is held (`Factored`).
+//! Plain types: the workspace (`data::Data`) holds them, the kernels (`uk`) read them.
+
+use crate::error::{Error, Result};
+
+/// Which UK correction path a `Data` uses (a build option of the System).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum UkSolver {
+    /// Sparse when `data::prefer_sparse` says it pays (measured crossover, docs/scale.md), dense
+    /// otherwise.
+    #[default]
+    Auto,
+    /// The dense pseudoinverse of `B^T` (`svd_backend`) every call.
+    Dense,
+    /// The band Cholesky of `A M^-1 A^T` with its full-rank certificate (`uk::sparse`); the
+    /// dense rank-revealing path when the certificate fails.
+    Sparse,
+}
+
+impl UkSolver {
+    pub fn parse(s: &str) -> Result<UkSolver> {
+        match s {
+            "auto" => Ok(UkSolver::Auto),
+            "dense" => Ok(UkSolver::Dense),
+            "sparse" => Ok(UkSolver::Sparse),
+            other => Err(Error::argument("uk_solver", format!("unknown UK solver '{other}' (use 'auto', 'dense' or 'sparse')"))),
+        }
+    }
+}
+
+/// How the UK pseudoinverse `(A F^-T)^+` is computed. Every choice is allocation free per
+/// call and gives the `scipy.linalg.pinv` semantics (singular values at or below
+/// `max(atol, rcond sigma_max)` dropped); see `docs/performance.md` for the measurements.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SvdBackend {
+    /// Householder QR `B^T = Q R`; when `1/|R^-1|_F > max(atol, rcond |R|_F)` (a certificate
+    /// that no singular value can fall below the tolerance) the pseudoinverse is the full-rank
+    /// `B^+ = Q R^-T` (triangular solves); otherwise the Jacobi SVD of R as in `QrJacobi`.
+    /// `rank_info` then holds the exact rank with bounds for the singular values
+    /// (`RankInfo::exact == false`); `uk::exact_rank_info` computes the exact values on demand.
+    #[default]
+    Auto,
+    /// Householder QR of `B^T` then one-sided Jacobi SVD of the m x m factor (`small_svd`),
+    /// every call. Used when `m <= n`; otherwise the faer path runs.
+    QrJacobi,
+    /// faer's bidiagonal SVD through its scratch (`MemBuffer`) API, every call.
+    Faer,
+}
+
+/// Which factorization of `B^T` is currently held in `Data` (set by `uk::factor_constraints`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Factored {
+    #[default]
+    None,
+    /// Certified full rank: QR with `R^-1` in `qrj`.
+    FullRankQr,
+    /// Jacobi SVD in `qrj` (sorted values and V also in `svd_s`, `svd_v`).
+    Jacobi,
+    /// faer SVD in `svd_u`, `svd_s`, `svd_v`.
+    Faer,
+    /// Certified full-rank band Cholesky of `A M^-1 A^T` in `sparse` (`uk::sparse`).
+    SparseGram,
+}
+
+/// Rank decision of the pseudoinverse: singular values below
+/// `max(atol, rcond * sigma_max)` are dropped; `rcond = None` means `max(m, n) * eps`
+/// (the default of `scipy.linalg.pinv`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RankTolerance {
+    pub rcond: Option<f64>,
+    pub atol: f64,
+}
+
+impl Default for RankTolerance {
+    fn default() -> Self {
+        RankTolerance { rcond: None, atol: 0.0 }
+    }
+}
+
+/// Constraint stabilization applied inside the acceleration kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Stabilization {
+    /// Plain UK (the paper): position and velocity drift are left alone.
+    #[default]
+    None,
+    /// Baumgarte (1972): enforce `Phi_dd + 2 alpha Phi_d + beta^2 Phi = 0`, i.e.
+    /// `b <- gamma - 2 alpha (A qd + Phi_t) - beta^2 Phi`. `alpha = beta` gives critical damping
+    /// of the drift; values of order 1/(time scale of interest) are usual.
+    Baumgarte { alpha: f64, beta: f64 },
+}
+
+/// What the last pseudoinverse found.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RankInfo {
+    pub rank: usize,
+    pub sigma_max: f64,
+    /// Smallest singular value kept (0 if none kept).
+    pub sigma_min_kept: f64,
+    /// Largest singular value dropped (0 if none dropped).
+    pub sigma_max_dropped: f64,
+    pub tolerance: f64,
+    /// `false` when the certified full-rank path ran: `rank` is exact, `sigma_max` is the upper
+    /// bound `|R|_F`, `sigma_min_kept` the lower bound `1/|R^-1|_F`, `tolerance` the bound
+    /// `max(atol, rcond |R|_F)`; `uk::exact_rank_info` gives the exact values.
+    pub exact: bool,
+}
