@@ -34,7 +34,7 @@ import numpy as np
 
 import ukflex
 from ukflex import Scene
-from ukflex.scene import Circular
+from ukflex.model.scene import Circular
 
 L, D, RHO, E = 1.0, 0.002, 7850.0, 2.1e11
 H = 1e-4

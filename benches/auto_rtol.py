@@ -31,8 +31,8 @@ import numpy as np
 
 import ukflex
 from ukflex import Scene, scenes
-from ukflex.choice import FLOOR_POINTS
-from ukflex.outputs import beam_names
+from ukflex.run.choice import FLOOR_POINTS
+from ukflex.results.outputs import beam_names
 
 
 def spun_cable() -> Scene:

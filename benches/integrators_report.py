@@ -24,8 +24,8 @@ import numpy as np
 
 import ukflex
 from ukflex import scenes, simulate
-from ukflex.choice import choose_method
-from ukflex.simulate import time_acceleration
+from ukflex.run.choice import choose_method
+from ukflex.run.simulate import time_acceleration
 
 REPEAT = 5
 
@@ -169,7 +169,7 @@ def former_default(system, t_end):
     """The step and options the former chooser gave GENALPHA (rtol 1e-6): a phase budget of
     0.1 rad over the run for omega_c, period error (omega h)^2 / 12; Newton at the local error
     level where h omega_max >= 8."""
-    from ukflex.choice import LOCAL_NEWTON_MIN_STEP_OMEGA, NEWTON_LOCAL_ERROR
+    from ukflex.run.choice import LOCAL_NEWTON_MIN_STEP_OMEGA, NEWTON_LOCAL_ERROR
     c = choose_method(system, 0.0, t_end, 1e-6)
     eps = min(1e-2, 0.1 / (c.omega_elastic * t_end))
     h = min(math.sqrt(12.0 * eps) / c.omega_elastic, t_end / 20)

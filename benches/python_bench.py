@@ -27,7 +27,7 @@ import numpy as np
 import ukflex
 from ukflex.reference import ReferenceModel, uk_qdd
 from ukflex.reference.cp import choose_partition, reduced_accelerations
-from ukflex.simulate import time_acceleration
+from ukflex.run.simulate import time_acceleration
 
 
 def per_call(fn, states, repeats=15, min_time=0.05):

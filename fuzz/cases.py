@@ -267,7 +267,7 @@ def _toml_case(draw):
 
 def _check_toml(case: Dict[str, Any]) -> List[Finding]:
     uk = _ukflex()
-    from ukflex import scenefile
+    from ukflex.model import scenefile
 
     with _quiet():
         try:

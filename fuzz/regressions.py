@@ -14,7 +14,7 @@ _PER_CALL = ("qdd", "rhs", "M", "Q", "phi", "A", "b", "multipliers", "residuals"
 
 
 def _wrap_system_methods(wrap: Callable[[Callable], Callable]) -> None:
-    from ukflex import system as system_module
+    from ukflex.model import system as system_module
 
     init = system_module.System.__init__
 
@@ -75,14 +75,14 @@ def _nan_results() -> None:
 
 def _unresolved_positions() -> None:
     """No resolution check of the corrected state: a mechanism 1e17 m from the origin builds."""
-    from ukflex import system as system_module
+    from ukflex.model import system as system_module
 
     system_module.System._check_resolution = lambda self, q: None
 
 
 def _shared_settings() -> None:
     """stability.run configuring the caller's System (settings shared across threads)."""
-    from ukflex import system as system_module
+    from ukflex.model import system as system_module
 
     system_module.System.copy = lambda self: self
 
@@ -140,7 +140,7 @@ def _dense_unchecked() -> None:
         return out
 
     _core.dense_eval = dense_eval
-    sim_module = __import__("sys").modules["ukflex.simulate"]
+    sim_module = __import__("sys").modules["ukflex.run.simulate"]
     sim_module._core.dense_eval = dense_eval
     init = sim_module.DenseSolution.__init__
 
@@ -159,7 +159,7 @@ _NON_FINITE_CALLS = ("project", "phi_t", "tangent_stiffness", "axial_forces", "b
 def _percall_nonfinite() -> None:
     """The per-call methods that returned inf and NaN before: NonFiniteError turned back into NaN."""
     import ukflex
-    from ukflex import system as system_module
+    from ukflex.model import system as system_module
 
     bind = system_module.System._bind
 
@@ -190,7 +190,7 @@ def _pickle_unchecked() -> None:
     """System pickle states restored without checks (KeyError, AttributeError, wrong shapes accepted)."""
     import json
 
-    from ukflex import system as system_module
+    from ukflex.model import system as system_module
 
     def setstate(self, state):
         self.description = state["description"]
@@ -208,7 +208,7 @@ def _pickle_unchecked() -> None:
 
 def _deep_lists() -> None:
     """Descriptions converted by recursion without a depth limit (RecursionError on deep lists)."""
-    from ukflex import description
+    from ukflex.model import description
 
     plain = description.plain
 
@@ -246,7 +246,7 @@ def _sweep_eager() -> None:
 
     import ukflex  # noqa: F401 - loads ukflex.sweep (the package's `sweep` is the function)
 
-    sweep_module = sys.modules["ukflex.sweep"]
+    sweep_module = sys.modules["ukflex.run.sweep"]
 
     def init(self, grid, max_cases=None):
         if isinstance(grid, dict):
@@ -277,7 +277,7 @@ def _count_overflow() -> None:
             raise arguments.InvalidArgumentError(name, f"must be a positive integer, got {value!r}")
         return int(value)
 
-    sys.modules["ukflex.simulate"]._count = count
+    sys.modules["ukflex.run.simulate"]._count = count
 
 
 def _unchecked_builtins() -> None:
@@ -290,7 +290,7 @@ def _unchecked_builtins() -> None:
 
 def _late_plot_check() -> None:
     """Output expressions that name a joint or driver accepted before the run (they fail after it)."""
-    from ukflex import sensors
+    from ukflex.results import sensors
 
     parse = sensors.Sensors.parse.__func__
 

@@ -648,7 +648,7 @@ def _dense_case(draw):
 
 def _check_dense(case: Dict[str, Any]) -> List[Finding]:
     uk = _ukflex()
-    from ukflex.simulate import DenseSolution
+    from ukflex.run.simulate import DenseSolution
 
     meta, data, parts = _dense_record(case["method"])
     meta, data, parts = meta.copy(), data.copy(), list(parts)

@@ -28,7 +28,7 @@ print("ukflex", ukflex.__version__, "from", os.path.dirname(ukflex.__file__), "|
 try:
     import matplotlib  # noqa: F401
 except ImportError:
-    from ukflex.animate import animate
+    from ukflex.results.animate import animate
     try:
         animate(res, "x.gif")
     except ukflex.MissingDependencyError as exc:

@@ -22,7 +22,7 @@ def core_available() -> bool:
 
 @pytest.fixture(scope="session")
 def paper_data():
-    from ukflex.scenes import PAPER
+    from ukflex.model.scenes import PAPER
 
     return dict(PAPER)
 
@@ -39,7 +39,7 @@ def no_success_on_garbage(monkeypatch):
     except ImportError:  # the extension is not built: nothing to check
         yield
         return
-    sim = sys.modules["ukflex.simulate"]  # the module (ukflex.simulate is the function)
+    sim = sys.modules["ukflex.run.simulate"]  # the module (ukflex.simulate is the function)
     seen = []
     original = sim._report
 

@@ -20,7 +20,7 @@ import pytest
 
 import ukflex
 from ukflex import Circular, InvalidSceneError, Scene, scenes
-from ukflex import outputs
+from ukflex.results import outputs
 from ukflex.reference import ReferenceModel
 from ukflex.reference import ancf as ref
 
@@ -342,7 +342,7 @@ def test_ffrf_descriptions_are_unchanged_and_ancf_is_recorded():
 
 
 def test_animate_draws_an_ancf_beam_through_its_axis_points(tmp_path):
-    from ukflex.animate import MechanismDrawer, snapshots
+    from ukflex.results.animate import MechanismDrawer, snapshots
 
     system = scenes.slider_crank(formulation="ancf", elements=2).build()
     res = ukflex.simulate(system, 2e-3, method="DOPRI5", rtol=1e-8, t_eval=np.linspace(0, 2e-3, 5))

@@ -8,8 +8,8 @@ import pytest
 
 import ukflex
 from ukflex import scenes, simulate
-from ukflex import choice
-from ukflex.choice import choose_method, elastic_shares
+from ukflex.run import choice
+from ukflex.run.choice import choose_method, elastic_shares
 
 
 def test_rigid_scenes_go_explicit():
@@ -163,7 +163,7 @@ def test_auto_states_its_floor_within_3x_of_the_error_it_reaches():
     DOPRI5 at rtol 1e-11, which keeps every mode; benches/auto_rtol.py): paper scene, nonlinear
     FFRF N = 4: 8.0e-6 m stated, 7.6e-6 m measured; the undamped cantilever 6.1e-5 / 5.8e-5;
     both flat in rtol below 1e-5 on the paper scene (the axial mode, 26.7 krad/s)."""
-    from ukflex.choice import FLOOR_POINTS
+    from ukflex.run.choice import FLOOR_POINTS
 
     for make, T in ((lambda: scenes.slider_crank(strain="nonlinear", elements=4), 0.1), (scenes.cantilever, 0.8)):
         te = np.linspace(0.0, T, 401)

@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 import ukflex
-from ukflex import cli, outputs, scenes
-from ukflex.animate import MechanismDrawer
+from ukflex import cli, scenes
+from ukflex.results import outputs
+from ukflex.results.animate import MechanismDrawer
 
 ENV = dict(os.environ, MPLBACKEND="Agg")
 EXAMPLES = os.path.join(os.path.dirname(__file__), os.pardir, "examples")
@@ -176,7 +177,7 @@ def test_export_then_run(tmp_path):
     p = tmp_path / "sc.toml"
     r = ukflex_cli("export", "slider_crank", "--param", "elements=2", "-o", p, "--t-end", "0.002")
     assert r.returncode == 0, r.stderr
-    from ukflex import scenefile
+    from ukflex.model import scenefile
 
     assert scenefile.load(p).scene.to_dict() == scenes.slider_crank(elements=2).to_dict()
     r = ukflex_cli("run", p, "--out", tmp_path, "--no-plot")

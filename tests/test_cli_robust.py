@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from ukflex.cli import main
-from ukflex.scenes import SCENES, scene_parameters
+from ukflex.model.scenes import SCENES, scene_parameters
 
 ROOT = Path(__file__).resolve().parents[1]
 PENDULUM = (ROOT / "examples" / "pendulum.toml").read_text()
@@ -125,7 +125,7 @@ def test_hostile_scene_files(cwd, capsys, text, match):
 
 
 def test_toml_error_path_is_linear_in_file_size():
-    from ukflex import scenefile
+    from ukflex.model import scenefile
 
     body = '[[bodies]]\nname = "b{i}"\nkind = "rigid"\nmass = 1.0\ninertia = 1.0\n\n'
     bad = '[[joints]]\nkind = "revolute"\na = { body = "nope", point = [0, 0] }\nb = { body = "b0", point = [0, 0] }\n'

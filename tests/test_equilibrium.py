@@ -8,7 +8,7 @@ import pytest
 
 import ukflex
 from ukflex import NonFiniteError, SolverError, scenes
-from ukflex.scenes import PAPER
+from ukflex.model.scenes import PAPER
 
 
 def test_cantilever_under_tip_load_and_weight():

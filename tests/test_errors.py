@@ -9,7 +9,7 @@ import pytest
 
 import ukflex
 from ukflex import Scene, scenes, simulate
-from ukflex.scene import Marker
+from ukflex.model.scene import Marker
 
 
 @pytest.fixture(scope="module")

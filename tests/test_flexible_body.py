@@ -161,7 +161,7 @@ def _plate_mesh(nx=12, ny=3, length=0.3, height=0.02):
 
 @pytest.mark.parametrize("frame", ["mean-axis", "fixed", "craig-bampton"])
 def test_mesh_invariants_match_an_independent_quadrature(frame):
-    fe = pytest.importorskip("ukflex.fe")
+    fe = pytest.importorskip("ukflex.model.fe")
     pytest.importorskip("skfem")
     pts, tris = _plate_mesh()
     left = [i for i, p in enumerate(pts) if p[0] == 0.0]
@@ -195,7 +195,7 @@ def test_mesh_invariants_match_an_independent_quadrature(frame):
 
 
 def test_flexible_body_round_trips_through_a_toml_scene_file():
-    from ukflex import scenefile
+    from ukflex.model import scenefile
     from ukflex.reference import testset_crank as ts
     from ukflex.studies import simeon_crank as sc
 
@@ -209,8 +209,9 @@ def test_flexible_body_round_trips_through_a_toml_scene_file():
 def test_holed_link_example_loads_runs_and_draws(tmp_path):
     import os
 
-    from ukflex import scenefile, simulate
-    from ukflex.animate import MechanismDrawer
+    from ukflex.model import scenefile
+    from ukflex import simulate
+    from ukflex.results.animate import MechanismDrawer
 
     path = os.path.join(os.path.dirname(__file__), os.pardir, "examples", "slider_crank_holed_link.toml")
     system = scenefile.load(path).build()
@@ -305,7 +306,7 @@ def test_quadratic_mesh_of_the_coupler_converges_to_the_timoshenko_beam():
 def test_quadratic_mesh_invariants_of_a_rectangle():
     """P2 triangles: mass, centre of mass and inertia of the rectangle exactly; the chord-frame
     reference conditions hold; interfaces by a node predicate take the mid-edge nodes too."""
-    fe = pytest.importorskip("ukflex.fe")
+    fe = pytest.importorskip("ukflex.model.fe")
     pytest.importorskip("skfem")
     pts, tris = _plate_mesh(nx=6, ny=2)
     length, height, t, rho = 0.3, 0.02, 0.01, 7800.0
@@ -331,7 +332,7 @@ def test_quadratic_mesh_invariants_of_a_rectangle():
 
 # -------------------------------------------------------------------------------- bad FE input
 def _nodal_plate():
-    fe = pytest.importorskip("ukflex.fe")
+    fe = pytest.importorskip("ukflex.model.fe")
     pytest.importorskip("skfem")
     pts, tris = _plate_mesh(nx=4, ny=1)
     mm, kk, nodes = fe.plane_stress_mesh_matrices(pts, tris, thickness=0.01, density=7800.0, youngs_modulus=2e11,
@@ -386,7 +387,7 @@ def test_bad_fe_input_raises_named_errors(case, match):
 def test_green_lagrange_tensors_of_a_mesh_match_direct_quadrature():
     """k3/k4 of a P2 mesh on a (random) basis are the cubic and quartic parts of the plane-stress
     Green-Lagrange energy integrated directly; the modal-derivative loads are k3's contraction."""
-    fe = pytest.importorskip("ukflex.fe")
+    fe = pytest.importorskip("ukflex.model.fe")
     pytest.importorskip("skfem")
     pts, tris = _plate_mesh(nx=4, ny=1)
     basis, perm, nodes = fe._mesh_basis(pts, tris, 2)
@@ -432,7 +433,7 @@ def test_mesh_coupler_with_modal_derivatives_does_not_lock():
     v, lin = _static_midpoint_deflection(md, 85.0)
     assert abs(v - lin) <= 5e-3 * abs(lin)
     with pytest.raises(ukflex.InvalidArgumentError, match="reference conditions"):
-        fe = pytest.importorskip("ukflex.fe")
+        fe = pytest.importorskip("ukflex.model.fe")
         pts, tris = _plate_mesh(nx=4, ny=1)
         fe.from_mesh(pts, cells=tris, thickness=0.01, density=7800.0, youngs_modulus=2e11, poisson_ratio=0.3,
                      interfaces={"A": [0]}, modes=2, strain="nonlinear", modal_derivatives=True)

@@ -8,7 +8,7 @@ import pytest
 from scipy.linalg import eigh
 
 from ukflex import NonFiniteError, scenes
-from ukflex.scenes import PAPER
+from ukflex.model.scenes import PAPER
 
 LB = PAPER["coupler_length"]
 D = PAPER["diameter"]

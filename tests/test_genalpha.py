@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 import ukflex
-from ukflex import choice, scenes
+from ukflex.run import choice
+from ukflex import scenes
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from _exudyn_ref import exudyn_reference  # noqa: E402

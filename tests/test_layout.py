@@ -21,7 +21,7 @@ PKG = Path(__file__).resolve().parents[1] / "python" / "ukflex"
 ENV = dict(os.environ, MPLBACKEND="Agg")
 
 #: Deprecated forwarders (removed with the old names): their imports are not dependencies.
-DEPRECATED_FORWARDERS = {("ukflex.stability", "__getattr__"), ("ukflex.stability", "main")}
+DEPRECATED_FORWARDERS = {("ukflex.analysis.stability", "__getattr__"), ("ukflex.analysis.stability", "main")}
 #: scene.py <-> system.py (Scene.build imports System lazily): owned by the core rewrite.
 KNOWN_CYCLES: list = []
 
@@ -188,7 +188,7 @@ def test_stability_report_alias_and_module_entry_point():
 
     with pytest.warns(DeprecationWarning, match="ukflex.studies.stability.report"):
         assert stability.report is report
-    r = subprocess.run([sys.executable, "-m", "ukflex.stability", "--help"], capture_output=True, text=True, env=ENV)
+    r = subprocess.run([sys.executable, "-m", "ukflex.analysis.stability", "--help"], capture_output=True, text=True, env=ENV)
     assert r.returncode == 0 and "usage: ukflex stability" in r.stdout
     assert "DeprecationWarning" in r.stderr and "ukflex stability" in r.stderr
 

@@ -5,7 +5,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import ukflex
-from ukflex.results import SimulationResult
+from ukflex.results.simulation import SimulationResult
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import pytest
 
 import ukflex
 from ukflex import InvalidSceneError, NonFiniteError, scenes
-from ukflex.stability import DriftWarning
+from ukflex.analysis.stability import DriftWarning
 
 
 @pytest.mark.parametrize("kwargs, match", [

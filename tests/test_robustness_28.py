@@ -18,7 +18,7 @@ import pytest
 
 import ukflex
 from ukflex import ExpressionError, InvalidArgumentError, InvalidSceneError, NonFiniteError, UnknownNameError, scenes
-from ukflex.simulate import DenseSolution
+from ukflex.run.simulate import DenseSolution
 
 PY = sys.executable
 
@@ -353,7 +353,7 @@ def test_cli_param_nan_plot_names_out_paths_and_home(tmp_path):
 # ------------------------------------------------------------------ 9. sweeps
 def test_huge_sweep_grids_are_refused_at_once_and_cases_are_lazy():
     pytest.importorskip("pandas")
-    from ukflex.sweep import Cases
+    from ukflex.run.sweep import Cases
 
     grid = {"a": list(range(1000)), "b": list(range(1000)), "c": list(range(1000))}
     tic = time.perf_counter()

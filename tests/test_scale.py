@@ -131,7 +131,7 @@ def test_rank_info_after_a_large_sparse_solve_reports_the_certificate():
 def test_lattice_example_is_the_builtin_scene():
     from pathlib import Path
 
-    from ukflex import scenefile
+    from ukflex.model import scenefile
 
     sf = scenefile.load(Path(__file__).resolve().parents[1] / "examples" / "lattice.toml")
     assert sf.scene.to_dict() == scenes.lattice(columns=6, rows=4).to_dict()

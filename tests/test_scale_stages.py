@@ -10,8 +10,8 @@ import pytest
 
 import ukflex
 from ukflex import Scene, scenes
-from ukflex.choice import choose_method
-from ukflex.scene import Circular
+from ukflex.run.choice import choose_method
+from ukflex.model.scene import Circular
 
 
 def wire(elements, angle=0.0):

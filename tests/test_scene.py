@@ -12,7 +12,7 @@ import pytest
 import ukflex
 from ukflex import Circular, ConstantSpeed, CustomSection, Harmonic, Polynomial, Rectangular, Scene
 from ukflex import scenes
-from ukflex.scene import Marker, elastic_dofs
+from ukflex.model.scene import Marker, elastic_dofs
 
 
 def _beam_kwargs(**over):

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 import ukflex
-from ukflex import scenefile, scenes
-from ukflex.scenefile import SceneFileError
+from ukflex.model import scenefile
+from ukflex import scenes
+from ukflex.model.scenefile import SceneFileError
 
 EXAMPLES = os.path.join(os.path.dirname(__file__), os.pardir, "examples")
 
@@ -138,7 +139,7 @@ def test_dumps_values():
 
 
 def test_native_integrator_names_are_accepted():
-    from ukflex.simulate import NATIVE_METHODS
+    from ukflex.run.simulate import NATIVE_METHODS
 
     for m in NATIVE_METHODS:
         assert scenefile.loads(TINY.replace('method = "DOP853"', f'method = "{m}"')).solver["method"] == m

@@ -11,7 +11,7 @@ import pytest
 import ukflex
 from ukflex import ExpressionError, InvalidSceneError, Scene, scenes
 from ukflex import _core
-from ukflex.outputs import evaluate, validate
+from ukflex.results.outputs import evaluate, validate
 from ukflex.reference import ReferenceModel
 from ukflex.reference.uk import augmented_qdd, correct_initial_state
 
@@ -327,7 +327,7 @@ def test_spring_damper_keywords_and_the_deprecated_positional_form():
 
 
 def test_toml_drivers_from_an_expression_and_a_table():
-    from ukflex.scenefile import loads
+    from ukflex.model.scenefile import loads
 
     text = """
 gravity = [0.0, -9.81]

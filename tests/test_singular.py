@@ -27,7 +27,7 @@ from scipy.integrate import solve_ivp
 
 import ukflex
 from ukflex import Scene, SingularConfigurationWarning, scenes, simulate
-from ukflex.simulate import branch_keeping
+from ukflex.run.simulate import branch_keeping
 
 T_A02 = 20.0
 OUT = np.linspace(0.0, T_A02, 401)  # the benchmark's 400 output steps

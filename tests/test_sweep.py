@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import ukflex
-from ukflex.sweep import cases_of
+from ukflex.run.sweep import cases_of
 
 pd = pytest.importorskip("pandas")
 

@@ -46,7 +46,7 @@ import exudyn_slider_crank as es  # noqa: E402
 
 import ukflex  # noqa: E402
 from ukflex import scenes, simulate  # noqa: E402
-from ukflex.choice import NEWTON_LOCAL_ERROR  # noqa: E402
+from ukflex.run.choice import NEWTON_LOCAL_ERROR  # noqa: E402
 
 DATA = os.path.normpath(os.path.join(HERE, "..", "data"))
 T_END, PEAK_END = 0.1, 0.07

@@ -30,7 +30,7 @@ from .errors import (
     UnknownNameError,
     UnknownOptionError,
 )
-from .scene import (
+from .model.scene import (
     BeamRef,
     Circular,
     ConstantSpeed,
@@ -47,12 +47,27 @@ from .scene import (
     Scene,
     Spline,
 )
-from .flexible import FlexibleData, InterfacePoint
-from .system import InitialCorrection, System
-from .results import SimulationResult
-from .simulate import simulate
-from .sweep import sweep
-from . import scenes
+from .model.flexible import FlexibleData, InterfacePoint
+from .model.system import InitialCorrection, System
+from .results.simulation import SimulationResult
+from .run.simulate import simulate
+from .run.sweep import sweep
+from .model import scenes
+
+#: Public modules of the rooms, loaded on first use: ``ukflex.fe`` (flexible bodies from FE
+#: data, :mod:`ukflex.model.fe`) and ``ukflex.stability`` (diagnostics of runs,
+#: :mod:`ukflex.analysis.stability`).
+_LAZY = {"fe": "ukflex.model.fe", "stability": "ukflex.analysis.stability"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        module = importlib.import_module(_LAZY[name])
+        globals()[name] = module
+        return module
+    raise AttributeError(f"module 'ukflex' has no attribute {name!r}")
 
 def _version() -> str:
     """The installed distribution's version (single source: Cargo.toml, through maturin)."""

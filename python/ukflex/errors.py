@@ -78,6 +78,20 @@ class MissingDependencyError(UkflexError, ImportError):  # type: ignore[misc, va
     the message names the feature and the ``pip install 'ukflex[extra]'`` that provides it."""
 
 
+def require(module: str, what: str, extra: str = "plot") -> Any:
+    """Import ``module`` or raise :class:`MissingDependencyError` saying that ``what`` needs it
+    (the one place that names a missing optional dependency)."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        pkg = {"PIL": "pillow", "skfem": "scikit-fem"}.get(module.split(".")[0], module.split(".")[0])
+        raise MissingDependencyError(
+            f"{what} needs {pkg!r}, which is not installed: pip install 'ukflex[{extra}]' (or {pkg} alone)"
+        ) from None
+
+
 class InvalidArgumentError(UkflexError, ValueError, TypeError):  # type: ignore[misc, valid-type]
     """A function argument of the Python API is invalid (wrong type, out of range, masked or
     complex array, ...).  A ``ValueError`` and a ``TypeError`` too, so code written against

@@ -35,7 +35,7 @@ from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from .. import Circular, ConstantSpeed, Scene
 from ..errors import UnknownNameError
-from ..scenes import PAPER, double_pendulum, gravity_vector, slider_crank
+from ..model.scenes import PAPER, double_pendulum, gravity_vector, slider_crank
 
 __all__ = [
     "stiff",

@@ -29,10 +29,10 @@ from typing import Any, Dict, List, Optional
 import numpy as np
 
 from .. import fe, scenes
-from ..flexible import FlexibleData, InterfacePoint
+from ..model.flexible import FlexibleData, InterfacePoint
 from ..reference import fe_invariants as fi
-from ..scene import ConstantSpeed, Scene
-from ..simulate import simulate
+from ..model.scene import ConstantSpeed, Scene
+from ..run.simulate import simulate
 
 __all__ = ["coupler_data", "mesh_coupler_data", "scene", "peak", "study", "mesh_study", "beam_frequencies", "figure"]
 
@@ -210,7 +210,7 @@ def mesh_study(meshes=MESHES, ks=(2, 4, 8), order: int = 2, cells: str = "quad",
 def figure(path: str, k: int = 4, modal_derivatives: Any = 2, rtol: float = 1e-8) -> None:
     """Midpoint deflection over 0-0.07 s: the built-in beam N = 8 (linear and nonlinear strain)
     and the k-mode coupler with nonlinear strain, without and with modal derivatives."""
-    from ..plotting import figure as new_figure
+    from ..results.plotting import figure as new_figure
 
     nodal = coupler_data(8, None, "nonlinear")
     curves = [("built-in beam N=8, linear strain", run_beam(8, "linear", rtol), dict(color="0.6", lw=2.5)),

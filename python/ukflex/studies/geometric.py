@@ -49,7 +49,7 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tupl
 import numpy as np
 
 from .. import UkflexError, scenes, simulate
-from ..scenes import PAPER
+from ..model.scenes import PAPER
 from .machine import machine_info, machine_line
 
 __all__ = [
@@ -853,7 +853,7 @@ COLORS = {"linear-ffrf": "tab:gray", "nonlinear-ffrf": "tab:blue", "nonlinear-ff
 
 
 def _figure(w: float = 7.0, h: float = 4.2, rows: int = 1, cols: int = 1, **kw):
-    from ..plotting import figure
+    from ..results.plotting import figure
 
     fig = figure((w, h), "the geometric study's plots (--no-plot skips them)", dpi=90)
     axes = fig.subplots(rows, cols, squeeze=False, **kw)

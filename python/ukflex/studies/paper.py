@@ -61,7 +61,7 @@ import numpy as np
 
 from .. import System, scenes, simulate
 from ..reference import CPSystem, ReferenceModel, choose_partition, reduced_accelerations, single_blas_thread, uk_qdd
-from ..simulate import time_acceleration
+from ..run.simulate import time_acceleration
 from .machine import machine_info, machine_line
 
 __all__ = ["run_fig4", "table1", "run_paper", "machine_info", "PAPER_TABLE1", "PAPER_WINDOW"]
@@ -166,7 +166,7 @@ def run_fig4(
 
 def _plot_fig4(path: str, t: np.ndarray, curves: Dict[str, np.ndarray], elements: int, gravity: bool,
                method: str = "", rtol: float = float("nan")) -> None:
-    from ..plotting import figure
+    from ..results.plotting import figure
 
     fig = figure((7.0, 4.2), "Fig. 4 (--no-plot skips it)")
     ax = fig.add_subplot(1, 1, 1)

@@ -22,10 +22,10 @@ from typing import Any, Dict, Optional
 
 import numpy as np
 
-from ..flexible import FlexibleData, InterfacePoint
+from ..model.flexible import FlexibleData, InterfacePoint
 from ..reference import testset_crank as ts
-from ..scene import ConstantSpeed, Scene
-from ..simulate import NATIVE_METHODS, simulate
+from ..model.scene import ConstantSpeed, Scene
+from ..run.simulate import NATIVE_METHODS, simulate
 
 __all__ = ["rod_data", "crank_scene", "crank_state", "run"]
 

@@ -19,7 +19,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from .. import System, SimulationResult, UkflexError, simulate
-from ..stability import (IntegrationFailure, beam_properties, buckling_ratio, check, drift, ffrf_validity,
+from ..analysis.stability import (IntegrationFailure, beam_properties, buckling_ratio, check, drift, ffrf_validity,
                          rank_history, run, scaling_accuracy)
 from . import extreme
 

@@ -65,7 +65,7 @@ def crank_study(omegas: Sequence[float] = OMEGAS, diameters: Sequence[float] = D
 
 
 def _contours(df: Any, path: str) -> None:
-    from ..plotting import figure
+    from ..results.plotting import figure
 
     fig = figure((11.0, 4.2), "the sweep's contour plot")
     from matplotlib.colors import LogNorm

@@ -45,7 +45,7 @@ from typing import Any, Dict, Iterator, List, Optional, Sequence, TextIO, Tuple
 import numpy as np
 
 from .. import System, scenes, simulate
-from ..simulate import FORMULATIONS, NATIVE_METHODS
+from ..run.simulate import FORMULATIONS, NATIVE_METHODS
 from .machine import machine_info, machine_line
 
 __all__ = [
@@ -518,7 +518,7 @@ _FORM_STYLE = {"uk": ("-", "o"), "uk-numpy": ("--", "s"), "cp": (":", "^"), "nat
 
 
 def _figure(size):
-    from ..plotting import figure
+    from ..results.plotting import figure
 
     fig = figure(size, "the work-precision plot (--no-plot skips it)")
     return fig

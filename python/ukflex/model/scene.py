@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from .description import Checker, normalize
-from .errors import InvalidArgumentError, InvalidSceneError, core
+from ..errors import InvalidArgumentError, InvalidSceneError, core
 from .system import System
 
 __all__ = [

@@ -286,7 +286,7 @@ def animate(
     int
         Number of frames written.
     """
-    from .plotting import require
+    from ..errors import require
 
     require("matplotlib", "the animation (a GIF)")
     Image = require("PIL.Image", "the animation (a GIF)")

@@ -28,10 +28,10 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .errors import SolverError, UnknownNameError
-from .results import SimulationResult
-from .simulate import DEFAULT_MAX_STEPS, NATIVE_METHODS, as_system, simulate
-from .system import System
+from ..errors import SolverError, UnknownNameError
+from ..results.simulation import SimulationResult
+from ..run.simulate import DEFAULT_MAX_STEPS, NATIVE_METHODS, as_system, simulate
+from ..model.system import System
 
 __all__ = [
     "StabilityWarning",
@@ -59,7 +59,7 @@ __all__ = [
 
 # ------------------------------------------------------------------------------------ warnings
 # (defined with the errors, so that simulate can warn without importing this module)
-from .errors import (  # noqa: E402
+from ..errors import (  # noqa: E402
     BucklingWarning,
     DriftWarning,
     ModelValidityWarning,
@@ -598,7 +598,7 @@ def augmented_reference(M, Q, A, b) -> np.ndarray:
 
 
 def _uk_symmetric(M, Q, A, b):
-    from .reference.uk import uk_qdd
+    from ..reference.uk import uk_qdd
 
     return uk_qdd(M, Q, A, b)
 
@@ -675,7 +675,7 @@ def __getattr__(name: str) -> Any:
     if name == "report":  # deprecated alias, removed in the next release
         warnings.warn("ukflex.stability.report moved to ukflex.studies.stability.report", DeprecationWarning,
                       stacklevel=2)
-        from .studies.stability import report
+        from ..studies.stability import report
 
         return report
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
@@ -685,7 +685,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     """Deprecated: ``python -m ukflex.stability ARGS`` is ``ukflex stability ARGS``."""
     warnings.warn("'python -m ukflex.stability' is deprecated; use 'ukflex stability'", DeprecationWarning,
                   stacklevel=2)
-    from .cli import main as cli_main
+    from ..cli import main as cli_main
 
     return cli_main(["stability", *(sys.argv[1:] if argv is None else argv)])
 

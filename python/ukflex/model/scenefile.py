@@ -54,7 +54,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
-from .errors import InvalidSceneError
+from ..errors import InvalidSceneError
 from .scene import Scene
 
 try:  # Python >= 3.11
@@ -292,7 +292,7 @@ def _initial(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
 
 
 def _solver(path: str, d: Dict[str, Any]) -> Dict[str, Any]:
-    from .simulate import FORMULATIONS, METHODS, NATIVE_METHODS
+    from ..run.simulate import FORMULATIONS, METHODS, NATIVE_METHODS
 
     METHODS = ("auto",) + tuple(METHODS) + tuple(NATIVE_METHODS)
     _check_keys(path, "[solver]", d, SOLVER_KEYS)

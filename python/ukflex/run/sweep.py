@@ -27,7 +27,7 @@ import sys
 import time
 from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
-from .errors import InvalidArgumentError
+from ..errors import InvalidArgumentError
 
 __all__ = ["sweep", "cases_of", "Cases", "RESERVED_COLUMNS", "MAX_CASES"]
 
@@ -38,7 +38,7 @@ Grid = Union[Mapping[str, Any], Sequence[Mapping[str, Any]]]
 
 
 def _need(module: str, what: str) -> Any:
-    from .plotting import require  # the one place that names a missing optional dependency
+    from ..errors import require
 
     return require(module, what, extra="sweep")
 
@@ -59,7 +59,7 @@ class Cases:
     """
 
     def __init__(self, grid: Grid, max_cases: int = MAX_CASES):
-        from .arguments import count
+        from ..arguments import count
 
         max_cases = count("max_cases", max_cases)
         self._keys: List[str] = []
@@ -133,7 +133,7 @@ def run_case(build: Callable[..., Any], outputs: Callable[[Any], Mapping[str, An
 
     Never raises for a problem of the case itself: it is reported in ``status``/``error``.
     """
-    from .reference._blas import blas_threads
+    from ..reference._blas import blas_threads
     from .simulate import simulate
 
     row: Dict[str, Any] = dict(case)
@@ -225,7 +225,7 @@ def _chunks(cases: Cases, nworkers: int, chunksize: Optional[int]) -> Iterator[C
     if chunksize is None:
         size = min(64, max(1, -(-len(cases) // (8 * nworkers))))
     else:
-        from .arguments import count
+        from ..arguments import count
 
         size = count("chunksize", chunksize)
     it = enumerate(cases)
@@ -330,7 +330,7 @@ def sweep(
     if not callable(build) or not callable(outputs):
         raise TypeError("sweep: build and outputs must be callables")
     cases = Cases(grid, max_cases)
-    from .arguments import count
+    from ..arguments import count
 
     blas = None if blas_threads is None else count("blas_threads", blas_threads)
     rows: List[Optional[Dict[str, Any]]] = [None] * len(cases)

@@ -16,7 +16,7 @@ import numbers
 import reprlib
 from typing import Any, Dict, List, Mapping, Optional, Tuple
 
-from .errors import InvalidSceneError, core
+from ..errors import InvalidSceneError, core
 
 __all__ = ["SECTIONS", "Checker", "normalize", "plain"]
 

@@ -9,7 +9,6 @@
 from __future__ import annotations
 
 import json
-import math
 import reprlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -17,12 +16,12 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from .arguments import real
+from ..arguments import real
 from .description import normalize
-from .errors import (InconsistentInitialStateError, InvalidArgumentError, InvalidSceneError, NonFiniteError,
+from ..errors import (InconsistentInitialStateError, InvalidArgumentError, InvalidSceneError, NonFiniteError,
                      UnknownNameError, core as _core)
 
-__all__ = ["System", "InitialCorrection", "Equilibrium"]
+__all__ = ["System", "InitialCorrection"]
 
 
 @dataclass
@@ -92,17 +91,6 @@ class InitialCorrection:
             f"max|A qd + Phi_t| {self.velocity_residual_before:.3e} -> {self.velocity_residual_after:.3e}; "
             f"max|dq| {worst(self.dq)}; max|dqd| {worst(self.dqd)}"
         )
-
-
-@dataclass
-class Equilibrium:
-    """A static equilibrium (:meth:`System.equilibrium`)."""
-
-    q: np.ndarray
-    multipliers: np.ndarray
-    iterations: int
-    force_residual: float
-    position_residual: float
 
 
 def length_scale(description: Dict[str, Any]) -> float:
@@ -537,256 +525,27 @@ class System:
         count: Optional[int] = None,
         deadline: Optional[float] = None,
     ):
-        """Natural frequencies [rad/s] of the constrained system linearized at a state.
+        """Natural frequencies [rad/s] of the constrained system linearized at a state (default
+        the initial state): :func:`ukflex.analysis.frequencies.frequencies`."""
+        from ..analysis.frequencies import frequencies
 
-        The UK accelerations ``qdd(t, q, qd)`` are linearized in ``q`` by the core's central
-        differences (everything that depends on ``q``: elastic and spring stiffness, gravity and
-        the constraint forces through the multipliers, which give a pendulum its frequency;
-        the structured Jacobian of the integrators leaves the last out); the motion is restricted to the
-        tangent space ``N`` of the constraints (an orthonormal basis of the null space of
-        ``A(q)``, from an SVD) and the symmetric part of ``K_r = -N^T M (dqdd/dq) N`` is solved
-        against ``M_r = N^T M N``.  Velocity terms (damping, gyroscopic) are left out: these are
-        the undamped frequencies of the frozen state.  At an equilibrium this is the classical
-        constrained modal analysis; on a moving state (a driven crank) the centrifugal stiffening
-        at that state is included.
-
-        With ``count=k`` only the ``k`` modes nearest zero (the slowest; ascending).  From
-        :attr:`SPARSE_MODES_MIN` coordinates on (and ``k`` below half the degrees of freedom)
-        they come without a dense eigenproblem: the core's sparse linearization (coloured
-        differences, O(n); the same stiffness on the tangent space) and shift-invert Lanczos
-        with a sparse saddle-point factorization (:mod:`ukflex.modes`).  All modes of a system
-        that large are dense work: its ``n x n`` arrays are checked against ``memory_limit``.
-
-        Parameters
-        ----------
-        t, q, qd : optional
-            The state; default the system's initial state ``t0, q0, qd0``.
-        modes : bool
-            Also return the mode shapes in ``q`` coordinates.
-        count : int, optional
-            Only the ``count`` modes nearest zero.
-        deadline : float, optional
-            A ``time.perf_counter()`` value: past it :class:`ukflex.modes.BudgetExceeded` is
-            raised naming the stage (``simulate``'s ``max_wall_time`` for ``method="auto"``).
-
-        Returns
-        -------
-        omega : ndarray (k,)
-            ``k = n - rank(A)`` frequencies (or ``count``) in ascending order,
-            ``omega = sign(lam) sqrt(|lam|)`` for the eigenvalues ``lam`` of the reduced problem:
-            a negative value is an unstable (divergent) direction, ~0 a free rigid-body motion.
-        shapes : ndarray (n, k), only with ``modes=True``
-            Mass-normalized (``shapes.T @ M @ shapes = I``) mode shapes.
-        """
-        from scipy.linalg import eigh, null_space
-
-        t = self.t0 if t is None else float(t)
-        q = self.q0 if q is None else np.asarray(q, dtype=float)
-        qd = self.qd0 if qd is None else np.asarray(qd, dtype=float)
-        n = self.n_coords
-        for name, v in (("q", q), ("qd", qd)):
-            if v.shape != (n,):
-                raise ValueError(f"{name}: expected shape ({n},), got {v.shape}")
-        if count is not None:
-            count = int(count)
-            if count < 1:
-                raise ValueError(f"count must be at least 1, got {count}")
-        large = n >= self.SPARSE_MODES_MIN
-        if large and count is not None:
-            from . import modes as _modes
-
-            n_dof = n - _modes._rank(self, t, q, qd)
-            if 2 * count < n_dof:
-                return _modes.lowest_modes(self, t, q, qd, count, modes=modes, deadline=deadline)
-        if large:
-            # every mode (or most of them) of a large system: dense eigenproblem on the sparse
-            # linearization (no 4n UK calls of differences); its n x n arrays checked first
-            from . import modes as _modes
-
-            self._check_dense("the dense modal analysis (n x n arrays)", 6 * 8 * n * n)
-            Ms, Ks, As, _ = _modes.linearization(self, t, q, qd)
-            M = Ms.toarray()
-            N = null_space(As.toarray()) if self.n_constraints else np.eye(n)
-            Mr = N.T @ M @ N
-            Kr = N.T @ (Ks @ N)
-        else:
-            jac = np.asarray(self.core.jac(t, np.concatenate([q, qd]), "central"))
-            Jq = jac[n:, :n]
-            M = np.asarray(self.M(q))
-            N = null_space(np.asarray(self.A(q))) if self.n_constraints else np.eye(n)
-            Mr = N.T @ M @ N
-            Kr = -(N.T @ (M @ Jq) @ N)
-        Kr = 0.5 * (Kr + Kr.T)
-        lam, V = eigh(Kr, 0.5 * (Mr + Mr.T))
-        omega = np.sign(lam) * np.sqrt(np.abs(lam))
-        if count is not None and count < omega.size:
-            keep = np.sort(np.argsort(np.abs(omega), kind="stable")[:count])
-            omega, V = omega[keep], V[:, keep]
-        return (omega, N @ V) if modes else omega
+        return frequencies(self, t, q, qd, modes=modes, count=count, deadline=deadline)
 
     def max_frequency(self, t: Optional[float] = None, q: Optional[np.ndarray] = None,
                       qd: Optional[np.ndarray] = None, deadline: Optional[float] = None) -> float:
-        """The fastest natural frequency ``omega_max`` [rad/s] of the constrained system
-        linearized at a state (default the initial state): below :attr:`SPARSE_MODES_MIN`
-        coordinates the largest ``|omega|`` of :meth:`frequencies`; above, Lanczos on the sparse
-        linearization in the constraints' tangent space (:func:`ukflex.modes.max_frequency`: an
-        estimate from below, within 1e-3 on the scenes measured, docs/scale.md)."""
-        t = self.t0 if t is None else float(t)
-        q = self.q0 if q is None else np.asarray(q, dtype=float)
-        qd = self.qd0 if qd is None else np.asarray(qd, dtype=float)
-        if self.n_coords >= self.SPARSE_MODES_MIN:
-            from . import modes as _modes
+        """The fastest natural frequency [rad/s] at a state (default the initial state):
+        :func:`ukflex.analysis.frequencies.max_frequency`."""
+        from ..analysis.frequencies import max_frequency
 
-            return abs(_modes.max_frequency(self, t, q, qd, deadline=deadline))
-        omega = self.frequencies(t, q, qd)
-        return float(np.abs(omega).max()) if omega.size else 0.0
+        return max_frequency(self, t, q, qd, deadline=deadline)
 
-    def _check_dense(self, what: str, nbytes: float) -> None:
-        """Refuse a dense Python-side allocation above the System's ``memory_limit``."""
-        from .errors import MemoryLimitError
+    def equilibrium(self, t: Optional[float] = None, q: Optional[np.ndarray] = None, tol: float = 1e-10,
+                    max_iterations: int = 50):
+        """Static equilibrium at time ``t`` (default ``t0``) from ``q`` (default ``q0``):
+        :func:`ukflex.analysis.equilibrium.equilibrium`."""
+        from ..analysis.equilibrium import equilibrium
 
-        limit = int(self.core.memory_limit)
-        if nbytes > limit:
-            raise MemoryLimitError(
-                f"{what} needs about {nbytes / 2**20:.1f} MiB, above the memory limit of {limit / 2**20:.1f} MiB; "
-                "ask for the lowest modes only (count=k: sparse), or raise memory_limit")
-
-    def equilibrium(
-        self,
-        t: Optional[float] = None,
-        q: Optional[np.ndarray] = None,
-        tol: float = 1e-10,
-        max_iterations: int = 50,
-    ) -> "Equilibrium":
-        """Static equilibrium at time ``t`` (drivers held at their values there), from ``q``.
-
-        Newton on ``Q(t, q, 0) = A(q)^T lambda`` and ``Phi(t, q) = 0`` (zero velocities, so the
-        applied, elastic, spring and gravity forces balance the constraint forces), with the
-        tangent of both sides by central differences of the core's ``Q`` and ``A`` and a
-        backtracking line search on the residual.  Use it to start a run from a preloaded state
-        (``simulate(system, T, q0=eq.q, qd0=zeros)``) or to check a structure's static deflection.
-
-        Parameters
-        ----------
-        t, q : optional
-            Time and starting positions (default ``t0``, ``q0``).
-        tol : float
-            Converged when the Newton step is below ``tol`` (per coordinate, relative to
-            ``max(1, |q|)``), ``max |Phi| <= tol`` and the forces balance to 1e-8 of
-            ``max |Q|``.
-        max_iterations : int
-            Newton iterations.
-
-        Returns
-        -------
-        Equilibrium
-            ``q``, ``multipliers`` (with ``M qdd + A^T lambda = Q``), ``iterations``,
-            ``force_residual`` (``max |Q - A^T lambda|``), ``position_residual``.
-
-        Raises
-        ------
-        ValueError, NonFiniteError
-            Bad arguments.
-        SolverError
-            No convergence (e.g. no equilibrium: a free body under gravity).
-        """
-        from .errors import SolverError
-
-        n, m = self.n_coords, self.n_constraints
-        t = self.t0 if t is None else float(t)
-        q = np.array(self.q0 if q is None else q, dtype=float)
-        if q.shape != (n,):
-            raise ValueError(f"q: expected shape ({n},), got {q.shape}")
-        if not np.all(np.isfinite(q)) or not math.isfinite(t):
-            raise NonFiniteError("equilibrium: t and q must be finite")
-        if not (tol > 0 and math.isfinite(tol)) or int(max_iterations) < 1:
-            raise ValueError(f"tol must be positive and max_iterations >= 1, got {tol!r}, {max_iterations!r}")
-        zero = np.zeros(n)
-        if n >= self.SPARSE_MODES_MIN:
-            residual, step_of, lam = self._equilibrium_sparse_parts(t, q)
-        else:
-            lam = np.zeros(m)
-
-            def residual(q, lam):
-                A = np.asarray(self.A(q)).reshape(m, n)
-                return np.concatenate([np.asarray(self.Q(t, q, zero)) - A.T @ lam, np.asarray(self.phi(t, q))])
-
-            def step_of(q, lam, r):
-                J = np.zeros((n + m, n + m))
-                for j in range(n):
-                    h = 1e-6 * max(1.0, abs(q[j]))
-                    qp, qm = q.copy(), q.copy()
-                    qp[j] += h
-                    qm[j] -= h
-                    J[:, j] = (residual(qp, lam) - residual(qm, lam)) / (2.0 * h)
-                A = np.asarray(self.A(q)).reshape(m, n)
-                J[:n, n:] = -A.T
-                return np.linalg.lstsq(J, -r, rcond=None)[0]
-
-        r = residual(q, lam)
-        for it in range(1, int(max_iterations) + 1):
-            step = step_of(q, lam, r)
-            alpha, norm0 = 1.0, np.linalg.norm(r)
-            while True:  # backtracking on |R|
-                q_new, lam_new = q + alpha * step[:n], lam + alpha * step[n:]
-                r_new = residual(q_new, lam_new)
-                if np.linalg.norm(r_new) <= (1.0 - 1e-4 * alpha) * norm0 or alpha < 1e-4:
-                    break
-                alpha *= 0.5
-            q, lam, r = q_new, lam_new, r_new
-            if not np.all(np.isfinite(r)):
-                break
-            small = np.all(np.abs(alpha * step[:n]) <= tol * np.maximum(1.0, np.abs(q)))
-            force_scale = max(float(np.max(np.abs(np.asarray(self.Q(t, q, zero))), initial=0.0)), 1e-300)
-            balanced = np.max(np.abs(r[:n]), initial=0.0) <= 1e-8 * force_scale
-            if small and balanced and np.max(np.abs(r[n:]), initial=0.0) <= tol:
-                return Equilibrium(q, lam, it, float(np.max(np.abs(r[:n]), initial=0.0)),
-                                   float(np.max(np.abs(r[n:]), initial=0.0)))
-        raise SolverError(
-            f"equilibrium: no convergence after {max_iterations} Newton iteration(s) at t = {t}: "
-            f"max |Q - A^T lambda| = {np.max(np.abs(r[:n]), initial=0.0):.3e}, max |Phi| = "
-            f"{np.max(np.abs(r[n:]), initial=0.0):.3e} (a scene without a static equilibrium, e.g. a free body "
-            "under gravity, or a start too far from it)")
-
-    def _equilibrium_sparse_parts(self, t: float, q: np.ndarray):
-        """``equilibrium`` above :attr:`SPARSE_MODES_MIN` coordinates: ``(residual, step,
-        lam0)`` for the same Newton iteration and line search, with the sparse tangent
-        ``[-K, -A^T; A, 0]`` (``K = -d/dq (Q - A^T lambda)`` at the iterate's multipliers: the
-        core's coloured differences, O(n)) and a sparse LU.  The multipliers start from the UK
-        solution at rest (the constraint forces that hold the start; from zero, a mechanism
-        whose links carry their weight only through its joints has a singular first tangent,
-        which the dense path passes with a least-squares step); a tangent still exactly singular
-        is shifted by 1e-10 of its scale on the stiffness block and 1e-12 on the multiplier
-        block."""
-        from scipy.sparse import bmat, coo_array, identity
-        from scipy.sparse.linalg import splu
-
-        n, m = self.n_coords, self.n_constraints
-        zero = np.zeros(n)
-
-        def parts(q, lam, stiffness):
-            lin = self.core.linearization(t, q, zero, zero, lam, stiffness)
-            A = coo_array((np.asarray(lin["A"]), (np.asarray(lin["a_rows"]), np.asarray(lin["a_cols"]))), shape=(m, n)).tocsr()
-            K = coo_array((np.asarray(lin["K"]), (np.asarray(lin["rows"]), np.asarray(lin["cols"]))), shape=(n, n)).tocsc()
-            return A, K
-
-        def residual(q, lam):
-            A, _ = parts(q, lam, False)
-            return np.concatenate([np.asarray(self.Q(t, q, zero)) - A.T @ lam, np.asarray(self.phi(t, q))])
-
-        def step_of(q, lam, r):
-            A, K = parts(q, lam, True)
-            J = bmat([[-K, -A.T], [A, None]], format="csc") if m else (-K).tocsc()
-            try:
-                return splu(J).solve(-r)
-            except RuntimeError:  # exactly singular: a neutral direction or redundant rows
-                scale = max(float(abs(K).max()) if K.nnz else 0.0, float(abs(A).max()) if A.nnz else 0.0, 1e-300)
-                shift = -K - 1e-10 * scale * identity(n)
-                Js = bmat([[shift, -A.T], [A, -1e-12 * scale * identity(m)]], format="csc") if m else shift.tocsc()
-                return splu(Js).solve(-r)
-
-        lam = np.asarray(self.multipliers(t, q, zero), dtype=float) if m else np.zeros(0)
-        return residual, step_of, lam
+        return equilibrium(self, t, q, tol=tol, max_iterations=max_iterations)
 
     # ------------------------------------------------------------------------------ correction
     @staticmethod

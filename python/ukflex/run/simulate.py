@@ -19,13 +19,13 @@ from scipy.integrate._ivp.common import OdeSolution
 from scipy.integrate import DenseOutput
 from scipy.integrate._ivp.ivp import METHODS as _SCIPY_SOLVERS, find_active_events, handle_events, prepare_events
 
-from . import _core
-from .errors import (DriftWarning, InvalidArgumentError, NonFiniteError, SingularConfigurationWarning, SolverError,
+from .. import _core
+from ..errors import (DriftWarning, InvalidArgumentError, NonFiniteError, SingularConfigurationWarning, SolverError,
                      UnknownOptionError)
-from .arguments import COUNT_LIMIT, count as _count, positive as _positive, real as _real, real_array as _real_array
-from .results import SimulationResult
-from .scene import Scene
-from .system import System, length_scale
+from ..arguments import COUNT_LIMIT, count as _count, positive as _positive, real as _real, real_array as _real_array
+from ..results.simulation import SimulationResult
+from ..model.scene import Scene
+from ..model.system import System, length_scale
 
 __all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "time_acceleration", "DenseSolution"]
 
@@ -338,7 +338,7 @@ def simulate(
             "formulation", f"events, dense_output and args need formulation='uk' (the NumPy reference {formulation!r} "
             "runs its own solve_ivp call)")
     if method == "auto":
-        from .modes import BudgetExceeded
+        from ..analysis.modes import BudgetExceeded
 
         start = time.perf_counter()
         try:
@@ -983,7 +983,7 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
 
 def _simulate_reference(system, formulation, t_end, method, rtol, atol, t_eval, q0, qd0, partition, options):
     """Run the NumPy reference (uk-numpy or coordinate partitioning) on the same description."""
-    from . import reference
+    from .. import reference
 
     fn = reference.simulate_uk_numpy if formulation == "uk-numpy" else reference.simulate_cp
     kwargs: Dict[str, Any] = dict(method=method, rtol=rtol, atol=atol, t_eval=t_eval, q0=q0, qd0=qd0)

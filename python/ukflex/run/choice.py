@@ -96,7 +96,7 @@ def _mode_displacements(system, q: np.ndarray, shapes: np.ndarray) -> np.ndarray
     out = np.zeros(shapes.shape[1])
     scale = np.abs(shapes).max(axis=0)
     eps = 1e-7 / np.where(scale > 0.0, scale, 1.0)
-    from .outputs import beam_names
+    from ..results.outputs import beam_names
 
     for body in beam_names(system):
         plus = q[:, None] + shapes * eps

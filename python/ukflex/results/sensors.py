@@ -32,7 +32,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .errors import UnknownNameError
+from ..errors import UnknownNameError
 
 def parse_xi(expr: str, xi_text: str) -> float:
     """The axis coordinate XI of an output expression such as ``v(coupler, 0.5)``: a number in [0, 1]."""

@@ -10,7 +10,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import UnknownNameError
+from ..errors import UnknownNameError
 
 __all__ = ["SimulationResult"]
 

@@ -32,8 +32,8 @@ from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 import scipy.linalg as sla
 
-from .arguments import count, non_negative, positive, real
-from .errors import InvalidArgumentError
+from ..arguments import count, non_negative, positive, real
+from ..errors import InvalidArgumentError
 from .flexible import FlexibleData, InterfacePoint
 
 __all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices", "reduce"]
@@ -265,7 +265,7 @@ def _invariants(x: np.ndarray, mm: np.ndarray, m_scalar: np.ndarray, phi: np.nda
 def _mesh_basis(points: np.ndarray, cells: np.ndarray, order: int) -> Tuple[Any, np.ndarray, np.ndarray]:
     """scikit-fem vector basis of the mesh, the permutation ``perm`` (node dof ``j`` = scikit-fem
     dof ``perm[j]``; node dofs ``x_1, y_1, x_2, ...``) and the node coordinates (N, 2)."""
-    from .plotting import require
+    from ..errors import require
 
     skfem = require("skfem", "ukflex.fe.from_mesh", extra="fe")
     if order not in (1, 2) or isinstance(order, bool):
@@ -321,7 +321,7 @@ def _mesh_arrays(points: Any, cells: Any) -> Tuple[np.ndarray, np.ndarray]:
 
 
 def _real_array(name: str, value: Any) -> np.ndarray:
-    from .arguments import real_array
+    from ..arguments import real_array
 
     return real_array(name, value)
 

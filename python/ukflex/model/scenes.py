@@ -20,8 +20,8 @@ import math
 import numbers
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
-from ._deprecation import renamed_parameters
-from .errors import InvalidSceneError
+from .._deprecation import renamed_parameters
+from ..errors import InvalidSceneError
 from .scene import Circular, ConstantSpeed, CustomSection, Harmonic, Polynomial, Rectangular, Scene
 
 __all__ = [

@@ -58,7 +58,7 @@ def _positive_float(text: str) -> float:
 
 
 def _positive_int(text: str) -> int:
-    from .scenefile import MAX_COUNT
+    from ..model.scenefile import MAX_COUNT
 
     try:
         x = int(text)
@@ -204,7 +204,7 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
     With ``defaults=None`` the options default to None, so that a scene file's ``[solver]``
     values fill in what the command line does not give (then :data:`RUN_DEFAULTS`).
     """
-    from .simulate import FORMULATIONS, METHODS, NATIVE_METHODS
+    from ..run.simulate import FORMULATIONS, METHODS, NATIVE_METHODS
 
     native = list(NATIVE_METHODS)
 
@@ -233,7 +233,7 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
 
 # ----------------------------------------------------------------------------------- paper
 def _cmd_paper(args: argparse.Namespace) -> int:
-    from .studies.paper import run_paper
+    from ..studies.paper import run_paper
 
     prog = _progress_from(args)
     try:
@@ -269,8 +269,8 @@ def _load_scene(scene: str, params: Sequence[str]):
     ``source`` identifies what was run (``builtin:NAME [params]`` or the file's absolute path);
     :func:`_default_out` keeps different sources in different folders.
     """
-    from .scenefile import SceneFileError, load
-    from .scenes import SCENES
+    from ..model.scenefile import SceneFileError, load
+    from ..model.scenes import SCENES
 
     looks_like_file = scene.endswith(".toml") or os.sep in scene or os.path.exists(scene)
     if scene in SCENES and not os.path.exists(scene):
@@ -321,7 +321,7 @@ def _write_outputs_csv(path: str, t: np.ndarray, names: Sequence[str], values: S
 
 def _plot_outputs(path: str, name: str, t: np.ndarray, labels: Sequence[str], values: Sequence[np.ndarray],
                   subtitle: str) -> None:
-    from .plotting import figure
+    from ..results.plotting import figure
 
     k = len(values)
     fig = figure((7.0, 1.2 + 2.0 * k), "the output plot (ukflex run; --no-plot skips it)")
@@ -337,8 +337,8 @@ def _plot_outputs(path: str, name: str, t: np.ndarray, labels: Sequence[str], va
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from . import outputs
-    from .simulate import simulate
+    from ..results import outputs
+    from ..run.simulate import simulate
 
     if args.out is not None:  # fail before loading or running anything
         _writable_dir(args.out, "--out")
@@ -358,7 +358,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     fps = args.fps if args.fps is not None else file_output.get("fps", 25)
     frames = args.frames if args.frames is not None else file_output.get("frames", 150)
     if not args.no_plot or animate:  # matplotlib is optional: say so before the run, not after it
-        from .plotting import require
+        from ..errors import require
 
         require("matplotlib", "the output plot and the animation (--no-plot, without --animate, skips both)")
     out = args.out or _default_out(args.scene, name, args.param, source)
@@ -400,7 +400,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
                       f"{res.method}, rtol {res.rtol:g}, {res.formulation}")
         written.append(base + ".png")
     if animate:
-        from .animate import animate as write_gif
+        from ..results.animate import animate as write_gif
 
         nfr = write_gif(res, base + ".gif", fps=fps, frames=frames, deform_scale=deform_scale, title=name)
         written.append(f"{base}.gif ({nfr} frames)")
@@ -418,7 +418,7 @@ def _scene_summary(fn: Callable[..., Any]) -> str:
 
 
 def _cmd_list(args: argparse.Namespace) -> int:
-    from .scenes import SCENES, scene_parameters
+    from ..model.scenes import SCENES, scene_parameters
 
     for name, fn in SCENES.items():
         print(f"{name}: {_scene_summary(fn)}")
@@ -430,8 +430,8 @@ def _cmd_list(args: argparse.Namespace) -> int:
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
-    from .scenefile import dumps
-    from .scenes import SCENES
+    from ..model.scenefile import dumps
+    from ..model.scenes import SCENES
 
     if args.output not in (None, "-"):
         _writable_file(args.output, "-o")
@@ -453,7 +453,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
 # ----------------------------------------------------------------------------------- bench
 def _cmd_bench_wp(args: argparse.Namespace) -> int:
-    from .studies.workprecision import run_work_precision
+    from ..studies.workprecision import run_work_precision
 
     rtols = args.rtols or ([1e-3, 1e-5, 1e-7] if args.quick else None)
     if args.quick and args.formulations is None:
@@ -476,7 +476,7 @@ def _cmd_bench_wp(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_elements(args: argparse.Namespace) -> int:
-    from .studies.workprecision import run_elements
+    from ..studies.workprecision import run_elements
 
     cases = []
     for c in args.cases.split(","):
@@ -495,7 +495,7 @@ def _cmd_bench_elements(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_table1(args: argparse.Namespace) -> int:
-    from .studies.paper import table1
+    from ..studies.paper import table1
 
     table1(args.out, mode=args.mode, elements=args.elements, t_end=args.t_end, method=args.method, rtol=args.rtol,
            repeats=args.repeats, max_states=args.max_states, whole=args.whole or None,
@@ -505,7 +505,7 @@ def _cmd_bench_table1(args: argparse.Namespace) -> int:
 
 # ----------------------------------------------------------------------------------- stability, crosscheck
 def _cmd_stability(args: argparse.Namespace) -> int:
-    from .studies.stability import report
+    from ..studies.stability import report
 
     report(args.out, quick=args.quick, cases=args.case)
     print(f"wrote {os.path.join(args.out, 'stability.md')}")
@@ -513,14 +513,14 @@ def _cmd_stability(args: argparse.Namespace) -> int:
 
 
 def _cmd_crosscheck(args: argparse.Namespace) -> int:
-    from .studies.crosscheck import run
+    from ..studies.crosscheck import run
 
     run(args.study, t_end=args.t_end, rtol=args.rtol, theory=args.theory)
     return 0
 
 
 def _cmd_study_geometric(args: argparse.Namespace) -> int:
-    from .studies.geometric import run_geometric
+    from ..studies.geometric import run_geometric
 
     run_geometric(args.out, quick=args.quick, models=args.models, elements=args.elements, cases=args.cases,
                   exudyn_data=args.exudyn_data, checks=not args.no_checks, cost=not args.no_cost,
@@ -587,8 +587,8 @@ def _add_paper_parser(sub) -> None:
 
 
 def _add_run_parser(sub) -> None:
-    from .outputs import OUTPUT_HELP
-    from .scenes import SCENES
+    from ..results.outputs import OUTPUT_HELP
+    from ..model.scenes import SCENES
 
     p = sub.add_parser(
         "run", formatter_class=_FMT,
@@ -624,7 +624,7 @@ def _add_run_parser(sub) -> None:
 
 
 def _add_list_export_parsers(sub) -> None:
-    from .scenes import SCENES
+    from ..model.scenes import SCENES
 
     p = sub.add_parser("list", help="list the built-in scenes", description="List the built-in scenes.")
     p.set_defaults(func=_cmd_list)
@@ -643,9 +643,9 @@ def _add_list_export_parsers(sub) -> None:
 
 
 def _add_bench_parsers(sub) -> None:
-    from .simulate import FORMULATIONS, NATIVE_METHODS
-    from .studies.paper import PAPER_WINDOW
-    from .studies.workprecision import DEFAULT_RTOLS, SCIPY_METHODS
+    from ..run.simulate import FORMULATIONS, NATIVE_METHODS
+    from ..studies.paper import PAPER_WINDOW
+    from ..studies.workprecision import DEFAULT_RTOLS, SCIPY_METHODS
 
     p = sub.add_parser("bench", help="work-precision studies and the Table 1 analogue",
                        description="Benchmarks on the paper's slider-crank: 'work-precision', 'elements', 'table1'.")
@@ -745,7 +745,7 @@ def _add_stability_parser(sub) -> None:
 
 
 def _add_crosscheck_parser(sub) -> None:
-    from .studies.crosscheck import STUDIES
+    from ..studies.crosscheck import STUDIES
 
     p = sub.add_parser(
         "crosscheck", formatter_class=_FMT,
@@ -766,7 +766,7 @@ def _add_crosscheck_parser(sub) -> None:
 
 
 def _add_study_geometric_parser(sub) -> None:
-    from .studies.geometric import CASES, MODELS
+    from ..studies.geometric import CASES, MODELS
 
     p = sub.add_parser(
         "study-geometric", formatter_class=_FMT,
@@ -838,7 +838,7 @@ def _private_matplotlib_cache() -> None:
 
 def main(argv: Optional[List[str]] = None) -> int:
     """Entry point of the ``ukflex`` console script."""
-    from .errors import UkflexError
+    from ..errors import UkflexError
 
     parser = _build_parser()
     args = parser.parse_args(argv)  # argument errors: one line, SystemExit(2) (--help: SystemExit(0))
