@@ -4,7 +4,7 @@
 
 Reports, per call (minimum over repeats, and median), for the paper's slider-crank:
 
-* the Rust UK acceleration alone (``ukflex.simulate.time_acceleration``: a loop inside Rust),
+* the Rust UK acceleration alone (``ukflex.run.simulate.time_acceleration``: a loop inside Rust),
 * ``System.qdd(t, q, qd)`` and ``System.rhs(t, y)`` (the binding: argument checks, copies,
   a fresh output array),
 * ``System.jac(t, y)`` (Rust finite-difference Jacobian, 2n x 2n),

@@ -3,7 +3,6 @@ work; output folders never collide or escape; `ukflex list` shows every paramete
 
 import os
 import time
-import warnings
 from pathlib import Path
 
 import pytest
@@ -150,32 +149,15 @@ def test_list_shows_every_parameter_untruncated(capsys):
     assert "DESIGN" not in out and "/work" not in out
     for name, fn in SCENES.items():
         assert f"\n{name}: " in "\n" + out
-        for p, default, aliases in scene_parameters(fn):
+        for p, default in scene_parameters(fn):
             assert f"--param {p}={default!r}" in out
-            for a in aliases:
-                assert f"deprecated alias: {', '.join(aliases)}" in out
-    assert "(deprecated alias: flexible_coupler)" in out and "(deprecated alias: beam)" in out
 
 
-def test_one_name_per_concept_and_old_names_still_work():
-    names = {p for fn in SCENES.values() for p, _, _ in scene_parameters(fn)}
+def test_one_name_per_concept():
+    names = {p for fn in SCENES.values() for p, _ in scene_parameters(fn)}
     for old in ("beam", "g", "flexible_coupler", "crank", "coupler", "rocker", "ground"):
         assert old not in names
     for gravity_name in ("gravity",):
-        assert all(gravity_name in [p for p, _, _ in scene_parameters(fn)] for fn in SCENES.values())
-    from ukflex import scenes
-
-    with pytest.warns(DeprecationWarning, match="flexible_coupler"):
-        old = scenes.four_bar(flexible_coupler="timoshenko", crank=0.12)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        new = scenes.four_bar(theory="timoshenko", crank_length=0.12)
-    assert old.to_dict() == new.to_dict()
-    with pytest.raises(TypeError, match="both"):
-        scenes.four_bar(crank=0.1, crank_length=0.1)
+        assert all(gravity_name in [p for p, _ in scene_parameters(fn)] for fn in SCENES.values())
 
 
-def test_deprecated_param_on_the_command_line(cwd, capsys):
-    with pytest.warns(DeprecationWarning, match="crank_length"):
-        code, out, err = run(capsys, "run", "four_bar", "--param", "crank=0.11", "--t-end", "0.01", "--no-plot")
-    assert code == 0

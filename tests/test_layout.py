@@ -1,27 +1,21 @@
-"""The package layout (issue 10): the library stands apart from the studies, the reference never
-reaches the Rust core, studies use only public names, no import cycles, and the old names still
-work for one release with a DeprecationWarning."""
+"""The package layout (issues 10, 29): the library stands apart from the studies, the reference never
+reaches the Rust core, studies use only public names, no import cycles."""
 
 import ast
-import importlib
-import json
 import os
 import subprocess
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import ukflex
-from ukflex import cli, scenes
+from ukflex import scenes
 
 PKG = Path(__file__).resolve().parents[1] / "python" / "ukflex"
 ENV = dict(os.environ, MPLBACKEND="Agg")
 
-#: Deprecated forwarders (removed with the old names): their imports are not dependencies.
-DEPRECATED_FORWARDERS = {("ukflex.analysis.stability", "__getattr__"), ("ukflex.analysis.stability", "main")}
 #: scene.py <-> system.py (Scene.build imports System lazily): owned by the core rewrite.
 KNOWN_CYCLES: list = []
 
@@ -69,7 +63,7 @@ def _edges(name, path):
     """Modules of the package that ``name`` imports: ``from P import sub`` depends on the
     submodule ``P.sub`` (the compiled ``_core`` counts as one), ``from P import attr`` on ``P``."""
     for mod, names, func in _imports(name, path):
-        if (name, func) in DEPRECATED_FORWARDERS or not mod.startswith("ukflex"):
+        if not mod.startswith("ukflex"):
             continue
         subs = [n for n in names if f"{mod}.{n}" in MODULES or n == "_core"]
         if mod in MODULES and (not names or len(subs) < len(names)) and mod != name:
@@ -150,66 +144,7 @@ def test_extreme_is_not_exported_at_top_level():
     assert "extreme" not in ukflex.__all__
 
 
-# ---------------------------------------------------------------------------- deprecated names
-def _fresh_import(name):
-    sys.modules.pop(name, None)
-    return importlib.import_module(name)
-
-
-@pytest.mark.parametrize("old,new", [("ukflex.extreme", "ukflex.studies.extreme"),
-                                     ("ukflex.paper", "ukflex.studies.paper"),
-                                     ("ukflex.workprecision", "ukflex.studies.workprecision")])
-def test_moved_modules_forward_with_a_warning(old, new):
-    with pytest.warns(DeprecationWarning, match=new.replace(".", r"\.")):
-        mod = _fresh_import(old)
-    target = importlib.import_module(new)
-    for name in target.__all__:
-        got = getattr(mod, name)
-        assert got is getattr(target, name) or got.__wrapped__ is getattr(target, name), name
-
-
-def test_old_extreme_and_workprecision_accept_beam():
-    with pytest.warns(DeprecationWarning):
-        X = _fresh_import("ukflex.extreme")
-    from ukflex.studies import extreme
-
-    with pytest.warns(DeprecationWarning, match="theory="):
-        old = X.flexible(beam="timoshenko").to_dict()
-    assert old == extreme.flexible(theory="timoshenko").to_dict()
-    with pytest.warns(DeprecationWarning):
-        wp = _fresh_import("ukflex.workprecision")
-    with pytest.raises(TypeError, match=r"run_work_precision\(\) got both beam= \(deprecated\) and theory="):
-        wp.run_work_precision("unused", beam="timoshenko", theory="timoshenko")
-
-
-def test_stability_report_alias_and_module_entry_point():
-    from ukflex import stability
-    from ukflex.studies.stability import report
-
-    with pytest.warns(DeprecationWarning, match="ukflex.studies.stability.report"):
-        assert stability.report is report
-    r = subprocess.run([sys.executable, "-m", "ukflex.analysis.stability", "--help"], capture_output=True, text=True, env=ENV)
-    assert r.returncode == 0 and "usage: ukflex stability" in r.stdout
-    assert "DeprecationWarning" in r.stderr and "ukflex stability" in r.stderr
-
-
-def test_scene_parameter_aliases():
-    with pytest.warns(DeprecationWarning, match=r"slider_crank\(beam=...\).*theory="):
-        old = scenes.slider_crank(beam="euler-bernoulli", elements=2).to_dict()
-    assert old == scenes.slider_crank(theory="euler-bernoulli", elements=2).to_dict()
-    assert old["bodies"][1]["theory"] == "euler-bernoulli"
-    with pytest.raises(TypeError, match="both"):
-        scenes.slider_crank(beam="timoshenko", theory="timoshenko")
-    for fn in (scenes.pendulum, scenes.double_pendulum):
-        with pytest.warns(DeprecationWarning, match="gravity="):
-            old = fn(g=3.7).to_dict()
-        assert old == fn(gravity=3.7).to_dict() and old["gravity"] == [0.0, -3.7]
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")  # the new names warn about nothing
-        scenes.slider_crank(theory="timoshenko", gravity=False)
-        scenes.pendulum(gravity=(1.0, -2.0))
-
-
+# ---------------------------------------------------------------------------- built-in scenes
 def test_gravity_forms():
     g = scenes.gravity_vector
     assert g(True) == (0.0, -9.81) and g(False) is None and g(None) is None
@@ -220,21 +155,3 @@ def test_gravity_forms():
     for gravity, expected in ((True, [0.0, -9.81]), (False, None), (1.62, [0.0, -1.62]), ((0.0, -3.0), [0.0, -3.0])):
         for fn in scenes.SCENES.values():
             assert fn(gravity=gravity).to_dict().get("gravity") == expected, (fn.__name__, gravity)
-
-
-def test_cli_deprecated_spellings_still_work(capsys):
-    args = cli._build_parser().parse_args(["bench", "elements", "--out", "x", "--beam", "euler-bernoulli"])
-    assert args.theory == "euler-bernoulli"
-    assert "--beam is deprecated" in capsys.readouterr().err
-    r = subprocess.run([sys.executable, "-m", "ukflex", "export", "slider_crank", "--param", "beam=euler-bernoulli"],
-                       capture_output=True, text=True, env=ENV)
-    assert r.returncode == 0 and 'theory = "euler-bernoulli"' in r.stdout
-    assert "DeprecationWarning" in r.stderr and "theory=" in r.stderr
-
-
-def test_deprecated_names_are_listed():
-    """Each deprecated spelling the package keeps, and where the docs say so."""
-    doc = (PKG.parents[1] / "docs" / "scene-format.md").read_text()
-    for spelling in ("beam=", "g=", "--beam", "ukflex.extreme", "python -m ukflex.stability"):
-        assert spelling in doc, spelling
-    assert json.dumps(scenes.PAPER)  # the paper data stays plain data

@@ -172,7 +172,7 @@ def test_slider_crank_energy_balance_closes_with_the_driver_work():
     assert bal["change"][-1] > 1.0                       # the driver does work ...
     assert bal["relative_error"] < 2e-7                   # ... and the balance closes with it
     assert np.all(bal["dissipated"] == 0.0) and np.all(bal["external_work"] == 0.0)
-    line = ukflex.sensors.energy_line(res)
+    line = ukflex.results.sensors.energy_line(res)
     assert "driver work +1.789e+00" in line and "balance closes" in line
     ga = ukflex.simulate(system, 0.07, method="auto", t_eval=t_eval)
     gbal = ga.sensors.energy_balance()
@@ -299,28 +299,16 @@ def test_sensor_expressions_in_outputs_and_npz(tmp_path):
         assert "reaction(slider).fy" in z.files and z["t"].shape == res.t.shape
 
 
-def test_spring_damper_keywords_and_the_deprecated_positional_form():
-    def build(positional):
-        s = Scene()
-        r = s.rigid_body("r", mass=1.0, inertia=0.1, position=(1.0, 0.0))
-        if positional:
-            s.spring_damper(s.ground.point(0, 0), r.point(0, 0), 10.0, 0.5, 2.0, "k")
-        else:
-            s.spring_damper(s.ground.point(0, 0), r.point(0, 0), stiffness=10.0, damping=0.5, rest_length=2.0, name="k")
-        return s.to_dict()
-
+def test_spring_damper_keywords():
+    s = Scene()
+    r = s.rigid_body("r", mass=1.0, inertia=0.1, position=(1.0, 0.0))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        new = build(False)
-    with pytest.warns(DeprecationWarning, match="stiffness=..., damping=..., rest_length=..., name="):
-        old = build(True)
-    assert old == new
+        s.spring_damper(s.ground.point(0, 0), r.point(0, 0), stiffness=10.0, damping=0.5, rest_length=2.0, name="k")
     s = Scene()
     r = s.rigid_body("r", mass=1.0, inertia=0.1, position=(1.0, 0.0))
     with pytest.raises(TypeError, match="stiffness"):
         s.spring_damper(s.ground.point(0, 0), r.point(0, 0))
-    with pytest.raises(TypeError, match="both"):
-        s.spring_damper(s.ground.point(0, 0), r.point(0, 0), 10.0, stiffness=3.0)
     # the default rest length is the initial distance (recorded in the description)
     s.spring_damper(s.ground.point(0, 0), r.point(0, 0), stiffness=1.0)
     assert s.to_dict()["forces"][-1]["rest_length"] == pytest.approx(1.0)

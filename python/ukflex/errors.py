@@ -3,7 +3,7 @@
 The classes raised by the compiled core (``ukflex._core``) are re-exported here unchanged, so
 ``except ukflex.InvalidSceneError`` catches every scene error (the core is the only place that
 validates a scene).  :class:`InconsistentInitialStateError` is defined in Python (raised by the
-initial-state correction in :mod:`ukflex.system` from the core's report) as a subclass of the
+initial-state correction in :mod:`ukflex.model.system` from the core's report) as a subclass of the
 core's base class :class:`UkflexError`.
 """
 

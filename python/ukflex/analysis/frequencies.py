@@ -52,7 +52,7 @@ def frequencies(
     count : int, optional
         Only the ``count`` modes nearest zero.
     deadline : float, optional
-        A ``time.perf_counter()`` value: past it :class:`ukflex.modes.BudgetExceeded` is
+        A ``time.perf_counter()`` value: past it :class:`ukflex.analysis.modes.BudgetExceeded` is
         raised naming the stage (``simulate``'s ``max_wall_time`` for ``method="auto"``).
 
     Returns
@@ -115,7 +115,7 @@ def max_frequency(system: Any, t: Optional[float] = None, q: Optional[np.ndarray
     """The fastest natural frequency ``omega_max`` [rad/s] of the constrained system
     linearized at a state (default the initial state): below :attr:`SPARSE_MODES_MIN`
     coordinates the largest ``|omega|`` of :meth:`frequencies`; above, Lanczos on the sparse
-    linearization in the constraints' tangent space (:func:`ukflex.modes.max_frequency`: an
+    linearization in the constraints' tangent space (:func:`ukflex.analysis.modes.max_frequency`: an
     estimate from below, within 1e-3 on the scenes measured, docs/scale.md)."""
     t = system.t0 if t is None else float(t)
     q = system.q0 if q is None else np.asarray(q, dtype=float)

@@ -19,7 +19,6 @@ The stability *report* over the catalogue of extreme scenes is a study:
 from __future__ import annotations
 
 import math
-import sys
 import time
 import warnings
 from dataclasses import dataclass
@@ -668,27 +667,3 @@ def scaling_accuracy(system: System, t: Optional[float] = None, q=None, qd=None)
     B = np.linalg.solve(L, A.T).T
     out["cond_B"] = float(np.linalg.cond(B))
     return out
-
-
-# ------------------------------------------------------------------------------------ deprecated
-def __getattr__(name: str) -> Any:
-    if name == "report":  # deprecated alias, removed in the next release
-        warnings.warn("ukflex.stability.report moved to ukflex.studies.stability.report", DeprecationWarning,
-                      stacklevel=2)
-        from ..studies.stability import report
-
-        return report
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    """Deprecated: ``python -m ukflex.stability ARGS`` is ``ukflex stability ARGS``."""
-    warnings.warn("'python -m ukflex.stability' is deprecated; use 'ukflex stability'", DeprecationWarning,
-                  stacklevel=2)
-    from ..cli import main as cli_main
-
-    return cli_main(["stability", *(sys.argv[1:] if argv is None else argv)])
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

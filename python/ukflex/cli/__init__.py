@@ -36,7 +36,6 @@ import csv
 import os
 import sys
 import time
-import warnings
 from typing import Any, Callable, Dict, List, Optional, Sequence, TextIO
 
 import numpy as np
@@ -422,9 +421,8 @@ def _cmd_list(args: argparse.Namespace) -> int:
 
     for name, fn in SCENES.items():
         print(f"{name}: {_scene_summary(fn)}")
-        for p, default, aliases in scene_parameters(fn):
-            old = f"  (deprecated alias: {', '.join(aliases)})" if aliases else ""
-            print(f"    --param {p}={default!r}{old}")
+        for p, default in scene_parameters(fn):
+            print(f"    --param {p}={default!r}")
     print("Run 'ukflex run NAME --param KEY=VALUE ...'; 'ukflex export NAME' writes a scene as a TOML file.")
     return 0
 
@@ -535,25 +533,10 @@ _FMT = argparse.RawDescriptionHelpFormatter
 _THEORIES = ("timoshenko", "euler-bernoulli")
 
 
-class _DeprecatedAlias(argparse.Action):
-    """An old option name that still works for one release: stores into the new option's
-    destination and says so on stderr."""
-
-    def __init__(self, option_strings: Sequence[str], dest: str, new: str = "", **kwargs: Any):
-        self.new = new
-        super().__init__(option_strings, dest, **kwargs)
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        print(f"{parser.prog}: {option_string} is deprecated and will be removed; use {self.new}", file=sys.stderr)
-        setattr(namespace, self.dest, values)
-
-
 def _add_theory_option(p: argparse.ArgumentParser, default: Optional[str] = "timoshenko") -> None:
-    """--theory (and its deprecated alias --beam)."""
+    """--theory."""
     shown = f"default {default}" if default else "default both"
     p.add_argument("--theory", choices=_THEORIES, default=default, help=f"coupler beam theory ({shown})")
-    p.add_argument("--beam", dest="theory", choices=_THEORIES, action=_DeprecatedAlias, new="--theory",
-                   help=argparse.SUPPRESS)
 
 
 def _add_paper_parser(sub) -> None:
@@ -847,25 +830,22 @@ def main(argv: Optional[List[str]] = None) -> int:
         if getattr(args, key, None) not in (None, "-"):
             setattr(args, key, os.path.normpath(getattr(args, key)))
     _private_matplotlib_cache()
-    with warnings.catch_warnings():
-        # old parameter names (--param beam=..., g=...) still work: say so on stderr
-        warnings.filterwarnings("default", category=DeprecationWarning, module=r"ukflex(\.|$)")
-        try:
-            if getattr(args, "out", None):  # an unwritable output folder fails now, not after the work
-                _writable_dir(args.out, "--out")
-            return int(args.func(args) or 0)
-        except (UkflexError, UserError, ValueError, TypeError, NotImplementedError, KeyError, OverflowError,
-                RecursionError, MemoryError, OSError) as exc:
-            # user-facing problems (bad scene files, paths or parameters, inconsistent scenes, sizes
-            # beyond this machine): one line, exit 2
-            msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
-            text = " ".join(f"{msg}".split()) or type(exc).__name__
-            label = "" if isinstance(exc, UserError) else f"{type(exc).__name__}: "
-            print(f"ukflex {args.command}: error: {label}{text}", file=sys.stderr)
-            return 2
-        except KeyboardInterrupt:
-            print(f"ukflex {args.command}: interrupted", file=sys.stderr)
-            return 130
+    try:
+        if getattr(args, "out", None):  # an unwritable output folder fails now, not after the work
+            _writable_dir(args.out, "--out")
+        return int(args.func(args) or 0)
+    except (UkflexError, UserError, ValueError, TypeError, NotImplementedError, KeyError, OverflowError,
+            RecursionError, MemoryError, OSError) as exc:
+        # user-facing problems (bad scene files, paths or parameters, inconsistent scenes, sizes
+        # beyond this machine): one line, exit 2
+        msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+        text = " ".join(f"{msg}".split()) or type(exc).__name__
+        label = "" if isinstance(exc, UserError) else f"{type(exc).__name__}: "
+        print(f"ukflex {args.command}: error: {label}{text}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"ukflex {args.command}: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

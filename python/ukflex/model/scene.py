@@ -22,7 +22,6 @@ Example
 from __future__ import annotations
 
 import copy
-import warnings
 from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
@@ -373,23 +372,6 @@ _REFS = {"rigid": RigidBodyRef, "beam": BeamRef, "ancf_beam": BeamRef, "point_ma
 # --------------------------------------------------------------------------------------------
 
 
-def _positional_spring_args(args: Sequence[Any], stiffness: Any, damping: Any, rest_length: Any, name: Any):
-    """The deprecated positional ``spring_damper(a, b, stiffness, damping, rest_length, name)``."""
-    order = ("stiffness", "damping", "rest_length", "name")
-    if len(args) > len(order):
-        raise TypeError(f"spring_damper() takes at most {2 + len(order)} positional arguments, got {2 + len(args)}")
-    given = {"stiffness": stiffness, "damping": damping, "rest_length": rest_length, "name": name}
-    defaults = {"stiffness": None, "damping": 0.0, "rest_length": None, "name": None}
-    for key, value in zip(order, args):
-        if given[key] != defaults[key]:
-            raise TypeError(f"spring_damper() got {key} both by position and by keyword")
-        given[key] = value
-    warnings.warn("spring_damper(a, b, stiffness, damping, ...) with positional values is deprecated: write "
-                  f"spring_damper(a, b, {', '.join(f'{k}=...' for k in order[:len(args)])})",
-                  DeprecationWarning, stacklevel=3)
-    return given["stiffness"], given["damping"], given["rest_length"], given["name"]
-
-
 def _given(**fields: Any) -> Dict[str, Any]:
     """The fields that were given (``None`` means: the core's default)."""
     return {k: v for k, v in fields.items() if v is not None}
@@ -663,7 +645,7 @@ class Scene:
         self,
         a: MarkerLike,
         b: MarkerLike,
-        *args: Any,
+        *,
         stiffness: Optional[float] = None,
         damping: float = 0.0,
         rest_length: Optional[float] = None,
@@ -674,11 +656,8 @@ class Scene:
 
         ``rest_length=None`` (the default) takes the distance between the markers at the
         initial guess (undeformed beams), so the spring starts unloaded; the description
-        records the value. The old positional form ``spring_damper(a, b, k, c, l0, name)``
-        still works with a ``DeprecationWarning``.
+        records the value.
         """
-        if args:
-            stiffness, damping, rest_length, name = _positional_spring_args(args, stiffness, damping, rest_length, name)
         if stiffness is None:
             raise TypeError("spring_damper() missing the keyword argument 'stiffness'")
         d = dict(kind="spring_damper", a=a, b=b, stiffness=stiffness, damping=damping, **_given(rest_length=rest_length))

@@ -16,7 +16,7 @@ optional tables:
     ``t_end``, ``method``, ``rtol``, ``atol``, ``formulation``, ``samples`` (output points),
     ``max_step``, ``first_step``.  Command-line options override them.
 ``[output]``
-    ``plot`` (list of output expressions, see :mod:`ukflex.outputs`), ``animate`` (bool),
+    ``plot`` (list of output expressions, see :mod:`ukflex.results.outputs`), ``animate`` (bool),
     ``deform_scale``, ``fps``, ``frames``.
 
 Example (a rigid pendulum)::

@@ -8,10 +8,7 @@ Parameter names are the same in every scene (and in ``ukflex run NAME --param KE
 ``"euler-bernoulli"``; on the four-bar ``None`` keeps the coupler rigid), ``elements`` a beam's
 element count, ``gravity`` is ``True`` (9.81 m/s^2 along -Y), ``False``, a magnitude along -Y or
 a vector (:func:`gravity_vector`), ``<link>_length`` a link length, ``omega`` a crank speed,
-``density``, ``youngs_modulus``, ``poisson_ratio``, ``shear_factor`` the material.  The old
-spellings ``beam=`` (slider_crank), ``g=`` (pendulum, double_pendulum), ``flexible_coupler=``,
-``crank=``, ``coupler=``, ``rocker=``, ``ground=`` (four_bar) still work for one release, with a
-``DeprecationWarning``.
+``density``, ``youngs_modulus``, ``poisson_ratio``, ``shear_factor`` the material.
 """
 
 from __future__ import annotations
@@ -20,7 +17,6 @@ import math
 import numbers
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
-from .._deprecation import renamed_parameters
 from ..errors import InvalidSceneError
 from .scene import Circular, ConstantSpeed, CustomSection, Harmonic, Polynomial, Rectangular, Scene
 
@@ -158,7 +154,6 @@ def _round_beam(s: Scene, name: str, length: float, elements: int, theory: str, 
                   **_beam_kind(formulation, theory, strain, poisson_ratio, shear_factor))
 
 
-@renamed_parameters(beam="theory")
 @_checked
 def slider_crank(
     theory: Optional[str] = None,
@@ -189,7 +184,7 @@ def slider_crank(
     Parameters
     ----------
     theory : {"timoshenko", "euler-bernoulli"}, optional
-        Coupler beam theory (deprecated alias: ``beam``); default ``"timoshenko"`` (the paper's)
+        Coupler beam theory; default ``"timoshenko"`` (the paper's)
         for the FFRF coupler, ``"euler-bernoulli"`` (the only one) for the ANCF coupler.
     elements : int
         Number of coupler elements (the paper: 1).
@@ -251,7 +246,6 @@ def slider_crank(
     return s
 
 
-@renamed_parameters(g="gravity")
 @_checked
 def pendulum(
     length: float = 1.0,
@@ -265,7 +259,7 @@ def pendulum(
     The body reference point is the rod's centre, so all three coordinates move; the pivot is the
     rod end ``(-L/2, 0)`` pinned to the world origin.  ``angle`` is measured from +X (``-pi/2``
     hangs straight down).  Conservative: ``T + V`` is constant.  ``gravity``: see
-    :func:`gravity_vector` (deprecated alias: ``g``, a magnitude).
+    :func:`gravity_vector`.
     """
     s = Scene(gravity=gravity_vector(gravity))
     c, si = math.cos(angle), math.sin(angle)
@@ -283,7 +277,6 @@ def pendulum(
     return s
 
 
-@renamed_parameters(g="gravity")
 @_checked
 def double_pendulum(
     lengths: Tuple[float, float] = (1.0, 0.7),
@@ -292,7 +285,7 @@ def double_pendulum(
     gravity: Any = True,
 ) -> Scene:
     """Two uniform rigid rods in a chain, released from rest (angles from +X).  ``gravity``: see
-    :func:`gravity_vector` (deprecated alias: ``g``, a magnitude)."""
+    :func:`gravity_vector`."""
     s = Scene(gravity=gravity_vector(gravity))
     (l1, l2), (m1, m2), (a1, a2) = lengths, masses, angles
     p1 = (0.5 * l1 * math.cos(a1), 0.5 * l1 * math.sin(a1))
@@ -305,8 +298,6 @@ def double_pendulum(
     return s
 
 
-@renamed_parameters(crank="crank_length", coupler="coupler_length", rocker="rocker_length", ground="ground_length",
-                    flexible_coupler="theory")
 @_checked
 def four_bar(
     crank_length: float = 0.1,
@@ -330,11 +321,10 @@ def four_bar(
     Parameters
     ----------
     crank_length, coupler_length, rocker_length, ground_length : float
-        Link lengths [m] (deprecated aliases: ``crank``, ``coupler``, ``rocker``, ``ground``).
+        Link lengths [m].
     theory : {None, "timoshenko", "euler-bernoulli"}
         ``None``: rigid coupler; else the coupler is a pinned-pinned steel beam (rectangular
-        10 x 5 mm section) with ``elements`` elements of this theory (deprecated alias:
-        ``flexible_coupler``).
+        10 x 5 mm section) with ``elements`` elements of this theory.
     formulation : {None, "ffrf", "ancf"}
         The flexible coupler's formulation: ``"ffrf"`` (the default when ``theory`` is given) or
         ``"ancf"`` (the ANCF cable, Euler-Bernoulli: ``theory`` may stay ``None``).  ``None`` with
@@ -791,14 +781,9 @@ SCENES: Dict[str, Callable[..., Scene]] = {
 }
 
 
-def scene_parameters(fn: Callable[..., Scene]) -> List[Tuple[str, Any, List[str]]]:
-    """``[(name, default, deprecated aliases)]`` of a scene function's parameters (``ukflex list``)."""
+def scene_parameters(fn: Callable[..., Scene]) -> List[Tuple[str, Any]]:
+    """``[(name, default)]`` of a scene function's parameters (``ukflex list``)."""
     import inspect
 
-    renamed: Dict[str, str] = getattr(fn, "__renamed_parameters__", {})
-    out = []
-    for p in inspect.signature(fn).parameters.values():
-        if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
-            continue
-        out.append((p.name, p.default, [old for old, new in renamed.items() if new == p.name]))
-    return out
+    return [(p.name, p.default) for p in inspect.signature(fn).parameters.values()
+            if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]

@@ -14,7 +14,7 @@ An *output expression* is one of
   length (``v(coupler, 0.5)/L``, the paper's Fig. 4);
 * ``psi(BEAM, XI)``: cross-section rotation relative to the beam frame;
 * ``x(BEAM, XI)``, ``y(BEAM, XI)``: world position of the deformed beam axis point;
-* sensors (:mod:`ukflex.sensors`, docs/outputs.md): ``reaction(JOINT).fx`` (``fy``, ``torque``,
+* sensors (:mod:`ukflex.results.sensors`, docs/outputs.md): ``reaction(JOINT).fx`` (``fy``, ``torque``,
   ``fx_local``, ``fy_local``, ``power``), ``work(DRIVER)``, ``energy.kinetic`` (``strain``,
   ``gravity``, ``springs``, ``loads``, ``total``), ``energy(BODY).kinetic``, ``work.drivers``,
   ``work.external``, ``dissipated``, ``balance``, ``N(BEAM, XI)`` (``V``, ``M``, ``eps``,

@@ -56,7 +56,7 @@ class SimulationResult:
         ``solve_ivp`` returns them.
     sol : callable or None
         With ``dense_output=True``: ``sol(t)`` -> (2n,) or (2n, k) (scipy's ``OdeSolution`` or
-        :class:`ukflex.simulate.DenseSolution`).
+        :class:`ukflex.run.simulate.DenseSolution`).
     stop : dict or None
         Why a run ended early (``status == -1``): ``cause`` (``"max_steps"``, ``"max_nfev"``,
         ``"max_wall_time"``, ``"min_step"``, ``"non_finite"``, ``"solver"``), ``t`` (the last
@@ -162,7 +162,7 @@ class SimulationResult:
 
     @property
     def sensors(self):
-        """Reactions, energies, work, beam internal forces (:class:`ukflex.sensors.Sensors`)."""
+        """Reactions, energies, work, beam internal forces (:class:`ukflex.results.sensors.Sensors`)."""
         from .sensors import Sensors
 
         return self.__dict__.setdefault("_sensors", Sensors(self))

@@ -299,7 +299,7 @@ def local_newton_ok(h: float, omega_max: float) -> bool:
 def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.ndarray] = None,
                   qd: Optional[np.ndarray] = None, deadline: Optional[float] = None) -> MethodChoice:
     """The integrator ``method="auto"`` runs for ``system`` over ``[t0, t_end]`` at ``rtol``
-    (``deadline``: a ``time.perf_counter()`` value; past it ``ukflex.modes.BudgetExceeded``)."""
+    (``deadline``: a ``time.perf_counter()`` value; past it ``ukflex.analysis.modes.BudgetExceeded``)."""
     span = float(t_end) - float(t0)
     if not (math.isfinite(span) and span > 0.0):
         raise ValueError(f"t_end must be finite and greater than t0 = {t0}, got {t_end!r}")

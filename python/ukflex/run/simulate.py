@@ -154,7 +154,7 @@ def simulate(
         ``jacobian``, RADAU5M and GENALPHA also ``step`` (with a fixed step ``rtol`` sets only
         the Newton tolerance), GENALPHA also ``rho_inf`` and ``newton_local_error`` (Newton may
         stop at this fraction of the step's local error estimate; safe only on coarse steps,
-        ``h omega_max >= ukflex.choice.LOCAL_NEWTON_MIN_STEP_OMEGA``: on finer ones it feeds on
+        ``h omega_max >= ukflex.run.choice.LOCAL_NEWTON_MIN_STEP_OMEGA``: on finer ones it feeds on
         its own error);
         see docs/integrators.md.
     rtol : float

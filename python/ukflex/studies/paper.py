@@ -22,7 +22,7 @@ call.  Here:
    states, in order; the time of one sweep is summed with ``time.perf_counter`` and the best of
    ``repeats`` (default 5) sweeps is kept:
 
-   * UK, Rust kernel (:func:`ukflex.simulate.time_acceleration`: the kernel timed inside Rust,
+   * UK, Rust kernel (:func:`ukflex.run.simulate.time_acceleration`: the kernel timed inside Rust,
      one call per state);
    * UK, Rust through the Python binding (``System.qdd(t, q, qd)``, what scipy pays);
    * UK, NumPy (``ukflex.reference``: ``ReferenceModel.terms`` + ``uk_qdd``, the paper's
