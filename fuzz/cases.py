@@ -642,10 +642,10 @@ def _check_threads(case: Dict[str, Any]) -> List[Finding]:
         t, y = s
         return np.concatenate([system.rhs(t, y), system.multipliers(t, y[:n], y[n:])])
 
-    def configured(st):  # per-run settings on the shared System (stability.run must not leak them)
-        from ukflex import stability
+    def configured(st):  # per-run settings on the shared System (simulate's stabilization= must not leak them)
+        import ukflex
 
-        return np.asarray(stability.run(system, 0.002, "RK45", rtol=1e-6, t_eval=te[:3], stabilization=st).y)
+        return np.asarray(ukflex.simulate(system, 0.002, "RK45", rtol=1e-6, t_eval=te[:3], stabilization=st or "none", raise_on_failure=True).y)
 
     jobs = ([lambda r=r: run(r) for r in case["rtols"]] + [lambda s=s: calls(s) for s in states]
             + [lambda st=st: configured(st) for st in case.get("settings", [])])

@@ -34,9 +34,8 @@ r = ukflex.simulate(sy, 1e-3, method="RADAU5"); print(r.status, r.message)"""),
 r = ukflex.simulate(ukflex.scenes.pendulum(), 1e9, method="RK45")
 print("status", r.status, "t reached", r.t[-1], "|", r.message)"""),
     ("max_step=1e-300", "py", """ukflex.simulate(ukflex.scenes.pendulum(), 1.0, method="RK45", max_step=1e-300)"""),
-    ("stability.run with default budgets, 1e4 s", "py", """
-from ukflex import stability
-r = stability.run(ukflex.scenes.pendulum(), 1e4, raise_on_failure=False)
+    ("simulate with a stabilization and default budgets, 1e4 s", "py", """
+r = ukflex.simulate(ukflex.scenes.pendulum(), 1e4, "DOPRI5", stabilization="none")
 print("status", r.status, "outputs", r.t.size, "|", r.message)"""),
     ("slider_crank(diameter=1e100)", "py", "ukflex.System(ukflex.scenes.slider_crank(diameter=1e100))"),
     ("custom section area 1e-300, I 1e300", "py", """

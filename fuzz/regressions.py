@@ -81,7 +81,7 @@ def _unresolved_positions() -> None:
 
 
 def _shared_settings() -> None:
-    """stability.run configuring the caller's System (settings shared across threads)."""
+    """simulate(..., stabilization=...) configuring the caller's System (settings shared across threads)."""
     from ukflex.model import system as system_module
 
     system_module.System.copy = lambda self: self

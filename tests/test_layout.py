@@ -42,6 +42,8 @@ def _imports(name, path):
 
     def visit(node, func):
         for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.If) and getattr(child.test, "id", None) == "TYPE_CHECKING":
+                continue  # annotations only: not a dependency
             f = child.name if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)) and func is None else func
             if isinstance(child, ast.Import):
                 out.extend((a.name, [], func) for a in child.names)
@@ -101,6 +103,55 @@ def test_studies_use_only_public_names():
                 assert node.attr != "core", f"{name}:{node.lineno} reaches into System.core"
                 private = node.attr.startswith("_") and not node.attr.startswith("__")
                 assert not private, f"{name}:{node.lineno} uses private attribute {node.attr}"
+
+
+#: The rooms of the package (docs/architecture.md) and the rooms each may import. The base
+#: (``errors``, ``arguments``, ``_core``) is open to every room; ``ukflex/__init__.py`` (the public
+#: names) and ``__main__`` may import any room.
+ROOMS = {
+    "reference": set(),                                          # the independent NumPy model
+    "analysis": {"reference"},                                   # works on the System it is given
+    "model": {"analysis"},                                       # System's documented analysis methods delegate
+    "results": set(),
+    "run": {"model", "results", "analysis", "reference"},
+    "benchmarks": {"model", "results", "analysis", "run", "reference"},  # ukflex paper, ukflex bench
+    "cli": {"model", "results", "analysis", "run", "reference", "benchmarks", "studies"},
+    "studies": {"model", "results", "analysis", "run", "reference"},  # leaves the wheel (issue 29 item 5)
+}
+#: (module, imported module) edges allowed against the room rules, each with its reason.
+ROOM_EXCEPTIONS = {
+    # the method lists a scene file's [solver] table is checked against; they move into the core
+    # with the run-option rules (issue 29 item 3, the Rust side)
+    ("ukflex.model.scenefile", "ukflex.run.simulate"): "method names",
+}
+BASE = {"ukflex.errors", "ukflex.arguments", "ukflex._core"}
+
+
+def _room(module):
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 and parts[1] in ROOMS else None
+
+
+def test_rooms_import_only_what_their_rules_allow():
+    bad = []
+    for name, path in MODULES.items():
+        room = _room(name)
+        if room is None:
+            continue
+        for e in set(_edges(name, path)):
+            other = _room(e)
+            if e in BASE or other == room or (name, e) in ROOM_EXCEPTIONS:
+                continue
+            if e == "ukflex" and room in ("benchmarks", "cli", "studies"):
+                continue  # the public names
+            if other is None or other not in ROOMS[room]:
+                bad.append(f"{name} -> {e}")
+    assert bad == []
+
+
+def test_base_imports_no_room():
+    for name in BASE - {"ukflex._core"}:
+        assert {e for e in _edges(name, MODULES[name]) if e not in BASE} == set(), name
 
 
 def test_no_import_cycles():

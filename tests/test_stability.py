@@ -27,7 +27,7 @@ def test_scaling_accuracy_on_a_fine_mesh():
     """cond(M) ~ 1e8: the core's block-Cholesky UK keeps full accuracy; the paper's symmetric
     root M^-1/2 loses digits, and the diagonal scaling D = diag(M)^-1/2 recovers them."""
     system = X.stiff(1.0, elements=64).build()
-    r = S.run(system, 0.002, "DOPRI5", rtol=1e-8, t_eval=[0.0, 0.002])
+    r = ukflex.simulate(system, 0.002, "DOPRI5", rtol=1e-8, t_eval=[0.0, 0.002], stabilization="none", raise_on_failure=True)
     a = S.scaling_accuracy(system, r.t[-1], r.q[:, -1], r.qd[:, -1])
     assert a["cond_M"] > 5e7 and a["cond_M_scaled"] < 1e4
     assert a["rust_uk"] < 1e-13
@@ -38,23 +38,23 @@ def test_scaling_accuracy_on_a_fine_mesh():
 def test_native_failure_raises_with_partial_result():
     system = ukflex.scenes.slider_crank().build()
     with pytest.raises(S.IntegrationFailure) as ei:
-        S.run(system, 0.01, "DOPRI5", rtol=1e-6, max_steps=50)
+        ukflex.simulate(system, 0.01, "DOPRI5", rtol=1e-6, max_steps=50, stabilization="none", raise_on_failure=True)
     part = ei.value.result
     assert part.status == -1 and 0 < part.t[-1] < 0.01 and part.t.size > 10
     assert ei.value.t_fail == part.t[-1]
-    res = S.run(system, 0.01, "DOPRI5", rtol=1e-6, max_steps=50, raise_on_failure=False)
+    res = ukflex.simulate(system, 0.01, "DOPRI5", rtol=1e-6, max_steps=50, raise_on_failure=False, stabilization="none")
     assert res.status == -1 and np.array_equal(res.t, part.t)
 
 
 def test_drift_warning_and_baumgarte_option_validation():
     system = ukflex.scenes.slider_crank().build()
-    r = S.run(system, 0.01, "DOPRI5", rtol=1e-3)
+    r = ukflex.simulate(system, 0.01, "DOPRI5", rtol=1e-3, stabilization="none", raise_on_failure=True)
     with pytest.warns(S.DriftWarning):
         S.check(r, drift_threshold=1e-14, rank=False)
     with pytest.raises(ValueError):
-        S.run(system, 0.01, "DOPRI5", stabilization="sideways")
+        ukflex.simulate(system, 0.01, "DOPRI5", stabilization="sideways", raise_on_failure=True)
     with pytest.raises(ValueError):
-        S.run(system, 0.01, "DOPRI5", stabilization=("baumgarte", -1.0, 1.0))
+        ukflex.simulate(system, 0.01, "DOPRI5", stabilization=("baumgarte", -1.0, 1.0), raise_on_failure=True)
 
 
 def test_report_writes_markdown_for_one_case(tmp_path):

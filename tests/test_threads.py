@@ -110,16 +110,14 @@ def test_native_run_releases_the_gil():
 
 def test_concurrent_runs_with_different_settings_on_one_system_match_serial():
     # issue 15: settings used to live on the shared System, so two threads with different
-    # stabilizations got each other's (35 of 40 scipy runs wrong here without the copy); stability.run
-    # now works on a copy
-    from ukflex import stability
-
+    # stabilizations got each other's (35 of 40 scipy runs wrong here without the copy); simulate's
+    # stabilization= now works on a copy
     shared = ukflex.System(ukflex.scenes.slider_crank(elements=2))
     settings = [None, ("baumgarte", 50.0, 50.0), ("baumgarte", 500.0, 500.0), "projection"] * 2
     te = np.linspace(0.0, 0.004, 5)
 
     def run(st):
-        r = stability.run(shared, 0.004, "RK45", rtol=1e-6, t_eval=te, stabilization=st)  # rhs reads settings per call
+        r = ukflex.simulate(shared, 0.004, "RK45", rtol=1e-6, t_eval=te, stabilization=st or "none", raise_on_failure=True)  # rhs reads settings per call
         return r.y
 
     serial = [run(st) for st in settings]

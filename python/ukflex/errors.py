@@ -24,6 +24,7 @@ __all__ = [
     "InvalidSceneError",
     "SingularMassError",
     "SolverError",
+    "IntegrationFailure",
     "NonFiniteError",
     "MemoryLimitError",
     "BudgetError",
@@ -90,6 +91,26 @@ def require(module: str, what: str, extra: str = "plot") -> Any:
         raise MissingDependencyError(
             f"{what} needs {pkg!r}, which is not installed: pip install 'ukflex[{extra}]' (or {pkg} alone)"
         ) from None
+
+
+class IntegrationFailure(SolverError):  # type: ignore[misc, valid-type]
+    """The integration failed; ``result`` holds everything computed up to the failure.
+
+    Attributes
+    ----------
+    result : ukflex.SimulationResult
+        Accepted steps (or requested outputs) up to the failure, ``status = -1``.
+    reason : str
+        The integrator's or the core's message.
+    t_fail : float
+        Last time reached.
+    """
+
+    def __init__(self, message: str, result: Any = None, reason: str = "", t_fail: float = float("nan")):
+        super().__init__(message)
+        self.result = result
+        self.reason = reason
+        self.t_fail = t_fail
 
 
 class InvalidArgumentError(UkflexError, ValueError, TypeError):  # type: ignore[misc, valid-type]

@@ -1,9 +1,5 @@
 """Numerical stability on stiff and extreme cases: safeguards and diagnostics.
 
-* :func:`run` -- integrate with a chosen stabilization (``None``, Baumgarte, projection onto the
-  constraint manifold), rank tolerance and integrator (native Rust ``DOPRI5`` / ``RADAU5`` or any
-  ``solve_ivp`` method), keeping the partial result when the integration fails
-  (:class:`IntegrationFailure` carries it).
 * diagnostics on a :class:`ukflex.SimulationResult`: :func:`rank_history` (rank of the UK
   pseudoinverse and the dropped singular values, reported where they change),
   :func:`drift`, :func:`axial_force` / :func:`buckling_load` / :func:`buckling_ratio`,
@@ -12,25 +8,27 @@
   without the diagonal scaling ``D = diag(M)^-1/2``, against an extended-precision (x87 80-bit
   ``longdouble``) augmented solve.
 
-The stability *report* over the catalogue of extreme scenes is a study:
-:func:`ukflex.studies.stability.report` (``ukflex stability --out DIR [--quick]``).
+Runs with a chosen stabilization (none, Baumgarte, projection), rank tolerance and
+pseudoinverse are :func:`ukflex.simulate`'s (``stabilization=``, ``rank_tolerance=``,
+``pseudoinverse=``; ``raise_on_failure=True`` raises :class:`IntegrationFailure` with the partial
+result).  The stability *report* over the catalogue of extreme scenes is a study of the
+repository: ``python -m studies stability --out DIR [--quick]``.
 """
 
 from __future__ import annotations
 
 import math
-import time
 import warnings
 from dataclasses import dataclass
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import TYPE_CHECKING, Any, Dict, List, Optional, Tuple
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
-from ..errors import SolverError, UnknownNameError
-from ..results.simulation import SimulationResult
-from ..run.simulate import DEFAULT_MAX_STEPS, NATIVE_METHODS, as_system, simulate
-from ..model.system import System
+from ..errors import UnknownNameError
+
+if TYPE_CHECKING:  # annotations only: the diagnostics read the System and result they are given
+    from ..model.system import System
+    from ..results.simulation import SimulationResult
 
 __all__ = [
     "StabilityWarning",
@@ -40,8 +38,6 @@ __all__ = [
     "ModelValidityWarning",
     "IntegrationFailure",
     "Diagnosis",
-    "NATIVE_METHODS",
-    "run",
     "rank_history",
     "drift",
     "beam_properties",
@@ -61,259 +57,11 @@ __all__ = [
 from ..errors import (  # noqa: E402
     BucklingWarning,
     DriftWarning,
+    IntegrationFailure,
     ModelValidityWarning,
     RankDeficiencyWarning,
     StabilityWarning,
 )
-
-
-class IntegrationFailure(SolverError):  # type: ignore[misc, valid-type]
-    """The integration failed; ``result`` holds everything computed up to the failure.
-
-    Attributes
-    ----------
-    result : SimulationResult
-        Accepted steps (or requested outputs) up to the failure, ``status = -1``.
-    reason : str
-        The integrator's or the core's message.
-    t_fail : float
-        Last time reached.
-    """
-
-    def __init__(self, message: str, result: Optional[SimulationResult] = None, reason: str = "", t_fail: float = float("nan")):
-        super().__init__(message)
-        self.result = result
-        self.reason = reason
-        self.t_fail = t_fail
-
-
-# ------------------------------------------------------------------------------------ running
-def _configure(system: System, stabilization: Any, rank_tolerance: Any,
-               pseudoinverse: Optional[str]) -> Tuple[Any, Optional[float], float]:
-    """Apply stabilization, rank tolerance and pseudoinverse to the system.
-
-    Returns ``(label, projection_tol, interval)``: ``label`` is ``"none"``, ``"projection"`` or
-    ``{"kind": "baumgarte", "alpha": a, "beta": b}`` (stored in the result's ``extra``).
-    """
-    label: Any = "none"
-    proj_tol, interval = None, 0.0
-    system.set_stabilization("none")
-    if stabilization is None or stabilization == "none":
-        pass
-    elif isinstance(stabilization, str) and stabilization == "projection":
-        label, proj_tol = "projection", 1e-12
-    elif isinstance(stabilization, dict):
-        kind = stabilization.get("kind", "none")
-        if kind == "baumgarte":
-            label = _baumgarte(system, stabilization["alpha"], stabilization["beta"])
-        elif kind == "projection":
-            label = "projection"
-            proj_tol = float(stabilization.get("tol", 1e-12))
-            interval = float(stabilization.get("interval", 0.0))
-        elif kind != "none":
-            raise ValueError(f"unknown stabilization kind {kind!r} (use 'none', 'baumgarte', 'projection')")
-    elif isinstance(stabilization, (tuple, list)) and stabilization and stabilization[0] == "baumgarte":
-        label = _baumgarte(system, stabilization[1], stabilization[2])
-    else:
-        raise ValueError(
-            "stabilization must be None, 'projection', ('baumgarte', alpha, beta) or a dict with kind "
-            f"'none' | 'baumgarte' (alpha, beta) | 'projection' (tol, interval); got {stabilization!r}"
-        )
-    if rank_tolerance is not None:
-        if isinstance(rank_tolerance, dict):
-            system.set_rank_tolerance(rank_tolerance.get("rcond"), float(rank_tolerance.get("atol", 0.0)))
-        else:
-            rcond, atol = rank_tolerance
-            system.set_rank_tolerance(rcond, float(atol))
-    if pseudoinverse is not None:
-        system.set_pseudoinverse(pseudoinverse)
-    return label, proj_tol, interval
-
-
-def _baumgarte(system: System, alpha: Any, beta: Any) -> Dict[str, Any]:
-    system.set_stabilization("baumgarte", float(alpha), float(beta))
-    return {"kind": "baumgarte", "alpha": alpha, "beta": beta}
-
-
-def run(
-    scene_or_system: Any,
-    t_end: float,
-    method: str = "DOPRI5",
-    rtol: float = 1e-6,
-    atol: Optional[float] = None,
-    t_eval: Optional[Sequence[float]] = None,
-    *,
-    stabilization: Any = None,
-    rank_tolerance: Any = None,
-    pseudoinverse: Optional[str] = None,
-    max_step: Optional[float] = None,
-    max_steps: int = DEFAULT_MAX_STEPS,
-    max_nfev: Optional[int] = None,
-    raise_on_failure: bool = True,
-) -> SimulationResult:
-    """Integrate the UK equations (Rust core) with a stabilization option.
-
-    Parameters
-    ----------
-    scene_or_system : Scene, dict or System
-        What to run.  The system's stabilization and rank tolerance are set by this call.
-    t_end : float
-        End time [s].
-    method : str
-        ``"DOPRI5"`` / ``"RADAU5"`` (native Rust, GIL released) or a ``solve_ivp`` method
-        (``"DOP853"``, ``"Radau"``, ...).
-    rtol, atol : float
-        Tolerances (``atol`` default ``1e-3 rtol``).
-    t_eval : array, optional
-        Output times (default: every accepted step).
-    stabilization : None, "projection", ("baumgarte", alpha, beta) or dict
-        * ``None``: plain UK (the paper): ``Phi`` drifts.
-        * ``("baumgarte", alpha, beta)`` or ``{"kind": "baumgarte", "alpha": a, "beta": b}``
-          [1/s]: the acceleration constraint becomes
-          ``Phi_dd + 2 alpha Phi_d + beta^2 Phi = 0`` (``alpha = beta``: critically damped drift,
-          decay time ``1/alpha``).  Large values make the system stiff (eigenvalues ~ -alpha).
-        * ``"projection"`` or ``{"kind": "projection", "tol": 1e-12, "interval": dt}``: after
-          each accepted step (native methods) -- or every ``interval`` seconds by restarting the
-          scipy integrator (scipy methods; default ``interval = (t_end - t0) / 100``) -- project
-          ``q`` onto ``Phi = 0`` (Newton in the mass metric) and ``qd`` onto
-          ``A qd + Phi_t = 0`` (:meth:`ukflex.System.project`).
-    rank_tolerance : (rcond, atol) or dict, optional
-        Pseudoinverse tolerance: singular values of ``A F^-T`` at or below
-        ``max(atol, rcond sigma_max)`` are dropped (``rcond=None``: ``max(m, n) eps``).
-    pseudoinverse : {"auto", "qr-jacobi", "faer"}, optional
-        Pseudoinverse backend of the core.
-    max_steps : int
-        Native methods: step limit (default: :func:`ukflex.simulate`'s, one million; it was ten
-        million, which ran 144 s on a 1e4 s pendulum before stopping).
-    max_nfev : int, optional
-        scipy methods: stop with a failure after this many right-hand-side calls (a step-size
-        collapse -- e.g. a rank decision flipping at every call -- otherwise runs for ever).
-    raise_on_failure : bool
-        When the integration fails, raise :class:`IntegrationFailure` (with the partial result in
-        ``.result``); with ``False`` return the partial result (``status = -1``).
-
-    Returns
-    -------
-    SimulationResult
-        ``extra`` holds ``stabilization``, ``projections`` (scipy) and the native statistics.
-    """
-    system = as_system(scene_or_system)
-    if system is scene_or_system:
-        # never change the caller's System: another thread may be using it with other settings
-        system = system.copy()
-    label, proj_tol, interval = _configure(system, stabilization, rank_tolerance, pseudoinverse)
-    atol_v = 1e-3 * rtol if atol is None else float(atol)
-    te = None if t_eval is None else np.asarray(t_eval, dtype=float)
-    if method.upper() in NATIVE_METHODS:
-        # "none" and Baumgarte: no projection (the native methods project by default)
-        res = simulate(system, t_end, method.upper(), rtol=rtol, atol=atol_v, t_eval=te, max_step=max_step,
-                       max_steps=max_steps, projection_tol=0.0 if proj_tol is None else proj_tol)
-    else:
-        res = _run_scipy(system, float(t_end), method, rtol, atol_v, te, proj_tol, interval, max_step, max_nfev)
-    res.extra["stabilization"] = label
-    if res.status < 0:
-        reason = res.message
-        t_fail = float(res.t[-1]) if res.t.size else system.t0
-        if raise_on_failure:
-            kind = label["kind"] if isinstance(label, dict) else label
-            raise IntegrationFailure(
-                f"integration failed at t = {t_fail:.6g} s ({res.method}, {kind}): {reason}; "
-                f"the partial result ({res.t.size} outputs) is in .result", res, reason, t_fail
-            )
-    return res
-
-
-class _Budget(Exception):
-    pass
-
-
-def _run_scipy(system, t_end, method, rtol, atol, t_eval, proj_tol, interval, max_step, max_nfev=None):
-    """solve_ivp with an accepted-step recorder (partial results survive an exception) and
-    optional projection at segment ends."""
-    n = system.n_coords
-    t0 = system.t0
-    opts: Dict[str, Any] = {}
-    if max_step is not None:
-        opts["max_step"] = max_step
-    if method in ("Radau", "BDF"):
-        opts["jac"] = system.jac
-    fun = system.rhs
-    if max_nfev is not None:
-        count = [0]
-        core_rhs = system.rhs
-
-        def fun(t, y):
-            count[0] += 1
-            if count[0] > max_nfev:
-                raise _Budget(f"more than {max_nfev} right-hand-side calls (step size collapsed near t = {t:.9g} s)")
-            return core_rhs(t, y)
-    if proj_tol is not None:
-        if interval <= 0.0:
-            interval = (t_end - t0) / 100.0
-        bounds = list(np.arange(t0, t_end, interval)) + [t_end]
-        if len(bounds) > 1 and bounds[-1] - bounds[-2] < 1e-12 * max(1.0, abs(t_end)):
-            bounds.pop(-2)
-    else:
-        bounds = [t0, t_end]
-    ts: List[float] = []
-    ys: List[np.ndarray] = []
-    y = system.y0.copy()
-    nfev = njev = nlu = 0
-    status, message = 0, "The solver successfully reached the end of the integration interval."
-    projections: List[Dict[str, float]] = []
-    tic = time.perf_counter()
-    for k in range(len(bounds) - 1):
-        ta, tb = bounds[k], bounds[k + 1]
-        rec_t: List[float] = []
-        rec_y: List[np.ndarray] = []
-
-        def recorder(t, yy):
-            rec_t.append(float(t))
-            rec_y.append(np.array(yy, dtype=float))
-            return 1.0
-
-        seg_eval = None
-        if t_eval is not None:
-            sel = (t_eval >= ta) & (t_eval <= tb) if k == 0 else (t_eval > ta) & (t_eval <= tb)
-            seg_eval = t_eval[sel]
-        try:
-            sol = solve_ivp(fun, (ta, tb), y, method=method, rtol=rtol, atol=atol, t_eval=seg_eval,
-                            events=recorder, **opts)
-        except Exception as exc:  # keep the accepted steps (requested outputs are lost with solve_ivp)
-            status, message = -1, f"{type(exc).__name__}: {exc}"
-            for tt, yy in zip(rec_t, rec_y):
-                if not ts or tt > ts[-1]:
-                    ts.append(tt)
-                    ys.append(yy)
-            break
-        nfev += int(sol.nfev)
-        njev += int(sol.njev)
-        nlu += int(sol.nlu)
-        if t_eval is None:
-            first = 0 if k == 0 else 1
-            ts.extend(sol.t[first:])
-            ys.extend(sol.y[:, first:].T)
-        else:  # a segment without requested outputs gives an empty list from solve_ivp
-            ts.extend(sol.t)
-            ys.extend(np.asarray(sol.y, dtype=float).reshape(len(y), -1).T)
-        if sol.status < 0:
-            status, message = -1, sol.message
-            break
-        y = np.array(rec_y[-1])  # the segment end state (the last accepted step, t = tb)
-        if proj_tol is not None and k < len(bounds) - 2:
-            qn, qdn, rep = system.project(tb, y[:n], y[n:], tol=proj_tol)
-            projections.append({"t": tb, **{kk: float(v) for kk, v in rep.items()}})
-            y = np.concatenate([qn, qdn])
-            if t_eval is None and ts and ts[-1] == tb:
-                ys[-1] = y.copy()
-    wall = time.perf_counter() - tic
-    extra: Dict[str, Any] = {"projections": len(projections)}
-    if projections:
-        extra["max_projection_correction"] = max(p["position_correction"] for p in projections)
-    y_arr = np.asarray(ys, dtype=float).T if ys else np.zeros((2 * n, 0))
-    return SimulationResult.from_trajectory(
-        system, np.asarray(ts, dtype=float), y_arr, method=method, formulation="uk", rtol=rtol, atol=atol, nfev=nfev,
-        njev=njev, nlu=nlu, wall_time=wall, status=status, message=message, extra=extra)
 
 
 # ------------------------------------------------------------------------------------ diagnostics

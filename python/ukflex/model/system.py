@@ -402,7 +402,7 @@ class System:
         """An independent System: same description, build options, settings and initial state,
         its own compiled object and workspace.  Settings (``set_stabilization``,
         ``set_rank_tolerance``, ``set_pseudoinverse``) belong to a System object; threads that
-        need different settings at the same time each use their own copy (``stability.run`` and
+        need different settings at the same time each use their own copy (``simulate(..., stabilization=...)`` and
         ``stability.rank_history`` do this for you)."""
         new = System.__new__(System)
         new._restore(self.__getstate__())

@@ -20,12 +20,13 @@ from scipy.integrate import DenseOutput
 from scipy.integrate._ivp.ivp import METHODS as _SCIPY_SOLVERS, find_active_events, handle_events, prepare_events
 
 from .. import _core
-from ..errors import (DriftWarning, InvalidArgumentError, NonFiniteError, SingularConfigurationWarning, SolverError,
-                     UnknownOptionError)
+from ..errors import (DriftWarning, IntegrationFailure, InvalidArgumentError, NonFiniteError,
+                     SingularConfigurationWarning, SolverError, UnknownOptionError)
 from ..arguments import COUNT_LIMIT, count as _count, positive as _positive, real as _real, real_array as _real_array
 from ..results.simulation import SimulationResult
 from ..model.scene import Scene
 from ..model.system import System, length_scale
+from .stabilization import configure, segment_bounds
 
 __all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "time_acceleration", "DenseSolution"]
 
@@ -121,6 +122,10 @@ def simulate(
     max_wall_time: Optional[float] = None,
     min_step: float = 0.0,
     on_drift: str = "stop",
+    stabilization: Any = None,
+    rank_tolerance: Any = None,
+    pseudoinverse: Optional[str] = None,
+    raise_on_failure: bool = False,
     **options: Any,
 ) -> SimulationResult:
     """Integrate the equations of motion from the system's consistent initial state to ``t_end``.
@@ -207,6 +212,34 @@ def simulate(
         its partial result and a message naming the time and the residual (a result that left
         its constraints is not the mechanism's motion); ``"warn"`` goes on and reports it
         (:class:`ukflex.DriftWarning`, ``res.extra["drift"]``).
+    stabilization : None, "none", "projection", ("baumgarte", alpha, beta) or dict
+        Constraint stabilization (formulation ``"uk"``; docs/stability.md), applied to a copy
+        of the system (the caller's System is never changed):
+
+        * ``None`` (default): the method's own (the native methods, and scipy's explicit
+          Runge-Kutta methods, project onto the constraints after every step);
+        * ``"none"``: plain UK (the paper): nothing projects and ``Phi`` drifts;
+        * ``("baumgarte", alpha, beta)`` or ``{"kind": "baumgarte", "alpha": a, "beta": b}``
+          [1/s]: the acceleration constraint becomes ``Phi_dd + 2 alpha Phi_d + beta^2 Phi = 0``
+          (``alpha = beta``: critically damped drift, decay time ``1/alpha``); large values make
+          the system stiff (eigenvalues ~ -alpha); nothing projects;
+        * ``"projection"`` or ``{"kind": "projection", "tol": 1e-12, "interval": dt}``: native
+          methods project after each accepted step to ``tol``; scipy methods stop every
+          ``interval`` seconds (default ``(t_end - t0) / 100``), project ``q`` onto ``Phi = 0``
+          (Newton in the mass metric) and ``qd`` onto ``A qd + Phi_t = 0``
+          (:meth:`ukflex.System.project`) and restart (``res.extra["projections"]``; no events
+          or dense output there).
+
+        ``res.extra["stabilization"]`` records it.
+    rank_tolerance : (rcond, atol) or dict, optional
+        Pseudoinverse tolerance of the UK solve: singular values of ``A F^-T`` at or below
+        ``max(atol, rcond sigma_max)`` are dropped (``rcond=None``: ``max(m, n) eps``); on the
+        copy of the system, as ``stabilization``.
+    pseudoinverse : {"auto", "qr-jacobi", "faer"}, optional
+        Pseudoinverse backend of the core, on the copy of the system.
+    raise_on_failure : bool
+        A run that ends early (``status = -1``) raises :class:`ukflex.stability.IntegrationFailure`
+        with the partial result in ``.result`` (default: return it).
     **options
         Solver options: ``first_step``, ``max_step``, ``jac``, ... (scipy); ``first_step``,
         ``max_step``, ``projection_tol``, ``rho_inf``, ``step``, ``newton_local_error``, ``jacobian``, ``linear_solver``
@@ -252,6 +285,14 @@ def simulate(
         system = as_system(scene_or_system, max_wall_time=_positive("max_wall_time", max_wall_time))
     else:
         system = as_system(scene_or_system)
+    label = proj_tol = None
+    interval = 0.0
+    if stabilization is not None or rank_tolerance is not None or pseudoinverse is not None:
+        if formulation != "uk":
+            raise InvalidArgumentError("stabilization", f"applies to formulation='uk' only, not {formulation!r}")
+        if system is scene_or_system:  # never change the caller's System: another thread may be using it
+            system = system.copy()
+        label, proj_tol, interval = configure(system, stabilization, rank_tolerance, pseudoinverse)
     n = system.n_coords
     if t_span is not None:
         if t_end is not None:
@@ -358,13 +399,17 @@ def simulate(
         res = simulate(system, None, method, run_rtol, atol, t_eval_v, formulation, t_span=(t0, t_end_f), q0=q_init,
                        qd0=qd_init, partition=partition, progress=progress, events=ev_list or None,
                        dense_output=dense_output, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
-                       max_wall_time=budget.remaining(), min_step=budget.min_step, on_drift=on_drift, **options)
+                       max_wall_time=budget.remaining(), min_step=budget.min_step, on_drift=on_drift,
+                       stabilization=stabilization, rank_tolerance=rank_tolerance, pseudoinverse=pseudoinverse,
+                       raise_on_failure=raise_on_failure, **options)
         if choice is not None:
             res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
         return res
     y0 = np.concatenate([q_init, qd_init])
     guard = _Guard(drift_limit(system, rtol, atol_v), on_drift == "stop")
     if method in NATIVE_METHODS:
+        if label is not None:  # "none" and Baumgarte: no projection (the native methods project by default)
+            options.setdefault("projection_tol", 0.0 if proj_tol is None else proj_tol)
         res = _simulate_native(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
                                dense_output, guard)
         if progress is not None and res.t.size:
@@ -379,9 +424,24 @@ def simulate(
     else:
         if method in ("Radau", "BDF") and "jac" not in options:
             options["jac"] = system.jac  # Rust finite differences, GIL released
-        res = _simulate_scipy(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
-                              dense_output, progress, guard)
+        if proj_tol is not None:
+            if ev_list or dense_output:
+                raise InvalidArgumentError("stabilization", "a scipy run projected at restarts takes no events or "
+                                           "dense_output (use a native method, which projects after every step)")
+            res = _simulate_scipy_restarts(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget,
+                                           progress, guard, proj_tol, interval)
+        else:
+            res = _simulate_scipy(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
+                                  dense_output, progress, guard, project=label is None)
+    res.extra.pop("_end", None)
     _report(system, res, guard, method, options)
+    if label is not None:
+        res.extra["stabilization"] = label
+    if raise_on_failure and res.status < 0:
+        t_fail = float(res.t[-1]) if res.t.size else t0
+        kind = label["kind"] if isinstance(label, dict) else (label or "default")
+        raise IntegrationFailure(f"integration failed at t = {t_fail:.6g} s ({res.method}, {kind}): {res.message}; "
+                                 f"the partial result ({res.t.size} outputs) is in .result", res, res.message, t_fail)
     return res
 
 
@@ -645,11 +705,14 @@ def _after_step(system, solver, fun, project, position_tol, atol, rtol, n, saved
     return phi, shift, False
 
 
-def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, budget, events, dense, progress, guard):
-    """``solve_ivp``'s loop over a scipy ``OdeSolver``, with work budgets, a non-finite check
-    with its cause, the drift guard at every step, and the trajectory kept when the run stops
-    early. scipy's explicit Runge-Kutta methods project onto the constraints after every step
-    and filter their error estimate (``_tangent_filtered``), as native DOPRI5 does."""
+def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, budget, events, dense, progress, guard,
+                    project=True):
+    """``solve_ivp``'s loop over a scipy ``OdeSolver`` (the one scipy driver loop), with work
+    budgets, a non-finite check with its cause, the drift guard at every step, and the
+    trajectory kept when the run stops early. With ``project``, scipy's explicit Runge-Kutta
+    methods project onto the constraints after every step and filter their error estimate
+    (``_tangent_filtered``), as native DOPRI5 does; ``extra["_end"]`` is the last accepted
+    state."""
     n = system.n_coords
     rhs = system.rhs
     nfev = [0]
@@ -673,7 +736,7 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
     solver_cls = _SCIPY_SOLVERS[method] if isinstance(method, str) else method
     name = method if isinstance(method, str) else method.__name__
     # explicit Runge-Kutta on a constrained system: projection after every step, filtered estimate
-    project = system.n_constraints > 0 and issubclass(solver_cls, RungeKutta)
+    project = project and system.n_constraints > 0 and issubclass(solver_cls, RungeKutta)
     if project:
         solver_cls = _tangent_filtered(solver_cls, system)
     atol_q = float(np.min(np.broadcast_to(atol, (2 * n,))[:n]))
@@ -805,7 +868,7 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
         t_last = float(solver.t) if solver is not None else t0
         if solver is not None and s.cause == "non_finite":
             t_last = float(solver.t)  # the last accepted step: the non-finite value came from a stage beyond it
-        detail = {"max_steps": f"{steps} steps", "max_nfev": f"{nfev[0] - 1} evaluations",
+        detail = {"max_steps": f"{steps} steps", "max_nfev": f"{nfev[0] - 1} right-hand-side calls",
                   "max_wall_time": f"{budget.max_wall_time} s",
                   "min_step": f"h = {getattr(solver, 'step_size', None) or 0.0:.3g} s < min_step = {budget.min_step:g} s"}
         stop, message = _stop_info(system, s.cause, t_last, s.stage, s.index, s.detail or detail.get(s.cause, ""))
@@ -825,6 +888,8 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
     if dense and interpolants:
         sol_obj = OdeSolution(ti, interpolants, alt_segment=method in ("BDF", "LSODA"))
     extra: Dict[str, Any] = {"steps": steps}
+    if solver is not None:
+        extra["_end"] = (float(solver.t), np.array(solver.y, dtype=float))
     if "report" in drift:
         extra["drift"] = drift["report"]
     if system.n_constraints > 0:
@@ -832,6 +897,70 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
     return _result(system, t_arr, y_arr, name, rtol, atol, nfev=solver.nfev if solver is not None else nfev[0],
                    njev=getattr(solver, "njev", 0), nlu=getattr(solver, "nlu", 0), wall=wall, status=status,
                    message=message, stop=stop, t_events=t_events, y_events=y_events, sol=sol_obj, extra=extra)
+
+
+def _simulate_scipy_restarts(system, method, t0, tf, y0, rtol, atol, t_eval, options, budget, progress, guard,
+                             proj_tol, interval):
+    """``stabilization="projection"`` on a scipy method: the driver loop of :func:`_simulate_scipy`
+    over the pieces between :func:`segment_bounds`, each restarted from the previous end projected
+    onto the constraints (``System.project``); one result (``extra["projections"]``,
+    ``extra["max_projection_correction"]``)."""
+    n = system.n_coords
+    bounds = segment_bounds(t0, tf, interval)
+    ts: List[np.ndarray] = []
+    ys: List[np.ndarray] = []
+    steps_t: List[np.ndarray] = []
+    steps_y: List[np.ndarray] = []
+    projections: List[float] = []
+    nfev = njev = nlu = steps = 0
+    wall = 0.0
+    drift: Optional[Dict[str, Any]] = None
+    y = np.array(y0, dtype=float)
+    part = None
+    for k in range(len(bounds) - 1):
+        ta, tb = bounds[k], bounds[k + 1]
+        seg_eval = None
+        if t_eval is not None:
+            seg_eval = t_eval[(t_eval >= ta) & (t_eval <= tb)] if k == 0 else t_eval[(t_eval > ta) & (t_eval <= tb)]
+        seg_budget = _Budget(max(1, budget.max_steps - steps), max(1, budget.max_nfev - nfev), budget.max_wall_time,
+                             budget.min_step)
+        seg_budget.deadline = budget.deadline
+        part = _simulate_scipy(system, method, ta, tb, y, rtol, atol, seg_eval if seg_eval is None or seg_eval.size
+                               else None, options, seg_budget, [], False, progress, guard, project=False)
+        nfev, njev, nlu = nfev + int(part.nfev), njev + int(part.njev), nlu + int(part.nlu)
+        steps += int(part.extra.get("steps", 0))
+        wall += float(part.wall_time)
+        if "drift" in part.extra and (drift is None or part.extra["drift"]["max_residual"] > drift["max_residual"]):
+            drift = dict(part.extra["drift"], t_first=(drift or part.extra["drift"])["t_first"])
+        if "_steps" in part.extra:
+            st, sy = part.extra["_steps"]
+            steps_t.append(st if k == 0 else st[1:])
+            steps_y.append(sy if k == 0 else sy[:, 1:])
+        if seg_eval is None or seg_eval.size:
+            t_part, y_part = part.t, np.vstack([part.q, part.qd])
+            if t_eval is None and k > 0:  # the restart state replaces the previous piece's end
+                ts[-1], ys[-1] = ts[-1][:-1], ys[-1][:, :-1]
+            ts.append(t_part)
+            ys.append(y_part)
+        if part.status != 0 or "_end" not in part.extra:
+            break
+        t_end_part, y = part.extra["_end"]
+        if k < len(bounds) - 2:
+            qn, qdn, rep = system.project(tb, y[:n], y[n:], tol=proj_tol)
+            projections.append(float(rep["position_correction"]))
+            y = np.concatenate([np.asarray(qn), np.asarray(qdn)])
+    t_arr = np.concatenate(ts) if ts else np.zeros(0)
+    y_arr = np.concatenate(ys, axis=1) if ys else np.zeros((2 * n, 0))
+    extra: Dict[str, Any] = {"steps": steps, "projections": len(projections)}
+    if projections:
+        extra["max_projection_correction"] = max(projections)
+    if drift is not None:
+        extra["drift"] = drift
+    if steps_t:
+        extra["_steps"] = (np.concatenate(steps_t), np.concatenate(steps_y, axis=1))
+    return _result(system, t_arr, y_arr, part.method, rtol, atol, nfev=nfev, njev=njev, nlu=nlu, wall=wall,
+                   status=part.status, message=part.message, stop=part.stop, t_events=None, y_events=None, sol=None,
+                   extra=extra)
 
 
 def _result(system, t, y, method, rtol, atol, *, nfev, njev, nlu, wall, status, message, stop, t_events, y_events,

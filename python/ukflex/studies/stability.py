@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import System, SimulationResult, UkflexError, simulate
 from ..analysis.stability import (IntegrationFailure, beam_properties, buckling_ratio, check, drift, ffrf_validity,
-                         rank_history, run, scaling_accuracy)
+                         rank_history, scaling_accuracy)
 from . import extreme
 
 __all__ = ["report"]
@@ -95,7 +95,7 @@ def _case_runs(c, quick: bool, log) -> Dict[str, Any]:
     tic = time.perf_counter()
     ref = None
     try:
-        ref = run(system, T, "DOPRI5", rtol=1e-10, t_eval=t_eval, rank_tolerance=rank_tol)
+        ref = simulate(system, T, "DOPRI5", rtol=1e-10, t_eval=t_eval, rank_tolerance=rank_tol, stabilization="none", raise_on_failure=True)
         rec["reference"] = "UK (Rust) DOPRI5, rtol 1e-10"
     except IntegrationFailure as exc:
         rec["reference_error"] = str(exc)
@@ -127,7 +127,7 @@ def _case_runs(c, quick: bool, log) -> Dict[str, Any]:
         entry: Dict[str, Any] = {"formulation": form, "method": meth, "rtol": 1e-6}
         try:
             rt = None if form == "UK default rcond" else rank_tol
-            r = run(system, T, meth, rtol=1e-6, t_eval=t_eval, rank_tolerance=rt, max_nfev=2_000_000)
+            r = simulate(system, T, meth, rtol=1e-6, t_eval=t_eval, rank_tolerance=rt, max_nfev=2_000_000, stabilization="none", raise_on_failure=True)
             entry.update(ok=True, wall=time.perf_counter() - tic, nfev=r.nfev, drift=drift(r)["max_position"])
             if ref is not None:
                 entry["error"] = float(np.abs(_observable(r)[1] - ref_obs).max())
@@ -173,7 +173,7 @@ def _long_run_study(quick: bool, log) -> Dict[str, Any]:
     for label, stab in [("none", None), ("Baumgarte alpha = beta = 10/s", ("baumgarte", 10.0, 10.0)),
                         ("Baumgarte alpha = beta = 100/s", ("baumgarte", 100.0, 100.0)), ("projection every step", "projection")]:
         tic = time.perf_counter()
-        r = run(system, T, "DOPRI5", rtol=1e-6, t_eval=t_eval, stabilization=stab)
+        r = simulate(system, T, "DOPRI5", rtol=1e-6, t_eval=t_eval, stabilization=stab or "none", raise_on_failure=True)
         wall = time.perf_counter() - tic
         d = drift(r)
         out["rows"].append({"stabilization": label, "max_position": d["max_position"], "final_position": d["final_position"],
@@ -184,9 +184,9 @@ def _long_run_study(quick: bool, log) -> Dict[str, Any]:
     # scipy path: projection by restarts
     tic = time.perf_counter()
     Ts = min(T, 10 * extreme.REVOLUTION)
-    r = run(system, Ts, "DOP853", rtol=1e-6, t_eval=np.linspace(0, Ts, 201))
-    r2 = run(system, Ts, "DOP853", rtol=1e-6, t_eval=np.linspace(0, Ts, 201),
-             stabilization={"kind": "projection", "interval": extreme.REVOLUTION / 10})
+    r = simulate(system, Ts, "DOP853", rtol=1e-6, t_eval=np.linspace(0, Ts, 201), stabilization="none", raise_on_failure=True)
+    r2 = simulate(system, Ts, "DOP853", rtol=1e-6, t_eval=np.linspace(0, Ts, 201),
+             stabilization={"kind": "projection", "interval": extreme.REVOLUTION / 10}, raise_on_failure=True)
     out["scipy"] = {"revolutions": round(Ts / extreme.REVOLUTION), "none": drift(r)["max_position"],
                     "projection_every_0.1_rev": drift(r2)["max_position"], "projections": r2.extra.get("projections")}
     log(f"  long run scipy: {time.perf_counter() - tic:.1f}s")
@@ -201,7 +201,7 @@ def _scaling_study(quick: bool) -> List[Dict[str, Any]]:
              ("paper N = 2, mm", extreme.slider_crank_units("mm"))]
     for label, sc in cases:
         system = System(sc)
-        r = run(system, 0.01, "DOPRI5", rtol=1e-8, t_eval=[0.0, 0.01])
+        r = simulate(system, 0.01, "DOPRI5", rtol=1e-8, t_eval=[0.0, 0.01], stabilization="none", raise_on_failure=True)
         a = scaling_accuracy(system, r.t[-1], r.q[:, -1], r.qd[:, -1])
         a["case"] = label
         rows.append(a)
@@ -215,7 +215,7 @@ def _units_study(quick: bool) -> Dict[str, Any]:
     res = {}
     for u in ("m", "mm"):
         system = System(extreme.slider_crank_units(u))
-        res[u] = run(system, T, "DOPRI5", rtol=1e-10, t_eval=te)
+        res[u] = simulate(system, T, "DOPRI5", rtol=1e-10, t_eval=te, stabilization="none", raise_on_failure=True)
     out["max_abs_diff_v_over_Lb"] = float(np.abs(_v_mid(res["m"]) - _v_mid(res["mm"])).max())
     out["peak_v_over_Lb"] = float(np.abs(_v_mid(res["m"])).max())
     out["t_end"] = T
