@@ -277,7 +277,7 @@ def _count_overflow() -> None:
             raise arguments.InvalidArgumentError(name, f"must be a positive integer, got {value!r}")
         return int(value)
 
-    sys.modules["ukflex.run.simulate"]._count = count
+    sys.modules["ukflex.run.simulate"].count = count
 
 
 def _unchecked_builtins() -> None:

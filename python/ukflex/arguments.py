@@ -1,7 +1,10 @@
-"""Argument checks of the Python API: each coerces one value of a public function (NumPy scalars
-and arrays included) or raises :class:`ukflex.InvalidArgumentError` naming the argument.  The
-rules of a scene are the core's; these are the rules of function arguments (budgets, tolerances,
-ratios, arrays) that only Python sees."""
+"""The one number checker of the Python API: each function coerces one value of a public
+function (NumPy scalars and arrays included) or raises :class:`ukflex.InvalidArgumentError`
+naming the argument (and, with ``where``, the function).  The rules of a scene are the core's;
+these are the types of builder arguments (``real(..., finite=False)``: the core judges the
+value) and the rules of function arguments (budgets, tolerances, ratios, counts, arrays) that
+only Python sees.  Used by every room: the builders and built-in scenes (``model/``), the runs
+(``run/``), the analyses (``analysis/``)."""
 
 from __future__ import annotations
 
@@ -13,7 +16,7 @@ import numpy as np
 
 from .errors import InvalidArgumentError, NonFiniteError
 
-__all__ = ["real", "positive", "non_negative", "count", "real_array", "COUNT_LIMIT"]
+__all__ = ["real", "reals", "positive", "non_negative", "count", "integer", "real_array", "COUNT_LIMIT"]
 
 
 def _shown(value: Any) -> str:
@@ -25,19 +28,36 @@ def _shown(value: Any) -> str:
     return r.repr(value)
 
 
-def real(name: str, value: Any) -> float:
-    """A real scalar: int or float (NumPy's too); bool, str, complex, None and arrays refused."""
+def real(name: str, value: Any, *, finite: bool = True, where: str = "") -> float:
+    """A real scalar: int or float (NumPy's too); bool, str, complex, None and arrays refused;
+    beyond the double range refused; with ``finite`` (default) NaN and infinity refused."""
     if isinstance(value, np.ndarray) and value.ndim == 0 and not isinstance(value, np.ma.MaskedArray):
         value = value[()]
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise InvalidArgumentError(name, f"must be a real number, got {type(value).__name__} {_shown(value)}")
+        raise InvalidArgumentError(name, f"must be a real number, got {type(value).__name__} {_shown(value)}", where)
     try:
         x = float(value)
     except OverflowError:
-        raise InvalidArgumentError(name, f"{_shown(value)} is beyond the double-precision range") from None
-    if not math.isfinite(x):
-        raise InvalidArgumentError(name, f"must be finite, got {_shown(value)}")
+        raise InvalidArgumentError(name, f"{_shown(value)} is beyond the double-precision range", where) from None
+    if finite and not math.isfinite(x):
+        raise InvalidArgumentError(name, f"must be finite, got {_shown(value)}", where)
     return x
+
+
+def reals(name: str, values: Any, *, finite: bool = True, where: str = "") -> list:
+    """A sequence of real numbers (a list, tuple or 1-D array), each as :func:`real`."""
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__") or getattr(values, "ndim", 1) != 1:
+        raise InvalidArgumentError(name, f"must be a sequence of real numbers, got {_shown(values)}", where)
+    return [real(f"{name}[{i}]", x, finite=finite, where=where) for i, x in enumerate(values)]
+
+
+def integer(name: str, value: Any, *, at_most: Optional[int] = None, where: str = "") -> int:
+    """An integer (NumPy's too; bools and floats such as 2.0 refused), ``|value| <= at_most``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise InvalidArgumentError(name, f"must be an integer, got {_shown(value)}", where)
+    if at_most is not None and abs(value) > at_most:
+        raise InvalidArgumentError(name, f"= {_shown(value)} is beyond the limit of {at_most:,}", where)
+    return int(value)
 
 
 def positive(name: str, value: Any) -> float:

@@ -121,11 +121,13 @@ class InvalidArgumentError(UkflexError, ValueError, TypeError):  # type: ignore[
     Attributes
     ----------
     argument : str
-        The argument's name (e.g. ``"t_end"``, ``"rtol"``, ``"q0"``).
+        The argument's name (e.g. ``"t_end"``, ``"rtol"``, ``"q0"``); ``where`` (optional) names
+        the function it was given to.
     """
 
-    def __init__(self, argument: str, message: str):
-        super().__init__(f"{argument}: {message}")
+    def __init__(self, argument: str, message: str, where: str = ""):
+        # "rtol: must be positive, got 0"; with where: "slider_crank: elements must be an integer, got 1.5"
+        super().__init__(f"{where}: {argument} {message}" if where else f"{argument}: {message}")
         self.argument = argument
 
 

@@ -4,13 +4,13 @@ coordinates, with a sparse tangent above."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, Optional
 
 import numpy as np
 
-from ..errors import NonFiniteError, SolverError
+from ..arguments import count, positive, real, real_array
+from ..errors import SolverError
 
 __all__ = ["Equilibrium", "equilibrium"]
 
@@ -66,14 +66,10 @@ def equilibrium(
         No convergence (e.g. no equilibrium: a free body under gravity).
     """
     n, m = system.n_coords, system.n_constraints
-    t = system.t0 if t is None else float(t)
-    q = np.array(system.q0 if q is None else q, dtype=float)
-    if q.shape != (n,):
-        raise ValueError(f"q: expected shape ({n},), got {q.shape}")
-    if not np.all(np.isfinite(q)) or not math.isfinite(t):
-        raise NonFiniteError("equilibrium: t and q must be finite")
-    if not (tol > 0 and math.isfinite(tol)) or int(max_iterations) < 1:
-        raise ValueError(f"tol must be positive and max_iterations >= 1, got {tol!r}, {max_iterations!r}")
+    t = system.t0 if t is None else real("t", t)
+    q = np.array(system.q0, dtype=float) if q is None else real_array("q", q, (n,))
+    tol = positive("tol", tol)
+    max_iterations = count("max_iterations", max_iterations)
     zero = np.zeros(n)
     if n >= system.SPARSE_MODES_MIN:
         residual, step_of, lam = _sparse_parts(system, t, q)

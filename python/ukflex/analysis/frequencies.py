@@ -9,6 +9,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from ..arguments import count as positive_count, real, real_array
 from ..errors import MemoryLimitError
 
 __all__ = ["frequencies", "max_frequency"]
@@ -66,17 +67,12 @@ def frequencies(
     """
     from scipy.linalg import eigh, null_space
 
-    t = system.t0 if t is None else float(t)
-    q = system.q0 if q is None else np.asarray(q, dtype=float)
-    qd = system.qd0 if qd is None else np.asarray(qd, dtype=float)
     n = system.n_coords
-    for name, v in (("q", q), ("qd", qd)):
-        if v.shape != (n,):
-            raise ValueError(f"{name}: expected shape ({n},), got {v.shape}")
+    t = system.t0 if t is None else real("t", t)
+    q = system.q0 if q is None else real_array("q", q, (n,))
+    qd = system.qd0 if qd is None else real_array("qd", qd, (n,))
     if count is not None:
-        count = int(count)
-        if count < 1:
-            raise ValueError(f"count must be at least 1, got {count}")
+        count = positive_count("count", count)
     large = n >= system.SPARSE_MODES_MIN
     if large and count is not None:
         from . import modes as _modes

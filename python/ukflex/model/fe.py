@@ -32,7 +32,7 @@ from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 import scipy.linalg as sla
 
-from ..arguments import count, non_negative, positive, real
+from ..arguments import count, non_negative, positive, real, real_array
 from ..errors import InvalidArgumentError
 from .flexible import FlexibleData, InterfacePoint
 
@@ -129,9 +129,9 @@ def from_nodal(
     The returned data carries ``info["frequencies"]`` (rad/s, the kept normal modes; for
     Craig-Bampton those of the reduced model) and ``info["modes"]`` (2N, n_f), the nodal shapes.
     """
-    x = _real_array("nodes", nodes)
-    mm = _real_array("mass_matrix", mass_matrix)
-    kk = _real_array("stiffness_matrix", stiffness_matrix)
+    x = real_array("nodes", nodes)
+    mm = real_array("mass_matrix", mass_matrix)
+    kk = real_array("stiffness_matrix", stiffness_matrix)
     modes = count("modes", modes)
     damping_ratio = non_negative("damping_ratio", damping_ratio)
     if not isinstance(interfaces, Mapping):
@@ -295,7 +295,7 @@ def _mesh_basis(points: np.ndarray, cells: np.ndarray, order: int) -> Tuple[Any,
 def _mesh_arrays(points: Any, cells: Any) -> Tuple[np.ndarray, np.ndarray]:
     """The mesh as scikit-fem takes it: points (2, N) and cells (3|4, E), checked: finite points
     (N, 2) or (N, 3), cells of whole-number indices of the points, each cell's vertices distinct."""
-    p = _real_array("points", points)
+    p = real_array("points", points)
     if p.ndim != 2 or p.shape[1] not in (2, 3) or p.shape[0] < 3:
         raise InvalidArgumentError("points", f"expected an array (N, 2) or (N, 3) of N >= 3 points, got shape {p.shape}")
     t = _indices("cells", cells, p.shape[0], "cell vertices")
@@ -318,12 +318,6 @@ def _mesh_arrays(points: Any, cells: Any) -> Tuple[np.ndarray, np.ndarray]:
         raise InvalidArgumentError("cells", f"cell {k} {t[k].tolist()} at {xy[k].tolist()} is degenerate or folded "
                                    "(collinear vertices, zero area or a non-convex corner)")
     return np.ascontiguousarray(p[:, :2].T), np.ascontiguousarray(t.T)
-
-
-def _real_array(name: str, value: Any) -> np.ndarray:
-    from ..arguments import real_array
-
-    return real_array(name, value)
 
 
 def _material(thickness: Any, density: Any, youngs_modulus: Any, poisson_ratio: Any) -> Tuple[float, float, float, float]:

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from .description import Checker, normalize
+from ..arguments import real, reals
 from ..errors import InvalidArgumentError, InvalidSceneError, core
 from .system import System
 
@@ -72,7 +73,7 @@ class Circular:
     diameter: float
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"shape": "circular", "diameter": _num("diameter", self.diameter)}
+        return {"shape": "circular", "diameter": real("diameter", self.diameter, finite=False)}
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,7 @@ class Rectangular:
     height: float
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"shape": "rectangular", "width": _num("width", self.width), "height": _num("height", self.height)}
+        return {"shape": "rectangular", "width": real("width", self.width, finite=False), "height": real("height", self.height, finite=False)}
 
 
 @dataclass(frozen=True)
@@ -94,7 +95,7 @@ class CustomSection:
     second_moment: float
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"shape": "custom", "area": _num("area", self.area), "second_moment": _num("second_moment", self.second_moment)}
+        return {"shape": "custom", "area": real("area", self.area, finite=False), "second_moment": real("second_moment", self.second_moment, finite=False)}
 
 
 @dataclass(frozen=True)
@@ -105,7 +106,7 @@ class ConstantSpeed:
     initial: float = 0.0
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"kind": "constant_speed", "initial": _num("initial", self.initial), "speed": _num("speed", self.speed)}
+        return {"kind": "constant_speed", "initial": real("initial", self.initial, finite=False), "speed": real("speed", self.speed, finite=False)}
 
 
 @dataclass(frozen=True)
@@ -115,7 +116,7 @@ class Polynomial:
     coefficients: Sequence[float]
 
     def to_dict(self) -> Dict[str, Any]:
-        return {"kind": "polynomial", "coefficients": [_num("coefficients", c) for c in self.coefficients]}
+        return {"kind": "polynomial", "coefficients": [real("coefficients", c, finite=False) for c in self.coefficients]}
 
 
 @dataclass(frozen=True)
@@ -130,10 +131,10 @@ class Harmonic:
     def to_dict(self) -> Dict[str, Any]:
         return {
             "kind": "harmonic",
-            "offset": _num("offset", self.offset),
-            "amplitude": _num("amplitude", self.amplitude),
-            "frequency": _num("frequency", self.frequency),
-            "phase": _num("phase", self.phase),
+            "offset": real("offset", self.offset, finite=False),
+            "amplitude": real("amplitude", self.amplitude, finite=False),
+            "frequency": real("frequency", self.frequency, finite=False),
+            "phase": real("phase", self.phase, finite=False),
         }
 
 
@@ -165,9 +166,9 @@ class Spline:
     slopes: Optional[Sequence[float]] = None
 
     def to_dict(self) -> Dict[str, Any]:
-        d: Dict[str, Any] = {"kind": "spline", "times": _nums("times", self.times), "values": _nums("values", self.values)}
+        d: Dict[str, Any] = {"kind": "spline", "times": reals("times", self.times, finite=False), "values": reals("values", self.values, finite=False)}
         if self.slopes is not None:
-            d["slopes"] = _nums("slopes", self.slopes)
+            d["slopes"] = reals("slopes", self.slopes, finite=False)
         return d
 
 
@@ -199,32 +200,11 @@ class Marker:
     def to_dict(self) -> Dict[str, Any]:
         d: Dict[str, Any] = {"body": self.body}
         if self.point is not None:
-            d["point"] = [_num("point", self.point[0]), _num("point", self.point[1])]
+            d["point"] = [real("point", self.point[0], finite=False), real("point", self.point[1], finite=False)]
         if self.xi is not None:
-            d["xi"] = _num("xi", self.xi)
-        d["angle"] = _num("angle", self.angle)
+            d["xi"] = real("xi", self.xi, finite=False)
+        d["angle"] = real("angle", self.angle, finite=False)
         return d
-
-
-def _num(name: str, value: Any) -> float:
-    """``float(value)`` for a builder argument, with errors that name it (a 400-digit integer,
-    a string, a boolean, None or a complex number are refused, not converted or overflowed)."""
-    if isinstance(value, (bool, str, bytes)) or value is None or isinstance(value, complex):
-        raise InvalidArgumentError(name, f"expected a real number, got {value!r}")
-    try:
-        v = float(value)
-    except OverflowError:
-        raise InvalidArgumentError(name, f"{value!r:.40} is beyond the double-precision range") from None
-    except (TypeError, ValueError):
-        raise InvalidArgumentError(name, f"expected a real number, got {value!r}") from None
-    return v
-
-
-def _nums(name: str, values: Any) -> List[float]:
-    """A sequence of real numbers (a list, tuple or 1-D array) for a builder argument."""
-    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__") or getattr(values, "ndim", 1) != 1:
-        raise InvalidArgumentError(name, f"expected a sequence of real numbers, got {values!r:.80}")
-    return [_num(f"{name}[{i}]", x) for i, x in enumerate(values)]
 
 
 def _point_args(x: Any, y: Any) -> Vec2:
@@ -235,7 +215,7 @@ def _point_args(x: Any, y: Any) -> Vec2:
             raise InvalidArgumentError("x", f"expected a point (x, y) or two numbers, got {x!r}") from None
     else:
         px, py = x, y
-    return (_num("x", px), _num("y", py))
+    return (real("x", px, finite=False), real("y", py, finite=False))
 
 
 class BodyRef:
@@ -268,16 +248,16 @@ class _PointBody(BodyRef):
 
     def point(self, x: Any, y: Any = None, angle: float = 0.0) -> Marker:
         """Marker at body-frame point ``(x, y)`` (also accepts ``point((x, y))``)."""
-        return Marker(self.name, point=_point_args(x, y), angle=_num("angle", angle))
+        return Marker(self.name, point=_point_args(x, y), angle=real("angle", angle, finite=False))
 
     def frame(self, angle: float = 0.0) -> Marker:
         """Marker at the body-frame origin; its world angle is ``theta + angle``."""
-        return Marker(self.name, point=(0.0, 0.0), angle=_num("angle", angle))
+        return Marker(self.name, point=(0.0, 0.0), angle=real("angle", angle, finite=False))
 
     def line(self, origin: Any = (0.0, 0.0), angle: float = 0.0) -> Marker:
         """Marker describing a line through ``origin`` with direction ``(cos angle, sin angle)``
         in the body frame (for :meth:`Scene.point_on_line` and :meth:`Scene.prismatic`)."""
-        return Marker(self.name, point=_point_args(origin, None), angle=_num("angle", angle))
+        return Marker(self.name, point=_point_args(origin, None), angle=real("angle", angle, finite=False))
 
 
 class GroundRef(_PointBody):
@@ -307,7 +287,7 @@ class PointMassRef(BodyRef):
 
     def point(self, angle: float = 0.0) -> Marker:
         """The marker on the particle; ``angle`` fixes the direction of a line through it."""
-        return Marker(self.name, angle=_num("angle", angle))
+        return Marker(self.name, angle=real("angle", angle, finite=False))
 
     def line(self, angle: float = 0.0) -> Marker:
         """The line through the particle with the constant direction ``angle``."""
@@ -326,7 +306,7 @@ class BeamRef(BodyRef):
         beam ``angle`` plus the direction of the tangent ``r'(x)``, measured continuously from the
         beam's initial ``angle`` (valid while the tangent stays within +-pi of it).
         """
-        return Marker(self.name, xi=_num("xi", xi), angle=_num("angle", angle))
+        return Marker(self.name, xi=real("xi", xi, finite=False), angle=real("angle", angle, finite=False))
 
     def line(self, xi: float = 0.0, angle: float = 0.0) -> Marker:
         """Same as :meth:`at`: the line through the axis point with direction ``angle``."""
@@ -349,7 +329,7 @@ class FlexibleBodyRef(BodyRef):
         (``psi`` its elastic rotation, if the body gives one)."""
         for m in self._scene._body(self.name)["markers"]:
             if m["name"] == name:
-                return Marker(self.name, point=(float(m["point"][0]), float(m["point"][1])), angle=_num("angle", angle))
+                return Marker(self.name, point=(float(m["point"][0]), float(m["point"][1])), angle=real("angle", angle, finite=False))
         names = [m["name"] for m in self._scene._body(self.name)["markers"]]
         raise InvalidSceneError(f"flexible body {self.name!r} has no interface point {name!r}; its points are {names}")
 

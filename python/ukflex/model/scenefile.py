@@ -54,7 +54,8 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
-from ..errors import InvalidSceneError
+from .. import arguments
+from ..errors import InvalidArgumentError, InvalidSceneError
 from .scene import Scene
 
 try:  # Python >= 3.11
@@ -246,11 +247,14 @@ def _check_keys(path: str, where: str, d: Dict[str, Any], allowed: Sequence[str]
 
 def _number(path: str, where: str, key: str, value: Any, *, positive: bool = False, integer: bool = False,
             minimum: Optional[float] = None) -> Any:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if integer:
-        ok = ok and isinstance(value, int)
-    if ok and not (isinstance(value, int) and abs(value) <= 2 ** 53 or isinstance(value, float) and math.isfinite(value)):
-        ok = False  # non-finite, or an integer beyond what a double holds exactly (no OverflowError)
+    try:  # an int beyond what a double holds exactly is refused (no OverflowError later)
+        if integer or isinstance(value, int) and not isinstance(value, bool):
+            arguments.integer(key, value, at_most=2 ** 53)
+        else:
+            arguments.real(key, value)
+        ok = True
+    except InvalidArgumentError:
+        ok = False
     if ok and positive and value <= 0:
         ok = False
     if ok and minimum is not None and value < minimum:

@@ -17,6 +17,7 @@ import math
 import numbers
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
+from ..arguments import integer, real, reals
 from ..errors import InvalidSceneError
 from .scene import Circular, ConstantSpeed, CustomSection, Harmonic, Polynomial, Rectangular, Scene
 
@@ -79,18 +80,10 @@ def _checked(fn: Callable[..., Scene]) -> Callable[..., Scene]:
             default = sig.parameters[name].default
             if isinstance(default, bool) or not isinstance(default, (int, float)) or default is value:
                 continue
-            if isinstance(default, int) and not isinstance(value, numbers.Integral) or isinstance(value, bool):
-                raise TypeError(f"{fn.__name__}: {name} must be an integer, got {value!r}")
-            if isinstance(default, int) and abs(value) > MAX_ITEMS:
-                raise ValueError(f"{fn.__name__}: {name} = {value!r:.40} is beyond what a scene can hold (at most {MAX_ITEMS:,})")
-            if not isinstance(value, numbers.Real):
-                raise TypeError(f"{fn.__name__}: {name} must be a real number, got {value!r}")
-            try:
-                finite = math.isfinite(float(value))
-            except OverflowError:
-                finite = False
-            if isinstance(default, float) and not finite:
-                raise ValueError(f"{fn.__name__}: {name} must be finite, got {value!r:.40}")
+            if isinstance(default, int):
+                integer(name, value, at_most=MAX_ITEMS, where=fn.__name__)
+            else:
+                real(name, value, where=fn.__name__)
         try:
             return fn(*args, **kwargs)
         except (ZeroDivisionError, OverflowError) as exc:
@@ -120,14 +113,12 @@ def gravity_vector(gravity: Any) -> Optional[Tuple[float, float]]:
     if gravity is False or gravity is None:
         return None
     if isinstance(gravity, numbers.Real):
-        return (0.0, -float(gravity))
+        return (0.0, -real("gravity", gravity, finite=False))
     expected = f"gravity must be True, False, a magnitude or a 2-vector of numbers, got {gravity!r:.60}"
-    if isinstance(gravity, (str, bytes)) or not hasattr(gravity, "__iter__"):
+    if isinstance(gravity, (str, bytes)) or not hasattr(gravity, "__iter__") or len(tuple(gravity)) != 2:
         raise ValueError(expected)
-    g = tuple(gravity)
-    if len(g) != 2 or not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in g):
-        raise ValueError(expected)
-    return (float(g[0]), float(g[1]))
+    gx, gy = reals("gravity", tuple(gravity), finite=False)
+    return (gx, gy)
 
 
 def _beam_kind(formulation: str, theory: Optional[str], strain: Optional[str], poisson_ratio: float,

@@ -22,7 +22,7 @@ from scipy.integrate._ivp.ivp import METHODS as _SCIPY_SOLVERS, find_active_even
 from .. import _core
 from ..errors import (DriftWarning, IntegrationFailure, InvalidArgumentError, NonFiniteError,
                      SingularConfigurationWarning, SolverError, UnknownOptionError)
-from ..arguments import COUNT_LIMIT, count as _count, positive as _positive, real as _real, real_array as _real_array
+from ..arguments import count, positive, real, real_array
 from ..results.simulation import SimulationResult
 from ..model.scene import Scene
 from ..model.system import System, length_scale
@@ -282,7 +282,7 @@ def simulate(
         raise InvalidArgumentError("on_drift", f"must be 'stop' or 'warn', got {on_drift!r}")
     if max_wall_time is not None and not isinstance(scene_or_system, System):
         # a scene is built here: its initial-state correction spends the same budget
-        system = as_system(scene_or_system, max_wall_time=_positive("max_wall_time", max_wall_time))
+        system = as_system(scene_or_system, max_wall_time=positive("max_wall_time", max_wall_time))
     else:
         system = as_system(scene_or_system)
     label = proj_tol = None
@@ -299,7 +299,7 @@ def simulate(
             raise InvalidArgumentError("t_span", "give t_end or t_span, not both")
         if isinstance(t_span, (str, bytes)) or np.ndim(t_span) != 1 or len(t_span) != 2:
             raise InvalidArgumentError("t_span", f"must be a pair (t0, tf), got {t_span!r}")
-        t0 = _real("t_span[0]", t_span[0])
+        t0 = real("t_span[0]", t_span[0])
         t_end = t_span[1]
         if t0 != system.t0 and (q0 is None or qd0 is None):
             raise InvalidArgumentError(
@@ -308,10 +308,10 @@ def simulate(
         t0 = system.t0
     if t_end is None:
         raise InvalidArgumentError("t_end", "missing: give t_end or t_span=(t0, tf)")
-    t_end_f = _real("t_end", t_end)
+    t_end_f = real("t_end", t_end)
     if t_end_f <= t0:
         raise InvalidArgumentError("t_end", f"must be greater than t0 = {t0}, got {t_end!r}")
-    rtol = _positive("rtol", rtol)
+    rtol = positive("rtol", rtol)
     if rtol < RTOL_MIN:  # as solve_ivp does: below it the error norm divides by rounding
         warnings.warn(f"rtol = {rtol:g} is below {RTOL_MIN:.3g} (100 x machine epsilon); using {RTOL_MIN:.3g}",
                       UserWarning, stacklevel=2)
@@ -319,30 +319,30 @@ def simulate(
     if atol is None:
         atol_v: Any = 1e-3 * rtol
     elif np.ndim(atol) == 0 and not isinstance(atol, np.ma.MaskedArray):
-        atol_v = _positive("atol", atol)
+        atol_v = positive("atol", atol)
     else:
-        atol_v = _real_array("atol", atol, (2 * n,))
+        atol_v = real_array("atol", atol, (2 * n,))
         if np.any(atol_v <= 0):
             raise InvalidArgumentError("atol", "entries must be positive")
     t_eval_v: Optional[np.ndarray] = None
     if t_eval is not None:
-        t_eval_v = _real_array("t_eval", t_eval)
+        t_eval_v = real_array("t_eval", t_eval)
         if t_eval_v.ndim != 1 or t_eval_v.size == 0:
             raise InvalidArgumentError("t_eval", f"must be a non-empty 1-D array, got shape {t_eval_v.shape}")
         if np.any(np.diff(t_eval_v) <= 0):
             raise InvalidArgumentError("t_eval", "must be strictly increasing")
         if t_eval_v[0] < t0 or t_eval_v[-1] > t_end_f:
             raise InvalidArgumentError("t_eval", f"must lie within [t0, t_end] = [{t0}, {t_end_f}]")
-    q_init = system.q0 if q0 is None else _real_array("q0", q0, (n,))
-    qd_init = system.qd0 if qd0 is None else _real_array("qd0", qd0, (n,))
-    budget = _Budget(_count("max_steps", max_steps), _count("max_nfev", max_nfev),
-                     None if max_wall_time is None else _positive("max_wall_time", max_wall_time),
-                     0.0 if min_step == 0 else _positive("min_step", min_step), call_start)
+    q_init = system.q0 if q0 is None else real_array("q0", q0, (n,))
+    qd_init = system.qd0 if qd0 is None else real_array("qd0", qd0, (n,))
+    budget = _Budget(count("max_steps", max_steps), count("max_nfev", max_nfev),
+                     None if max_wall_time is None else positive("max_wall_time", max_wall_time),
+                     0.0 if min_step == 0 else positive("min_step", min_step), call_start)
     if options.get("first_step") is not None:  # every method's: a positive number (scipy's compare it as given)
-        options = dict(options, first_step=_positive("first_step", options["first_step"]))
+        options = dict(options, first_step=positive("first_step", options["first_step"]))
     for key in ("max_step", "step"):  # a step size that cannot reach t_end within the step budget
         if options.get(key) is not None:
-            h = _positive(key, options[key])
+            h = positive(key, options[key])
             options = dict(options, **{key: h})
             if (t_end_f - t0) / h > budget.max_steps:
                 raise InvalidArgumentError(
@@ -369,7 +369,7 @@ def simulate(
                                            f"occurrences up to 2**53 (solve_ivp's rule), got {terminal!r:.60}")
             direction = getattr(ev, "direction", None)
             if direction is not None:
-                _real(f"events[{k}].direction", direction)
+                real(f"events[{k}].direction", direction)
         if args is not None:
             ev_list = [_with_args(ev, args) for ev in ev_list]
     if args is not None and callable(options.get("jac")):
@@ -997,8 +997,8 @@ class DenseSolution:
     def __init__(self, method: str, meta: np.ndarray, data: np.ndarray, part_len: Sequence[int]):
         self.method = method
         # real numbers only (complex values are not cast to their real parts); the layout is the core's
-        self.meta = np.ascontiguousarray(_real_array("meta", meta))
-        self.data = np.ascontiguousarray(_real_array("data", data))
+        self.meta = np.ascontiguousarray(real_array("meta", meta))
+        self.data = np.ascontiguousarray(real_array("data", data))
         self.part_len = list(part_len)
         # the core checks the record against the method's layout (a ValueError naming what is
         # inconsistent; NonFiniteError for NaN in it), here once and at every evaluation
@@ -1057,10 +1057,10 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
     kwargs: Dict[str, Any] = {}
     for key in ("first_step", "max_step", "step"):
         if options.get(key) is not None:
-            kwargs[key] = _positive(key, options[key])
+            kwargs[key] = positive(key, options[key])
     for key in ("projection_tol", "rho_inf", "newton_local_error"):  # 0 is meaningful (projection off, full dissipation)
         if options.get(key) is not None:
-            kwargs[key] = _real(key, options[key])
+            kwargs[key] = real(key, options[key])
     for key in ("jacobian", "linear_solver"):
         if options.get(key) is not None:
             kwargs[key] = str(options[key])
