@@ -44,8 +44,13 @@ def spring_error(rtol, method="RADAU5M"):
 
 
 def simeon_error(rtol, method="RADAU5M"):
+    import sys
+    from pathlib import Path
+
     from ukflex.reference import testset_crank as ts
-    from ukflex.studies import simeon_crank as sc
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository's studies/
+    from studies import simeon_crank as sc
 
     system = sc.crank_scene(False).build(correct=False)
     q0, qd0 = sc.crank_state(system, ts.Y0[:14])

@@ -11,7 +11,7 @@ from conftest import core_available
 pytestmark = pytest.mark.skipif(not core_available(), reason="ukflex._core not built")
 
 import ukflex  # noqa: E402
-from ukflex.studies import extreme as X  # noqa: E402
+from studies import extreme as X  # noqa: E402
 from ukflex import stability as S  # noqa: E402
 
 

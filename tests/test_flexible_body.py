@@ -197,7 +197,7 @@ def test_mesh_invariants_match_an_independent_quadrature(frame):
 def test_flexible_body_round_trips_through_a_toml_scene_file():
     from ukflex.model import scenefile
     from ukflex.reference import testset_crank as ts
-    from ukflex.studies import simeon_crank as sc
+    from studies import simeon_crank as sc
 
     scene = sc.crank_scene(nonlinear=True)
     again = scenefile.loads(scenefile.dumps(scene)).scene
@@ -248,7 +248,7 @@ def test_modal_derivatives_let_the_reduced_coupler_shorten():
     strain by axial shortening (nonlinear = linear deflection); two bending modes alone cannot
     shorten and lock (> 30 % stiffer); with their modal derivatives they shorten exactly."""
     from ukflex import fe
-    from ukflex.studies import flexible_coupler as fc
+    from studies import flexible_coupler as fc
 
     nodal = fc.coupler_data(8, None, "nonlinear")
     v, lin = _static_midpoint_deflection(nodal, 85.0)
@@ -269,7 +269,7 @@ def test_modal_derivatives_let_the_reduced_coupler_shorten():
 
 def test_reduced_tensors_are_the_projection_of_the_nodal_ones():
     from ukflex import fe
-    from ukflex.studies import flexible_coupler as fc
+    from studies import flexible_coupler as fc
 
     nodal = fc.coupler_data(4, None, "nonlinear")
     red = fe.reduce(nodal, 3, modal_derivatives=2)
@@ -289,7 +289,7 @@ def test_quadratic_mesh_of_the_coupler_converges_to_the_timoshenko_beam():
     (shear factor of the rectangle, Cowper) under refinement; Q1 quads of the same mesh are far
     off (locking)."""
     pytest.importorskip("skfem")
-    from ukflex.studies import flexible_coupler as fc
+    from studies import flexible_coupler as fc
 
     nu = fc.P["poisson_ratio"]
     beam = fc.beam_frequencies(32, 10 * (1 + nu) / (12 + 11 * nu), count=4)
@@ -423,7 +423,7 @@ def test_mesh_coupler_with_modal_derivatives_does_not_lock():
     with their modal derivatives the nonlinear deflection is within 0.5 % of the linear one
     (a pinned-sliding beam shortens freely)."""
     pytest.importorskip("skfem")
-    from ukflex.studies import flexible_coupler as fc
+    from studies import flexible_coupler as fc
 
     locked = fc.mesh_coupler_data(16, 1, 2, 2, strain="nonlinear")
     v, lin = _static_midpoint_deflection(locked, 85.0)

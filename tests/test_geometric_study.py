@@ -1,4 +1,4 @@
-"""The geometric nonlinearity study (ukflex.studies.geometric, `ukflex study-geometric`): its quick
+"""The geometric nonlinearity study (studies.geometric, `python -m studies geometric`): its quick
 path on a tiny grid and its outputs, the peak metric, the membrane-locking illustration, and the
 physics it documents (docs/geometric-nonlinearity.md): at the paper speed the nonlinear FFRF
 coupler is within 0.5 % of Exudyn's geometrically exact peak and the paper's linear FFRF is more
@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ukflex import cli
-from ukflex.studies import geometric as G
+from studies.__main__ import main as studies_main
+from studies import geometric as G
 
 EXUDYN = G.load_exudyn()
 needs_exudyn_data = pytest.mark.skipif(EXUDYN is None, reason="benches/data/exudyn_*.csv not in this tree")
@@ -72,13 +72,13 @@ def test_quick_study_on_a_tiny_grid_writes_its_outputs(tmp_path):
 
 def test_cli_study_geometric_runs_a_restricted_grid(tmp_path, capsys):
     out = tmp_path / "g"
-    assert cli.main(["study-geometric", "--out", str(out), "--quick", "--models", "nonlinear-ffrf", "--elements", "2",
+    assert studies_main(["geometric", "--out", str(out), "--quick", "--models", "nonlinear-ffrf", "--elements", "2",
                      "--cases", "omega x1, omega x3", "--no-cost", "--no-plot", "--silent"]) == 0
     assert "summary.md" in capsys.readouterr().out
     runs = _rows(out / "runs.csv")
     assert [(r["case"], r["elements"]) for r in runs] == [("omega x1", "2"), ("omega x3", "2")]
     with pytest.raises(SystemExit):
-        cli.main(["study-geometric", "--out", str(out), "--cases", "omega x7"])
+        studies_main(["geometric", "--out", str(out), "--cases", "omega x7"])
 
 
 @needs_exudyn_data

@@ -82,20 +82,29 @@ def test_reference_never_imports_the_rest_of_ukflex():
             assert "_core" not in mod and "_core" not in names, (name, mod, names)
 
 
-def test_library_does_not_import_the_studies():
+STUDIES = PKG.parents[1] / "studies"
+
+
+def _study_modules():
+    """{dotted name: path} of the repository's studies/ and of the wheel's benchmarks (both run on
+    the public API only)."""
+    out = {f"studies.{p.stem}": p for p in sorted(STUDIES.glob("*.py"))}
+    out.update({n: p for n, p in MODULES.items() if n.startswith("ukflex.benchmarks")})
+    return out
+
+
+def test_studies_are_not_in_the_wheel_and_the_library_does_not_import_them():
+    assert not (PKG / "studies").exists() and (STUDIES / "__main__.py").exists()
+    assert 'python-source = "python"' in (PKG.parents[1] / "pyproject.toml").read_text()
     for name, path in MODULES.items():
-        if name.startswith(("ukflex.studies", "ukflex.reference")) or name == "ukflex.cli":
-            continue  # the CLI is the driver of both
-        bad = [e for e in _edges(name, path) if e.startswith("ukflex.studies")]
+        bad = [mod for mod, _, _ in _imports(name, path) if mod == "studies" or mod.startswith("studies.")]
         assert not bad, f"{name} imports {bad}"
 
 
 def test_studies_use_only_public_names():
-    for name, path in MODULES.items():
-        if not name.startswith("ukflex.studies"):
-            continue
+    for name, path in _study_modules().items():
         for mod, names, _ in _imports(name, path):
-            if mod.startswith("ukflex") and not mod.startswith("ukflex.studies"):
+            if mod.startswith("ukflex"):
                 assert not any(p.startswith("_") for p in mod.split(".")), f"{name} imports private module {mod}"
                 assert not [n for n in names if n.startswith("_")], f"{name} imports private {names} from {mod}"
         for node in ast.walk(ast.parse(path.read_text())):
@@ -115,8 +124,7 @@ ROOMS = {
     "results": set(),
     "run": {"model", "results", "analysis", "reference"},
     "benchmarks": {"model", "results", "analysis", "run", "reference"},  # ukflex paper, ukflex bench
-    "cli": {"model", "results", "analysis", "run", "reference", "benchmarks", "studies"},
-    "studies": {"model", "results", "analysis", "run", "reference"},  # leaves the wheel (issue 29 item 5)
+    "cli": {"model", "results", "analysis", "run", "reference", "benchmarks"},
 }
 #: (module, imported module) edges allowed against the room rules, each with its reason.
 ROOM_EXCEPTIONS = {
@@ -142,7 +150,7 @@ def test_rooms_import_only_what_their_rules_allow():
             other = _room(e)
             if e in BASE or other == room or (name, e) in ROOM_EXCEPTIONS:
                 continue
-            if e == "ukflex" and room in ("benchmarks", "cli", "studies"):
+            if e == "ukflex" and room in ("benchmarks", "cli"):
                 continue  # the public names
             if other is None or other not in ROOMS[room]:
                 bad.append(f"{name} -> {e}")
@@ -189,7 +197,7 @@ def test_no_import_cycles():
 
 def test_extreme_is_not_exported_at_top_level():
     r = subprocess.run([sys.executable, "-c", "import ukflex, sys; print('extreme' in dir(ukflex), "
-                        "any(m.startswith('ukflex.studies') for m in sys.modules))"],
+                        "any(m.split('.')[0] == 'studies' or m.startswith('ukflex.benchmarks') for m in sys.modules))"],
                        capture_output=True, text=True, env=ENV)
     assert r.returncode == 0 and r.stdout.split() == ["False", "False"], r.stdout + r.stderr
     assert "extreme" not in ukflex.__all__

@@ -58,7 +58,8 @@ def test_library_imports_without_matplotlib(no_matplotlib):
 
 def test_every_plot_entry_point_names_the_missing_matplotlib(no_matplotlib, tmp_path):
     from ukflex.results.animate import animate
-    from ukflex.studies import geometric, paper, sweeps, workprecision
+    from studies import geometric, sweeps
+    from ukflex.benchmarks import paper, workprecision
 
     res = ukflex.simulate(ukflex.scenes.pendulum(), 0.05, method="DOPRI5")
     with pytest.raises(ukflex.MissingDependencyError) as e:

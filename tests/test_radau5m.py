@@ -155,7 +155,7 @@ def _simeon_error(rtol):
     """Simeon's crank (Test Set), its 14 positions and velocities at t = 0.1 against the
     published reference, each relative to |ref| + 1e-3."""
     from ukflex.reference import testset_crank as ts
-    from ukflex.studies import simeon_crank as sc
+    from studies import simeon_crank as sc
 
     system = sc.crank_scene(False).build(correct=False)
     q0, qd0 = sc.crank_state(system, ts.Y0[:14])

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ukflex.reference import testset_crank as ts
-from ukflex.studies import simeon_crank as sc
+from studies import simeon_crank as sc
 
 
 def test_initial_state_maps_onto_the_constraints():

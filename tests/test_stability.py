@@ -1,5 +1,5 @@
 """Issue 6: safeguards of ukflex.stability (scaling accuracy, failures keep partial results) and the
-stability report (ukflex.studies.stability)."""
+stability report (studies.stability)."""
 
 import numpy as np
 import pytest
@@ -9,9 +9,9 @@ from conftest import core_available
 pytestmark = pytest.mark.skipif(not core_available(), reason="ukflex._core not built")
 
 import ukflex  # noqa: E402
-from ukflex.studies import extreme as X  # noqa: E402
+from studies import extreme as X  # noqa: E402
 from ukflex import stability as S  # noqa: E402
-from ukflex.studies import stability as report_study  # noqa: E402
+from studies import stability as report_study  # noqa: E402
 
 
 def test_longdouble_reference_solves_to_extended_precision():

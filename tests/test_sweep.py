@@ -94,7 +94,7 @@ def test_blas_threads_limited_in_each_case():
 
 
 def test_study_tiny():
-    from ukflex.studies.sweeps import crank_study
+    from studies.sweeps import crank_study
 
     df = crank_study(omegas=[60.0, 120.0], diameters=[0.005, 0.008], executor="serial")
     assert (df["status"] == "ok").all()

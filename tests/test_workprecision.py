@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import ukflex
-from ukflex.studies import workprecision as wp
+from ukflex.benchmarks import workprecision as wp
 
 T_END = 0.004
 SAMPLES = 41

@@ -102,8 +102,12 @@ def chord_deflection(r0: np.ndarray, r1: np.ndarray, rmid: np.ndarray) -> np.nda
     return np.einsum("ij,ij->i", en, rmid - r0)
 
 
-# the peak rule of the studies, one definition for both codes
-from ukflex.studies.geometric import refined_peak  # noqa: E402,F401
+# the peak rule of the studies, one definition for both codes (the repository's studies/)
+import sys as _sys  # noqa: E402
+from pathlib import Path as _Path  # noqa: E402
+
+_sys.path.insert(0, str(_Path(__file__).resolve().parents[2]))
+from studies.geometric import refined_peak  # noqa: E402,F401
 
 
 def interpolate(t_ref: np.ndarray, v_ref: np.ndarray, t: np.ndarray) -> np.ndarray:

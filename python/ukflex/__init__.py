@@ -7,10 +7,10 @@ Rust core (``ukflex._core``, private) + Python API:
 * :func:`simulate` -- time integration with ``scipy.integrate.solve_ivp``;
 * :func:`sweep` -- parameter sweeps (serial, a process pool or Dask), a DataFrame per sweep;
 * :mod:`ukflex.scenes` -- built-in scenes (the paper's slider-crank, pendulums, ...);
-* :mod:`ukflex.stability` -- stabilization and diagnostics (rank loss, drift, buckling, FFRF
-  validity);
-* :mod:`ukflex.studies` -- studies on the public API: the paper's reproduction, work-precision,
-  the extreme catalogue and its stability report, cross-checks against :mod:`ukflex.reference`;
+* :mod:`ukflex.stability` -- diagnostics of runs (rank loss, drift, buckling, FFRF validity);
+  stabilization is :func:`simulate`'s ``stabilization=``;
+* :mod:`ukflex.benchmarks` -- the paper's reproduction and the work-precision bench (``ukflex
+  paper``, ``ukflex bench``); the other studies are the repository's ``studies/`` package;
 * ``ukflex`` (also ``python -m ukflex``) -- the command line (:mod:`ukflex.cli`).
 """
 

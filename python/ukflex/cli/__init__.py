@@ -15,16 +15,11 @@ Commands
 ``ukflex bench work-precision|elements|table1 --out DIR``
     Error against run time for every integrator and formulation; the same over element
     counts; the Table 1 analogue alone.
-``ukflex stability --out DIR``
-    The stability report over the catalogue of extreme scenes.
-``ukflex crosscheck errata|sweep|timing|bdf``
-    Cross-checks against the NumPy reference (the paper's errata, Rust UK vs CP, timings).
-``ukflex study-geometric --out DIR``
-    Geometric nonlinearity of the coupler at speed: linear FFRF, nonlinear FFRF and ANCF against
-    Exudyn's geometrically exact references (docs/geometric-nonlinearity.md).
 
-``run``, ``list`` and ``export`` use the library; ``paper``, ``bench``, ``stability``,
-``crosscheck`` and ``study-geometric`` run the studies of :mod:`ukflex.studies` (imported when the command runs).
+``run``, ``list`` and ``export`` use the library; ``paper`` and ``bench`` run
+:mod:`ukflex.benchmarks` (imported when the command runs). The other studies (the stability
+report, the cross-checks, geometric nonlinearity, ...) live in the repository's ``studies/``
+package, outside the wheel: ``python -m studies NAME``.
 Each command is a ``_cmd_<name>(args)`` function; ``_build_parser`` registers them.
 """
 
@@ -232,7 +227,7 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
 
 # ----------------------------------------------------------------------------------- paper
 def _cmd_paper(args: argparse.Namespace) -> int:
-    from ..studies.paper import run_paper
+    from ..benchmarks.paper import run_paper
 
     prog = _progress_from(args)
     try:
@@ -451,7 +446,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
 # ----------------------------------------------------------------------------------- bench
 def _cmd_bench_wp(args: argparse.Namespace) -> int:
-    from ..studies.workprecision import run_work_precision
+    from ..benchmarks.workprecision import run_work_precision
 
     rtols = args.rtols or ([1e-3, 1e-5, 1e-7] if args.quick else None)
     if args.quick and args.formulations is None:
@@ -474,7 +469,7 @@ def _cmd_bench_wp(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_elements(args: argparse.Namespace) -> int:
-    from ..studies.workprecision import run_elements
+    from ..benchmarks.workprecision import run_elements
 
     cases = []
     for c in args.cases.split(","):
@@ -493,7 +488,7 @@ def _cmd_bench_elements(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_table1(args: argparse.Namespace) -> int:
-    from ..studies.paper import table1
+    from ..benchmarks.paper import table1
 
     table1(args.out, mode=args.mode, elements=args.elements, t_end=args.t_end, method=args.method, rtol=args.rtol,
            repeats=args.repeats, max_states=args.max_states, whole=args.whole or None,
@@ -501,34 +496,6 @@ def _cmd_bench_table1(args: argparse.Namespace) -> int:
     return 0
 
 
-# ----------------------------------------------------------------------------------- stability, crosscheck
-def _cmd_stability(args: argparse.Namespace) -> int:
-    from ..studies.stability import report
-
-    report(args.out, quick=args.quick, cases=args.case)
-    print(f"wrote {os.path.join(args.out, 'stability.md')}")
-    return 0
-
-
-def _cmd_crosscheck(args: argparse.Namespace) -> int:
-    from ..studies.crosscheck import run
-
-    run(args.study, t_end=args.t_end, rtol=args.rtol, theory=args.theory)
-    return 0
-
-
-def _cmd_study_geometric(args: argparse.Namespace) -> int:
-    from ..studies.geometric import run_geometric
-
-    run_geometric(args.out, quick=args.quick, models=args.models, elements=args.elements, cases=args.cases,
-                  exudyn_data=args.exudyn_data, checks=not args.no_checks, cost=not args.no_cost,
-                  plot=not args.no_plot, log=(lambda msg: None) if args.silent else
-                  (lambda msg: print(msg, file=sys.stderr, flush=True)))
-    print(f"wrote {os.path.join(args.out, 'summary.md')}")
-    return 0
-
-
-# ----------------------------------------------------------------------------------- parser
 _FMT = argparse.RawDescriptionHelpFormatter
 _THEORIES = ("timoshenko", "euler-bernoulli")
 
@@ -627,8 +594,8 @@ def _add_list_export_parsers(sub) -> None:
 
 def _add_bench_parsers(sub) -> None:
     from ..run.simulate import FORMULATIONS, NATIVE_METHODS
-    from ..studies.paper import PAPER_WINDOW
-    from ..studies.workprecision import DEFAULT_RTOLS, SCIPY_METHODS
+    from ..benchmarks.paper import PAPER_WINDOW
+    from ..benchmarks.workprecision import DEFAULT_RTOLS, SCIPY_METHODS
 
     p = sub.add_parser("bench", help="work-precision studies and the Table 1 analogue",
                        description="Benchmarks on the paper's slider-crank: 'work-precision', 'elements', 'table1'.")
@@ -712,72 +679,6 @@ def _add_bench_parsers(sub) -> None:
     q.set_defaults(func=_cmd_bench_table1)
 
 
-def _add_stability_parser(sub) -> None:
-    p = sub.add_parser(
-        "stability", formatter_class=_FMT,
-        help="the stability report over the catalogue of extreme scenes",
-        description="Run every case of the catalogue of stiff and extreme scenes (ukflex.studies.extreme) with the\n"
-                    "native and scipy integrators and the NumPy coordinate partitioning, then the long-run drift,\n"
-                    "scaling and units studies; write DIR/stability.md and DIR/stability.json.",
-    )
-    p.add_argument("--out", required=True, help="output directory (stability.md, stability.json)")
-    p.add_argument("--quick", action="store_true", help="reduced sizes (minutes instead of hours)")
-    p.add_argument("--case", action="append", default=None, metavar="NAME",
-                   help="run only this case (repeatable; skips the long-run, scaling and units studies)")
-    p.set_defaults(func=_cmd_stability)
-
-
-def _add_crosscheck_parser(sub) -> None:
-    from ..studies.crosscheck import STUDIES
-
-    p = sub.add_parser(
-        "crosscheck", formatter_class=_FMT,
-        help="cross-checks against the NumPy reference (errata, Rust UK vs CP, timings)",
-        description="Studies on the paper's slider-crank against the independent NumPy reference; each prints\n"
-                    "markdown tables (docs/errata.md):\n"
-                    "  errata  the paper's printed single-element terms, each erratum on and off (NumPy only)\n"
-                    "  sweep   Rust UK vs NumPy coordinate partitioning over rtol, with and without gravity\n"
-                    "  timing  acceleration time of NumPy UK vs CP (partition once / every call)\n"
-                    "  bdf     paper-like BDF runs (Rust UK, NumPy CP) against a tight reference; E-B vs Timoshenko",
-    )
-    p.add_argument("study", choices=STUDIES, metavar="STUDY", help=f"one of {', '.join(STUDIES)}")
-    p.add_argument("--t-end", type=_positive_float, default=None,
-                   help="simulated span [s] (default 0.07; timing 0.02)")
-    p.add_argument("--rtol", type=_positive_float, default=1e-8, help="rtol of the errata runs (default 1e-8)")
-    _add_theory_option(p, default=None)
-    p.set_defaults(func=_cmd_crosscheck)
-
-
-def _add_study_geometric_parser(sub) -> None:
-    from ..studies.geometric import CASES, MODELS
-
-    p = sub.add_parser(
-        "study-geometric", formatter_class=_FMT,
-        help="geometric nonlinearity of the coupler at speed: linear/nonlinear FFRF and ANCF vs Exudyn",
-        description="The paper's slider-crank with the linear FFRF, the nonlinear FFRF (Euler-Bernoulli and Timoshenko)\n"
-                    "and the ANCF cable coupler, N = 1, 2, 4, 8, 16, at omega/10 .. 5 omega and d/2, d/4, side by side with\n"
-                    "Exudyn's geometrically exact references (benches/data). Writes into DIR: runs.csv, axial.csv,\n"
-                    "extreme.csv, cost.csv, targets.csv, speeds.png, convergence.png, paper_history.png, axial.png,\n"
-                    "extreme.png, cost.png and summary.md (docs/geometric-nonlinearity.md).\n"
-                    "Full: DOPRI5 rtol 1e-8 (about 45 min on 2 cores); --quick: N = 1, 2, 4 with generalized-alpha\n"
-                    "(h = 2.5e-5 s), a reduced cost table (about a minute).",
-    )
-    p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--quick", action="store_true", help="N = 1, 2, 4, generalized-alpha, reduced checks (~1 min)")
-    p.add_argument("--models", type=_str_list(tuple(MODELS)), default=None,
-                   help=f"comma-separated models (default all: {','.join(MODELS)})")
-    p.add_argument("--elements", type=_int_list, default=None, help="comma-separated N (default 1,2,4,8,16; quick 1,2,4)")
-    p.add_argument("--cases", type=_str_list(tuple(c.name for c in CASES)), default=None,
-                   help=f"comma-separated cases (default all: {','.join(c.name for c in CASES)})")
-    p.add_argument("--exudyn-data", default=None,
-                   help="directory with Exudyn's exudyn_*.csv (default benches/data of the source tree)")
-    p.add_argument("--no-checks", action="store_true", help="skip the N = 32 and time-discretization checks")
-    p.add_argument("--no-cost", action="store_true", help="skip the cost table")
-    p.add_argument("--no-plot", action="store_true", help="skip the PNGs")
-    p.add_argument("--silent", action="store_true", help="no per-run lines on stderr")
-    p.set_defaults(func=_cmd_study_geometric)
-
-
 def _build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="ukflex",
@@ -790,15 +691,11 @@ def _build_parser() -> argparse.ArgumentParser:
                "  ukflex export four_bar > my_scene.toml    # start a scene file from a built-in scene\n"
                "  ukflex paper --out results/paper          # Fig. 4 and the Table 1 analogue\n"
                "  ukflex bench work-precision --out results/wp --quick\n"
-               "  ukflex stability --out results/stability --quick\n"
-               "  ukflex crosscheck errata\n"
-               "  ukflex study-geometric --out results/geometric --quick\n"
                "\nRun 'ukflex COMMAND --help' for the options of a command.",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for add in (_add_run_parser, _add_list_export_parsers, _add_paper_parser, _add_bench_parsers,
-                _add_stability_parser, _add_crosscheck_parser, _add_study_geometric_parser):
+    for add in (_add_run_parser, _add_list_export_parsers, _add_paper_parser, _add_bench_parsers):
         add(sub)
     return parser
 

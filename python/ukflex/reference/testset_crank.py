@@ -3,7 +3,7 @@
 An independent NumPy transcription of the Test Set's equations of motion (its Fortran
 subroutine ``RESMBS``, minimal coordinates ``p = (phi1, phi2, x3)``, ``q = (q1..q4)``), its
 initial values and its published reference solution at ``t = 0.1``.  It shares no code with
-ukflex: the study ``ukflex.studies.simeon_crank`` builds the same mechanism through the public
+ukflex: the study ``studies.simeon_crank`` builds the same mechanism through the public
 API (a rigid crank, a general flexible body for the rod, a slider) and compares the two.
 
 Model (Simeon, Math. Modelling of Systems 2, 1996; Test Set release 2.4, ``crank.f``): crank of

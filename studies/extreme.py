@@ -2,7 +2,7 @@
 
 Seven groups, each a function returning a scene (call ``.build()`` or pass it to
 :func:`ukflex.simulate`), and :data:`CASES`, the list the stability report
-(:mod:`ukflex.studies.stability`, ``ukflex stability``, ``docs/stability.md``) runs, with a full
+(:mod:`studies.stability`, ``python -m studies stability``, ``docs/stability.md``) runs, with a full
 and a reduced ("quick") size for each.  Parameters follow the built-in scenes:
 ``theory=`` is the coupler's beam theory, ``gravity=`` is ``True``/``False``, a magnitude or a
 vector (:func:`ukflex.scenes.gravity_vector`).
@@ -33,9 +33,10 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
-from .. import Circular, ConstantSpeed, Scene
-from ..errors import UnknownNameError
-from ..model.scenes import PAPER, double_pendulum, gravity_vector, slider_crank
+from ukflex import Circular, ConstantSpeed, Scene, UnknownNameError, scenes
+
+PAPER, double_pendulum, gravity_vector, slider_crank = (scenes.PAPER, scenes.double_pendulum, scenes.gravity_vector,
+                                                      scenes.slider_crank)
 
 __all__ = [
     "stiff",
@@ -263,7 +264,7 @@ class Case:
     Attributes
     ----------
     name : str
-        Identifier (``ukflex.studies.extreme.case(name)``).
+        Identifier (``studies.extreme.case(name)``).
     group : int
         Issue group 1-7 (stiff, flexible, high speed, singular, redundant, long run,
         ill-conditioning).

@@ -1,9 +1,9 @@
 """Cross-checks against the NumPy reference, behind docs/errata.md and the cross-validation report.
 
-    ukflex crosscheck errata   [--t-end 0.07] [--rtol 1e-8]   the paper's printed terms vs corrected
-    ukflex crosscheck sweep    [--t-end 0.07]                 Rust UK vs NumPy CP over rtol
-    ukflex crosscheck timing   [--t-end 0.02]                 NumPy UK vs CP acceleration time
-    ukflex crosscheck bdf      [--t-end 0.07]                 paper-like BDF runs, E-B vs Timoshenko
+    python -m studies crosscheck errata   [--t-end 0.07] [--rtol 1e-8]   the paper's printed terms vs corrected
+    python -m studies crosscheck sweep    [--t-end 0.07]                 Rust UK vs NumPy CP over rtol
+    python -m studies crosscheck timing   [--t-end 0.02]                 NumPy UK vs CP acceleration time
+    python -m studies crosscheck bdf      [--t-end 0.07]                 paper-like BDF runs, E-B vs Timoshenko
 
 (:func:`run` is the same as a function.)  ``errata`` and ``timing`` use only the NumPy
 reference; ``sweep`` and ``bdf`` compare it with the Rust core through :class:`ukflex.System`.
@@ -18,14 +18,14 @@ from typing import Optional, TextIO
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .. import System
-from ..reference import ReferenceModel, correct_initial_state, simulate_cp, simulate_uk_numpy
-from ..reference.paper_closed_form import ALL_FIXES, PaperSliderCrank
-from ..reference.uk import fd_jacobian
+from ukflex import System
+from ukflex.reference import ReferenceModel, correct_initial_state, simulate_cp, simulate_uk_numpy
+from ukflex.reference.paper_closed_form import ALL_FIXES, PaperSliderCrank
+from ukflex.reference.uk import fd_jacobian
 
 __all__ = ["STUDIES", "paper_description", "errata_effects", "rtol_sweep", "timing", "bdf_study", "run"]
 
-#: The studies of :func:`run` (``ukflex crosscheck STUDY``).
+#: The studies of :func:`run` (``python -m studies crosscheck STUDY``).
 STUDIES = ("errata", "sweep", "timing", "bdf")
 
 

@@ -13,11 +13,11 @@ The same coupler as a plane-stress rectangle meshed with quadratic quads
 
 Commands (docs/flexible-bodies.md has the figures and times)::
 
-    python -m ukflex.studies.flexible_coupler                                    # beam FE, linear
-    python -m ukflex.studies.flexible_coupler --nonlinear --modal-derivatives=2  # beam FE, nonlinear
-    python -m ukflex.studies.flexible_coupler --mesh                             # Q2 meshes, linear
-    python -m ukflex.studies.flexible_coupler --mesh --nonlinear --modal-derivatives=2
-    python -m ukflex.studies.flexible_coupler --figure coupler_nonlinear.png
+    python -m studies flexible-coupler                                    # beam FE, linear
+    python -m studies flexible-coupler --nonlinear --modal-derivatives=2  # beam FE, nonlinear
+    python -m studies flexible-coupler --mesh                             # Q2 meshes, linear
+    python -m studies flexible-coupler --mesh --nonlinear --modal-derivatives=2
+    python -m studies flexible-coupler --figure coupler_nonlinear.png
 """
 
 from __future__ import annotations
@@ -28,11 +28,8 @@ from typing import Any, Dict, List, Optional
 
 import numpy as np
 
-from .. import fe, scenes
-from ..model.flexible import FlexibleData, InterfacePoint
-from ..reference import fe_invariants as fi
-from ..model.scene import ConstantSpeed, Scene
-from ..run.simulate import simulate
+from ukflex import ConstantSpeed, FlexibleData, InterfacePoint, Scene, fe, scenes, simulate
+from ukflex.reference import fe_invariants as fi
 
 __all__ = ["coupler_data", "mesh_coupler_data", "scene", "peak", "study", "mesh_study", "beam_frequencies", "figure"]
 
@@ -210,7 +207,7 @@ def mesh_study(meshes=MESHES, ks=(2, 4, 8), order: int = 2, cells: str = "quad",
 def figure(path: str, k: int = 4, modal_derivatives: Any = 2, rtol: float = 1e-8) -> None:
     """Midpoint deflection over 0-0.07 s: the built-in beam N = 8 (linear and nonlinear strain)
     and the k-mode coupler with nonlinear strain, without and with modal derivatives."""
-    from ..results.plotting import figure as new_figure
+    from ukflex.results.plotting import figure as new_figure
 
     nodal = coupler_data(8, None, "nonlinear")
     curves = [("built-in beam N=8, linear strain", run_beam(8, "linear", rtol), dict(color="0.6", lw=2.5)),
@@ -248,24 +245,31 @@ def _print_mesh_study(out: Dict[str, Any]) -> None:
             print(f"    k={r['k']} (n_f {r['n_f']}): peak {r['peak']:.6e}  rel. error {r['error']:.2e}{ek}  {r['wall']:.2f} s")
 
 
-if __name__ == "__main__":  # pragma: no cover
+def main(argv: Optional[List[str]] = None) -> int:
+    """``python -m studies flexible-coupler [--nonlinear] [--mesh] [--modal-derivatives[=K]] [--figure PNG]``."""
     import sys
 
-    if "--figure" in sys.argv:
-        figure(sys.argv[sys.argv.index("--figure") + 1])
-        raise SystemExit(0)
-    strain = "nonlinear" if "--nonlinear" in sys.argv else "linear"
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if "--figure" in argv:
+        figure(argv[argv.index("--figure") + 1])
+        return 0
+    strain = "nonlinear" if "--nonlinear" in argv else "linear"
     md: Any = False
-    for a in sys.argv:
+    for a in argv:
         if a.startswith("--modal-derivatives"):
             md = True if a == "--modal-derivatives" else int(a.split("=")[1])
-    if "--mesh" in sys.argv:
+    if "--mesh" in argv:
         if strain == "linear":
             _print_mesh_study(mesh_study())
         else:
             _print_mesh_study(mesh_study(meshes=((32, 2),), strain="nonlinear", modal_derivatives=md))
-        raise SystemExit(0)
+        return 0
     for row in study(strain=strain, modal_derivatives=md, nodal=strain == "linear"):
         fmax = "" if row["f_max"] is None else f"  f_max {row['f_max']:.0f} Hz"
         nf = "" if row["n_f"] is None else f"  n_f {row['n_f']}"
         print(f"{row['model']:26s}{nf} peak |v(0.5)|/Lb {row['peak']:.6e}  rel. error {row['error']:.2e}  {row['wall']:.2f} s{fmax}")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())

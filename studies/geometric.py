@@ -1,5 +1,5 @@
-"""Geometric nonlinearity of the paper's coupler at speed (issue 11, item 4; ``ukflex
-study-geometric``, ``docs/geometric-nonlinearity.md``).
+"""Geometric nonlinearity of the paper's coupler at speed (issue 11, item 4; ``python -m studies
+geometric``, ``docs/geometric-nonlinearity.md``).
 
 The paper's slider-crank with four coupler models (:data:`MODELS`): the paper's linear FFRF
 beam, the nonlinear FFRF beam (second-order axial strain averaged per element, Euler-Bernoulli
@@ -48,9 +48,10 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tupl
 
 import numpy as np
 
-from .. import UkflexError, scenes, simulate
-from ..model.scenes import PAPER
-from .machine import machine_info, machine_line
+from ukflex import UkflexError, scenes, simulate
+from ukflex.benchmarks.machine import machine_info, machine_line
+
+PAPER = scenes.PAPER
 
 __all__ = [
     "Model",
@@ -650,7 +651,7 @@ def run_geometric(out: os.PathLike, quick: bool = False, *, models: Optional[Seq
 
     rows = [_run_row(r, exudyn, finest.get((r.model, r.case.name))) for r in list(runs.values()) + extra]
     _write_csv(outdir / "runs.csv", RUN_FIELDS, rows, comments=[
-        "ukflex study-geometric: paper slider-crank, gravity on, peak = max |v(0.5)|/Lb over crank angle 0..8.736 rad "
+        "python -m studies geometric: paper slider-crank, gravity on, peak = max |v(0.5)|/Lb over crank angle 0..8.736 rad "
         "(parabolic refinement on a 1e-5 s grid), runs to 12.48 rad",
         "peak_vs_exudyn: against Exudyn's ANCF cable (E-B models) or GE beam (Timoshenko), converged; hist_vs_exudyn "
         "(paper speed only): max |v - v_ref| over 0..0.1 s / reference peak; *_vs_finest: against the same model at "
@@ -853,7 +854,7 @@ COLORS = {"linear-ffrf": "tab:gray", "nonlinear-ffrf": "tab:blue", "nonlinear-ff
 
 
 def _figure(w: float = 7.0, h: float = 4.2, rows: int = 1, cols: int = 1, **kw):
-    from ..results.plotting import figure
+    from ukflex.results.plotting import figure
 
     fig = figure((w, h), "the geometric study's plots (--no-plot skips them)", dpi=90)
     axes = fig.subplots(rows, cols, squeeze=False, **kw)
@@ -991,7 +992,7 @@ def _summary_md(s: Dict[str, Any]) -> str:
     L: List[str] = []
     L.append("# Geometric nonlinearity study: summary")
     L.append("")
-    cmd = "ukflex study-geometric --out DIR" + (" --quick" if s["quick"] else "")
+    cmd = "python -m studies geometric --out DIR" + (" --quick" if s["quick"] else "")
     L.append(f"Written by `{cmd}` in {s['wall_total']:.0f} s. Integrator: {cfg.integrator.label} "
              f"(checks: {cfg.check_integrator.label}). Machine: {machine_line(s['machine_start'])}; load average at the "
              f"end {s['machine_end']['load_average'][0]:.2f}.")

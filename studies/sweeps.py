@@ -11,7 +11,7 @@ force ``max |N|`` over the run.
 ``LocalCluster`` in one go, checks that the three tables agree and writes ``sweep.csv``,
 ``timing.md`` and ``contours.png``::
 
-    python -m ukflex.studies.sweeps --out docs/results/sweeps
+    python -m studies sweeps --out docs/results/sweeps
 
 Public API only (``ukflex.sweep``, ``ukflex.scenes``, ``SimulationResult``).
 """
@@ -65,7 +65,7 @@ def crank_study(omegas: Sequence[float] = OMEGAS, diameters: Sequence[float] = D
 
 
 def _contours(df: Any, path: str) -> None:
-    from ..results.plotting import figure
+    from ukflex.results.plotting import figure
 
     fig = figure((11.0, 4.2), "the sweep's contour plot")
     from matplotlib.colors import LogNorm
@@ -129,7 +129,7 @@ def run_study(out: str, omegas: Sequence[float] = OMEGAS, diameters: Sequence[fl
         f"# Sweep timing: {len(first)} cases (omega x diameter = {len(omegas)} x {len(diameters)})",
         "",
         f"Machine: {os.cpu_count()} cores (shared); workers: {workers}; run: "
-        f"`python -m ukflex.studies.sweeps --out {out}`; 1-minute load average when each started: "
+        f"`python -m studies sweeps --out {out}`; 1-minute load average when each started: "
         f"{', '.join(load)}.",
         "",
         "| executor | wall time [s] | vs serial |",
@@ -155,7 +155,7 @@ def run_study(out: str, omegas: Sequence[float] = OMEGAS, diameters: Sequence[fl
 
 
 def main(argv: Optional[List[str]] = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m ukflex.studies.sweeps", description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(prog="python -m studies sweeps", description=__doc__.split("\n\n")[0])
     p.add_argument("--out", required=True, help="output directory (sweep.csv, timing.md, contours.png)")
     p.add_argument("--workers", type=int, default=2, help="processes of the pool and of the LocalCluster (default 2)")
     p.add_argument("--small", action="store_true", help="8 x 5 cases instead of 40 x 25 (a check, ~10 s)")

@@ -18,14 +18,13 @@ integrated directly (:mod:`ukflex.reference.testset_crank`).
 from __future__ import annotations
 
 import time
-from typing import Any, Dict, Optional
+from typing import Any, Dict, List, Optional
 
 import numpy as np
 
-from ..model.flexible import FlexibleData, InterfacePoint
-from ..reference import testset_crank as ts
-from ..model.scene import ConstantSpeed, Scene
-from ..run.simulate import NATIVE_METHODS, simulate
+from ukflex import ConstantSpeed, FlexibleData, InterfacePoint, Scene, simulate
+from ukflex.reference import testset_crank as ts
+from ukflex.run.simulate import NATIVE_METHODS
 
 __all__ = ["rod_data", "crank_scene", "crank_state", "run"]
 
@@ -154,7 +153,13 @@ def report(nonlinear: bool = False, **kw: Any) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":  # pragma: no cover
+def main(argv: Optional[List[str]] = None) -> int:
+    """``python -m studies simeon-crank [--nonlinear]``."""
     import sys
 
-    print(report(nonlinear="--nonlinear" in sys.argv))
+    print(report(nonlinear="--nonlinear" in (sys.argv[1:] if argv is None else argv)))
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())
