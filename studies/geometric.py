@@ -277,7 +277,7 @@ def history_error(t: np.ndarray, v: np.ndarray, t_ref: np.ndarray, v_ref: np.nda
 # ----------------------------------------------------------------------------------- Exudyn data
 def default_exudyn_dir() -> Path:
     """``benches/data`` of the source tree this package was loaded from."""
-    return Path(__file__).resolve().parents[3] / "benches" / "data"
+    return Path(__file__).resolve().parents[1] / "benches" / "data"
 
 
 def _read_reference(path: Path) -> Dict[str, Any]:
