@@ -24,6 +24,14 @@ pub struct Force {
 }
 
 impl Force {
+    /// Write the defaults this force resolved into its description (a spring-damper's rest
+    /// length taken at the initial guess).
+    pub fn fill_defaults(&self, d: &mut ForceDesc) {
+        if let (ForceKind::SpringDamper { rest_length: r, .. }, ForceDesc::SpringDamper { rest_length, .. }) = (&self.kind, d) {
+            *rest_length = Some(*r);
+        }
+    }
+
     /// Build a force element; `item` names it in errors.
     pub fn from_desc(ctx: &BuildContext, item: &str, name: String, d: &ForceDesc) -> Result<Force> {
         let kind = match d {

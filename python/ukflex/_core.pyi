@@ -205,6 +205,9 @@ class System:
         """(start, stop) of a body's elastic coordinates in q."""
     def body_info(self, body: str) -> Dict[str, Any]:
         """Properties of a body as the core derived them."""
+    def body_capabilities(self, body: str) -> Dict[str, bool]:
+        """What a body can be asked: beam, elastic, elastic_coordinates, axial_forces,
+        named_markers, oriented (so that Python keeps no lists of kinds)."""
     def correct(
         self,
         t: float,

@@ -4,14 +4,11 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use super::sensors::read_states;
-use super::{check_time, finite_out, mat, read_into, to_py, Real, SolverError, Vector};
-use crate::body::{ancf_cable, BodyKind};
-use crate::linalg::Banded;
+use super::{arg_err, array, check_time, finite_out, json_to_py, mat, read_into, to_py, Real, SolverError, Vector};
 use crate::correct::{self, CorrectOptions};
 use crate::data::{Data, RankTolerance, Stabilization, SvdBackend, UkSolver};
 use crate::dynamics;
@@ -137,7 +134,7 @@ impl PySystem {
         let memory_limit = match memory_limit {
             None => DEFAULT_MEMORY_LIMIT,
             Some(b) if b > 0.0 && !b.is_nan() => if b.is_finite() { b as u64 } else { u64::MAX },
-            Some(b) => return Err(PyValueError::new_err(format!("memory_limit must be a positive number of bytes, got {b}"))),
+            Some(b) => return Err(arg_err("memory_limit", format!("must be a positive number of bytes, got {b}"))),
         };
         let model = catch_unwind(|| Model::from_json(description_json))
             .map_err(|_| SolverError::new_err("internal error while building the model"))?
@@ -285,7 +282,7 @@ impl PySystem {
                 read_into("lam", &l.as_array(), &mut held.1).map_err(to_py)?;
             }
             (None, None) => {}
-            _ => return Err(PyValueError::new_err("linearization: give both qdd and lam, or neither (the UK solution at the state)")),
+            _ => return Err(arg_err("linearization", "give both qdd and lam, or neither (the UK solution at the state)")),
         }
         let given = qdd.is_some();
         let out = self.with_ws(|model, ws| {
@@ -489,7 +486,7 @@ impl PySystem {
         let nt = tv.len();
         let (qa, qda) = (q.as_array().to_owned(), qd.as_array().to_owned());
         if qa.shape() != [n, nt] || qda.shape() != [n, nt] {
-            return Err(PyValueError::new_err(format!(
+            return Err(arg_err("q", format!(
                 "residual_norms: expected q and qd of shape ({n}, {nt}), got {:?} and {:?}", qa.shape(), qda.shape())));
         }
         let out = py.detach(|| {
@@ -564,7 +561,7 @@ impl PySystem {
         let state = match (t, &q, &qd) {
             (Some(t), Some(q), Some(qd)) => Some((t, q, qd)),
             (None, None, None) => None,
-            _ => return Err(PyValueError::new_err("rank_info: give all of t, q, qd (a state) or none of them (the last solve)")),
+            _ => return Err(arg_err("rank_info", "give all of t, q, qd (a state) or none of them (the last solve)")),
         };
         let (info, path) = self.with_ws(|model, ws| {
             if let Some((t, q, qd)) = state {
@@ -594,11 +591,11 @@ impl PySystem {
     fn set_rank_tolerance(&self, rcond: Option<f64>, atol: f64) -> PyResult<()> {
         if let Some(r) = rcond {
             if !r.is_finite() || r < 0.0 {
-                return Err(PyValueError::new_err(format!("rcond must be >= 0 and finite, got {r}")));
+                return Err(arg_err("rcond", format!("must be >= 0 and finite, got {r}")));
             }
         }
         if !atol.is_finite() || atol < 0.0 {
-            return Err(PyValueError::new_err(format!("atol must be >= 0 and finite, got {atol}")));
+            return Err(arg_err("atol", format!("must be >= 0 and finite, got {atol}")));
         }
         self.with_ws(|_, ws| {
             ws.data.tolerance = RankTolerance { rcond, atol };
@@ -615,7 +612,7 @@ impl PySystem {
             "auto" => SvdBackend::Auto,
             "qr-jacobi" => SvdBackend::QrJacobi,
             "faer" => SvdBackend::Faer,
-            other => return Err(PyValueError::new_err(format!("unknown pseudoinverse kind '{other}' (use 'auto', 'qr-jacobi' or 'faer')"))),
+            other => return Err(arg_err("kind", format!("unknown pseudoinverse kind '{other}' (use 'auto', 'qr-jacobi' or 'faer')"))),
         };
         self.with_ws(|_, ws| {
             ws.data.svd_backend = b;
@@ -635,7 +632,7 @@ impl PySystem {
             "central" => Differences::Central,
             "forward" => Differences::Forward,
             "structured" => Differences::Structured,
-            other => return Err(PyValueError::new_err(format!("unknown scheme '{other}' (use 'central', 'forward' or 'structured')"))),
+            other => return Err(arg_err("scheme", format!("unknown scheme '{other}' (use 'central', 'forward' or 'structured')"))),
         };
         let mut yv = vec![0.0; 2 * n];
         read_into("y", &y.as_array(), &mut yv).map_err(to_py)?;
@@ -720,11 +717,11 @@ impl PySystem {
             "central" => Differences::Central,
             "forward" => Differences::Forward,
             "structured" => Differences::Structured,
-            other => return Err(PyValueError::new_err(format!("unknown jacobian '{other}' (use 'structured', 'central' or 'forward')"))),
+            other => return Err(arg_err("jacobian", format!("unknown jacobian '{other}' (use 'structured', 'central' or 'forward')"))),
         };
         let n = self.model.n;
         let mut method = Method::from_name(method)
-            .ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5', 'GENALPHA' or 'RADAU5M')")))?;
+            .ok_or_else(|| arg_err("method", format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5', 'GENALPHA' or 'RADAU5M')")))?;
         match &mut method {
             Method::GenAlpha(go) => {
                 go.rho_inf = rho_inf.unwrap_or(go.rho_inf);
@@ -732,9 +729,9 @@ impl PySystem {
                 go.newton_local_error = newton_local_error;
             }
             Method::RadauM(ro) if newton_local_error.is_none() && rho_inf.is_none() => ro.step = step,
-            Method::RadauM(_) => return Err(PyValueError::new_err("rho_inf and newton_local_error apply to GENALPHA only (RADAU5M is L-stable: no dissipation setting)")),
+            Method::RadauM(_) => return Err(arg_err("rho_inf", "rho_inf and newton_local_error apply to GENALPHA only (RADAU5M is L-stable: no dissipation setting)")),
             _ if step.is_some() || newton_local_error.is_some() || rho_inf.is_some() => {
-                return Err(PyValueError::new_err("step (a fixed step size) applies to GENALPHA and RADAU5M, rho_inf and newton_local_error to GENALPHA only"));
+                return Err(arg_err("step", "step (a fixed step size) applies to GENALPHA and RADAU5M, rho_inf and newton_local_error to GENALPHA only"));
             }
             _ => {}
         }
@@ -751,7 +748,7 @@ impl PySystem {
         let stop_on_drift = match on_drift {
             "stop" => true,
             "warn" => false,
-            other => return Err(PyValueError::new_err(format!("on_drift must be 'stop' or 'warn', got {other:?}"))),
+            other => return Err(arg_err("on_drift", format!("must be 'stop' or 'warn', got {other:?}"))),
         };
         let opts = Options {
             rtol,
@@ -772,7 +769,7 @@ impl PySystem {
             None => Some(crate::integrate::default_projection(&atol_full)),
             Some(0.0) => None,
             Some(p) if p > 0.0 && p.is_finite() => Some(crate::correct::ProjectionTolerance { position_tol: p, velocity_tol: p, max_iter: 20 }),
-            Some(p) => return Err(PyValueError::new_err(format!("projection_tol must be >= 0 and finite, got {p}"))),
+            Some(p) => return Err(arg_err("projection_tol", format!("must be >= 0 and finite, got {p}"))),
         };
         // a fresh workspace with this System's settings: the run does not hold the lock
         let (tolerance, stabilization, backend, solver, limit) =
@@ -791,7 +788,7 @@ impl PySystem {
             opts.linear_solver = match jacobian {
                 Differences::Structured => NewtonMatrices::resolve(model, &data, linear_solver, true).map_err(to_py)?,
                 _ if linear_solver == LinearSolver::Sparse => {
-                    return Err(PyValueError::new_err("linear_solver='sparse' with RADAU5 needs jacobian='structured' (a difference Jacobian is dense)"));
+                    return Err(arg_err("linear_solver", "linear_solver='sparse' with RADAU5 needs jacobian='structured' (a difference Jacobian is dense)"));
                 }
                 _ => LinearSolver::Dense,
             };
@@ -888,7 +885,7 @@ impl PySystem {
         read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
         let sa = shapes.as_array();
         if sa.shape()[0] != n {
-            return Err(PyValueError::new_err(format!("material_energies: expected shapes of shape ({n}, k), got {:?}", sa.shape())));
+            return Err(arg_err("material_energies", format!("expected shapes of shape ({n}, k), got {:?}", sa.shape())));
         }
         let k = sa.shape()[1];
         let mut v = vec![0.0; n];
@@ -937,13 +934,13 @@ impl PySystem {
         let tv: Vec<f64> = t.as_array().to_vec();
         let ya = y.as_array();
         if ya.shape() != [2 * n, tv.len()] {
-            return Err(PyValueError::new_err(format!("singular_passages: expected y of shape ({}, {}), got {:?}", 2 * n, tv.len(), ya.shape())));
+            return Err(arg_err("singular_passages", format!("expected y of shape ({}, {}), got {:?}", 2 * n, tv.len(), ya.shape())));
         }
         if tv.iter().any(|x| !x.is_finite()) || ya.iter().any(|x| !x.is_finite()) {
             return Err(to_py(Error::NonFinite { what: "singular_passages: t or y".into(), index: 0 }));
         }
         if tv.windows(2).any(|w| !(w[1] > w[0])) {
-            return Err(PyValueError::new_err("singular_passages: t must be strictly increasing"));
+            return Err(arg_err("singular_passages", "t must be strictly increasing"));
         }
         let (tolerance, solver, limit) = self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.uk_solver, ws.data.memory_limit)))?;
         let model = &self.model;
@@ -970,7 +967,7 @@ impl PySystem {
         let n = self.model.n;
         let va = v.as_array();
         if va.shape().len() != 2 || va.shape()[0] != n {
-            return Err(PyValueError::new_err(format!("tangent_project: expected V of shape ({n}, k), got {:?}", va.shape())));
+            return Err(arg_err("tangent_project", format!("expected V of shape ({n}, k), got {:?}", va.shape())));
         }
         let k = va.shape()[1];
         let mut cols: Vec<Vec<f64>> = (0..k).map(|j| (0..n).map(|i| va[[i, j]]).collect()).collect();
@@ -1020,7 +1017,7 @@ impl PySystem {
     fn project_step<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, position_tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64, bool)> {
         let t = t.0;
         if !(position_tol >= 0.0) || !position_tol.is_finite() {
-            return Err(PyValueError::new_err(format!("position_tol must be >= 0 and finite, got {position_tol}")));
+            return Err(arg_err("position_tol", format!("must be >= 0 and finite, got {position_tol}")));
         }
         let (qn, qdn, phi0, phi1) = self.with_ws(|model, ws| {
             check_time(t)?;
@@ -1045,11 +1042,11 @@ impl PySystem {
             "none" => Stabilization::None,
             "baumgarte" => {
                 if !alpha.is_finite() || !beta.is_finite() || alpha < 0.0 || beta < 0.0 {
-                    return Err(PyValueError::new_err(format!("Baumgarte alpha and beta must be >= 0 and finite, got {alpha}, {beta}")));
+                    return Err(arg_err("alpha", format!("Baumgarte alpha and beta must be >= 0 and finite, got {alpha}, {beta}")));
                 }
                 Stabilization::Baumgarte { alpha, beta }
             }
-            other => return Err(PyValueError::new_err(format!("unknown stabilization '{other}' (use 'none' or 'baumgarte')"))),
+            other => return Err(arg_err("kind", format!("unknown stabilization '{other}' (use 'none' or 'baumgarte')"))),
         };
         self.with_ws(|_, ws| {
             ws.data.stabilization = st;
@@ -1065,7 +1062,7 @@ impl PySystem {
     fn project<'py>(&self, py: Python<'py>, t: Real, q: Vector<'py>, qd: Vector<'py>, tol: f64, max_iter: usize) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let t = t.0;
         if !tol.is_finite() || tol <= 0.0 {
-            return Err(PyValueError::new_err(format!("tol must be positive and finite, got {tol}")));
+            return Err(arg_err("tol", format!("must be positive and finite, got {tol}")));
         }
         let (qn, qdn, rep) = self.with_ws(|model, ws| {
             check_time(t)?;
@@ -1086,119 +1083,60 @@ impl PySystem {
         Ok((PyArray1::from_vec(py, qn), PyArray1::from_vec(py, qdn), d))
     }
 
-    /// Shape of a beam at xi in [0, 1]. FFRF beam: (S (2, n_f), N_psi (n_f,)) with the elastic
-    /// displacement u_f = S q_f in the beam frame and psi = N_psi q_f. ANCF beam:
-    /// (S (2, n_b), S' (2, n_b)) over the body's n_b = 4 (N + 1) coordinates e, with the world
-    /// position r = S e and the slope r' = S' e (d/dx) of the axis point.
+    /// Shape of a beam at xi in [0, 1] (`Body::shape`). FFRF beam: (S (2, n_f), N_psi (n_f,))
+    /// with the elastic displacement u_f = S q_f in the beam frame and psi = N_psi q_f. ANCF
+    /// beam: (S (2, n_b), S' (2, n_b)) over the body's n_b = 4 (N + 1) coordinates e, with the
+    /// world position r = S e and the slope r' = S' e (d/dx) of the axis point.
     #[allow(clippy::type_complexity)]
-    fn beam_shape<'py>(&self, py: Python<'py>, body: &str, xi: Real) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyAny>)> {
-        let xi = xi.0;
-        let bi = self.body(body)?;
-        if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
-            return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {xi}")));
-        }
-        let beam = match &self.model.bodies[bi].kind {
-            BodyKind::Beam(beam) => beam,
-            BodyKind::AncfBeam(cable) => {
-                let nb = cable.n_coords();
-                let p = cable.point(xi);
-                let (mut s, mut d) = (vec![0.0; 2 * nb], vec![0.0; 2 * nb]);
-                for a in 0..4 {
-                    for c in 0..2 {
-                        s[c * nb + p.first + 2 * a + c] = p.s[a];
-                        d[c * nb + p.first + 2 * a + c] = p.d[a];
-                    }
-                }
-                return Ok((mat(py, s, 2, nb)?, mat(py, d, 2, nb)?.into_any()));
-            }
-            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam"))),
-        };
-        let nf = beam.n_f;
-        let ps = beam.point_shape(xi);
-        let (mut s, mut npsi) = (vec![0.0; 2 * nf], vec![0.0; nf]);
-        for &(i, su, sv, sp) in &ps.entries {
-            s[i] = su;
-            s[nf + i] = sv;
-            npsi[i] = sp;
-        }
-        Ok((mat(py, s, 2, nf)?, PyArray1::from_vec(py, npsi).into_any()))
+    fn beam_shape<'py>(&self, py: Python<'py>, body: &str, xi: Real) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let (s, p) = self.model.bodies[self.body(body)?].shape(xi.0).map_err(to_py)?;
+        Ok((array(py, s)?, array(py, p)?))
     }
 
-    /// Constant elastic blocks of a beam: (M_ff, K_ff), each (n_f, n_f). ANCF beam: the
-    /// constant mass matrix M and the tangent stiffness at the undeformed initial guess (the
-    /// linear stiffness), each (n_b, n_b) over its n_b = 4 (N + 1) coordinates.
+    /// Constant elastic blocks of a beam (`Body::matrices`): (M_ff, K_ff), each (n_f, n_f). ANCF
+    /// beam: the constant mass matrix M and the tangent stiffness at the undeformed initial
+    /// guess (the linear stiffness), each (n_b, n_b) over its n_b = 4 (N + 1) coordinates.
     #[allow(clippy::type_complexity)]
-    fn beam_matrices<'py>(&self, py: Python<'py>, body: &str) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-        let bi = self.body(body)?;
-        let b = &self.model.bodies[bi];
-        let beam = match &b.kind {
-            BodyKind::Beam(beam) => beam,
-            BodyKind::AncfBeam(cable) => {
-                let nb = b.n_coords;
-                self.check_square("System.beam_matrices (two dense n_b x n_b)", nb, 2, "raise memory_limit")?;
-                let mut m = vec![0.0; nb * nb];
-                cable.dense_block(&Default::default(), &mut |i, j, v| m[i * nb + j] = v);
-                let mut k = Banded::zeros(nb, ancf_cable::HB);
-                cable.add_tangent_stiffness(&self.model.q0[b.offset..b.offset + nb], &mut k);
-                return Ok((mat(py, m, nb, nb)?, mat(py, k.to_dense(), nb, nb)?));
-            }
-            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam"))),
-        };
-        let nf = beam.n_f;
-        self.check_square("System.beam_matrices (two dense n_f x n_f)", nf, 2, "raise memory_limit")?;
-        Ok((mat(py, beam.m_ff.to_dense(), nf, nf)?, mat(py, beam.k_ff.to_dense(), nf, nf)?))
+    fn beam_matrices<'py>(&self, py: Python<'py>, body: &str) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let b = &self.model.bodies[self.body(body)?];
+        b.require_beam().map_err(to_py)?;
+        self.check_square("System.beam_matrices (two dense square blocks)", b.n_coords, 2, "raise memory_limit")?;
+        let (m, k) = b.matrices(&self.model.q0).map_err(to_py)?;
+        Ok((array(py, m)?, array(py, k)?))
     }
 
     /// Axial force of each element of a beam at q (E a times the element's averaged axial strain,
     /// second-order with nonlinear strain; tension positive), shape (elements,).
     fn axial_forces<'py>(&self, py: Python<'py>, body: &str, q: Vector<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let bi = self.body(body)?;
-        if !matches!(self.model.bodies[bi].kind, BodyKind::Beam(_)) {
-            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
+        let b = &self.model.bodies[bi];
+        if !b.capabilities().axial_forces {
+            return Err(to_py(b.axial_forces(&b.new_data()).unwrap_err()));
         }
         let v = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
             dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
-            let crate::body::BodyData::Beam(bd) = &ws.data.bodies[bi] else {
-                return Err(Error::Solver("axial_forces: the workspace of a beam is not a beam's".into()));
-            };
-            finite_out("axial_forces", &bd.axial_force)?;
-            Ok(bd.axial_force.clone())
+            let v = model.bodies[bi].axial_forces(&ws.data.bodies[bi])?;
+            finite_out("axial_forces", &v)?;
+            Ok(v)
         })?;
         Ok(PyArray1::from_vec(py, v))
     }
 
-    /// Tangent stiffness -dQ_el/dq_b of a beam's elastic forces at q (n,), shape (n_b, n_b) over
-    /// the body's coordinates: ANCF beam: the analytic K_t = d2U/dq_b2 (undamped); FFRF beam:
-    /// the elastic block, K_ff plus, with nonlinear strain, the geometric and second-order axial
-    /// stiffness of its averaged axial strain; flexible body: K_ff + k3 q_f + k4 q_f q_f / 2.
+    /// Tangent stiffness -dQ_el/dq_b of a body's elastic forces at q (n,), shape (n_b, n_b) over
+    /// the body's coordinates (`Body::tangent_stiffness`): ANCF beam: the analytic
+    /// K_t = d2U/dq_b2 (undamped); FFRF beam: the elastic block, K_ff plus, with nonlinear
+    /// strain, the geometric and second-order axial stiffness of its averaged axial strain;
+    /// flexible body: K_ff + k3 q_f + k4 q_f q_f / 2.
     fn tangent_stiffness<'py>(&self, py: Python<'py>, body: &str, q: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let bi = self.body(body)?;
-        let b = &self.model.bodies[bi];
+        let b = &self.model.bodies[self.body(body)?];
         let nb = b.n_coords;
         let mut qv = vec![0.0; self.model.n];
         read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
-        if matches!(b.kind, BodyKind::AncfBeam(_) | BodyKind::Beam(_) | BodyKind::Flexible(_)) {
+        if b.capabilities().elastic {
             self.check_square("System.tangent_stiffness (dense n_b x n_b)", nb, 1, "raise memory_limit")?;
         }
-        let k = match &b.kind {
-            BodyKind::AncfBeam(cable) => {
-                let mut k = Banded::zeros(nb, ancf_cable::HB);
-                cable.add_tangent_stiffness(&qv[b.offset..b.offset + nb], &mut k);
-                k.to_dense()
-            }
-            BodyKind::Beam(beam) => {
-                let mut k = vec![0.0; nb * nb];
-                beam.elastic_tangent(&qv[b.elastic_range()], &mut |i, j, v| k[(3 + i) * nb + 3 + j] += v);
-                k
-            }
-            BodyKind::Flexible(flex) => {
-                let mut k = vec![0.0; nb * nb];
-                flex.elastic_tangent(&qv[b.elastic_range()], &mut |i, j, v| k[(3 + i) * nb + 3 + j] += v);
-                k
-            }
-            _ => return Err(PyValueError::new_err(format!("body '{body}' is not a beam or a flexible body"))),
-        };
+        let k = b.tangent_stiffness(&qv).map_err(to_py)?;
         finite_out("tangent_stiffness", &k).map_err(to_py)?;
         mat(py, k, nb, nb)
     }
@@ -1211,32 +1149,24 @@ impl PySystem {
     /// of the ends) and an ANCF beam's chord frame of the ends, so the two compare one to one.
     fn beam_point<'py>(&self, py: Python<'py>, body: &str, xi: Real, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let xi = xi.0;
-        let bi = self.body(body)?;
-        if !xi.is_finite() || !(0.0..=1.0).contains(&xi) {
-            return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {xi}")));
-        }
-        let b = &self.model.bodies[bi];
-        if b.beam_point(xi, &self.model.q0).is_none() {
-            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
-        }
+        let b = &self.model.bodies[self.body(body)?];
+        b.beam_point(xi, &self.model.q0).map_err(to_py)?;
         let n = self.model.n;
         let arr = py.import("numpy")?.call_method1("asarray", (q, "float64"))?.cast_into::<numpy::PyArrayDyn<f64>>()
-            .map_err(|_| PyValueError::new_err("q must be an array of floats"))?;
+            .map_err(|_| arg_err("q", "must be an array of floats"))?;
         let view = arr.readonly();
         let a = view.as_array();
         let (cols, one) = match a.shape() {
             [m] if *m == n => (1, true),
             [m, nt] if *m == n => (*nt, false),
-            other => return Err(PyValueError::new_err(format!("q must have shape (n,) or (n, nt) with n = {n}, got {other:?}"))),
+            other => return Err(arg_err("q", format!("must have shape (n,) or (n, nt) with n = {n}, got {other:?}"))),
         };
         // one state per column: gather the transposed copy (state k contiguous)
         let flat: Vec<f64> = if one { a.iter().copied().collect() } else { a.t().iter().copied().collect() };
         crate::error::check_finite("q", &flat).map_err(to_py)?;
         let mut out = vec![0.0; 5 * cols];
         for k in 0..cols {
-            let Some(p) = b.beam_point(xi, &flat[k * n..(k + 1) * n]) else {
-                return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
-            };
+            let p = b.beam_point(xi, &flat[k * n..(k + 1) * n]).map_err(to_py)?;
             finite_out("beam_point", &p).map_err(to_py)?;
             for (r, v) in p.iter().enumerate() {
                 out[r * cols + k] = *v;
@@ -1262,7 +1192,7 @@ impl PySystem {
         let (qds, nt2) = read_states(qd, n, "qd")?;
         let ts: Vec<f64> = t.as_array().iter().copied().collect();
         if nt2 != nt || ts.len() != nt {
-            return Err(PyValueError::new_err(format!("t, q and qd must hold the same number of states, got {}, {nt} and {nt2}", ts.len())));
+            return Err(arg_err("t", format!("t, q and qd must hold the same number of states, got {}, {nt} and {nt2}", ts.len())));
         }
         crate::error::check_finite("t", &ts).map_err(to_py)?;
         let (nc, nb, nf) = (self.model.constraints.len(), self.model.bodies.len(), self.model.forces.len());
@@ -1310,14 +1240,11 @@ impl PySystem {
     /// force), M (bending moment), eps (axial strain), kappa (curvature), in the beam frame,
     /// from the body's kinematics and elastic law (`Beam::internal_forces`).
     fn beam_internal_forces<'py>(&self, py: Python<'py>, body: &str, xi: Vector<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        let bi = self.body(body)?;
-        let b = &self.model.bodies[bi];
-        if b.internal_forces(0.0, &self.model.q0).is_none() {
-            return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
-        }
+        let b = &self.model.bodies[self.body(body)?];
+        b.require_beam().map_err(to_py)?;
         let xs: Vec<f64> = xi.as_array().iter().copied().collect();
-        if let Some(x) = xs.iter().find(|x| !x.is_finite() || !(0.0..=1.0).contains(*x)) {
-            return Err(PyValueError::new_err(format!("xi must be in [0, 1], got {x}")));
+        for &x in &xs {
+            crate::body::inspect::check_xi(x).map_err(to_py)?;
         }
         let n = self.model.n;
         let (qs, nt) = read_states(q, n, "q")?;
@@ -1325,9 +1252,7 @@ impl PySystem {
         let mut out = Vec::with_capacity(nt * nx * 5);
         for k in 0..nt {
             for &x in &xs {
-                let Some(f) = b.internal_forces(x, &qs[k * n..(k + 1) * n]) else {
-                    return Err(PyValueError::new_err(format!("body '{body}' is not a beam")));
-                };
+                let f = b.internal_forces(x, &qs[k * n..(k + 1) * n]).map_err(to_py)?;
                 finite_out("beam_internal_forces", &f).map_err(to_py)?;
                 out.extend_from_slice(&f);
             }
@@ -1366,77 +1291,22 @@ impl PySystem {
         Ok((r.start, r.end))
     }
 
-    /// Properties of a body as the core derived them: kind, mass, n_coords, n_f, and for
-    /// beams formulation ("ffrf", "ancf"), length, elements, element_length, theory, area,
-    /// second_moment, density, youngs_modulus, rotary_inertia, damping; FFRF beams also frame,
-    /// shear_stiffness (k G), shear_parameter (phi); ANCF beams axial_quadrature and
-    /// bending_quadrature (the element's integration rules).
-    fn body_info<'py>(&self, py: Python<'py>, body: &str) -> PyResult<Bound<'py, PyDict>> {
-        let b = &self.model.bodies[self.body(body)?];
-        let d = PyDict::new(py);
-        d.set_item("kind", b.kind_name())?;
-        d.set_item("mass", b.total_mass())?;
-        d.set_item("n_coords", b.n_coords)?;
-        d.set_item("n_f", b.n_f())?;
-        match &b.kind {
-            BodyKind::Rigid(r) => {
-                d.set_item("inertia", r.inertia)?;
-                d.set_item("com", r.com.to_vec())?;
-            }
-            BodyKind::Beam(beam) => {
-                let sec = &beam.section;
-                d.set_item("formulation", "ffrf")?;
-                d.set_item("length", beam.length)?;
-                d.set_item("elements", beam.elements)?;
-                d.set_item("element_length", beam.element_length)?;
-                d.set_item("theory", match sec.theory {
-                    crate::description::BeamTheory::Timoshenko => "timoshenko",
-                    crate::description::BeamTheory::EulerBernoulli => "euler-bernoulli",
-                })?;
-                d.set_item("frame", match beam.reference {
-                    crate::description::ReferenceConditions::PinnedPinned => "pinned-pinned",
-                    crate::description::ReferenceConditions::Clamped => "clamped",
-                })?;
-                d.set_item("area", sec.area)?;
-                d.set_item("second_moment", sec.second_moment)?;
-                d.set_item("density", sec.density)?;
-                d.set_item("youngs_modulus", sec.youngs_modulus)?;
-                d.set_item("shear_stiffness", sec.shear_stiffness)?;
-                d.set_item("rotary_inertia", sec.rotary_inertia)?;
-                d.set_item("damping", beam.damping)?;
-                d.set_item("shear_parameter", beam.phi)?;
-                d.set_item("strain", match beam.strain {
-                    crate::description::Strain::Linear => "linear",
-                    crate::description::Strain::Nonlinear => "nonlinear",
-                })?;
-            }
-            BodyKind::AncfBeam(cable) => {
-                let sec = &cable.section;
-                d.set_item("formulation", "ancf")?;
-                d.set_item("length", cable.length)?;
-                d.set_item("elements", cable.elements)?;
-                d.set_item("element_length", cable.element_length)?;
-                d.set_item("theory", "euler-bernoulli")?;
-                d.set_item("area", sec.area)?;
-                d.set_item("second_moment", sec.second_moment)?;
-                d.set_item("density", sec.density)?;
-                d.set_item("youngs_modulus", sec.youngs_modulus)?;
-                d.set_item("rotary_inertia", false)?;
-                d.set_item("damping", cable.damping)?;
-                d.set_item("axial_quadrature", "lobatto-3")?;
-                d.set_item("bending_quadrature", "gauss-2")?;
-            }
-            BodyKind::Flexible(f) => {
-                d.set_item("markers", f.markers.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>())?;
-                d.set_item("strain", match f.strain {
-                    crate::description::Strain::Linear => "linear",
-                    crate::description::Strain::Nonlinear => "nonlinear",
-                })?;
-                d.set_item("damping", f.d_ff.is_some())?;
-            }
-            BodyKind::PointMass(_) => {}
-        }
-        Ok(d)
+    /// Properties of a body as the core derived them (`Body::info`): kind, mass, n_coords, n_f,
+    /// and each kind's own entries: for beams formulation ("ffrf", "ancf"), length, elements,
+    /// element_length, theory, area, second_moment, density, youngs_modulus, rotary_inertia,
+    /// damping; FFRF beams also frame, shear_stiffness (k G), shear_parameter (phi), strain; ANCF
+    /// beams axial_quadrature and bending_quadrature (the element's integration rules).
+    fn body_info<'py>(&self, py: Python<'py>, body: &str) -> PyResult<Bound<'py, PyAny>> {
+        let info = self.model.bodies[self.body(body)?].info();
+        json_to_py(py, &serde_json::Value::Object(info))
+    }
+
+    /// What a body can be asked (`Body::capabilities`): a dict of booleans (beam, elastic,
+    /// elastic_coordinates, axial_forces, named_markers, oriented), so that Python keeps no
+    /// lists of kinds.
+    fn body_capabilities<'py>(&self, py: Python<'py>, body: &str) -> PyResult<Bound<'py, PyAny>> {
+        let caps = serde_json::to_value(self.model.bodies[self.body(body)?].capabilities()).map_err(|e| to_py(Error::Solver(e.to_string())))?;
+        json_to_py(py, &caps)
     }
 
     /// Correct (q, qd) onto Phi(q, t) = 0 and A qd + Phi_t = 0 in the mass metric, holding the
@@ -1451,11 +1321,11 @@ impl PySystem {
         let t = t.0;
         let max_wall_time = max_wall_time.unwrap_or(f64::INFINITY);
         if !(max_wall_time > 0.0) {
-            return Err(PyValueError::new_err(format!("max_wall_time must be positive, got {max_wall_time}")));
+            return Err(arg_err("max_wall_time", format!("must be positive, got {max_wall_time}")));
         }
         for (what, v) in [("position_tol", position_tol), ("velocity_tol", velocity_tol)] {
             if !(v > 0.0) || !v.is_finite() {
-                return Err(PyValueError::new_err(format!("{what} must be positive and finite, got {v}")));
+                return Err(arg_err(what, format!("must be positive and finite, got {v}")));
             }
         }
         let opts = CorrectOptions { hold, rigid, position_tol, velocity_tol, max_iterations };

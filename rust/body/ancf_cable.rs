@@ -27,6 +27,8 @@
 use super::ffrf_beam::{beam_section, BeamSection};
 use super::marker::axis_marker_xi;
 use super::{finite_vec2, InitialState, MarkerState};
+use super::inspect::Array;
+use serde_json::{Map, Value};
 use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions};
 use crate::error::{Error, Result};
 use crate::linalg::{Banded, BandedCholesky, GAUSS4};
@@ -675,5 +677,48 @@ pub fn move_rigidly(q: &mut [f64], x: &[f64]) {
         q[k + 1] = c[1] + x[1] + s * rx + co * ry;
         q[k + 2] = co * sx - s * sy;
         q[k + 3] = s * sx + co * sy;
+    }
+}
+
+/// Inspection (`inspect.rs`).
+impl AncfCable {
+    pub fn shape_arrays(&self, xi: f64) -> (Array, Array) {
+        let nb = self.n_coords();
+        let p = self.point(xi);
+        let (mut s, mut d) = (vec![0.0; 2 * nb], vec![0.0; 2 * nb]);
+        for a in 0..4 {
+            for c in 0..2 {
+                s[c * nb + p.first + 2 * a + c] = p.s[a];
+                d[c * nb + p.first + 2 * a + c] = p.d[a];
+            }
+        }
+        (Array::matrix(2, nb, s), Array::matrix(2, nb, d))
+    }
+
+    pub fn matrices(&self, q0: &[f64]) -> (Array, Array) {
+        let nb = self.n_coords();
+        let mut m = vec![0.0; nb * nb];
+        self.dense_block(&Default::default(), &mut |i, j, v| m[i * nb + j] = v);
+        (Array::matrix(nb, nb, m), Array::matrix(nb, nb, self.tangent_dense(q0)))
+    }
+
+    /// `d2U/dq2` at `q` (the body's coordinates), dense row-major.
+    pub fn tangent_dense(&self, q: &[f64]) -> Vec<f64> {
+        let mut k = Banded::zeros(self.n_coords(), HB);
+        self.add_tangent_stiffness(q, &mut k);
+        k.to_dense()
+    }
+
+    pub fn info(&self, m: &mut Map<String, Value>) {
+        let sec = &self.section;
+        m.insert("formulation".into(), "ancf".into());
+        for (k, v) in [("length", self.length), ("element_length", self.element_length), ("area", sec.area), ("second_moment", sec.second_moment), ("density", sec.density), ("youngs_modulus", sec.youngs_modulus), ("damping", self.damping)] {
+            m.insert(k.into(), v.into());
+        }
+        m.insert("elements".into(), self.elements.into());
+        m.insert("theory".into(), "euler-bernoulli".into());
+        m.insert("rotary_inertia".into(), false.into());
+        m.insert("axial_quadrature".into(), "lobatto-3".into());
+        m.insert("bending_quadrature".into(), "gauss-2".into());
     }
 }

@@ -10,6 +10,8 @@
 use super::ffrf::{Ffrf, FfrfData, PointShape};
 use super::marker::axis_marker_xi;
 use super::InitialState;
+use super::inspect::{spelled, Array};
+use serde_json::{Map, Value};
 use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions, SectionDesc, Strain};
 use crate::error::{non_negative, positive, Error, Result};
 use crate::linalg::{Banded, BandedCholesky, GAUSS4};
@@ -652,5 +654,35 @@ impl std::ops::Deref for Beam {
     /// A beam is a floating-frame body with element-built invariants.
     fn deref(&self) -> &Ffrf {
         &self.frame
+    }
+}
+
+/// Inspection (`inspect.rs`).
+impl Beam {
+    pub fn shape_arrays(&self, xi: f64) -> (Array, Array) {
+        let nf = self.n_f;
+        let (mut s, mut npsi) = (vec![0.0; 2 * nf], vec![0.0; nf]);
+        for &(i, su, sv, sp) in &self.point_shape(xi).entries {
+            (s[i], s[nf + i], npsi[i]) = (su, sv, sp);
+        }
+        (Array::matrix(2, nf, s), Array::Vector(npsi))
+    }
+
+    pub fn matrices(&self) -> (Array, Array) {
+        let nf = self.n_f;
+        (Array::matrix(nf, nf, self.m_ff.to_dense()), Array::matrix(nf, nf, self.k_ff.to_dense()))
+    }
+
+    pub fn info(&self, m: &mut Map<String, Value>) {
+        let sec = &self.section;
+        m.insert("formulation".into(), "ffrf".into());
+        for (k, v) in [("length", self.length), ("element_length", self.element_length), ("area", sec.area), ("second_moment", sec.second_moment), ("density", sec.density), ("youngs_modulus", sec.youngs_modulus), ("shear_stiffness", sec.shear_stiffness), ("damping", self.damping), ("shear_parameter", self.phi)] {
+            m.insert(k.into(), v.into());
+        }
+        m.insert("elements".into(), self.elements.into());
+        m.insert("rotary_inertia".into(), sec.rotary_inertia.into());
+        m.insert("theory".into(), spelled(&sec.theory));
+        m.insert("frame".into(), spelled(&self.reference));
+        m.insert("strain".into(), spelled(&self.strain));
     }
 }

@@ -17,6 +17,7 @@ pub mod ffrf;
 pub mod ffrf_beam;
 pub mod frame;
 pub mod marker;
+pub mod inspect;
 pub mod modal;
 pub mod point_mass;
 pub mod rigid;
@@ -24,6 +25,7 @@ pub mod rigid;
 pub use ancf_cable::{AncfCable, AncfCableData, CablePoint};
 pub use ffrf::{Ffrf, FfrfData, PointShape};
 pub use ffrf_beam::{Beam, BeamData};
+pub use inspect::{Array, Capabilities};
 pub use marker::{Marker, MarkerShape, MarkerState};
 pub use modal::Modal;
 pub use point_mass::{PointMass, PointMassData};
@@ -338,8 +340,10 @@ impl Body {
     /// world position, displacement in the beam frame from the undeformed `(xi L, 0)` and the
     /// section rotation relative to that frame. The frame is the floating frame of an FFRF
     /// beam (for the pinned-pinned frame: the chord of the ends) and the chord frame of the
-    /// ends of an ANCF cable, so that both compare one to one. `None` for other kinds.
-    pub fn beam_point(&self, xi: f64, q: &[f64]) -> Option<[f64; 5]> {
+    /// ends of an ANCF cable, so that both compare one to one. An argument error for kinds
+    /// without an axis (`Capabilities::beam`).
+    pub fn beam_point(&self, xi: f64, q: &[f64]) -> Result<[f64; 5]> {
+        inspect::check_xi(xi)?;
         let qb = self.seg(q);
         match &self.kind {
             BodyKind::Beam(k) => {
@@ -350,24 +354,23 @@ impl Body {
                     u += su * qb[3 + i];
                     v += sv * qb[3 + i];
                 }
-                Some([ms.r[0], ms.r[1], u, v, ms.phi - qb[2]])
+                Ok([ms.r[0], ms.r[1], u, v, ms.phi - qb[2]])
             }
-            BodyKind::AncfBeam(k) => Some(k.chord_displacement(xi, qb)),
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Flexible(_) => None,
+            BodyKind::AncfBeam(k) => Ok(k.chord_displacement(xi, qb)),
+            _ => self.require_beam().map(|_| [0.0; 5]),
         }
     }
-}
 
-impl Body {
     /// `[N, V, M, eps, kappa]` at the axis point `xi` of a beam at `q` (see
-    /// `ffrf_beam::Beam::internal_forces`, `ancf_cable::AncfCable::internal_forces`); `None`
-    /// for other kinds.
-    pub fn internal_forces(&self, xi: f64, q: &[f64]) -> Option<[f64; 5]> {
+    /// `ffrf_beam::Beam::internal_forces`, `ancf_cable::AncfCable::internal_forces`); an
+    /// argument error for kinds without an axis.
+    pub fn internal_forces(&self, xi: f64, q: &[f64]) -> Result<[f64; 5]> {
+        inspect::check_xi(xi)?;
         let qb = self.seg(q);
         match &self.kind {
-            BodyKind::Beam(k) => Some(k.internal_forces(xi, qb)),
-            BodyKind::AncfBeam(k) => Some(k.internal_forces(xi, qb)),
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Flexible(_) => None,
+            BodyKind::Beam(k) => Ok(k.internal_forces(xi, qb)),
+            BodyKind::AncfBeam(k) => Ok(k.internal_forces(xi, qb)),
+            _ => self.require_beam().map(|_| [0.0; 5]),
         }
     }
 }

@@ -15,6 +15,7 @@
 
 use super::ffrf::{Ffrf, FfrfData, PointShape};
 use super::{finite_vec2, InitialState};
+use serde_json::{Map, Value};
 use crate::description::{FlexibleDesc, MarkerDesc, Strain};
 use crate::error::{check_finite_item, positive, Error, Result};
 use crate::linalg::dense::cholesky;
@@ -493,5 +494,14 @@ impl std::ops::Deref for Modal {
     /// A flexible body is a floating-frame body with invariants given by its description.
     fn deref(&self) -> &Ffrf {
         &self.frame
+    }
+}
+
+impl Modal {
+    /// Inspection entries (`inspect.rs`).
+    pub fn info(&self, m: &mut Map<String, Value>) {
+        m.insert("markers".into(), self.markers.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>().into());
+        m.insert("strain".into(), super::inspect::spelled(&self.strain));
+        m.insert("damping".into(), self.d_ff.is_some().into());
     }
 }

@@ -137,6 +137,14 @@ impl BuildContext<'_> {
 }
 
 impl Constraint {
+    /// Write the defaults this joint resolved into its description, so that the description
+    /// states them (a distance joint's length taken at the initial guess).
+    pub fn fill_defaults(&self, d: &mut JointDesc) {
+        if let (ConstraintKind::Distance(dist), JointDesc::Distance { length, .. }) = (&self.kind, d) {
+            *length = Some(dist.length);
+        }
+    }
+
     /// Build a joint; `item` names it in errors.
     pub fn from_joint(ctx: &BuildContext, item: &str, name: String, d: &JointDesc) -> Result<Constraint> {
         let kind = match d {
