@@ -14,7 +14,7 @@ use serde::de::DeserializeOwned;
 use serde::Deserialize;
 use serde_json::Value;
 
-use crate::body::{Body, BodyKind};
+use crate::body::Body;
 use crate::constraint::{BuildContext, Constraint};
 use crate::description::{to_external, to_internal, BodyDesc, Description, DriverDesc, ForceDesc, JointDesc, Vec2};
 use crate::error::{check_finite_item, Error, Result};
@@ -81,12 +81,7 @@ impl Model {
 
     /// Any body with stiffness-proportional damping (the scene is then truly stiff).
     pub fn has_damping(&self) -> bool {
-        self.bodies.iter().any(|b| match &b.kind {
-            BodyKind::Beam(beam) => beam.damping > 0.0,
-            BodyKind::AncfBeam(cable) => cable.damping > 0.0,
-            BodyKind::Flexible(f) => f.d_ff.is_some(),
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) => false,
-        })
+        self.bodies.iter().any(|b| b.capabilities().damped)
     }
 }
 

@@ -247,3 +247,9 @@ def beam_elastic_dofs(elements: int, frame: str) -> int:
 
 def dense_eval(method: str, meta: _F64, data: _F64, part_len: List[int], t: _F64) -> _F64:
     """Evaluate the dense output recorded by ``System.integrate(..., dense=True)`` at t (k,): (dim, k)."""
+def run_options() -> Dict[str, Any]:
+    """The native methods' run options as the core defines them: native_methods, common,
+    options ({method: options}), defaults (rtol, atol_per_rtol, rtol_min, projection_per_atol)."""
+def check_tolerances(rtol: float, atol: _F64, dim: int) -> _F64:
+    """The tolerance rule of every run: rtol > 0 and finite, atol >= 0 and finite (one value or
+    dim); returns atol as a (dim,) array."""

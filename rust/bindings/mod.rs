@@ -261,6 +261,32 @@ fn normal_weight(kappa: f64, kappa_ref: f64) -> f64 {
     crate::integrate::normal_weight(kappa.max(0.0), kappa_ref)
 }
 
+/// The native methods' run options as the core defines them (`rust/integrate/options.rs`): a
+/// dict with `native_methods`, `common` (options every method takes), `options` ({method: the
+/// options it takes}), and `defaults` (`rtol`, `atol_per_rtol`, `rtol_min`,
+/// `projection_per_atol`). The CLI, scene files and `simulate` read these; none restates them.
+#[pyfunction]
+fn run_options(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    use crate::integrate::{options_of, ATOL_PER_RTOL, COMMON_OPTIONS, DEFAULT_RTOL, NATIVE_METHODS, PROJECTION_PER_ATOL, RTOL_MIN};
+    let options: serde_json::Map<String, serde_json::Value> = NATIVE_METHODS.iter().map(|m| (m.to_string(), serde_json::json!(options_of(m)))).collect();
+    let v = serde_json::json!({
+        "native_methods": NATIVE_METHODS,
+        "common": COMMON_OPTIONS,
+        "options": options,
+        "defaults": {"rtol": DEFAULT_RTOL, "atol_per_rtol": ATOL_PER_RTOL, "rtol_min": RTOL_MIN, "projection_per_atol": PROJECTION_PER_ATOL},
+    });
+    json_to_py(py, &v)
+}
+
+/// The tolerance rule of every run (`integrate::check_tolerances`): `rtol > 0` and finite,
+/// `atol >= 0` and finite (one value or `dim`); returns atol as a (dim,) array.
+#[pyfunction]
+fn check_tolerances<'py>(py: Python<'py>, rtol: Real, atol: Vector<'py>, dim: usize) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let a: Vec<f64> = atol.as_array().iter().copied().collect();
+    let v = crate::integrate::check_tolerances(rtol.0, &a, dim).map_err(to_py)?;
+    Ok(PyArray1::from_vec(py, v))
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -270,6 +296,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(beam_elastic_dofs, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::motion_values, m)?)?;
     m.add_function(wrap_pyfunction!(dense_eval, m)?)?;
+    m.add_function(wrap_pyfunction!(run_options, m)?)?;
+    m.add_function(wrap_pyfunction!(check_tolerances, m)?)?;
     m.add("UkflexError", py.get_type::<UkflexError>())?;
     m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
     m.add("SingularMassError", py.get_type::<SingularMassError>())?;

@@ -14,7 +14,7 @@ use crate::data::{Data, RankTolerance, Stabilization, SvdBackend, UkSolver};
 use crate::dynamics;
 use crate::error::Error;
 use crate::integrate::singular::{Passage, SingularMonitor};
-use crate::integrate::{integrate_uk, LinearSolver, Method, NewtonMatrices, Options, UkSystem};
+use crate::integrate::{integrate_uk, LinearSolver, Method, NewtonMatrices, RunPlan, RunRequest, UkSystem};
 use crate::jacobian::{assemble_first_order, Differences, JacobianWorkspace};
 use crate::model::Model;
 use crate::sensors;
@@ -712,65 +712,34 @@ impl PySystem {
         monitor_singular: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let (t0, t_end) = (t0.0, t_end.0);
-        let linear_solver = LinearSolver::parse(linear_solver).map_err(to_py)?;
-        let jacobian = match jacobian {
-            "central" => Differences::Central,
-            "forward" => Differences::Forward,
-            "structured" => Differences::Structured,
-            other => return Err(arg_err("jacobian", format!("unknown jacobian '{other}' (use 'structured', 'central' or 'forward')"))),
-        };
         let n = self.model.n;
-        let mut method = Method::from_name(method)
-            .ok_or_else(|| arg_err("method", format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5', 'GENALPHA' or 'RADAU5M')")))?;
-        match &mut method {
-            Method::GenAlpha(go) => {
-                go.rho_inf = rho_inf.unwrap_or(go.rho_inf);
-                go.step = step;
-                go.newton_local_error = newton_local_error;
-            }
-            Method::RadauM(ro) if newton_local_error.is_none() && rho_inf.is_none() => ro.step = step,
-            Method::RadauM(_) => return Err(arg_err("rho_inf", "rho_inf and newton_local_error apply to GENALPHA only (RADAU5M is L-stable: no dissipation setting)")),
-            _ if step.is_some() || newton_local_error.is_some() || rho_inf.is_some() => {
-                return Err(arg_err("step", "step (a fixed step size) applies to GENALPHA and RADAU5M, rho_inf and newton_local_error to GENALPHA only"));
-            }
-            _ => {}
-        }
+        let request = RunRequest {
+            method: method.to_string(),
+            rtol,
+            atol: atol.map(|a| a.as_array().iter().copied().collect()),
+            first_step,
+            max_step,
+            max_steps,
+            max_nfev,
+            max_wall_time,
+            min_step,
+            projection_tol,
+            rho_inf,
+            step,
+            newton_local_error,
+            jacobian: jacobian.to_string(),
+            linear_solver: linear_solver.to_string(),
+            drift_limit,
+            on_drift: on_drift.to_string(),
+            monitor_singular,
+        };
+        let RunPlan { method, opts, projection, jacobian } = request.plan(2 * n).map_err(to_py)?;
+        let linear_solver = opts.linear_solver;
         let mut y = vec![0.0; 2 * n];
         read_into("y0", &y0.as_array(), &mut y).map_err(to_py)?;
         check_time(t0).map_err(to_py)?;
         check_time(t_end).map_err(to_py)?;
-        let atol = match atol {
-            None => vec![1e-3 * rtol],
-            Some(a) => a.as_array().iter().copied().collect(),
-        };
         let t_eval: Option<Vec<f64>> = t_eval.map(|a| a.as_array().iter().copied().collect());
-        let max_step = max_step.unwrap_or(f64::INFINITY);
-        let stop_on_drift = match on_drift {
-            "stop" => true,
-            "warn" => false,
-            other => return Err(arg_err("on_drift", format!("must be 'stop' or 'warn', got {other:?}"))),
-        };
-        let opts = Options {
-            rtol,
-            atol,
-            first_step,
-            max_step,
-            max_steps,
-            max_nfev: max_nfev.unwrap_or(usize::MAX),
-            max_wall_time: max_wall_time.unwrap_or(f64::INFINITY),
-            min_step,
-            linear_solver,
-            drift_limit: drift_limit.unwrap_or(f64::INFINITY),
-            stop_on_drift,
-            monitor_singular,
-        };
-        let atol_full = opts.validate(2 * n).map_err(to_py)?;
-        let projection = match projection_tol {
-            None => Some(crate::integrate::default_projection(&atol_full)),
-            Some(0.0) => None,
-            Some(p) if p > 0.0 && p.is_finite() => Some(crate::correct::ProjectionTolerance { position_tol: p, velocity_tol: p, max_iter: 20 }),
-            Some(p) => return Err(arg_err("projection_tol", format!("must be >= 0 and finite, got {p}"))),
-        };
         // a fresh workspace with this System's settings: the run does not hold the lock
         let (tolerance, stabilization, backend, solver, limit) =
             self.with_ws(|_, ws| Ok((ws.data.tolerance, ws.data.stabilization, ws.data.svd_backend, ws.data.uk_solver, ws.data.memory_limit)))?;
@@ -787,9 +756,6 @@ impl PySystem {
             // with the structured Jacobian RADAU5 solves its iteration matrices as saddle points
             opts.linear_solver = match jacobian {
                 Differences::Structured => NewtonMatrices::resolve(model, &data, linear_solver, true).map_err(to_py)?,
-                _ if linear_solver == LinearSolver::Sparse => {
-                    return Err(arg_err("linear_solver", "linear_solver='sparse' with RADAU5 needs jacobian='structured' (a difference Jacobian is dense)"));
-                }
                 _ => LinearSolver::Dense,
             };
         }
@@ -1280,7 +1246,8 @@ impl PySystem {
         })
     }
 
-    /// Kind of a body: "rigid", "beam" (FFRF), "ancf_beam" or "point_mass".
+    /// Kind of a body, as in the description: "rigid", "beam" (FFRF), "cable" (ANCF),
+    /// "point_mass" or "flexible".
     fn body_kind(&self, body: &str) -> PyResult<&'static str> {
         Ok(self.model.bodies[self.body(body)?].kind_name())
     }
@@ -1292,7 +1259,7 @@ impl PySystem {
     }
 
     /// Properties of a body as the core derived them (`Body::info`): kind, mass, n_coords, n_f,
-    /// and each kind's own entries: for beams formulation ("ffrf", "ancf"), length, elements,
+    /// and each kind's own entries: for beams and cables formulation ("ffrf", "ancf"), length, elements,
     /// element_length, theory, area, second_moment, density, youngs_modulus, rotary_inertia,
     /// damping; FFRF beams also frame, shear_stiffness (k G), shear_parameter (phi), strain; ANCF
     /// beams axial_quadrature and bending_quadrature (the element's integration rules).

@@ -206,17 +206,11 @@ pub fn elastic_dofs(elements: usize, frame: ReferenceConditions) -> usize {
 /// Largest number of elements of one beam.
 pub const MAX_ELEMENTS: usize = 4096;
 
-/// Validate what every beam formulation reads from its description -- length, element count,
-/// material, section, shear data (checked whenever given, required for Timoshenko) and damping
-/// -- and derive its section. Returns `(length, section)`.
+/// Validate what an FFRF beam reads from its description -- length, element count, material,
+/// section, shear data (checked whenever given, required for Timoshenko) and damping -- and
+/// derive its section. Returns `(length, section)`.
 pub fn beam_section(d: &BeamDesc, item: &str) -> Result<(f64, BeamSection)> {
-    let length = positive(item, "length", d.length)?;
-    if d.elements == 0 || d.elements > MAX_ELEMENTS {
-        return Err(Error::invalid(item, format!("elements must be in 1..={MAX_ELEMENTS}, got {}", d.elements)));
-    }
-    let density = positive(item, "density", d.density)?;
-    let e = positive(item, "youngs_modulus", d.youngs_modulus)?;
-    let (area, second_moment) = section_properties(item, &d.section)?;
+    let (length, mut section) = material_section(item, d.length, d.elements, d.density, d.youngs_modulus, &d.section, d.damping)?;
     // shear data: validated whenever given, required by Timoshenko
     let g = match (d.shear_modulus, d.poisson_ratio) {
         (Some(_), Some(_)) => return Err(Error::invalid(item, "give either poisson_ratio or shear_modulus, not both")),
@@ -225,32 +219,35 @@ pub fn beam_section(d: &BeamDesc, item: &str) -> Result<(f64, BeamSection)> {
             if !nu.is_finite() || nu <= -1.0 || nu >= 0.5 {
                 return Err(Error::invalid(item, format!("poisson_ratio must be in (-1, 0.5), got {nu}")));
             }
-            Some(e / (2.0 * (1.0 + nu)))
+            Some(section.youngs_modulus / (2.0 * (1.0 + nu)))
         }
         (None, None) => None,
     };
     let k = d.shear_factor.map(|k| positive(item, "shear_factor", k)).transpose()?;
-    let shear_stiffness = match d.theory {
-        BeamTheory::EulerBernoulli => 0.0,
-        BeamTheory::Timoshenko => {
-            let g = g.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs poisson_ratio or shear_modulus"))?;
-            let k = k.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs shear_factor"))?;
-            k * g
-        }
-    };
-    non_negative(item, "damping", d.damping)?;
-    derived_scales(item, length / d.elements as f64, density, e, area, second_moment, shear_stiffness)?;
-    let rotary_inertia = d.rotary_inertia.unwrap_or(d.theory == BeamTheory::Timoshenko);
-    let section = BeamSection {
-        area,
-        second_moment,
-        density,
-        youngs_modulus: e,
-        shear_stiffness,
-        rotary_inertia,
-        theory: d.theory,
-    };
+    if d.theory == BeamTheory::Timoshenko {
+        let g = g.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs poisson_ratio or shear_modulus"))?;
+        let k = k.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs shear_factor"))?;
+        section.shear_stiffness = k * g;
+        derived_scales(item, length / d.elements as f64, section.density, section.youngs_modulus, section.area, section.second_moment, section.shear_stiffness)?;
+    }
+    section.rotary_inertia = d.rotary_inertia.unwrap_or(d.theory == BeamTheory::Timoshenko);
+    section.theory = d.theory;
     Ok((length, section))
+}
+
+/// What every beam kind reads from its description (length, element count, density, modulus,
+/// section, damping), validated; an Euler-Bernoulli section without rotary inertia.
+pub fn material_section(item: &str, length: f64, elements: usize, density: f64, e: f64, section: &SectionDesc, damping: f64) -> Result<(f64, BeamSection)> {
+    let length = positive(item, "length", length)?;
+    if elements == 0 || elements > MAX_ELEMENTS {
+        return Err(Error::invalid(item, format!("elements must be in 1..={MAX_ELEMENTS}, got {elements}")));
+    }
+    let density = positive(item, "density", density)?;
+    let e = positive(item, "youngs_modulus", e)?;
+    let (area, second_moment) = section_properties(item, section)?;
+    non_negative(item, "damping", damping)?;
+    derived_scales(item, length / elements as f64, density, e, area, second_moment, 0.0)?;
+    Ok((length, BeamSection { area, second_moment, density, youngs_modulus: e, shear_stiffness: 0.0, rotary_inertia: false, theory: BeamTheory::EulerBernoulli }))
 }
 
 /// Highest elastic circular frequency a beam may have [rad/s]: beyond it no integrator can

@@ -46,6 +46,11 @@ pub struct Capabilities {
     pub named_markers: bool,
     /// It has an orientation (a frame angle; a point mass has none).
     pub oriented: bool,
+    /// Its deformation and its motion share coordinates (an ANCF cable's nodal positions and
+    /// slopes): holding its deformation means moving it rigidly (`rigid_motions`).
+    pub nodal_deformation: bool,
+    /// It has material damping (the scene is then truly stiff).
+    pub damped: bool,
 }
 
 impl Body {
@@ -53,9 +58,9 @@ impl Body {
         match &self.kind {
             BodyKind::Rigid(_) => Capabilities { oriented: true, ..Default::default() },
             BodyKind::PointMass(_) => Capabilities::default(),
-            BodyKind::Beam(_) => Capabilities { beam: true, elastic: true, elastic_coordinates: true, axial_forces: true, oriented: true, ..Default::default() },
-            BodyKind::AncfBeam(_) => Capabilities { beam: true, elastic: true, oriented: true, ..Default::default() },
-            BodyKind::Flexible(_) => Capabilities { elastic: true, elastic_coordinates: true, named_markers: true, oriented: true, ..Default::default() },
+            BodyKind::Beam(b) => Capabilities { beam: true, elastic: true, elastic_coordinates: true, axial_forces: true, oriented: true, damped: b.damping > 0.0, ..Default::default() },
+            BodyKind::Cable(c) => Capabilities { beam: true, elastic: true, oriented: true, nodal_deformation: true, damped: c.damping > 0.0, ..Default::default() },
+            BodyKind::Flexible(f) => Capabilities { elastic: true, elastic_coordinates: true, named_markers: true, oriented: true, damped: f.d_ff.is_some(), ..Default::default() },
         }
     }
 
@@ -70,7 +75,7 @@ impl Body {
         match &self.kind {
             BodyKind::Rigid(k) => k.info(&mut m),
             BodyKind::Beam(k) => k.info(&mut m),
-            BodyKind::AncfBeam(k) => k.info(&mut m),
+            BodyKind::Cable(k) => k.info(&mut m),
             BodyKind::Flexible(k) => k.info(&mut m),
             BodyKind::PointMass(_) => {}
         }
@@ -88,7 +93,7 @@ impl Body {
         check_xi(xi)?;
         match &self.kind {
             BodyKind::Beam(k) => Ok(k.shape_arrays(xi)),
-            BodyKind::AncfBeam(k) => Ok(k.shape_arrays(xi)),
+            BodyKind::Cable(k) => Ok(k.shape_arrays(xi)),
             _ => Err(self.not_a("a beam")),
         }
     }
@@ -98,7 +103,7 @@ impl Body {
     pub fn matrices(&self, q0: &[f64]) -> Result<(Array, Array)> {
         match &self.kind {
             BodyKind::Beam(k) => Ok(k.matrices()),
-            BodyKind::AncfBeam(k) => Ok(k.matrices(&q0[self.offset..self.offset + self.n_coords])),
+            BodyKind::Cable(k) => Ok(k.matrices(&q0[self.offset..self.offset + self.n_coords])),
             _ => Err(self.not_a("a beam")),
         }
     }
@@ -111,7 +116,7 @@ impl Body {
         // the FFRF kinds' elastic block sits after the 3 frame coordinates
         let mut put = |i: usize, j: usize, v: f64| k[(3 + i) * nb + 3 + j] += v;
         match &self.kind {
-            BodyKind::AncfBeam(c) => return Ok(c.tangent_dense(qb)),
+            BodyKind::Cable(c) => return Ok(c.tangent_dense(qb)),
             BodyKind::Beam(b) => b.elastic_tangent(&qb[3..], &mut put),
             BodyKind::Flexible(f) => f.elastic_tangent(&qb[3..], &mut put),
             _ => return Err(self.not_a("a beam or a flexible body")),

@@ -18,7 +18,7 @@ pub mod ffrf_beam;
 pub mod frame;
 pub mod marker;
 pub mod inspect;
-pub mod modal;
+pub mod flexible;
 pub mod point_mass;
 pub mod rigid;
 
@@ -27,11 +27,11 @@ pub use ffrf::{Ffrf, FfrfData, PointShape};
 pub use ffrf_beam::{Beam, BeamData};
 pub use inspect::{Array, Capabilities};
 pub use marker::{Marker, MarkerShape, MarkerState};
-pub use modal::Modal;
+pub use flexible::Flexible;
 pub use point_mass::{PointMass, PointMassData};
 pub use rigid::{Rigid, RigidData};
 
-use crate::description::{BeamFormulation, BodyDesc, MarkerDesc};
+use crate::description::{BodyDesc, MarkerDesc};
 use crate::error::{check_finite_item, Error, Result};
 
 /// `$e` with `$k` bound to the body's kind, one arm per kind (every kind implements the stage
@@ -42,7 +42,7 @@ macro_rules! with_kind {
             BodyKind::Rigid($k) => $e,
             BodyKind::Beam($k) => $e,
             BodyKind::PointMass($k) => $e,
-            BodyKind::AncfBeam($k) => $e,
+            BodyKind::Cable($k) => $e,
             BodyKind::Flexible($k) => $e,
         }
     };
@@ -54,7 +54,7 @@ macro_rules! with_elastic_kind {
     ($kind:expr, |$k:ident| $e:expr, rigid => $rigid:expr) => {
         match $kind {
             BodyKind::Beam($k) => $e,
-            BodyKind::AncfBeam($k) => $e,
+            BodyKind::Cable($k) => $e,
             BodyKind::Flexible($k) => $e,
             BodyKind::Rigid(_) | BodyKind::PointMass(_) => $rigid,
         }
@@ -68,7 +68,7 @@ macro_rules! with_kind_data {
             (BodyKind::Rigid($k), BodyData::Rigid($d)) => $e,
             (BodyKind::Beam($k), BodyData::Beam($d)) => $e,
             (BodyKind::PointMass($k), BodyData::PointMass($d)) => $e,
-            (BodyKind::AncfBeam($k), BodyData::AncfBeam($d)) => $e,
+            (BodyKind::Cable($k), BodyData::Cable($d)) => $e,
             (BodyKind::Flexible($k), BodyData::Flexible($d)) => $e,
             _ => unreachable!("body data of another kind"),
         }
@@ -83,8 +83,8 @@ pub enum BodyKind {
     Rigid(Rigid),
     Beam(Beam),
     PointMass(PointMass),
-    AncfBeam(AncfCable),
-    Flexible(Modal),
+    Cable(AncfCable),
+    Flexible(Flexible),
 }
 
 /// Per-body workspace, one variant per kind (sized once in `Data::new`).
@@ -94,7 +94,7 @@ pub enum BodyData {
     Rigid(RigidData),
     Beam(BeamData),
     PointMass(PointMassData),
-    AncfBeam(AncfCableData),
+    Cable(AncfCableData),
     Flexible(FfrfData),
 }
 
@@ -132,10 +132,10 @@ impl Body {
         }
         let (kind, init) = match d {
             BodyDesc::Rigid(r) => build!(Rigid, Rigid, r),
-            BodyDesc::Beam(b) if b.formulation == BeamFormulation::Ancf => build!(AncfBeam, AncfCable, b),
+            BodyDesc::Cable(c) => build!(Cable, AncfCable, c),
             BodyDesc::Beam(b) => build!(Beam, Beam, b),
             BodyDesc::PointMass(p) => build!(PointMass, PointMass, p),
-            BodyDesc::Flexible(f) => build!(Flexible, Modal, f),
+            BodyDesc::Flexible(f) => build!(Flexible, Flexible, f),
         };
         for (what, v) in [("initial state", &init.q), ("initial rates", &init.qd)] {
             check_finite_item(&item, what, v)?;
@@ -143,14 +143,14 @@ impl Body {
         Ok((Body { name, offset, n_coords: init.q.len(), kind }, init))
     }
 
-    /// The kind's name: as in the description (`"rigid"`, `"beam"`, `"point_mass"`), and
-    /// `"ancf_beam"` for a beam with formulation `ancf`.
+    /// The kind's name, as in the description (`"rigid"`, `"beam"`, `"point_mass"`, `"cable"`,
+    /// `"flexible"`).
     pub fn kind_name(&self) -> &'static str {
         match &self.kind {
             BodyKind::Rigid(_) => "rigid",
             BodyKind::Beam(_) => "beam",
             BodyKind::PointMass(_) => "point_mass",
-            BodyKind::AncfBeam(_) => "ancf_beam",
+            BodyKind::Cable(_) => "cable",
             BodyKind::Flexible(_) => "flexible",
         }
     }
@@ -160,7 +160,7 @@ impl Body {
     pub fn elastic_range(&self) -> std::ops::Range<usize> {
         match &self.kind {
             BodyKind::Beam(_) | BodyKind::Flexible(_) => self.offset + 3..self.offset + self.n_coords,
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::AncfBeam(_) => self.offset..self.offset,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Cable(_) => self.offset..self.offset,
         }
     }
 
@@ -170,7 +170,7 @@ impl Body {
     /// the implicit methods' sparse Newton matrices (`sparse_newton`).
     pub fn coupling_halfwidth(&self) -> usize {
         match &self.kind {
-            BodyKind::AncfBeam(_) => ancf_cable::HB.min(self.n_coords.saturating_sub(1)),
+            BodyKind::Cable(_) => ancf_cable::HB.min(self.n_coords.saturating_sub(1)),
             _ => self.n_coords.saturating_sub(1),
         }
     }
@@ -189,7 +189,7 @@ impl Body {
             BodyKind::Rigid(k) => BodyData::Rigid(k.new_data()),
             BodyKind::Beam(k) => BodyData::Beam(k.new_data()),
             BodyKind::PointMass(k) => BodyData::PointMass(k.new_data()),
-            BodyKind::AncfBeam(k) => BodyData::AncfBeam(k.new_data()),
+            BodyKind::Cable(k) => BodyData::Cable(k.new_data()),
             BodyKind::Flexible(k) => BodyData::Flexible(k.new_data()),
         }
     }
@@ -277,7 +277,7 @@ impl Body {
     pub fn rigid_motions(&self, q: &[f64], qd: &[f64], col0: usize, put: &mut impl FnMut(usize, usize, f64), cen: &mut [f64]) -> usize {
         let o = self.offset;
         match &self.kind {
-            BodyKind::AncfBeam(_) => {
+            BodyKind::Cable(_) => {
                 let (qb, vb) = (self.seg(q), self.seg(qd));
                 ancf_cable::rigid_motions(qb, vb, o, col0, put, &mut cen[o..o + self.n_coords])
             }
@@ -302,7 +302,7 @@ impl Body {
     pub fn move_rigidly(&self, q: &mut [f64], x: &[f64]) {
         let o = self.offset;
         match &self.kind {
-            BodyKind::AncfBeam(_) => ancf_cable::move_rigidly(&mut q[o..o + self.n_coords], x),
+            BodyKind::Cable(_) => ancf_cable::move_rigidly(&mut q[o..o + self.n_coords], x),
             BodyKind::PointMass(_) => {
                 q[o] += x[0];
                 q[o + 1] += x[1];
@@ -326,7 +326,7 @@ impl Body {
         let shape = match &self.kind {
             BodyKind::Rigid(_) => MarkerShape::Rigid(rigid::marker_point(md, &self.name, item)?),
             BodyKind::Beam(k) => MarkerShape::Beam(k.marker_shape(md, &self.name, item)?),
-            BodyKind::AncfBeam(k) => MarkerShape::Cable(k.marker_shape(md, &self.name, item)?),
+            BodyKind::Cable(k) => MarkerShape::Cable(k.marker_shape(md, &self.name, item)?),
             BodyKind::Flexible(k) => MarkerShape::Beam(k.marker_shape(md, &self.name, item)?),
             BodyKind::PointMass(_) => {
                 point_mass::check_marker(md, &self.name, item)?;
@@ -356,7 +356,7 @@ impl Body {
                 }
                 Ok([ms.r[0], ms.r[1], u, v, ms.phi - qb[2]])
             }
-            BodyKind::AncfBeam(k) => Ok(k.chord_displacement(xi, qb)),
+            BodyKind::Cable(k) => Ok(k.chord_displacement(xi, qb)),
             _ => self.require_beam().map(|_| [0.0; 5]),
         }
     }
@@ -369,7 +369,7 @@ impl Body {
         let qb = self.seg(q);
         match &self.kind {
             BodyKind::Beam(k) => Ok(k.internal_forces(xi, qb)),
-            BodyKind::AncfBeam(k) => Ok(k.internal_forces(xi, qb)),
+            BodyKind::Cable(k) => Ok(k.internal_forces(xi, qb)),
             _ => self.require_beam().map(|_| [0.0; 5]),
         }
     }
