@@ -24,7 +24,7 @@ fn cable_scene(elements: usize, damping: f64, gravity: bool) -> String {
 
 fn cable(model: &Model) -> &AncfCable {
     match &model.bodies[0].kind {
-        BodyKind::AncfBeam(c) => c,
+        BodyKind::Cable(c) => c,
         _ => panic!("not a cable"),
     }
 }

@@ -106,7 +106,7 @@ pub fn random_state(model: &Model, rng: &mut Lcg) -> (Vec<f64>, Vec<f64>) {
     let (mut q, mut qd) = (vec![0.0; model.n], vec![0.0; model.n]);
     for b in &model.bodies {
         let o = b.offset;
-        if let ukflex::body::BodyKind::AncfBeam(_) = b.kind {
+        if let ukflex::body::BodyKind::Cable(_) = b.kind {
             // nodal positions and slopes: the straight initial guess, moved and deformed a
             // little (slopes stay near their direction: marker angles are measured from it)
             for j in 0..b.n_coords {
