@@ -666,11 +666,8 @@ impl AncfCable {
         let nb = self.n_coords();
         let p = self.point(xi);
         let (mut s, mut d) = (vec![0.0; 2 * nb], vec![0.0; 2 * nb]);
-        for a in 0..4 {
-            for c in 0..2 {
-                s[c * nb + p.first + 2 * a + c] = p.s[a];
-                d[c * nb + p.first + 2 * a + c] = p.d[a];
-            }
+        for (a, c) in (0..4).flat_map(|a| [(a, 0), (a, 1)]) {
+            (s[c * nb + p.first + 2 * a + c], d[c * nb + p.first + 2 * a + c]) = (p.s[a], p.d[a]);
         }
         (Array::matrix(2, nb, s), Array::matrix(2, nb, d))
     }
@@ -691,14 +688,13 @@ impl AncfCable {
 
     pub fn info(&self, m: &mut Map<String, Value>) {
         let sec = &self.section;
-        m.insert("formulation".into(), "ancf".into());
+        for (k, v) in [("formulation", "ancf"), ("theory", "euler-bernoulli"), ("axial_quadrature", "lobatto-3"), ("bending_quadrature", "gauss-2")] {
+            m.insert(k.into(), v.into());
+        }
         for (k, v) in [("length", self.length), ("element_length", self.element_length), ("area", sec.area), ("second_moment", sec.second_moment), ("density", sec.density), ("youngs_modulus", sec.youngs_modulus), ("damping", self.damping)] {
             m.insert(k.into(), v.into());
         }
         m.insert("elements".into(), self.elements.into());
-        m.insert("theory".into(), "euler-bernoulli".into());
         m.insert("rotary_inertia".into(), false.into());
-        m.insert("axial_quadrature".into(), "lobatto-3".into());
-        m.insert("bending_quadrature".into(), "gauss-2".into());
     }
 }
