@@ -5,6 +5,7 @@
 
 mod scene;
 mod sensors;
+mod spatial;
 mod system;
 
 use numpy::ndarray::ArrayView1;
@@ -241,6 +242,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(beam_elastic_dofs, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::motion_values, m)?)?;
     m.add_function(wrap_pyfunction!(dense_eval, m)?)?;
+    m.add_function(wrap_pyfunction!(spatial::spatial_outputs, m)?)?;
     m.add("UkflexError", py.get_type::<UkflexError>())?;
     m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
     m.add("SingularMassError", py.get_type::<SingularMassError>())?;

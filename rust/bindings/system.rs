@@ -1434,7 +1434,11 @@ impl PySystem {
                 })?;
                 d.set_item("damping", f.d_ff.is_some())?;
             }
-            BodyKind::PointMass(_) => {}
+            BodyKind::PointMass(_) | BodyKind::Point3(_) => {}
+            BodyKind::Rigid3(r) => {
+                d.set_item("inertia", r.inertia.iter().map(|row| row.to_vec()).collect::<Vec<_>>())?;
+                d.set_item("com", r.com.to_vec())?;
+            }
         }
         Ok(d)
     }
