@@ -38,12 +38,16 @@ import numpy as np
 
 from . import _core
 from .errors import InvalidSceneError
-from .scene import _motion
 
 __all__ = ["SpatialScene", "SpatialMarker", "SpatialBodyRef", "outputs", "normalize_spatial", "NATIVE_METHODS_3D"]
 
 #: Native methods that run a spatial scene (the others are refused by name, see docs/spatial.md).
 NATIVE_METHODS_3D = ("DOPRI5", "RADAU5", "RADAU5M", "GENALPHA")
+
+
+def _motion(motion: Any) -> Dict[str, Any]:
+    """A motion's description: a motion object (``ukflex.ConstantSpeed``, ...) or an expression string."""
+    return {"kind": "expression", "expression": motion} if isinstance(motion, str) else motion.to_dict()
 
 
 def _vec(name: str, v: Any, n: int = 3) -> List[float]:
@@ -168,11 +172,11 @@ class SpatialScene:
     # -- drivers --------------------------------------------------------------------------
     def rotation_driver(self, a: SpatialMarker, b: SpatialMarker, motion: Any, name: Optional[str] = None) -> str:
         """The angle of ``x_b`` about ``z_a`` from ``x_a`` follows ``motion`` (any number of turns)."""
-        return self._pair("drivers", "rotation", a, b, name, motion=_motion(motion).to_dict())
+        return self._pair("drivers", "rotation", a, b, name, motion=_motion(motion))
 
     def translation_driver(self, a: SpatialMarker, b: SpatialMarker, motion: Any, name: Optional[str] = None) -> str:
         """``z_a . (P_b - P_a)`` follows ``motion``."""
-        return self._pair("drivers", "translation", a, b, name, motion=_motion(motion).to_dict())
+        return self._pair("drivers", "translation", a, b, name, motion=_motion(motion))
 
     # -- forces ---------------------------------------------------------------------------
     def _force(self, item: Dict[str, Any], name: Optional[str]) -> str:
