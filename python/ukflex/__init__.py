@@ -53,6 +53,8 @@ from .results import SimulationResult
 from .simulate import simulate
 from .sweep import sweep
 from . import scenes
+from . import spatial
+from .spatial import SpatialScene
 
 def _version() -> str:
     """The installed distribution's version (single source: Cargo.toml, through maturin)."""
@@ -68,6 +70,7 @@ __version__ = _version()
 
 __all__ = [
     "Scene",
+    "SpatialScene",
     "Marker",
     "RigidBodyRef",
     "PointMassRef",

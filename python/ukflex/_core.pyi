@@ -18,6 +18,7 @@ __all__ = [
     "item_name",
     "beam_elastic_dofs",
     "motion_values",
+    "spatial_outputs",
     "dense_eval",
     "UkflexError",
     "InvalidSceneError",
@@ -241,6 +242,9 @@ def item_name(section: str, kind: str, name: Optional[str], index: int) -> str:
 
 def motion_values(motion_json: str, t: _F64) -> _F64:
     """(f, f', f'') of a driver motion at the times t, shape (3, nt)."""
+    ...
+def spatial_outputs(description_json: str, t: _F64, q: Any, qd: Any, reactions: bool = True, rcond: Optional[float] = None, atol: float = 0.0) -> Dict[str, Any]:
+    """Spatial outputs (bodies, reactions, momentum, energies, driver values) at stored states (ukflex.spatial.outputs)."""
     ...
 def beam_elastic_dofs(elements: int, frame: str) -> int:
     """Number of elastic coordinates of a beam."""

@@ -17,10 +17,13 @@ pub mod ffrf;
 pub mod ffrf_beam;
 pub mod frame;
 pub mod marker;
-pub mod inspect;
 pub mod flexible;
+pub mod inspect;
+pub mod marker3;
+pub mod point3;
 pub mod point_mass;
 pub mod rigid;
+pub mod rigid3;
 
 pub use ancf_cable::{AncfCable, AncfCableData, CablePoint};
 pub use ffrf::{Ffrf, FfrfData, PointShape};
@@ -30,6 +33,8 @@ pub use marker::{Marker, MarkerShape, MarkerState};
 pub use flexible::Flexible;
 pub use point_mass::{PointMass, PointMassData};
 pub use rigid::{Rigid, RigidData};
+pub use point3::{Point3, Point3Data};
+pub use rigid3::{Rigid3, Rigid3Data};
 
 use crate::description::{BodyDesc, MarkerDesc};
 use crate::error::{check_finite_item, Error, Result};
@@ -44,6 +49,8 @@ macro_rules! with_kind {
             BodyKind::PointMass($k) => $e,
             BodyKind::Cable($k) => $e,
             BodyKind::Flexible($k) => $e,
+            BodyKind::Rigid3($k) => $e,
+            BodyKind::Point3($k) => $e,
         }
     };
 }
@@ -56,7 +63,7 @@ macro_rules! with_elastic_kind {
             BodyKind::Beam($k) => $e,
             BodyKind::Cable($k) => $e,
             BodyKind::Flexible($k) => $e,
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) => $rigid,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Rigid3(_) | BodyKind::Point3(_) => $rigid,
         }
     };
 }
@@ -70,6 +77,8 @@ macro_rules! with_kind_data {
             (BodyKind::PointMass($k), BodyData::PointMass($d)) => $e,
             (BodyKind::Cable($k), BodyData::Cable($d)) => $e,
             (BodyKind::Flexible($k), BodyData::Flexible($d)) => $e,
+            (BodyKind::Rigid3($k), BodyData::Rigid3($d)) => $e,
+            (BodyKind::Point3($k), BodyData::Point3($d)) => $e,
             _ => unreachable!("body data of another kind"),
         }
     };
@@ -85,6 +94,10 @@ pub enum BodyKind {
     PointMass(PointMass),
     Cable(AncfCable),
     Flexible(Flexible),
+    /// Spatial rigid body (`rigid3.rs`, built by `spatial::build`).
+    Rigid3(Rigid3),
+    /// Spatial point mass (`point3.rs`).
+    Point3(Point3),
 }
 
 /// Per-body workspace, one variant per kind (sized once in `Data::new`).
@@ -96,6 +109,8 @@ pub enum BodyData {
     PointMass(PointMassData),
     Cable(AncfCableData),
     Flexible(FfrfData),
+    Rigid3(Rigid3Data),
+    Point3(Point3Data),
 }
 
 #[derive(Debug, Clone)]
@@ -152,6 +167,8 @@ impl Body {
             BodyKind::PointMass(_) => "point_mass",
             BodyKind::Cable(_) => "cable",
             BodyKind::Flexible(_) => "flexible",
+            BodyKind::Rigid3(_) => "rigid3",
+            BodyKind::Point3(_) => "point3",
         }
     }
 
@@ -160,7 +177,7 @@ impl Body {
     pub fn elastic_range(&self) -> std::ops::Range<usize> {
         match &self.kind {
             BodyKind::Beam(_) | BodyKind::Flexible(_) => self.offset + 3..self.offset + self.n_coords,
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Cable(_) => self.offset..self.offset,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Cable(_) | BodyKind::Rigid3(_) | BodyKind::Point3(_) => self.offset..self.offset,
         }
     }
 
@@ -191,6 +208,8 @@ impl Body {
             BodyKind::PointMass(k) => BodyData::PointMass(k.new_data()),
             BodyKind::Cable(k) => BodyData::Cable(k.new_data()),
             BodyKind::Flexible(k) => BodyData::Flexible(k.new_data()),
+            BodyKind::Rigid3(k) => BodyData::Rigid3(k.new_data()),
+            BodyKind::Point3(k) => BodyData::Point3(k.new_data()),
         }
     }
 
@@ -286,6 +305,10 @@ impl Body {
                 put(o + 1, col0 + 1, 1.0);
                 2
             }
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) => {
+                let (qb, vb) = (self.seg(q), self.seg(qd));
+                rigid3_motions(qb, vb, o, col0, put, &mut cen[o..o + self.n_coords])
+            }
             BodyKind::Rigid(_) | BodyKind::Beam(_) | BodyKind::Flexible(_) => {
                 for k in 0..3 {
                     put(o + k, col0 + k, 1.0);
@@ -306,6 +329,10 @@ impl Body {
             BodyKind::PointMass(_) => {
                 q[o] += x[0];
                 q[o + 1] += x[1];
+            }
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) => {
+                let n = self.n_coords;
+                rigid3_move(&mut q[o..o + n], x)
             }
             BodyKind::Rigid(_) | BodyKind::Beam(_) | BodyKind::Flexible(_) => {
                 for k in 0..3 {
@@ -331,6 +358,9 @@ impl Body {
             BodyKind::PointMass(_) => {
                 point_mass::check_marker(md, &self.name, item)?;
                 MarkerShape::Particle
+            }
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) => {
+                return Err(Error::invalid(item, format!("body '{}' is spatial: a planar item cannot attach to it (a scene does not mix dimensions)", self.name)));
             }
         };
         Ok(Marker { body: Some(index), angle: md.angle, shape })
@@ -380,3 +410,55 @@ pub(crate) fn finite_vec2(item: &str, what: &str, v: [f64; 2]) -> Result<[f64; 2
     Ok(v)
 }
 
+/// Rigid motions of a spatial body (`Body::rigid_motions`): translations (3 columns) and, for a
+/// rigid3 body, rotations about the world axes through its centre of mass
+/// (`pd = 1/2 E(p)^T e_k`), with the centripetal part of the rotation at its angular velocity
+/// (`pdd = 1/2 E(pd)^T w`, `w = 2 E(p) pd / |p|^2`).
+fn rigid3_motions(q: &[f64], qd: &[f64], o: usize, col0: usize, put: &mut impl FnMut(usize, usize, f64), cen: &mut [f64]) -> usize {
+    for k in 0..3 {
+        put(o + k, col0 + k, 1.0);
+    }
+    if q.len() < 7 {
+        return 3;
+    }
+    use crate::spatial::rot::rot_e;
+    let e = rot_e(&q[3..7]);
+    for k in 0..3 {
+        for l in 0..4 {
+            put(o + 3 + l, col0 + 3 + k, 0.5 * e[k][l]);
+        }
+    }
+    let p2: f64 = q[3..7].iter().map(|x| x * x).sum();
+    let mut w = [0.0; 3];
+    for k in 0..3 {
+        w[k] = 2.0 * (0..4).map(|l| e[k][l] * qd[3 + l]).sum::<f64>() / p2;
+    }
+    let ed = rot_e(&qd[3..7]);
+    for l in 0..4 {
+        cen[3 + l] = 0.5 * (ed[0][l] * w[0] + ed[1][l] * w[1] + ed[2][l] * w[2]);
+    }
+    6
+}
+
+/// Move a spatial body rigidly by `x` (its `rigid3_motions` columns): `r += x[0..3]`, and for a
+/// rigid3 body `p <- exp(x[3..6] / 2) p` (the rotation by the vector `x[3..6]`, world axes).
+fn rigid3_move(q: &mut [f64], x: &[f64]) {
+    for k in 0..3 {
+        q[k] += x[k];
+    }
+    if q.len() < 7 {
+        return;
+    }
+    let th = (x[3] * x[3] + x[4] * x[4] + x[5] * x[5]).sqrt();
+    if th == 0.0 {
+        return;
+    }
+    let (s, c) = (0.5 * th).sin_cos();
+    let u = [x[3] / th * s, x[4] / th * s, x[5] / th * s];
+    let p = [q[3], q[4], q[5], q[6]];
+    // r * p with r = (c, u) (world-frame rotation applied after p)
+    q[3] = c * p[0] - u[0] * p[1] - u[1] * p[2] - u[2] * p[3];
+    q[4] = c * p[1] + u[0] * p[0] + u[1] * p[3] - u[2] * p[2];
+    q[5] = c * p[2] - u[0] * p[3] + u[1] * p[0] + u[2] * p[1];
+    q[6] = c * p[3] + u[0] * p[2] - u[1] * p[1] + u[2] * p[0];
+}

@@ -15,6 +15,7 @@ pub mod point_on_line;
 pub mod prismatic;
 pub mod revolute;
 pub mod rows;
+pub mod spatial;
 pub mod weld;
 
 use std::collections::HashMap;
@@ -40,6 +41,8 @@ pub enum ConstraintKind {
     Distance(Distance),
     AngleDriver(AngleDriver),
     CoordinateDriver(CoordinateDriver),
+    /// Spatial joints, drivers and normalization rows (`spatial/`).
+    Spatial(spatial::SpatialConstraint),
 }
 
 #[derive(Debug, Clone)]
@@ -180,6 +183,7 @@ impl Constraint {
             ConstraintKind::Distance(c) => [c.a.body, c.b.body],
             ConstraintKind::AngleDriver(c) => [c.a.body, c.b.body],
             ConstraintKind::CoordinateDriver(c) => [c.point.body, None],
+            ConstraintKind::Spatial(c) => c.bodies(),
         }
     }
 
@@ -195,6 +199,7 @@ impl Constraint {
             ConstraintKind::Distance(c) => [Some(&c.a), Some(&c.b)],
             ConstraintKind::AngleDriver(c) => [Some(&c.a), Some(&c.b)],
             ConstraintKind::CoordinateDriver(c) => [Some(&c.point), None],
+            ConstraintKind::Spatial(c) => c.markers(),
         }
     }
 
@@ -208,6 +213,7 @@ impl Constraint {
             ConstraintKind::Distance(_) => Distance::ROWS,
             ConstraintKind::AngleDriver(_) => AngleDriver::ROWS,
             ConstraintKind::CoordinateDriver(_) => CoordinateDriver::ROWS,
+            ConstraintKind::Spatial(c) => c.row_suffixes(),
         }
     }
 
@@ -221,12 +227,16 @@ impl Constraint {
         match &self.kind {
             ConstraintKind::AngleDriver(c) => c.motion.scratch_len(),
             ConstraintKind::CoordinateDriver(c) => c.motion.scratch_len(),
+            ConstraintKind::Spatial(c) => c.scratch_len(),
             _ => 0,
         }
     }
 
     pub fn is_driver(&self) -> bool {
-        matches!(self.kind, ConstraintKind::AngleDriver(_) | ConstraintKind::CoordinateDriver(_))
+        match &self.kind {
+            ConstraintKind::Spatial(c) => c.is_driver(),
+            k => matches!(k, ConstraintKind::AngleDriver(_) | ConstraintKind::CoordinateDriver(_)),
+        }
     }
 
     /// The reaction on the first marker's body from this constraint's multipliers `lam` (its
@@ -240,6 +250,8 @@ impl Constraint {
             ConstraintKind::Distance(c) => c.reaction(bodies, q, qd, lam),
             ConstraintKind::AngleDriver(c) => c.reaction(bodies, q, qd, lam),
             ConstraintKind::CoordinateDriver(c) => c.reaction(bodies, q, qd, lam),
+            // spatial reactions are 3D wrenches: spatial::outputs::reactions
+            ConstraintKind::Spatial(_) => Reaction::default(),
         }
     }
 
@@ -253,6 +265,7 @@ impl Constraint {
             ConstraintKind::Distance(c) => c.a.body,
             ConstraintKind::AngleDriver(c) => c.a.body,
             ConstraintKind::CoordinateDriver(c) => c.point.body,
+            ConstraintKind::Spatial(c) => c.first_body(),
         }
     }
 
@@ -269,6 +282,7 @@ impl Constraint {
             ConstraintKind::Distance(c) => c.eval(bodies, q, qd, n, out),
             ConstraintKind::AngleDriver(c) => c.eval(bodies, t, q, qd, n, out),
             ConstraintKind::CoordinateDriver(c) => c.eval(bodies, t, q, qd, n, out),
+            ConstraintKind::Spatial(c) => c.eval(bodies, t, q, qd, n, out),
         }
     }
 }
