@@ -3,12 +3,11 @@
 
 use numpy::PyArray1;
 use numpy::PyArrayMethods;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use super::sensors::read_states;
-use super::{finite_out, to_py, Vector};
+use super::{arg_err, finite_out, to_py, Vector};
 use crate::data::{Data, RankTolerance};
 use crate::dynamics;
 use crate::model::Model;
@@ -30,7 +29,7 @@ pub fn spatial_outputs<'py>(py: Python<'py>, description_json: &str, t: Vector<'
     let (qds, nt2) = read_states(qd, n, "qd")?;
     let ts: Vec<f64> = t.as_array().iter().copied().collect();
     if nt2 != nt || ts.len() != nt {
-        return Err(PyValueError::new_err(format!("t, q and qd must hold the same number of states, got {}, {nt} and {nt2}", ts.len())));
+        return Err(arg_err("t", format!("t, q and qd must hold the same number of states, got {}, {nt} and {nt2}", ts.len())));
     }
     let mut data = Data::new(&model);
     data.tolerance = RankTolerance { rcond, atol };
