@@ -93,6 +93,7 @@ pub enum BodyDesc {
     Beam(BeamDesc),
     PointMass(PointMassDesc),
     Flexible(FlexibleDesc),
+    Cable(CableDesc),
 }
 
 impl BodyDesc {
@@ -102,6 +103,7 @@ impl BodyDesc {
             BodyDesc::Beam(b) => &b.name,
             BodyDesc::PointMass(p) => &p.name,
             BodyDesc::Flexible(f) => &f.name,
+            BodyDesc::Cable(c) => &c.name,
         }
     }
 
@@ -112,12 +114,13 @@ impl BodyDesc {
             BodyDesc::Beam(_) => "beam",
             BodyDesc::PointMass(_) => "point_mass",
             BodyDesc::Flexible(_) => "flexible",
+            BodyDesc::Cable(_) => "cable",
         }
     }
 }
 
 /// A general planar FFRF body given by its inertia invariants and elastic matrices (body frame,
-/// `n_f` elastic coordinates; `rust/body/modal.rs`, docs/flexible-bodies.md). Matrices are lists
+/// `n_f` elastic coordinates; `rust/body/flexible.rs`, docs/flexible-bodies.md). Matrices are lists
 /// of rows.
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -236,22 +239,6 @@ pub enum Strain {
     Nonlinear,
 }
 
-/// How a beam is described: floating frame of reference (small elastic coordinates on a moving
-/// frame, the paper's model) or absolute nodal coordinates (the geometrically exact ANCF cable).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum BeamFormulation {
-    #[default]
-    Ffrf,
-    Ancf,
-}
-
-impl BeamFormulation {
-    pub fn is_ffrf(&self) -> bool {
-        *self == BeamFormulation::Ffrf
-    }
-}
-
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReferenceConditions {
@@ -277,9 +264,6 @@ pub struct BeamDesc {
     pub length: f64,
     #[serde(default = "one")]
     pub elements: usize,
-    /// Default `ffrf` (not written out then, so FFRF descriptions stay as they were).
-    #[serde(default, skip_serializing_if = "BeamFormulation::is_ffrf")]
-    pub formulation: BeamFormulation,
     pub theory: BeamTheory,
     /// Default: nonlinear (the physically right answer at speed).
     #[serde(default)]
@@ -310,6 +294,33 @@ pub struct BeamDesc {
     pub elastic: Option<Vec<f64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub elastic_rates: Option<Vec<f64>>,
+}
+
+/// A geometrically exact planar cable: ANCF elements (absolute positions and slopes of its
+/// nodes; `rust/body/ancf_cable.rs`), Euler-Bernoulli, no floating frame, exact strain. It
+/// starts straight and undeformed at `position` (its `xi = 0` end) and `angle`, moving rigidly
+/// with `velocity` (of that end) and `angular_velocity`.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CableDesc {
+    pub name: String,
+    pub length: f64,
+    #[serde(default = "one")]
+    pub elements: usize,
+    pub density: f64,
+    pub youngs_modulus: f64,
+    pub section: SectionDesc,
+    /// Stiffness-proportional (Kelvin-Voigt) damping time constant [s].
+    #[serde(default)]
+    pub damping: f64,
+    #[serde(default)]
+    pub position: Vec2,
+    #[serde(default)]
+    pub angle: f64,
+    #[serde(default)]
+    pub velocity: Vec2,
+    #[serde(default)]
+    pub angular_velocity: f64,
 }
 
 fn one() -> usize {

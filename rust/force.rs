@@ -15,6 +15,8 @@ pub enum ForceKind {
     /// Linear spring-damper between two markers:
     /// `Q -= (k (l - l0) + c l_dot) (r_a - r_b)_q^T e`, `e = (r_a - r_b) / l`.
     SpringDamper { a: Marker, b: Marker, stiffness: f64, damping: f64, rest_length: f64 },
+    /// Spatial force elements, gravity included (`spatial/force.rs`).
+    Spatial(crate::spatial::force::SpatialForce),
 }
 
 #[derive(Debug, Clone)]
@@ -24,6 +26,14 @@ pub struct Force {
 }
 
 impl Force {
+    /// Write the defaults this force resolved into its description (a spring-damper's rest
+    /// length taken at the initial guess).
+    pub fn fill_defaults(&self, d: &mut ForceDesc) {
+        if let (ForceKind::SpringDamper { rest_length: r, .. }, ForceDesc::SpringDamper { rest_length, .. }) = (&self.kind, d) {
+            *rest_length = Some(*r);
+        }
+    }
+
     /// Build a force element; `item` names it in errors.
     pub fn from_desc(ctx: &BuildContext, item: &str, name: String, d: &ForceDesc) -> Result<Force> {
         let kind = match d {
@@ -62,6 +72,7 @@ impl Force {
             ForceKind::PointForce { point, .. } => [Some(point), None],
             ForceKind::Torque { frame, .. } => [Some(frame), None],
             ForceKind::SpringDamper { a, b, .. } => [Some(a), Some(b)],
+            ForceKind::Spatial(f) => f.markers(),
         }
     }
 
@@ -91,6 +102,7 @@ impl Force {
                 a.add_point_jacobian(bodies, &sa, [-f * e[0], -f * e[1]], qvec);
                 b.add_point_jacobian(bodies, &sb, [f * e[0], f * e[1]], qvec);
             }
+            ForceKind::Spatial(f) => f.add_to(bodies, q, qd, qvec),
         }
     }
 
@@ -109,6 +121,7 @@ impl Force {
                 0.5 * stiffness * ldot * ldot
             }
             ForceKind::PointForce { .. } | ForceKind::Torque { .. } => 0.0,
+            ForceKind::Spatial(f) => f.material_energy(bodies, q, v),
         }
     }
 
@@ -132,6 +145,7 @@ impl Force {
                 let zeros = vec![0.0; q.len()];
                 -torque * frame.state(bodies, q, &zeros).phi
             }
+            ForceKind::Spatial(f) => f.potential(bodies, q),
         }
     }
 }

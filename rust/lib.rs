@@ -28,6 +28,7 @@ pub mod linalg;
 pub mod model;
 pub mod sensors;
 pub mod sparse_newton;
+pub mod spatial;
 pub mod uk;
 
 #[cfg(feature = "python")]

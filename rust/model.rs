@@ -14,7 +14,7 @@ use serde::de::DeserializeOwned;
 use serde::Deserialize;
 use serde_json::Value;
 
-use crate::body::{Body, BodyKind};
+use crate::body::Body;
 use crate::constraint::{BuildContext, Constraint};
 use crate::description::{to_external, to_internal, BodyDesc, Description, DriverDesc, ForceDesc, JointDesc, Vec2};
 use crate::error::{check_finite_item, Error, Result};
@@ -40,6 +40,9 @@ pub struct Model {
 impl Model {
     /// Parse and validate a JSON scene description (`docs/scene-format.md`).
     pub fn from_json(text: &str) -> Result<Model> {
+        if let Some(model) = crate::spatial::build::model_if_spatial(text)? {
+            return Ok(model);
+        }
         let raw: RawDescription = parse_json("scene", text)?;
         let mut b = ModelBuilder::new(raw.gravity)?;
         for v in raw.bodies {
@@ -81,12 +84,7 @@ impl Model {
 
     /// Any body with stiffness-proportional damping (the scene is then truly stiff).
     pub fn has_damping(&self) -> bool {
-        self.bodies.iter().any(|b| match &b.kind {
-            BodyKind::Beam(beam) => beam.damping > 0.0,
-            BodyKind::AncfBeam(cable) => cable.damping > 0.0,
-            BodyKind::Flexible(f) => f.d_ff.is_some(),
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) => false,
-        })
+        self.bodies.iter().any(|b| b.capabilities().damped)
     }
 }
 
@@ -94,6 +92,10 @@ impl Model {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawDescription {
+    /// 2 (planar; also when absent); 3 is built by `spatial::build`.
+    #[serde(default)]
+    #[allow(dead_code)]
+    dim: Option<u32>,
     #[serde(default)]
     gravity: Option<Vec2>,
     bodies: Vec<Value>,
@@ -276,6 +278,39 @@ pub fn parse_item_json<T: DeserializeOwned>(section: Section, index: usize, text
     parse_item(section, index, v)
 }
 
+/// The name of a joint/driver/force: the given one (unique among `used`, else an error) or a
+/// made-up `kind{index}` (made unique with `#k`). Shared by the planar and spatial builders.
+pub fn take_name(used: &mut HashMap<String, usize>, item: &str, given: Option<&str>, default: String) -> Result<String> {
+    if let Some(n) = given {
+        if n.is_empty() {
+            return Err(Error::invalid(item, "name must be a non-empty string"));
+        }
+        if used.contains_key(n) {
+            return Err(Error::invalid(item, "duplicate name (joint, driver and force names must be unique)"));
+        }
+        used.insert(n.to_string(), 1);
+        return Ok(n.to_string());
+    }
+    let k = used.entry(default.clone()).or_insert(0);
+    *k += 1;
+    Ok(if *k == 1 { default } else { format!("{default}#{k}") })
+}
+
+/// Number the constraints' rows consecutively (`Constraint::row`); returns `m` and the row
+/// names (`name` or `name.suffix`). Shared by the planar and spatial builders.
+pub fn assign_rows(constraints: &mut [Constraint]) -> (usize, Vec<String>) {
+    let mut row = 0;
+    let mut row_names = Vec::new();
+    for c in constraints.iter_mut() {
+        c.row = row;
+        for s in c.row_suffixes() {
+            row_names.push(if s.is_empty() { c.name.clone() } else { format!("{}.{s}", c.name) });
+        }
+        row += c.rows();
+    }
+    (row, row_names)
+}
+
 /// Builds a `Model` item by item; the only place where a scene is validated.
 #[derive(Debug, Clone)]
 pub struct ModelBuilder {
@@ -325,22 +360,9 @@ impl ModelBuilder {
         Ok(self.bodies.last().expect("just pushed"))
     }
 
-    /// The name of a joint/driver/force: the given one (unique, else an error) or a made-up
-    /// `kind{index}` (made unique with `#k`).
+    /// The name of a joint/driver/force (see [`take_name`]).
     fn take_name(&mut self, item: &str, given: Option<&str>, default: String) -> Result<String> {
-        if let Some(n) = given {
-            if n.is_empty() {
-                return Err(Error::invalid(item, "name must be a non-empty string"));
-            }
-            if self.used_names.contains_key(n) {
-                return Err(Error::invalid(item, "duplicate name (joint, driver and force names must be unique)"));
-            }
-            self.used_names.insert(n.to_string(), 1);
-            return Ok(n.to_string());
-        }
-        let k = self.used_names.entry(default.clone()).or_insert(0);
-        *k += 1;
-        Ok(if *k == 1 { default } else { format!("{default}#{k}") })
+        take_name(&mut self.used_names, item, given, default)
     }
 
     fn context(&self) -> BuildContext<'_> {
@@ -385,15 +407,7 @@ impl ModelBuilder {
         }
         let mut constraints = self.joints;
         constraints.extend(self.drivers);
-        let mut row = 0;
-        let mut row_names = Vec::new();
-        for c in constraints.iter_mut() {
-            c.row = row;
-            for s in c.row_suffixes() {
-                row_names.push(if s.is_empty() { c.name.clone() } else { format!("{}.{s}", c.name) });
-            }
-            row += c.rows();
-        }
+        let (row, row_names) = assign_rows(&mut constraints);
         Ok(Model {
             n: self.q0.len(),
             m: row,

@@ -15,16 +15,16 @@ use ukflex::Model;
 /// A cable alone (no joints): `damping` beta [s], `elements` N.
 fn cable_scene(elements: usize, damping: f64, gravity: bool) -> String {
     format!(
-        r#"{{"gravity": {g}, "bodies": [{{"name": "c", "kind": "beam", "formulation": "ancf", "length": 0.5, "elements": {elements},
-        "theory": "euler-bernoulli", "density": 7800, "youngs_modulus": 2e11, "section": {{"shape": "circular", "diameter": 0.01}},
-        "frame": "pinned-pinned", "damping": {damping}, "position": [0.2, -0.1], "angle": 0.7}}]}}"#,
+        r#"{{"gravity": {g}, "bodies": [{{"name": "c", "kind": "cable", "length": 0.5, "elements": {elements},
+        "density": 7800, "youngs_modulus": 2e11, "section": {{"shape": "circular", "diameter": 0.01}},
+        "damping": {damping}, "position": [0.2, -0.1], "angle": 0.7}}]}}"#,
         g = if gravity { "[0.3, -9.81]" } else { "null" }
     )
 }
 
 fn cable(model: &Model) -> &AncfCable {
     match &model.bodies[0].kind {
-        BodyKind::AncfBeam(c) => c,
+        BodyKind::Cable(c) => c,
         _ => panic!("not a cable"),
     }
 }

@@ -14,9 +14,9 @@ use ukflex::{Data, Model};
 fn wire_scene(elements: usize) -> String {
     format!(
         r#"{{"gravity": [0.0, -9.81],
-          "bodies": [{{"name": "wire", "kind": "beam", "formulation": "ancf", "length": 1.0, "elements": {elements},
-            "theory": "euler-bernoulli", "density": 7850.0, "youngs_modulus": 2.1e11,
-            "section": {{"shape": "circular", "diameter": 0.002}}, "frame": "pinned-pinned"}}],
+          "bodies": [{{"name": "wire", "kind": "cable", "length": 1.0, "elements": {elements},
+            "density": 7850.0, "youngs_modulus": 2.1e11,
+            "section": {{"shape": "circular", "diameter": 0.002}}}}],
           "joints": [{{"kind": "revolute", "a": {{"body": "ground"}}, "b": {{"body": "wire", "xi": 0.0}}}}]}}"#
     )
 }

@@ -1,4 +1,4 @@
-"""The general flexible body (rust/body/modal.rs): a beam given by its invariants computed in
+"""The general flexible body (rust/body/flexible.rs): a beam given by its invariants computed in
 NumPy by quadrature (ukflex.reference.fe_invariants) reproduces the built-in beam's mass matrix,
 forces and constraint Jacobian; the FE builders (ukflex.fe) against an independent quadrature;
 named errors for bad input."""

@@ -53,6 +53,8 @@ from .results.simulation import SimulationResult
 from .run.simulate import simulate
 from .run.sweep import sweep
 from .model import scenes
+from .model.spatial import SpatialScene
+from .results.spatial import outputs as spatial_outputs
 
 #: Public modules of the rooms, loaded on first use: ``ukflex.fe`` (flexible bodies from FE
 #: data, :mod:`ukflex.model.fe`) and ``ukflex.stability`` (diagnostics of runs,
@@ -83,6 +85,8 @@ __version__ = _version()
 
 __all__ = [
     "Scene",
+    "SpatialScene",
+    "spatial_outputs",
     "Marker",
     "RigidBodyRef",
     "PointMassRef",

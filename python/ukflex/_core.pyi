@@ -18,6 +18,7 @@ __all__ = [
     "item_name",
     "beam_elastic_dofs",
     "motion_values",
+    "spatial_outputs",
     "dense_eval",
     "UkflexError",
     "InvalidSceneError",
@@ -205,6 +206,9 @@ class System:
         """(start, stop) of a body's elastic coordinates in q."""
     def body_info(self, body: str) -> Dict[str, Any]:
         """Properties of a body as the core derived them."""
+    def body_capabilities(self, body: str) -> Dict[str, bool]:
+        """What a body can be asked: beam, elastic, elastic_coordinates, axial_forces,
+        named_markers, oriented (so that Python keeps no lists of kinds)."""
     def correct(
         self,
         t: float,
@@ -239,8 +243,17 @@ def item_name(section: str, kind: str, name: Optional[str], index: int) -> str:
 def motion_values(motion_json: str, t: _F64) -> _F64:
     """(f, f', f'') of a driver motion at the times t, shape (3, nt)."""
     ...
+def spatial_outputs(description_json: str, t: _F64, q: Any, qd: Any, reactions: bool = True, rcond: Optional[float] = None, atol: float = 0.0) -> Dict[str, Any]:
+    """Spatial outputs (bodies, reactions, momentum, energies, driver values) at stored states (ukflex.spatial_outputs)."""
+    ...
 def beam_elastic_dofs(elements: int, frame: str) -> int:
     """Number of elastic coordinates of a beam."""
 
 def dense_eval(method: str, meta: _F64, data: _F64, part_len: List[int], t: _F64) -> _F64:
     """Evaluate the dense output recorded by ``System.integrate(..., dense=True)`` at t (k,): (dim, k)."""
+def run_options() -> Dict[str, Any]:
+    """The native methods' run options as the core defines them: native_methods, common,
+    options ({method: options}), defaults (rtol, atol_per_rtol, rtol_min, projection_per_atol)."""
+def check_tolerances(rtol: float, atol: _F64, dim: int) -> _F64:
+    """The tolerance rule of every run: rtol > 0 and finite, atol >= 0 and finite (one value or
+    dim); returns atol as a (dim,) array."""

@@ -5,6 +5,7 @@
 
 mod scene;
 mod sensors;
+mod spatial;
 mod system;
 
 use numpy::ndarray::ArrayView1;
@@ -55,14 +56,14 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Vector<'py> {
         }
         let np = py.import("numpy")?;
         if obj.is_none() {
-            return Err(PyValueError::new_err("expected a 1-D array of floats, got None"));
+            return Err(arg_err("array", "expected a 1-D array of floats, got None"));
         }
         if np.getattr("ma")?.call_method1("isMaskedArray", (obj,))?.is_truthy()? {
-            return Err(PyValueError::new_err("expected a 1-D array of floats, got a masked array (fill or compress it first)"));
+            return Err(arg_err("array", "expected a 1-D array of floats, got a masked array (fill or compress it first)"));
         }
         // refuse what float64 conversion would silently change: complex (imaginary part dropped),
         // strings ("1.5" parsed), booleans, objects
-        let raw = np.call_method1("asarray", (obj,)).map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?;
+        let raw = np.call_method1("asarray", (obj,)).map_err(|e| arg_err("array", format!("expected a 1-D array of floats: {e}")))?;
         let kind: String = raw.getattr("dtype")?.getattr("kind")?.extract()?;
         if !matches!(kind.as_str(), "f" | "i" | "u") {
             let what = match kind.as_str() {
@@ -71,22 +72,22 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Vector<'py> {
                 "b" => "booleans".to_string(),
                 _ => format!("values of dtype {}", raw.getattr("dtype")?.str()?),
             };
-            return Err(PyValueError::new_err(format!("expected a 1-D array of floats, got {what}")));
+            return Err(arg_err("array", format!("expected a 1-D array of floats, got {what}")));
         }
         let converted = np
             .call_method1("asarray", (raw, "float64"))
-            .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?;
+            .map_err(|e| arg_err("array", format!("expected a 1-D array of floats: {e}")))?;
         let arr = converted
             .cast_into::<numpy::PyArrayDyn<f64>>()
-            .map_err(|_| PyValueError::new_err("expected a 1-D array of floats"))?;
+            .map_err(|_| arg_err("array", "expected a 1-D array of floats"))?;
         if arr.ndim() != 1 {
-            return Err(PyValueError::new_err(format!("expected a 1-D array of floats, got an array of shape {:?}", arr.shape())));
+            return Err(arg_err("array", format!("expected a 1-D array of floats, got an array of shape {:?}", arr.shape())));
         }
         let a = arr.readonly();
         let a1 = a
             .as_array()
             .into_dimensionality::<numpy::ndarray::Ix1>()
-            .map_err(|e| PyValueError::new_err(format!("expected a 1-D array of floats: {e}")))?
+            .map_err(|e| arg_err("array", format!("expected a 1-D array of floats: {e}")))?
             .to_owned();
         Ok(Vector(PyArray1::from_owned_array(py, a1).readonly()))
     }
@@ -105,7 +106,7 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Real {
             Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => {
                 let text = obj.repr().map(|r| r.to_string()).unwrap_or_default();
                 let shown: String = text.chars().take(40).collect();
-                Err(PyValueError::new_err(format!("expected a real number within the double-precision range, got {shown}{}", if text.chars().count() > 40 { "..." } else { "" })))
+                Err(arg_err("number", format!("expected a real number within the double-precision range, got {shown}{}", if text.chars().count() > 40 { "..." } else { "" })))
             }
             Err(e) => Err(e),
         }
@@ -116,7 +117,8 @@ pub(crate) fn to_py(e: Error) -> PyErr {
     let msg = e.to_string();
     match e {
         Error::Description(_) | Error::InvalidProperty { .. } | Error::UnknownBody { .. } => InvalidSceneError::new_err(msg),
-        Error::Shape { .. } | Error::Argument { .. } => PyValueError::new_err(msg),
+        Error::Argument { what, message } => invalid_argument(&what, &message).unwrap_or_else(|_| PyValueError::new_err(msg)),
+        Error::Shape { ref what, .. } => invalid_argument(what, &msg[what.len() + 2..]).unwrap_or_else(|_| PyValueError::new_err(msg)),
         Error::NonFinite { .. } => NonFiniteError::new_err(msg),
         Error::SingularMass { .. } => SingularMassError::new_err(msg),
         Error::Solver(_) | Error::Drift { .. } => SolverError::new_err(msg),
@@ -142,6 +144,20 @@ fn unknown_name(what: &str, name: &str, valid: &[String]) -> PyResult<PyErr> {
         let exc = cls.call_method1("of", (what, name, valid.to_vec()))?;
         Ok(PyErr::from_value(exc))
     })
+}
+
+/// `ukflex.InvalidArgumentError(what, message)` (a `UkflexError`, `ValueError` and `TypeError`,
+/// defined in `ukflex.errors`): the Python class of `Error::Argument` and `Error::Shape`.
+fn invalid_argument(what: &str, message: &str) -> PyResult<PyErr> {
+    Python::attach(|py| {
+        let cls = py.import("ukflex.errors")?.getattr("InvalidArgumentError")?;
+        Ok(PyErr::from_value(cls.call1((what, message))?))
+    })
+}
+
+/// An argument error raised from the bindings themselves (conversions of Python objects).
+pub(crate) fn arg_err(what: &str, message: impl Into<String>) -> PyErr {
+    to_py(Error::argument(what, message))
 }
 
 /// Copy a (possibly strided) NumPy vector into `dst`, checking length and finiteness.
@@ -179,6 +195,20 @@ pub(crate) fn check_time(t: f64) -> Result<(), Error> {
     if t.is_finite() { Ok(()) } else { Err(Error::NonFinite { what: "t".into(), index: 0 }) }
 }
 
+/// A core `Array` as a NumPy array (1-D or 2-D).
+pub(crate) fn array<'py>(py: Python<'py>, a: crate::body::Array) -> PyResult<Bound<'py, PyAny>> {
+    finite_out("result", a.values()).map_err(to_py)?;
+    match a {
+        crate::body::Array::Vector(v) => Ok(PyArray1::from_vec(py, v).into_any()),
+        crate::body::Array::Matrix { rows, cols, data } => Ok(mat(py, data, rows, cols)?.into_any()),
+    }
+}
+
+/// A JSON value of the core (an inspection answer) as Python objects (dicts, lists, floats).
+pub(crate) fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?.call_method1("loads", (v.to_string(),))
+}
+
 pub(crate) fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
     PyArray1::from_vec(py, v).reshape([rows, cols])
 }
@@ -193,16 +223,16 @@ pub(crate) fn mat<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -
 fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<'py, f64>, data: numpy::PyReadonlyArray2<'py, f64>, part_len: &Bound<'py, PyAny>, t: Vector<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     use crate::integrate::{DenseView, Method};
     // whole numbers >= 0 (a negative or huge one is a ValueError naming it, not an OverflowError)
-    let bad = || PyValueError::new_err("dense_eval: part_len must be a list of whole numbers >= 0 (the lengths of the record's parts)");
+    let bad = || arg_err("dense_eval", "part_len must be a list of whole numbers >= 0 (the lengths of the record's parts)");
     let mut lens = Vec::new();
     for x in part_len.try_iter().map_err(|_| bad())? {
         lens.push(x.map_err(|_| bad())?.extract::<u64>().map_err(|_| bad())?.try_into().map_err(|_| bad())?);
     }
     let part_len: Vec<usize> = lens;
-    let method = Method::from_name(method).ok_or_else(|| PyValueError::new_err(format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5', 'GENALPHA' or 'RADAU5M')")))?;
+    let method = Method::from_name(method).ok_or_else(|| arg_err("method", format!("unknown native method '{method}' (use 'DOPRI5', 'RADAU5', 'GENALPHA' or 'RADAU5M')")))?;
     let (meta, data) = (meta.as_array(), data.as_array());
     if meta.ncols() != 3 || meta.nrows() != data.nrows() {
-        return Err(PyValueError::new_err(format!(
+        return Err(arg_err("record", format!(
             "dense_eval: inconsistent dense record: meta must be (nseg, 3) and data (nseg, width), got {:?} and {:?}", meta.shape(), data.shape())));
     }
     // row-major views of the arrays (copied only when they are not C-contiguous)
@@ -213,7 +243,7 @@ fn dense_eval<'py>(py: Python<'py>, method: &str, meta: numpy::PyReadonlyArray2<
     let ts: Vec<f64> = t.as_array().iter().copied().collect();
     crate::error::check_finite("t", &ts).map_err(to_py)?;
     let k = ts.len();
-    let mut out = vec![0.0; dim.checked_mul(k).ok_or_else(|| PyValueError::new_err("dense_eval: too many values"))?];
+    let mut out = vec![0.0; dim.checked_mul(k).ok_or_else(|| arg_err("dense_eval", "too many values"))?];
     let mut buf = vec![0.0; dim];
     for (j, tj) in ts.iter().enumerate() {
         rec.eval(&method, *tj, &mut buf);
@@ -232,6 +262,32 @@ fn normal_weight(kappa: f64, kappa_ref: f64) -> f64 {
     crate::integrate::normal_weight(kappa.max(0.0), kappa_ref)
 }
 
+/// The native methods' run options as the core defines them (`rust/integrate/options.rs`): a
+/// dict with `native_methods`, `common` (options every method takes), `options` ({method: the
+/// options it takes}), and `defaults` (`rtol`, `atol_per_rtol`, `rtol_min`,
+/// `projection_per_atol`). The CLI, scene files and `simulate` read these; none restates them.
+#[pyfunction]
+fn run_options(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    use crate::integrate::{options_of, ATOL_PER_RTOL, COMMON_OPTIONS, DEFAULT_RTOL, NATIVE_METHODS, PROJECTION_PER_ATOL, RTOL_MIN};
+    let options: serde_json::Map<String, serde_json::Value> = NATIVE_METHODS.iter().map(|m| (m.to_string(), serde_json::json!(options_of(m)))).collect();
+    let v = serde_json::json!({
+        "native_methods": NATIVE_METHODS,
+        "common": COMMON_OPTIONS,
+        "options": options,
+        "defaults": {"rtol": DEFAULT_RTOL, "atol_per_rtol": ATOL_PER_RTOL, "rtol_min": RTOL_MIN, "projection_per_atol": PROJECTION_PER_ATOL},
+    });
+    json_to_py(py, &v)
+}
+
+/// The tolerance rule of every run (`integrate::check_tolerances`): `rtol > 0` and finite,
+/// `atol >= 0` and finite (one value or `dim`); returns atol as a (dim,) array.
+#[pyfunction]
+fn check_tolerances<'py>(py: Python<'py>, rtol: Real, atol: Vector<'py>, dim: usize) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let a: Vec<f64> = atol.as_array().iter().copied().collect();
+    let v = crate::integrate::check_tolerances(rtol.0, &a, dim).map_err(to_py)?;
+    Ok(PyArray1::from_vec(py, v))
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -241,6 +297,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(beam_elastic_dofs, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::motion_values, m)?)?;
     m.add_function(wrap_pyfunction!(dense_eval, m)?)?;
+    m.add_function(wrap_pyfunction!(run_options, m)?)?;
+    m.add_function(wrap_pyfunction!(check_tolerances, m)?)?;
+    m.add_function(wrap_pyfunction!(spatial::spatial_outputs, m)?)?;
     m.add("UkflexError", py.get_type::<UkflexError>())?;
     m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
     m.add("SingularMassError", py.get_type::<SingularMassError>())?;

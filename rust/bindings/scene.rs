@@ -1,13 +1,10 @@
 //! `ukflex._core.SceneChecker` and the small module functions the Python scene builder uses.
 
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::{to_py, InvalidSceneError};
-use crate::constraint::ConstraintKind;
+use super::{arg_err, to_py, InvalidSceneError};
 use crate::description::{BodyDesc, DriverDesc, ForceDesc, JointDesc};
-use crate::force::ForceKind;
 use crate::model::{parse_item_json, ModelBuilder, Section};
 
 /// Validates a scene item by item with the core's own rules (the Python `Scene` builder calls
@@ -59,10 +56,7 @@ impl PySceneChecker {
         let mut d: JointDesc = parse_item_json(Section::Joint, index, item_json).map_err(to_py)?;
         let c = self.builder.add_joint(&d).map_err(to_py)?;
         let out = constraint_info(py, c)?;
-        // the resolved default, written into the description so that it is explicit
-        if let (ConstraintKind::Distance(dist), JointDesc::Distance { length, .. }) = (&c.kind, &mut d) {
-            *length = Some(dist.length);
-        }
+        c.fill_defaults(&mut d);
         out.set_item("item", to_json(&d)?)?;
         Ok(out)
     }
@@ -84,9 +78,7 @@ impl PySceneChecker {
         let f = self.builder.add_force(&d).map_err(to_py)?;
         let out = PyDict::new(py);
         out.set_item("name", &f.name)?;
-        if let (ForceKind::SpringDamper { rest_length: r, .. }, ForceDesc::SpringDamper { rest_length, .. }) = (&f.kind, &mut d) {
-            *rest_length = Some(*r);
-        }
+        f.fill_defaults(&mut d);
         out.set_item("item", to_json(&d)?)?;
         Ok(out)
     }
@@ -107,7 +99,7 @@ fn to_json<T: serde::Serialize>(d: &T) -> PyResult<String> {
 #[pyfunction]
 #[pyo3(signature = (section, kind, name, index))]
 pub fn item_name(section: &str, kind: &str, name: Option<&str>, index: usize) -> PyResult<String> {
-    let s = Section::from_name(section).ok_or_else(|| PyValueError::new_err(format!("unknown section '{section}'")))?;
+    let s = Section::from_name(section).ok_or_else(|| arg_err("section", format!("unknown section '{section}'")))?;
     Ok(crate::model::item_name(s, kind, name, index))
 }
 

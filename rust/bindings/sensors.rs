@@ -2,10 +2,9 @@
 //! `motion_values`, which evaluates a driver motion description (inspection and tests).
 
 use numpy::{PyArray1, PyArrayMethods};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use super::{to_py, Vector};
+use super::{arg_err, to_py, Vector};
 use crate::constraint::Motion;
 use crate::description::{self, MotionDesc};
 use crate::error::Error;
@@ -16,15 +15,15 @@ pub(super) fn read_states(obj: &Bound<'_, PyAny>, n: usize, what: &str) -> PyRes
     let arr = py
         .import("numpy")?
         .call_method1("asarray", (obj, "float64"))
-        .map_err(|e| PyValueError::new_err(format!("{what}: expected an array of floats: {e}")))?
+        .map_err(|e| arg_err(what, format!("expected an array of floats: {e}")))?
         .cast_into::<numpy::PyArrayDyn<f64>>()
-        .map_err(|_| PyValueError::new_err(format!("{what}: expected an array of floats")))?;
+        .map_err(|_| arg_err(what, format!("expected an array of floats")))?;
     let view = arr.readonly();
     let a = view.as_array();
     let rows = match a.shape() {
         [m] if *m == n => 1,
         [nt, m] if *m == n => *nt,
-        other => return Err(PyValueError::new_err(format!("{what} must have shape (n,) or (nt, n) with n = {n}, got {other:?}"))),
+        other => return Err(arg_err(what, format!("must have shape (n,) or (nt, n) with n = {n}, got {other:?}"))),
     };
     let flat: Vec<f64> = a.iter().copied().collect();
     crate::error::check_finite(what, &flat).map_err(to_py)?;

@@ -24,10 +24,12 @@
 //! `finv`/`finvt` are two banded triangular solves on the x and y components. No quadratic
 //! velocity terms; gravity is a constant generalized force.
 
-use super::ffrf_beam::{beam_section, BeamSection};
+use super::ffrf_beam::{material_section, BeamSection};
 use super::marker::axis_marker_xi;
 use super::{finite_vec2, InitialState, MarkerState};
-use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions};
+use super::inspect::Array;
+use serde_json::{Map, Value};
+use crate::description::{CableDesc, MarkerDesc};
 use crate::error::{Error, Result};
 use crate::linalg::{Banded, BandedCholesky, GAUSS4};
 
@@ -206,23 +208,8 @@ pub struct CablePoint {
 }
 
 impl AncfCable {
-    pub fn from_desc(d: &BeamDesc, item: &str) -> Result<AncfCable> {
-        if d.theory == BeamTheory::Timoshenko {
-            return Err(Error::invalid(
-                item,
-                "the ANCF cable (formulation 'ancf') is an Euler-Bernoulli beam: theory 'timoshenko' is not available (use theory 'euler-bernoulli', or formulation 'ffrf' for a Timoshenko beam)",
-            ));
-        }
-        if d.frame != ReferenceConditions::PinnedPinned {
-            return Err(Error::invalid(
-                item,
-                "frame (the reference conditions of an FFRF beam's floating frame) does not apply to an ANCF beam, which has no floating frame: leave the default 'pinned-pinned', and clamp the beam with a weld joint",
-            ));
-        }
-        if d.rotary_inertia == Some(true) {
-            return Err(Error::invalid(item, "the ANCF cable has no rotary inertia (its mass matrix is rho A int S^T S dx): rotary_inertia must be false or absent"));
-        }
-        let (length, section) = beam_section(d, item)?;
+    pub fn from_desc(d: &CableDesc, item: &str) -> Result<AncfCable> {
+        let (length, section) = material_section(item, d.length, d.elements, d.density, d.youngs_modulus, &d.section, d.damping)?;
         let n_el = d.elements;
         let l = length / n_el as f64;
         let rho_a = section.density * section.area;
@@ -270,12 +257,7 @@ impl AncfCable {
 
     /// The straight undeformed beam from `position` (of the `xi = 0` end) and `angle`, in the
     /// rigid motion given by `velocity` (of the `xi = 0` end) and `angular_velocity`.
-    pub fn initial_state(&self, d: &BeamDesc, item: &str) -> Result<InitialState> {
-        for (what, given) in [("elastic", &d.elastic), ("elastic_rates", &d.elastic_rates)] {
-            if given.is_some() {
-                return Err(Error::invalid(item, format!("{what} does not apply to an ANCF beam (it starts straight and undeformed; its coordinates are nodal positions and slopes)")));
-            }
-        }
+    pub fn initial_state(&self, d: &CableDesc, item: &str) -> Result<InitialState> {
         let p = finite_vec2(item, "position", d.position)?;
         let v = finite_vec2(item, "velocity", d.velocity)?;
         let (s, c) = d.angle.sin_cos();
@@ -675,5 +657,44 @@ pub fn move_rigidly(q: &mut [f64], x: &[f64]) {
         q[k + 1] = c[1] + x[1] + s * rx + co * ry;
         q[k + 2] = co * sx - s * sy;
         q[k + 3] = s * sx + co * sy;
+    }
+}
+
+/// Inspection (`inspect.rs`).
+impl AncfCable {
+    pub fn shape_arrays(&self, xi: f64) -> (Array, Array) {
+        let nb = self.n_coords();
+        let p = self.point(xi);
+        let (mut s, mut d) = (vec![0.0; 2 * nb], vec![0.0; 2 * nb]);
+        for (a, c) in (0..4).flat_map(|a| [(a, 0), (a, 1)]) {
+            (s[c * nb + p.first + 2 * a + c], d[c * nb + p.first + 2 * a + c]) = (p.s[a], p.d[a]);
+        }
+        (Array::matrix(2, nb, s), Array::matrix(2, nb, d))
+    }
+
+    pub fn matrices(&self, q0: &[f64]) -> (Array, Array) {
+        let nb = self.n_coords();
+        let mut m = vec![0.0; nb * nb];
+        self.dense_block(&Default::default(), &mut |i, j, v| m[i * nb + j] = v);
+        (Array::matrix(nb, nb, m), Array::matrix(nb, nb, self.tangent_dense(q0)))
+    }
+
+    /// `d2U/dq2` at `q` (the body's coordinates), dense row-major.
+    pub fn tangent_dense(&self, q: &[f64]) -> Vec<f64> {
+        let mut k = Banded::zeros(self.n_coords(), HB);
+        self.add_tangent_stiffness(q, &mut k);
+        k.to_dense()
+    }
+
+    pub fn info(&self, m: &mut Map<String, Value>) {
+        let sec = &self.section;
+        for (k, v) in [("formulation", "ancf"), ("theory", "euler-bernoulli"), ("axial_quadrature", "lobatto-3"), ("bending_quadrature", "gauss-2")] {
+            m.insert(k.into(), v.into());
+        }
+        for (k, v) in [("length", self.length), ("element_length", self.element_length), ("area", sec.area), ("second_moment", sec.second_moment), ("density", sec.density), ("youngs_modulus", sec.youngs_modulus), ("damping", self.damping)] {
+            m.insert(k.into(), v.into());
+        }
+        m.insert("elements".into(), self.elements.into());
+        m.insert("rotary_inertia".into(), false.into());
     }
 }

@@ -1,5 +1,5 @@
 //! The floating-frame (FFRF) core shared by the FFRF beam (`ffrf_beam.rs`) and the general
-//! flexible body (`modal.rs`): a frame `(x, y, theta)` plus `n_f` elastic coordinates `q_f`,
+//! flexible body (`flexible.rs`): a frame `(x, y, theta)` plus `n_f` elastic coordinates `q_f`,
 //! the displacement field `u_f(P) = S(P) q_f` of a point with undeformed body-frame position
 //! `u0`. A kind only builds its invariants (`Ffrf`: the beam by Gauss quadrature of its
 //! elements, the modal body from its description) and adds the elastic forces beyond the

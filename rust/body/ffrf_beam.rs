@@ -10,6 +10,8 @@
 use super::ffrf::{Ffrf, FfrfData, PointShape};
 use super::marker::axis_marker_xi;
 use super::InitialState;
+use super::inspect::{spelled, Array};
+use serde_json::{Map, Value};
 use crate::description::{BeamDesc, BeamTheory, MarkerDesc, ReferenceConditions, SectionDesc, Strain};
 use crate::error::{non_negative, positive, Error, Result};
 use crate::linalg::{Banded, BandedCholesky, GAUSS4};
@@ -204,17 +206,11 @@ pub fn elastic_dofs(elements: usize, frame: ReferenceConditions) -> usize {
 /// Largest number of elements of one beam.
 pub const MAX_ELEMENTS: usize = 4096;
 
-/// Validate what every beam formulation reads from its description -- length, element count,
-/// material, section, shear data (checked whenever given, required for Timoshenko) and damping
-/// -- and derive its section. Returns `(length, section)`.
+/// Validate what an FFRF beam reads from its description -- length, element count, material,
+/// section, shear data (checked whenever given, required for Timoshenko) and damping -- and
+/// derive its section. Returns `(length, section)`.
 pub fn beam_section(d: &BeamDesc, item: &str) -> Result<(f64, BeamSection)> {
-    let length = positive(item, "length", d.length)?;
-    if d.elements == 0 || d.elements > MAX_ELEMENTS {
-        return Err(Error::invalid(item, format!("elements must be in 1..={MAX_ELEMENTS}, got {}", d.elements)));
-    }
-    let density = positive(item, "density", d.density)?;
-    let e = positive(item, "youngs_modulus", d.youngs_modulus)?;
-    let (area, second_moment) = section_properties(item, &d.section)?;
+    let (length, mut section) = material_section(item, d.length, d.elements, d.density, d.youngs_modulus, &d.section, d.damping)?;
     // shear data: validated whenever given, required by Timoshenko
     let g = match (d.shear_modulus, d.poisson_ratio) {
         (Some(_), Some(_)) => return Err(Error::invalid(item, "give either poisson_ratio or shear_modulus, not both")),
@@ -223,32 +219,35 @@ pub fn beam_section(d: &BeamDesc, item: &str) -> Result<(f64, BeamSection)> {
             if !nu.is_finite() || nu <= -1.0 || nu >= 0.5 {
                 return Err(Error::invalid(item, format!("poisson_ratio must be in (-1, 0.5), got {nu}")));
             }
-            Some(e / (2.0 * (1.0 + nu)))
+            Some(section.youngs_modulus / (2.0 * (1.0 + nu)))
         }
         (None, None) => None,
     };
     let k = d.shear_factor.map(|k| positive(item, "shear_factor", k)).transpose()?;
-    let shear_stiffness = match d.theory {
-        BeamTheory::EulerBernoulli => 0.0,
-        BeamTheory::Timoshenko => {
-            let g = g.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs poisson_ratio or shear_modulus"))?;
-            let k = k.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs shear_factor"))?;
-            k * g
-        }
-    };
-    non_negative(item, "damping", d.damping)?;
-    derived_scales(item, length / d.elements as f64, density, e, area, second_moment, shear_stiffness)?;
-    let rotary_inertia = d.rotary_inertia.unwrap_or(d.theory == BeamTheory::Timoshenko);
-    let section = BeamSection {
-        area,
-        second_moment,
-        density,
-        youngs_modulus: e,
-        shear_stiffness,
-        rotary_inertia,
-        theory: d.theory,
-    };
+    if d.theory == BeamTheory::Timoshenko {
+        let g = g.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs poisson_ratio or shear_modulus"))?;
+        let k = k.ok_or_else(|| Error::invalid(item, "a Timoshenko beam needs shear_factor"))?;
+        section.shear_stiffness = k * g;
+        derived_scales(item, length / d.elements as f64, section.density, section.youngs_modulus, section.area, section.second_moment, section.shear_stiffness)?;
+    }
+    section.rotary_inertia = d.rotary_inertia.unwrap_or(d.theory == BeamTheory::Timoshenko);
+    section.theory = d.theory;
     Ok((length, section))
+}
+
+/// What every beam kind reads from its description (length, element count, density, modulus,
+/// section, damping), validated; an Euler-Bernoulli section without rotary inertia.
+pub fn material_section(item: &str, length: f64, elements: usize, density: f64, e: f64, section: &SectionDesc, damping: f64) -> Result<(f64, BeamSection)> {
+    let length = positive(item, "length", length)?;
+    if elements == 0 || elements > MAX_ELEMENTS {
+        return Err(Error::invalid(item, format!("elements must be in 1..={MAX_ELEMENTS}, got {elements}")));
+    }
+    let density = positive(item, "density", density)?;
+    let e = positive(item, "youngs_modulus", e)?;
+    let (area, second_moment) = section_properties(item, section)?;
+    non_negative(item, "damping", damping)?;
+    derived_scales(item, length / elements as f64, density, e, area, second_moment, 0.0)?;
+    Ok((length, BeamSection { area, second_moment, density, youngs_modulus: e, shear_stiffness: 0.0, rotary_inertia: false, theory: BeamTheory::EulerBernoulli }))
 }
 
 /// Highest elastic circular frequency a beam may have [rad/s]: beyond it no integrator can
@@ -652,5 +651,35 @@ impl std::ops::Deref for Beam {
     /// A beam is a floating-frame body with element-built invariants.
     fn deref(&self) -> &Ffrf {
         &self.frame
+    }
+}
+
+/// Inspection (`inspect.rs`).
+impl Beam {
+    pub fn shape_arrays(&self, xi: f64) -> (Array, Array) {
+        let nf = self.n_f;
+        let (mut s, mut npsi) = (vec![0.0; 2 * nf], vec![0.0; nf]);
+        for &(i, su, sv, sp) in &self.point_shape(xi).entries {
+            (s[i], s[nf + i], npsi[i]) = (su, sv, sp);
+        }
+        (Array::matrix(2, nf, s), Array::Vector(npsi))
+    }
+
+    pub fn matrices(&self) -> (Array, Array) {
+        let nf = self.n_f;
+        (Array::matrix(nf, nf, self.m_ff.to_dense()), Array::matrix(nf, nf, self.k_ff.to_dense()))
+    }
+
+    pub fn info(&self, m: &mut Map<String, Value>) {
+        let sec = &self.section;
+        m.insert("formulation".into(), "ffrf".into());
+        for (k, v) in [("length", self.length), ("element_length", self.element_length), ("area", sec.area), ("second_moment", sec.second_moment), ("density", sec.density), ("youngs_modulus", sec.youngs_modulus), ("shear_stiffness", sec.shear_stiffness), ("damping", self.damping), ("shear_parameter", self.phi)] {
+            m.insert(k.into(), v.into());
+        }
+        m.insert("elements".into(), self.elements.into());
+        m.insert("rotary_inertia".into(), sec.rotary_inertia.into());
+        m.insert("theory".into(), spelled(&sec.theory));
+        m.insert("frame".into(), spelled(&self.reference));
+        m.insert("strain".into(), spelled(&self.strain));
     }
 }

@@ -20,6 +20,9 @@ pub enum MarkerShape {
     Particle,
     /// An axis point of an ANCF cable.
     Cable(CablePoint),
+    /// A spatial marker (`marker3.rs` holds its frame and kinematics): here only its body, for
+    /// the structural pattern; the planar kinematics below never see it.
+    Spatial,
 }
 
 /// A point and a frame attached to a body (`body == None` for the ground).
@@ -83,7 +86,7 @@ impl Marker {
     #[inline]
     pub fn state(&self, bodies: &[Body], q: &[f64], qd: &[f64]) -> MarkerState {
         let Some(bi) = self.body else {
-            let MarkerShape::Ground(p) = self.shape else { unreachable!("ground markers are points") };
+            let MarkerShape::Ground(p) = self.shape else { return MarkerState::default() }; // a spatial ground marker: marker3.rs
             return MarkerState { r: p, phi: self.angle, cs: [1.0, 0.0], ..Default::default() };
         };
         let body = &bodies[bi];
@@ -94,6 +97,7 @@ impl Marker {
             MarkerShape::Particle => point_mass::marker_state(self.angle, qb, qdb),
             MarkerShape::Cable(p) => ancf_cable::marker_state(p, self.angle, qb, qdb),
             MarkerShape::Ground(_) => unreachable!("ground marker on a body"),
+            MarkerShape::Spatial => MarkerState::default(),
         }
     }
 
@@ -114,7 +118,7 @@ impl Marker {
             MarkerShape::Beam(ps) => ffrf::add_point_jacobian(ps, ms, w, rb),
             MarkerShape::Particle => point_mass::add_point_jacobian(w, rb),
             MarkerShape::Cable(p) => ancf_cable::add_point_jacobian(p, w, rb),
-            MarkerShape::Ground(_) => {}
+            MarkerShape::Ground(_) | MarkerShape::Spatial => {}
         }
     }
 
@@ -133,7 +137,7 @@ impl Marker {
             MarkerShape::Rigid(_) => rigid::add_angle_jacobian(w, rb),
             MarkerShape::Beam(ps) => ffrf::add_angle_jacobian(ps, w, rb),
             MarkerShape::Cable(p) => ancf_cable::add_angle_jacobian(p, ms, w, rb),
-            MarkerShape::Particle | MarkerShape::Ground(_) => {}
+            MarkerShape::Particle | MarkerShape::Ground(_) | MarkerShape::Spatial => {}
         }
     }
 }

@@ -17,19 +17,26 @@ pub mod ffrf;
 pub mod ffrf_beam;
 pub mod frame;
 pub mod marker;
-pub mod modal;
+pub mod flexible;
+pub mod inspect;
+pub mod marker3;
+pub mod point3;
 pub mod point_mass;
 pub mod rigid;
+pub mod rigid3;
 
 pub use ancf_cable::{AncfCable, AncfCableData, CablePoint};
 pub use ffrf::{Ffrf, FfrfData, PointShape};
 pub use ffrf_beam::{Beam, BeamData};
+pub use inspect::{Array, Capabilities};
 pub use marker::{Marker, MarkerShape, MarkerState};
-pub use modal::Modal;
+pub use flexible::Flexible;
 pub use point_mass::{PointMass, PointMassData};
 pub use rigid::{Rigid, RigidData};
+pub use point3::{Point3, Point3Data};
+pub use rigid3::{Rigid3, Rigid3Data};
 
-use crate::description::{BeamFormulation, BodyDesc, MarkerDesc};
+use crate::description::{BodyDesc, MarkerDesc};
 use crate::error::{check_finite_item, Error, Result};
 
 /// `$e` with `$k` bound to the body's kind, one arm per kind (every kind implements the stage
@@ -40,8 +47,10 @@ macro_rules! with_kind {
             BodyKind::Rigid($k) => $e,
             BodyKind::Beam($k) => $e,
             BodyKind::PointMass($k) => $e,
-            BodyKind::AncfBeam($k) => $e,
+            BodyKind::Cable($k) => $e,
             BodyKind::Flexible($k) => $e,
+            BodyKind::Rigid3($k) => $e,
+            BodyKind::Point3($k) => $e,
         }
     };
 }
@@ -52,9 +61,9 @@ macro_rules! with_elastic_kind {
     ($kind:expr, |$k:ident| $e:expr, rigid => $rigid:expr) => {
         match $kind {
             BodyKind::Beam($k) => $e,
-            BodyKind::AncfBeam($k) => $e,
+            BodyKind::Cable($k) => $e,
             BodyKind::Flexible($k) => $e,
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) => $rigid,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Rigid3(_) | BodyKind::Point3(_) => $rigid,
         }
     };
 }
@@ -66,8 +75,10 @@ macro_rules! with_kind_data {
             (BodyKind::Rigid($k), BodyData::Rigid($d)) => $e,
             (BodyKind::Beam($k), BodyData::Beam($d)) => $e,
             (BodyKind::PointMass($k), BodyData::PointMass($d)) => $e,
-            (BodyKind::AncfBeam($k), BodyData::AncfBeam($d)) => $e,
+            (BodyKind::Cable($k), BodyData::Cable($d)) => $e,
             (BodyKind::Flexible($k), BodyData::Flexible($d)) => $e,
+            (BodyKind::Rigid3($k), BodyData::Rigid3($d)) => $e,
+            (BodyKind::Point3($k), BodyData::Point3($d)) => $e,
             _ => unreachable!("body data of another kind"),
         }
     };
@@ -81,8 +92,12 @@ pub enum BodyKind {
     Rigid(Rigid),
     Beam(Beam),
     PointMass(PointMass),
-    AncfBeam(AncfCable),
-    Flexible(Modal),
+    Cable(AncfCable),
+    Flexible(Flexible),
+    /// Spatial rigid body (`rigid3.rs`, built by `spatial::build`).
+    Rigid3(Rigid3),
+    /// Spatial point mass (`point3.rs`).
+    Point3(Point3),
 }
 
 /// Per-body workspace, one variant per kind (sized once in `Data::new`).
@@ -92,8 +107,10 @@ pub enum BodyData {
     Rigid(RigidData),
     Beam(BeamData),
     PointMass(PointMassData),
-    AncfBeam(AncfCableData),
+    Cable(AncfCableData),
     Flexible(FfrfData),
+    Rigid3(Rigid3Data),
+    Point3(Point3Data),
 }
 
 #[derive(Debug, Clone)]
@@ -130,10 +147,10 @@ impl Body {
         }
         let (kind, init) = match d {
             BodyDesc::Rigid(r) => build!(Rigid, Rigid, r),
-            BodyDesc::Beam(b) if b.formulation == BeamFormulation::Ancf => build!(AncfBeam, AncfCable, b),
+            BodyDesc::Cable(c) => build!(Cable, AncfCable, c),
             BodyDesc::Beam(b) => build!(Beam, Beam, b),
             BodyDesc::PointMass(p) => build!(PointMass, PointMass, p),
-            BodyDesc::Flexible(f) => build!(Flexible, Modal, f),
+            BodyDesc::Flexible(f) => build!(Flexible, Flexible, f),
         };
         for (what, v) in [("initial state", &init.q), ("initial rates", &init.qd)] {
             check_finite_item(&item, what, v)?;
@@ -141,15 +158,17 @@ impl Body {
         Ok((Body { name, offset, n_coords: init.q.len(), kind }, init))
     }
 
-    /// The kind's name: as in the description (`"rigid"`, `"beam"`, `"point_mass"`), and
-    /// `"ancf_beam"` for a beam with formulation `ancf`.
+    /// The kind's name, as in the description (`"rigid"`, `"beam"`, `"point_mass"`, `"cable"`,
+    /// `"flexible"`).
     pub fn kind_name(&self) -> &'static str {
         match &self.kind {
             BodyKind::Rigid(_) => "rigid",
             BodyKind::Beam(_) => "beam",
             BodyKind::PointMass(_) => "point_mass",
-            BodyKind::AncfBeam(_) => "ancf_beam",
+            BodyKind::Cable(_) => "cable",
             BodyKind::Flexible(_) => "flexible",
+            BodyKind::Rigid3(_) => "rigid3",
+            BodyKind::Point3(_) => "point3",
         }
     }
 
@@ -158,7 +177,7 @@ impl Body {
     pub fn elastic_range(&self) -> std::ops::Range<usize> {
         match &self.kind {
             BodyKind::Beam(_) | BodyKind::Flexible(_) => self.offset + 3..self.offset + self.n_coords,
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::AncfBeam(_) => self.offset..self.offset,
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Cable(_) | BodyKind::Rigid3(_) | BodyKind::Point3(_) => self.offset..self.offset,
         }
     }
 
@@ -168,7 +187,7 @@ impl Body {
     /// the implicit methods' sparse Newton matrices (`sparse_newton`).
     pub fn coupling_halfwidth(&self) -> usize {
         match &self.kind {
-            BodyKind::AncfBeam(_) => ancf_cable::HB.min(self.n_coords.saturating_sub(1)),
+            BodyKind::Cable(_) => ancf_cable::HB.min(self.n_coords.saturating_sub(1)),
             _ => self.n_coords.saturating_sub(1),
         }
     }
@@ -187,8 +206,10 @@ impl Body {
             BodyKind::Rigid(k) => BodyData::Rigid(k.new_data()),
             BodyKind::Beam(k) => BodyData::Beam(k.new_data()),
             BodyKind::PointMass(k) => BodyData::PointMass(k.new_data()),
-            BodyKind::AncfBeam(k) => BodyData::AncfBeam(k.new_data()),
+            BodyKind::Cable(k) => BodyData::Cable(k.new_data()),
             BodyKind::Flexible(k) => BodyData::Flexible(k.new_data()),
+            BodyKind::Rigid3(k) => BodyData::Rigid3(k.new_data()),
+            BodyKind::Point3(k) => BodyData::Point3(k.new_data()),
         }
     }
 
@@ -275,7 +296,7 @@ impl Body {
     pub fn rigid_motions(&self, q: &[f64], qd: &[f64], col0: usize, put: &mut impl FnMut(usize, usize, f64), cen: &mut [f64]) -> usize {
         let o = self.offset;
         match &self.kind {
-            BodyKind::AncfBeam(_) => {
+            BodyKind::Cable(_) => {
                 let (qb, vb) = (self.seg(q), self.seg(qd));
                 ancf_cable::rigid_motions(qb, vb, o, col0, put, &mut cen[o..o + self.n_coords])
             }
@@ -283,6 +304,10 @@ impl Body {
                 put(o, col0, 1.0);
                 put(o + 1, col0 + 1, 1.0);
                 2
+            }
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) => {
+                let (qb, vb) = (self.seg(q), self.seg(qd));
+                rigid3_motions(qb, vb, o, col0, put, &mut cen[o..o + self.n_coords])
             }
             BodyKind::Rigid(_) | BodyKind::Beam(_) | BodyKind::Flexible(_) => {
                 for k in 0..3 {
@@ -300,10 +325,14 @@ impl Body {
     pub fn move_rigidly(&self, q: &mut [f64], x: &[f64]) {
         let o = self.offset;
         match &self.kind {
-            BodyKind::AncfBeam(_) => ancf_cable::move_rigidly(&mut q[o..o + self.n_coords], x),
+            BodyKind::Cable(_) => ancf_cable::move_rigidly(&mut q[o..o + self.n_coords], x),
             BodyKind::PointMass(_) => {
                 q[o] += x[0];
                 q[o + 1] += x[1];
+            }
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) => {
+                let n = self.n_coords;
+                rigid3_move(&mut q[o..o + n], x)
             }
             BodyKind::Rigid(_) | BodyKind::Beam(_) | BodyKind::Flexible(_) => {
                 for k in 0..3 {
@@ -324,11 +353,14 @@ impl Body {
         let shape = match &self.kind {
             BodyKind::Rigid(_) => MarkerShape::Rigid(rigid::marker_point(md, &self.name, item)?),
             BodyKind::Beam(k) => MarkerShape::Beam(k.marker_shape(md, &self.name, item)?),
-            BodyKind::AncfBeam(k) => MarkerShape::Cable(k.marker_shape(md, &self.name, item)?),
+            BodyKind::Cable(k) => MarkerShape::Cable(k.marker_shape(md, &self.name, item)?),
             BodyKind::Flexible(k) => MarkerShape::Beam(k.marker_shape(md, &self.name, item)?),
             BodyKind::PointMass(_) => {
                 point_mass::check_marker(md, &self.name, item)?;
                 MarkerShape::Particle
+            }
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) => {
+                return Err(Error::invalid(item, format!("body '{}' is spatial: a planar item cannot attach to it (a scene does not mix dimensions)", self.name)));
             }
         };
         Ok(Marker { body: Some(index), angle: md.angle, shape })
@@ -338,8 +370,10 @@ impl Body {
     /// world position, displacement in the beam frame from the undeformed `(xi L, 0)` and the
     /// section rotation relative to that frame. The frame is the floating frame of an FFRF
     /// beam (for the pinned-pinned frame: the chord of the ends) and the chord frame of the
-    /// ends of an ANCF cable, so that both compare one to one. `None` for other kinds.
-    pub fn beam_point(&self, xi: f64, q: &[f64]) -> Option<[f64; 5]> {
+    /// ends of an ANCF cable, so that both compare one to one. An argument error for kinds
+    /// without an axis (`Capabilities::beam`).
+    pub fn beam_point(&self, xi: f64, q: &[f64]) -> Result<[f64; 5]> {
+        inspect::check_xi(xi)?;
         let qb = self.seg(q);
         match &self.kind {
             BodyKind::Beam(k) => {
@@ -350,24 +384,23 @@ impl Body {
                     u += su * qb[3 + i];
                     v += sv * qb[3 + i];
                 }
-                Some([ms.r[0], ms.r[1], u, v, ms.phi - qb[2]])
+                Ok([ms.r[0], ms.r[1], u, v, ms.phi - qb[2]])
             }
-            BodyKind::AncfBeam(k) => Some(k.chord_displacement(xi, qb)),
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Flexible(_) => None,
+            BodyKind::Cable(k) => Ok(k.chord_displacement(xi, qb)),
+            _ => self.require_beam().map(|_| [0.0; 5]),
         }
     }
-}
 
-impl Body {
     /// `[N, V, M, eps, kappa]` at the axis point `xi` of a beam at `q` (see
-    /// `ffrf_beam::Beam::internal_forces`, `ancf_cable::AncfCable::internal_forces`); `None`
-    /// for other kinds.
-    pub fn internal_forces(&self, xi: f64, q: &[f64]) -> Option<[f64; 5]> {
+    /// `ffrf_beam::Beam::internal_forces`, `ancf_cable::AncfCable::internal_forces`); an
+    /// argument error for kinds without an axis.
+    pub fn internal_forces(&self, xi: f64, q: &[f64]) -> Result<[f64; 5]> {
+        inspect::check_xi(xi)?;
         let qb = self.seg(q);
         match &self.kind {
-            BodyKind::Beam(k) => Some(k.internal_forces(xi, qb)),
-            BodyKind::AncfBeam(k) => Some(k.internal_forces(xi, qb)),
-            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Flexible(_) => None,
+            BodyKind::Beam(k) => Ok(k.internal_forces(xi, qb)),
+            BodyKind::Cable(k) => Ok(k.internal_forces(xi, qb)),
+            _ => self.require_beam().map(|_| [0.0; 5]),
         }
     }
 }
@@ -377,3 +410,55 @@ pub(crate) fn finite_vec2(item: &str, what: &str, v: [f64; 2]) -> Result<[f64; 2
     Ok(v)
 }
 
+/// Rigid motions of a spatial body (`Body::rigid_motions`): translations (3 columns) and, for a
+/// rigid3 body, rotations about the world axes through its centre of mass
+/// (`pd = 1/2 E(p)^T e_k`), with the centripetal part of the rotation at its angular velocity
+/// (`pdd = 1/2 E(pd)^T w`, `w = 2 E(p) pd / |p|^2`).
+fn rigid3_motions(q: &[f64], qd: &[f64], o: usize, col0: usize, put: &mut impl FnMut(usize, usize, f64), cen: &mut [f64]) -> usize {
+    for k in 0..3 {
+        put(o + k, col0 + k, 1.0);
+    }
+    if q.len() < 7 {
+        return 3;
+    }
+    use crate::spatial::rot::rot_e;
+    let e = rot_e(&q[3..7]);
+    for k in 0..3 {
+        for l in 0..4 {
+            put(o + 3 + l, col0 + 3 + k, 0.5 * e[k][l]);
+        }
+    }
+    let p2: f64 = q[3..7].iter().map(|x| x * x).sum();
+    let mut w = [0.0; 3];
+    for k in 0..3 {
+        w[k] = 2.0 * (0..4).map(|l| e[k][l] * qd[3 + l]).sum::<f64>() / p2;
+    }
+    let ed = rot_e(&qd[3..7]);
+    for l in 0..4 {
+        cen[3 + l] = 0.5 * (ed[0][l] * w[0] + ed[1][l] * w[1] + ed[2][l] * w[2]);
+    }
+    6
+}
+
+/// Move a spatial body rigidly by `x` (its `rigid3_motions` columns): `r += x[0..3]`, and for a
+/// rigid3 body `p <- exp(x[3..6] / 2) p` (the rotation by the vector `x[3..6]`, world axes).
+fn rigid3_move(q: &mut [f64], x: &[f64]) {
+    for k in 0..3 {
+        q[k] += x[k];
+    }
+    if q.len() < 7 {
+        return;
+    }
+    let th = (x[3] * x[3] + x[4] * x[4] + x[5] * x[5]).sqrt();
+    if th == 0.0 {
+        return;
+    }
+    let (s, c) = (0.5 * th).sin_cos();
+    let u = [x[3] / th * s, x[4] / th * s, x[5] / th * s];
+    let p = [q[3], q[4], q[5], q[6]];
+    // r * p with r = (c, u) (world-frame rotation applied after p)
+    q[3] = c * p[0] - u[0] * p[1] - u[1] * p[2] - u[2] * p[3];
+    q[4] = c * p[1] + u[0] * p[0] + u[1] * p[3] - u[2] * p[2];
+    q[5] = c * p[2] - u[0] * p[3] + u[1] * p[0] + u[2] * p[1];
+    q[6] = c * p[3] + u[0] * p[2] - u[1] * p[1] + u[2] * p[0];
+}

@@ -3,6 +3,7 @@
 
 use super::frame::{add_frame_gravity, add_frame_point_jacobian, frame_mass_block, frame_mass_moment, frame_point_state, frame_sin_cos};
 use super::{finite_vec2, InitialState, MarkerState};
+use serde_json::{Map, Value};
 use crate::description::{MarkerDesc, RigidDesc};
 use crate::error::{positive, Error, Result};
 use crate::linalg::{cholesky3, solve_lower3, solve_upper3};
@@ -142,4 +143,12 @@ pub fn add_point_jacobian(ms: &MarkerState, w: [f64; 2], row: &mut [f64]) {
 #[inline]
 pub fn add_angle_jacobian(w: f64, row: &mut [f64]) {
     row[2] += w;
+}
+
+impl Rigid {
+    /// Inspection entries (`inspect.rs`).
+    pub fn info(&self, m: &mut Map<String, Value>) {
+        m.insert("inertia".into(), self.inertia.into());
+        m.insert("com".into(), self.com.to_vec().into());
+    }
 }

@@ -15,6 +15,7 @@ pub mod point_on_line;
 pub mod prismatic;
 pub mod revolute;
 pub mod rows;
+pub mod spatial;
 pub mod weld;
 
 use std::collections::HashMap;
@@ -40,6 +41,8 @@ pub enum ConstraintKind {
     Distance(Distance),
     AngleDriver(AngleDriver),
     CoordinateDriver(CoordinateDriver),
+    /// Spatial joints, drivers and normalization rows (`spatial/`).
+    Spatial(spatial::SpatialConstraint),
 }
 
 #[derive(Debug, Clone)]
@@ -137,6 +140,14 @@ impl BuildContext<'_> {
 }
 
 impl Constraint {
+    /// Write the defaults this joint resolved into its description, so that the description
+    /// states them (a distance joint's length taken at the initial guess).
+    pub fn fill_defaults(&self, d: &mut JointDesc) {
+        if let (ConstraintKind::Distance(dist), JointDesc::Distance { length, .. }) = (&self.kind, d) {
+            *length = Some(dist.length);
+        }
+    }
+
     /// Build a joint; `item` names it in errors.
     pub fn from_joint(ctx: &BuildContext, item: &str, name: String, d: &JointDesc) -> Result<Constraint> {
         let kind = match d {
@@ -172,6 +183,7 @@ impl Constraint {
             ConstraintKind::Distance(c) => [c.a.body, c.b.body],
             ConstraintKind::AngleDriver(c) => [c.a.body, c.b.body],
             ConstraintKind::CoordinateDriver(c) => [c.point.body, None],
+            ConstraintKind::Spatial(c) => c.bodies(),
         }
     }
 
@@ -187,6 +199,7 @@ impl Constraint {
             ConstraintKind::Distance(c) => [Some(&c.a), Some(&c.b)],
             ConstraintKind::AngleDriver(c) => [Some(&c.a), Some(&c.b)],
             ConstraintKind::CoordinateDriver(c) => [Some(&c.point), None],
+            ConstraintKind::Spatial(c) => c.markers(),
         }
     }
 
@@ -200,6 +213,7 @@ impl Constraint {
             ConstraintKind::Distance(_) => Distance::ROWS,
             ConstraintKind::AngleDriver(_) => AngleDriver::ROWS,
             ConstraintKind::CoordinateDriver(_) => CoordinateDriver::ROWS,
+            ConstraintKind::Spatial(c) => c.row_suffixes(),
         }
     }
 
@@ -213,12 +227,16 @@ impl Constraint {
         match &self.kind {
             ConstraintKind::AngleDriver(c) => c.motion.scratch_len(),
             ConstraintKind::CoordinateDriver(c) => c.motion.scratch_len(),
+            ConstraintKind::Spatial(c) => c.scratch_len(),
             _ => 0,
         }
     }
 
     pub fn is_driver(&self) -> bool {
-        matches!(self.kind, ConstraintKind::AngleDriver(_) | ConstraintKind::CoordinateDriver(_))
+        match &self.kind {
+            ConstraintKind::Spatial(c) => c.is_driver(),
+            k => matches!(k, ConstraintKind::AngleDriver(_) | ConstraintKind::CoordinateDriver(_)),
+        }
     }
 
     /// The reaction on the first marker's body from this constraint's multipliers `lam` (its
@@ -232,6 +250,8 @@ impl Constraint {
             ConstraintKind::Distance(c) => c.reaction(bodies, q, qd, lam),
             ConstraintKind::AngleDriver(c) => c.reaction(bodies, q, qd, lam),
             ConstraintKind::CoordinateDriver(c) => c.reaction(bodies, q, qd, lam),
+            // spatial reactions are 3D wrenches: spatial::outputs::reactions
+            ConstraintKind::Spatial(_) => Reaction::default(),
         }
     }
 
@@ -245,6 +265,7 @@ impl Constraint {
             ConstraintKind::Distance(c) => c.a.body,
             ConstraintKind::AngleDriver(c) => c.a.body,
             ConstraintKind::CoordinateDriver(c) => c.point.body,
+            ConstraintKind::Spatial(c) => c.first_body(),
         }
     }
 
@@ -261,6 +282,7 @@ impl Constraint {
             ConstraintKind::Distance(c) => c.eval(bodies, q, qd, n, out),
             ConstraintKind::AngleDriver(c) => c.eval(bodies, t, q, qd, n, out),
             ConstraintKind::CoordinateDriver(c) => c.eval(bodies, t, q, qd, n, out),
+            ConstraintKind::Spatial(c) => c.eval(bodies, t, q, qd, n, out),
         }
     }
 }

@@ -210,7 +210,7 @@ pub fn correct_within(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
     let free: Vec<bool> = opts.hold.iter().map(|h| !h).collect();
     // bodies that move only rigidly: the cables' nodal fields (the other kinds' deformation is
     // their elastic coordinates, held by the mask)
-    let rigid = opts.rigid && model.bodies.iter().any(|b| matches!(b.kind, crate::body::BodyKind::AncfBeam(_)));
+    let rigid = opts.rigid && model.bodies.iter().any(|b| b.capabilities().nodal_deformation);
     let zeros = vec![0.0; n];
     let mut q = q.to_vec();
     constraints(model, data, t, &q, &zeros, true);

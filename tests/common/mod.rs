@@ -39,7 +39,17 @@ pub fn paper_scene(theory: &str, elements: usize, gravity: bool) -> String {
 
 /// The paper's slider-crank with the coupler as an ANCF cable of `elements` elements.
 pub fn ancf_paper_scene(elements: usize, gravity: bool) -> String {
-    paper_scene("euler-bernoulli", elements, gravity).replace(r#""kind": "beam","#, r#""kind": "beam", "formulation": "ancf","#)
+    let mut v: serde_json::Value = serde_json::from_str(&paper_scene("euler-bernoulli", elements, gravity)).expect("paper scene");
+    for b in v["bodies"].as_array_mut().expect("bodies") {
+        if b["kind"] == "beam" {
+            let o = b.as_object_mut().expect("body");
+            o.insert("kind".into(), "cable".into());
+            for k in ["theory", "strain", "frame", "rotary_inertia", "poisson_ratio", "shear_modulus", "shear_factor"] {
+                o.remove(k);
+            }
+        }
+    }
+    v.to_string()
 }
 
 /// A scene that uses every joint, driver and force kind on rigid bodies and beams, and motions
@@ -96,7 +106,7 @@ pub fn random_state(model: &Model, rng: &mut Lcg) -> (Vec<f64>, Vec<f64>) {
     let (mut q, mut qd) = (vec![0.0; model.n], vec![0.0; model.n]);
     for b in &model.bodies {
         let o = b.offset;
-        if let ukflex::body::BodyKind::AncfBeam(_) = b.kind {
+        if let ukflex::body::BodyKind::Cable(_) = b.kind {
             // nodal positions and slopes: the straight initial guess, moved and deformed a
             // little (slopes stay near their direction: marker angles are measured from it)
             for j in 0..b.n_coords {
@@ -161,13 +171,11 @@ pub fn ancf_scene() -> String {
     r#"{"gravity": [0.4, -9.81],
       "bodies": [
         {"name": "crank", "kind": "rigid", "mass": 0.3, "inertia": 0.002, "com": [0.05, 0.01]},
-        {"name": "cable", "kind": "beam", "formulation": "ancf", "length": 0.4, "elements": 3, "theory": "euler-bernoulli",
-         "density": 7800, "youngs_modulus": 2e11, "section": {"shape": "circular", "diameter": 0.01}, "frame": "pinned-pinned",
+        {"name": "cable", "kind": "cable", "length": 0.4, "elements": 3, "density": 7800, "youngs_modulus": 2e11, "section": {"shape": "circular", "diameter": 0.01},
          "damping": 1e-4, "position": [0.1, 0.0], "angle": 0.2, "velocity": [0.1, 0.3], "angular_velocity": 1.5},
         {"name": "slider", "kind": "rigid", "mass": 0.5, "inertia": 0.001, "position": [0.3, 0.1]},
-        {"name": "rope", "kind": "beam", "formulation": "ancf", "length": 0.3, "elements": 2, "theory": "euler-bernoulli",
-         "density": 2700, "youngs_modulus": 7e10, "section": {"shape": "rectangular", "width": 0.01, "height": 0.004},
-         "frame": "pinned-pinned", "position": [0.3, 0.3], "angle": 2.5},
+        {"name": "rope", "kind": "cable", "length": 0.3, "elements": 2, "density": 2700, "youngs_modulus": 7e10, "section": {"shape": "rectangular", "width": 0.01, "height": 0.004},
+         "position": [0.3, 0.3], "angle": 2.5},
         {"name": "bob", "kind": "point_mass", "mass": 0.2, "position": [0.1, 0.5]}],
       "joints": [
         {"kind": "revolute", "a": {"body": "ground", "point": [0.0, 0.0]}, "b": {"body": "crank", "point": [0.0, 0.0]}},

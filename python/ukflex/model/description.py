@@ -127,6 +127,9 @@ def normalize(description: Mapping[str, Any]) -> Tuple[Checker, Dict[str, Any]]:
     An error about an item carries ``exc.entry = (section, index)`` (0-based) so that callers
     (scene files) can say where it stands.
     """
+    if isinstance(description, Mapping) and description.get("dim", 2) != 2:
+        from .spatial import normalize_spatial  # spatial scenes: validated whole by the core
+        return normalize_spatial(dict(description))
     check_top_level(description)
     checker = Checker(description.get("gravity"))
     for section in SECTIONS:

@@ -4,7 +4,7 @@ interface points (``docs/flexible-bodies.md``).
 :class:`FlexibleData` is what :meth:`ukflex.Scene.flexible_body` takes.  Users rarely write one
 by hand: the builders in :mod:`ukflex.fe` compute it from a finite-element model (node
 coordinates and nodal mass/stiffness matrices, or a planar mesh) reduced to a few modes.  The
-core (``rust/body/modal.rs``) validates it: sizes, symmetry, a positive definite mass, a
+core (``rust/body/flexible.rs``) validates it: sizes, symmetry, a positive definite mass, a
 stiffness without rigid-body modes, markers that fit.
 """
 

@@ -1,5 +1,5 @@
 """Inertia invariants of planar flexible bodies computed independently in NumPy, by quadrature
-over the elements (the check of ``rust/body/ffrf_beam.rs`` and ``rust/body/modal.rs``).
+over the elements (the check of ``rust/body/ffrf_beam.rs`` and ``rust/body/flexible.rs``).
 
 ``beam_invariants`` integrates the Davis et al. Timoshenko (or Euler-Bernoulli) beam element's
 shape functions with Gauss-Legendre quadrature of its own order and returns the invariants in the

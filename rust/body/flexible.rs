@@ -15,6 +15,7 @@
 
 use super::ffrf::{Ffrf, FfrfData, PointShape};
 use super::{finite_vec2, InitialState};
+use serde_json::{Map, Value};
 use crate::description::{FlexibleDesc, MarkerDesc, Strain};
 use crate::error::{check_finite_item, positive, Error, Result};
 use crate::linalg::dense::cholesky;
@@ -29,7 +30,7 @@ const SYM_TOL: f64 = 1e-9;
 
 /// One flexible body with its constant invariants (see the module docs).
 #[derive(Debug, Clone)]
-pub struct Modal {
+pub struct Flexible {
     /// The floating-frame invariants (read through `Deref` as `modal.n_f`, ...).
     pub frame: Ffrf,
     pub d_ff: Option<Banded>,
@@ -284,10 +285,10 @@ fn interface_points(d: &FlexibleDesc, item: &str, n: usize) -> Result<Vec<(Strin
     Ok(markers)
 }
 
-impl Modal {
+impl Flexible {
     /// Validate the description (in this order: sizes, mass data, matrices, vectors,
     /// definiteness, strain tensors, interface points) and build the invariants.
-    pub fn from_desc(d: &FlexibleDesc, item: &str) -> Result<Modal> {
+    pub fn from_desc(d: &FlexibleDesc, item: &str) -> Result<Flexible> {
         let n = d.k_ff.len();
         if n == 0 || n > MAX_ELASTIC {
             return Err(Error::invalid(item, format!("k_ff must be n_f x n_f with n_f in 1..={MAX_ELASTIC} elastic coordinates, got n_f = {n} (a body without elastic coordinates is a rigid body)")));
@@ -319,7 +320,7 @@ impl Modal {
             m_ff,
             l_ff,
         };
-        Ok(Modal { frame, d_ff: mats.dmp.map(|dd| banded(&dd, n, hb)), strain, k3, k4, markers })
+        Ok(Flexible { frame, d_ff: mats.dmp.map(|dd| banded(&dd, n, hb)), strain, k3, k4, markers })
     }
 
     /// Initial guess: frame state from the description, elastic coordinates (default zero).
@@ -487,11 +488,20 @@ impl Modal {
     }
 }
 
-impl std::ops::Deref for Modal {
+impl std::ops::Deref for Flexible {
     type Target = Ffrf;
 
     /// A flexible body is a floating-frame body with invariants given by its description.
     fn deref(&self) -> &Ffrf {
         &self.frame
+    }
+}
+
+impl Flexible {
+    /// Inspection entries (`inspect.rs`).
+    pub fn info(&self, m: &mut Map<String, Value>) {
+        m.insert("markers".into(), self.markers.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>().into());
+        m.insert("strain".into(), super::inspect::spelled(&self.strain));
+        m.insert("damping".into(), self.d_ff.is_some().into());
     }
 }

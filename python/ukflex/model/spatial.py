@@ -1,0 +1,239 @@
+"""Spatial (3D) rigid multibody scenes: the builder and the spatial outputs.
+
+Design of the API (issue 30): the dimension is explicit in the *type* of the builder,
+:class:`SpatialScene`, and in the description it produces (``"dim": 3``). A planar
+:class:`ukflex.Scene` and a spatial one never mix: their bodies, markers (a point and an angle
+in 2D, a point and a frame in 3D), forces (a scalar torque in 2D, a vector in 3D) and gravity
+(2 vs 3 components) differ in shape, so one class holding both would accept half of its
+arguments only in one dimension. A separate class keeps every signature honest and lets a
+planar scene build and run exactly as before. The rest of the API is shared: ``ukflex.System``
+builds a ``SpatialScene`` (or its dict), ``ukflex.simulate`` runs it, the motions
+(:class:`ukflex.ConstantSpeed`, :class:`ukflex.Polynomial`, :class:`ukflex.Harmonic`,
+:class:`ukflex.Expression`, :class:`ukflex.Spline`) drive its joints. Python only builds the
+description; the Rust core validates it (named :class:`ukflex.InvalidSceneError` messages).
+
+Coordinates (docs/spatial-design.md): a ``rigid3`` body has ``[x, y, z, e0, e1, e2, e3]`` (its
+centre of mass and the Euler parameters of its body frame, with one normalization constraint
+row each), a ``point3`` body ``[x, y, z]``.
+
+Example::
+
+    s = ukflex.SpatialScene(gravity=(0, 0, -9.81))
+    top = s.rigid_body("top", mass=1.0, inertia=np.diag([2.5e-3, 2.5e-3, 5e-3]),
+                       position=(0, 0, 0.1), angular_velocity=(0, 0, 50))
+    s.spherical(s.ground.marker((0, 0, 0)), top.marker((0, 0, -0.1)), name="pivot")
+    sys = ukflex.System(s)
+    res = ukflex.simulate(sys, 1.0, method="DOPRI5", rtol=1e-10)
+    out = ukflex.spatial_outputs(sys, res)      # positions, rotations, reactions, energies
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from dataclasses import dataclass
+from typing import Any, Dict, List, Optional, Sequence
+
+import numpy as np
+
+from .. import _core
+from ..errors import InvalidSceneError
+
+__all__ = ["SpatialScene", "SpatialMarker", "SpatialBodyRef", "outputs", "normalize_spatial", "NATIVE_METHODS_3D"]
+
+#: Native methods that run a spatial scene (the others are refused by name, see docs/spatial.md).
+NATIVE_METHODS_3D = ("DOPRI5", "RADAU5", "RADAU5M", "GENALPHA")
+
+
+def _motion(motion: Any) -> Dict[str, Any]:
+    """A motion's description: a motion object (``ukflex.ConstantSpeed``, ...) or an expression string."""
+    return {"kind": "expression", "expression": motion} if isinstance(motion, str) else motion.to_dict()
+
+
+def _vec(name: str, v: Any, n: int = 3) -> List[float]:
+    a = np.asarray(v, dtype=float).reshape(-1)
+    if a.size != n:
+        raise InvalidSceneError(f"{name} must have {n} components, got {a.size}")
+    return [float(x) for x in a]
+
+
+@dataclass(frozen=True)
+class SpatialMarker:
+    """A frame on a body (or the ground): ``point`` in body coordinates (world for the ground;
+    the user's body frame, not the centre of mass), ``z`` its z axis (normalized by the core; a
+    zero or non-finite axis is an error) and ``x`` an optional hint for its x axis."""
+
+    body: str
+    point: Sequence[float] = (0.0, 0.0, 0.0)
+    z: Optional[Sequence[float]] = None
+    x: Optional[Sequence[float]] = None
+
+    def to_dict(self) -> Dict[str, Any]:
+        d: Dict[str, Any] = {"body": self.body, "point": _vec("marker point", self.point)}
+        if self.z is not None:
+            d["z"] = _vec("marker axis z", self.z)
+        if self.x is not None:
+            d["x"] = _vec("marker axis x", self.x)
+        return d
+
+
+@dataclass(frozen=True)
+class SpatialBodyRef:
+    """A handle on a body (or the ground) of a :class:`SpatialScene`."""
+
+    name: str
+
+    def marker(self, point: Sequence[float] = (0.0, 0.0, 0.0), z: Optional[Sequence[float]] = None,
+               x: Optional[Sequence[float]] = None) -> SpatialMarker:
+        return SpatialMarker(self.name, tuple(point), None if z is None else tuple(z), None if x is None else tuple(x))
+
+
+class SpatialScene:
+    """Builder of a spatial scene description (``"dim": 3``); see the module docstring."""
+
+    def __init__(self, gravity: Sequence[float] = (0.0, 0.0, 0.0)):
+        self._d: Dict[str, Any] = {"dim": 3, "gravity": _vec("gravity", gravity), "bodies": [], "joints": [],
+                                   "drivers": [], "forces": []}
+        self.ground = SpatialBodyRef("ground")
+
+    # -- bodies ---------------------------------------------------------------------------
+    def rigid_body(self, name: str, mass: float, inertia: Any, *, com: Sequence[float] = (0, 0, 0),
+                   position: Sequence[float] = (0, 0, 0), orientation: Any = None,
+                   velocity: Sequence[float] = (0, 0, 0), angular_velocity: Sequence[float] = (0, 0, 0)) -> SpatialBodyRef:
+        """A rigid body: ``inertia`` (3x3, or its 3 principal moments) about the centre of mass in
+        body axes; ``com`` in the body frame; ``position`` and ``velocity`` of the body frame
+        origin; ``orientation`` a unit quaternion ``[e0, e1, e2, e3]`` or a rotation matrix (body
+        -> world); ``angular_velocity`` in world axes."""
+        J = np.asarray(inertia, dtype=float)
+        if J.shape == (3,):
+            J = np.diag(J)
+        if J.shape != (3, 3):
+            raise InvalidSceneError(f"body '{name}': inertia must be 3x3 or 3 principal moments, got shape {J.shape}")
+        b: Dict[str, Any] = {"kind": "rigid3", "name": name, "mass": float(mass), "inertia": J.tolist(),
+                             "com": _vec("com", com), "position": _vec("position", position),
+                             "velocity": _vec("velocity", velocity), "angular_velocity": _vec("angular_velocity", angular_velocity)}
+        if orientation is not None:
+            o = np.asarray(orientation, dtype=float)
+            b["orientation"] = o.tolist() if o.shape in ((4,), (3, 3)) else _vec("orientation", o, 4)
+        self._d["bodies"].append(b)
+        return SpatialBodyRef(name)
+
+    def point_mass(self, name: str, mass: float, *, position: Sequence[float] = (0, 0, 0),
+                   velocity: Sequence[float] = (0, 0, 0)) -> SpatialBodyRef:
+        self._d["bodies"].append({"kind": "point3", "name": name, "mass": float(mass),
+                                  "position": _vec("position", position), "velocity": _vec("velocity", velocity)})
+        return SpatialBodyRef(name)
+
+    # -- joints ---------------------------------------------------------------------------
+    def _pair(self, section: str, kind: str, a: SpatialMarker, b: SpatialMarker, name: Optional[str], **extra: Any) -> str:
+        item: Dict[str, Any] = {"kind": kind, "a": a.to_dict(), "b": b.to_dict(), **extra}
+        if name is not None:
+            item["name"] = name
+        self._d[section].append(item)
+        return name or f"{kind}{len(self._d[section]) - 1}"
+
+    def spherical(self, a: SpatialMarker, b: SpatialMarker, name: Optional[str] = None) -> str:
+        return self._pair("joints", "spherical", a, b, name)
+
+    def revolute(self, a: SpatialMarker, b: SpatialMarker, name: Optional[str] = None) -> str:
+        """About the markers' common ``z`` axis."""
+        return self._pair("joints", "revolute", a, b, name)
+
+    def prismatic(self, a: SpatialMarker, b: SpatialMarker, name: Optional[str] = None) -> str:
+        """Along ``z_a``; no rotation."""
+        return self._pair("joints", "prismatic", a, b, name)
+
+    def cylindrical(self, a: SpatialMarker, b: SpatialMarker, name: Optional[str] = None) -> str:
+        return self._pair("joints", "cylindrical", a, b, name)
+
+    def universal(self, a: SpatialMarker, b: SpatialMarker, name: Optional[str] = None) -> str:
+        """Cross arms ``x_a`` (body of ``a``) and ``y_b`` (body of ``b``)."""
+        return self._pair("joints", "universal", a, b, name)
+
+    def fixed(self, a: SpatialMarker, b: SpatialMarker, name: Optional[str] = None) -> str:
+        return self._pair("joints", "fixed", a, b, name)
+
+    def planar(self, a: SpatialMarker, b: SpatialMarker, name: Optional[str] = None) -> str:
+        """``b``'s point in ``a``'s ``x y`` plane, rotation about ``z`` only."""
+        return self._pair("joints", "planar", a, b, name)
+
+    def distance(self, a: SpatialMarker, b: SpatialMarker, length: Optional[float] = None, name: Optional[str] = None) -> str:
+        extra = {} if length is None else {"length": float(length)}
+        return self._pair("joints", "distance", a, b, name, **extra)
+
+    def point_on_line(self, line: SpatialMarker, point: SpatialMarker, name: Optional[str] = None) -> str:
+        """``point`` on the ``z`` line of ``line``."""
+        return self._pair("joints", "point_on_line", line, point, name)
+
+    def point_on_plane(self, plane: SpatialMarker, point: SpatialMarker, name: Optional[str] = None) -> str:
+        """``point`` on the ``x y`` plane of ``plane``."""
+        return self._pair("joints", "point_on_plane", plane, point, name)
+
+    # -- drivers --------------------------------------------------------------------------
+    def rotation_driver(self, a: SpatialMarker, b: SpatialMarker, motion: Any, name: Optional[str] = None) -> str:
+        """The angle of ``x_b`` about ``z_a`` from ``x_a`` follows ``motion`` (any number of turns)."""
+        return self._pair("drivers", "rotation", a, b, name, motion=_motion(motion))
+
+    def translation_driver(self, a: SpatialMarker, b: SpatialMarker, motion: Any, name: Optional[str] = None) -> str:
+        """``z_a . (P_b - P_a)`` follows ``motion``."""
+        return self._pair("drivers", "translation", a, b, name, motion=_motion(motion))
+
+    # -- forces ---------------------------------------------------------------------------
+    def _force(self, item: Dict[str, Any], name: Optional[str]) -> str:
+        if name is not None:
+            item["name"] = name
+        self._d["forces"].append(item)
+        return name or f"{item['kind']}{len(self._d['forces']) - 1}"
+
+    def point_force(self, point: SpatialMarker, force: Sequence[float], frame: str = "world", name: Optional[str] = None) -> str:
+        """A constant force at a marker, world components or the marker's axes (``frame="body"``)."""
+        return self._force({"kind": "point_force", "point": point.to_dict(), "force": _vec("force", force), "frame": frame}, name)
+
+    def torque(self, body: SpatialBodyRef, torque: Sequence[float], frame: str = "world", name: Optional[str] = None) -> str:
+        return self._force({"kind": "torque", "body": body.name, "torque": _vec("torque", torque), "frame": frame}, name)
+
+    def spring_damper(self, a: SpatialMarker, b: SpatialMarker, stiffness: float, damping: float = 0.0,
+                      rest_length: Optional[float] = None, name: Optional[str] = None) -> str:
+        item: Dict[str, Any] = {"kind": "spring_damper", "a": a.to_dict(), "b": b.to_dict(), "stiffness": float(stiffness),
+                                "damping": float(damping)}
+        if rest_length is not None:
+            item["rest_length"] = float(rest_length)
+        return self._force(item, name)
+
+    def rotational_spring_damper(self, a: SpatialMarker, b: SpatialMarker, stiffness: float, damping: float = 0.0,
+                                 angle0: float = 0.0, name: Optional[str] = None) -> str:
+        """About ``z_a`` (a revolute's axis): torque ``-k (theta - angle0) - c thetad``."""
+        return self._force({"kind": "rotational_spring_damper", "a": a.to_dict(), "b": b.to_dict(),
+                            "stiffness": float(stiffness), "damping": float(damping), "angle0": float(angle0)}, name)
+
+    # -- description ----------------------------------------------------------------------
+    def to_dict(self) -> Dict[str, Any]:
+        return copy.deepcopy(self._d)
+
+    def validate(self) -> None:
+        """Build the description in the core (every rule is the core's; named errors)."""
+        normalize_spatial(self._d)
+
+
+def _check_transportable(v: Any, path: str) -> None:
+    """JSON carries no NaN or infinity: name where one stands (every other rule is the core's)."""
+    if isinstance(v, float) and not np.isfinite(v):
+        raise InvalidSceneError(f"scene: {path.lstrip('.')} must be finite, got {v}")
+    if isinstance(v, dict):
+        for k, x in v.items():
+            _check_transportable(x, f"{path}.{k}")
+    elif isinstance(v, (list, tuple)):
+        for i, x in enumerate(v):
+            _check_transportable(x, f"{path}[{i}]")
+
+
+def normalize_spatial(description: Dict[str, Any]):
+    """Validate a spatial description dict in the core; returns ``(None, dict)`` like
+    :func:`ukflex.description.normalize` (spatial scenes have no item-by-item checker)."""
+    _check_transportable(description, "")
+    try:
+        text = json.dumps(description, allow_nan=False)
+    except (TypeError, ValueError) as exc:
+        raise InvalidSceneError(f"scene: not a JSON-compatible description ({exc})") from exc
+    _core.System(text)
+    return None, copy.deepcopy(dict(description))

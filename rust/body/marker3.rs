@@ -1,0 +1,157 @@
+//! Spatial markers: a frame on a body (docs/spatial-design.md, section 2): a point `s'` and
+//! axes `C` (columns `x, y, z`). World point and axes with their Jacobian blocks and the
+//! quadratic terms of their second derivatives (`vdd = J qdd + h`):
+//!
+//! `P = r + A s'`, `J_P = [I, B(p, s')]`, `Pd = rd + B(p, s') pd`, `h_P = 2 A(pd) s'`;
+//! `a = A c`, `J_a = [0, B(p, c)]`, `ad = B(p, c) pd`, `h_a = 2 A(pd) c`.
+//!
+//! Ground markers are constants; a point mass's marker is the particle with the world axes.
+//! `base` is the marker as the planar machinery sees it (its body, `MarkerShape::Spatial`),
+//! which gives the structural pattern (`Marker::coords`) to `sparse_newton`.
+
+use super::{Body, BodyKind, Marker, MarkerShape};
+use crate::error::{check_finite_item, Error, Result};
+use crate::spatial::desc::Marker3Desc;
+use crate::spatial::rot::{add, col, frame_from_z, m34_t_vec, m34_vec, mat_vec, norm, quad_term, rot_a, rot_b, scale, sub, M3, M34, V3};
+
+#[derive(Debug, Clone)]
+pub struct Marker3 {
+    pub base: Marker,
+    pub body: Option<usize>,
+    /// On a rigid body (its kinematics depend on `p`).
+    pub rigid: bool,
+    /// Point relative to the centre of mass in body axes (world point for the ground, zero for
+    /// a point mass).
+    pub s: V3,
+    /// Axes (columns `x, y, z`) in body axes (world axes for the ground and point masses).
+    pub c: M3,
+}
+
+/// A vector quantity of one marker with its Jacobian (`jr`: the identity `r` block of a point,
+/// 0 for an axis; `jp`: `d v / d p`), velocity and quadratic acceleration term.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Kin3 {
+    pub v: V3,
+    pub vd: V3,
+    pub h: V3,
+    pub jr: f64,
+    pub jp: M34,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Marker3State {
+    pub body: Option<usize>,
+    pub rigid: bool,
+    pub point: Kin3,
+    pub axes: [Kin3; 3],
+}
+
+/// A frame's axes from a description: `z` (default `(0, 0, 1)`, normalized; zero or non-finite
+/// is an error) and an optional `x` hint.
+pub fn axes_from_desc(item: &str, md: &Marker3Desc) -> Result<M3> {
+    let z = md.z.unwrap_or([0.0, 0.0, 1.0]);
+    check_finite_item(item, "marker axis z", &z)?;
+    let nz = norm(&z);
+    if !(nz > 0.0) || !nz.is_finite() {
+        return Err(Error::invalid(item, format!("marker axis z must be finite and nonzero, got {z:?}")));
+    }
+    let z = scale(1.0 / nz, &z);
+    if let Some(x) = &md.x {
+        check_finite_item(item, "marker axis x", x)?;
+        if !(norm(x) > 0.0) {
+            return Err(Error::invalid(item, format!("marker axis x must be finite and nonzero, got {x:?}")));
+        }
+    }
+    frame_from_z(&z, md.x.as_ref()).ok_or_else(|| Error::invalid(item, "marker axis x must not be parallel to its z axis"))
+}
+
+impl Marker3 {
+    /// Resolve a marker description on the ground or a spatial body (`index`: name -> body).
+    pub fn from_desc(item: &str, md: &Marker3Desc, bodies: &[Body], index: &std::collections::HashMap<String, usize>) -> Result<Marker3> {
+        let c = axes_from_desc(item, md)?;
+        let point = md.point.unwrap_or([0.0; 3]);
+        check_finite_item(item, "marker point", &point)?;
+        if md.body == "ground" {
+            return Ok(Marker3 { base: Marker { body: None, angle: 0.0, shape: MarkerShape::Spatial }, body: None, rigid: false, s: point, c });
+        }
+        let Some(&bi) = index.get(&md.body) else {
+            let mut known: Vec<&str> = vec!["ground"];
+            known.extend(bodies.iter().map(|b| b.name.as_str()));
+            return Err(Error::UnknownBody { item: item.to_string(), body: md.body.clone(), known: known.join(", ") });
+        };
+        let base = Marker { body: Some(bi), angle: 0.0, shape: MarkerShape::Spatial };
+        match &bodies[bi].kind {
+            BodyKind::Rigid3(k) => Ok(Marker3 { base, body: Some(bi), rigid: true, s: sub(&point, &k.com), c }),
+            BodyKind::Point3(_) => {
+                if point != [0.0; 3] {
+                    return Err(Error::invalid(item, format!("a marker on point mass '{}' is the particle itself: point must be [0, 0, 0], got {point:?}", md.body)));
+                }
+                Ok(Marker3 { base, body: Some(bi), rigid: false, s: point, c })
+            }
+            _ => Err(Error::invalid(item, format!("body '{}' is planar: a spatial scene holds only rigid3 and point3 bodies", md.body))),
+        }
+    }
+
+    /// A marker that turns with its body (joints and forces that need an orientation).
+    pub fn check_oriented(&self, item: &str, what: &str) -> Result<()> {
+        if self.body.is_some() && !self.rigid {
+            return Err(Error::invalid(item, format!("{what}: a point mass has no orientation; this needs a rigid3 body or the ground")));
+        }
+        Ok(())
+    }
+
+    /// Kinematics at `(q, qd)`.
+    #[inline]
+    pub fn state(&self, bodies: &[Body], q: &[f64], qd: &[f64]) -> Marker3State {
+        let mut st = Marker3State { body: self.body, rigid: self.rigid, ..Default::default() };
+        for k in 0..3 {
+            st.axes[k].v = col(&self.c, k);
+        }
+        let Some(bi) = self.body else {
+            st.point.v = self.s;
+            return st;
+        };
+        let o = bodies[bi].offset;
+        let r = [q[o], q[o + 1], q[o + 2]];
+        let rd = [qd[o], qd[o + 1], qd[o + 2]];
+        st.point.jr = 1.0;
+        if !self.rigid {
+            st.point.v = r;
+            st.point.vd = rd;
+            return st;
+        }
+        let (p, pd) = (&q[o + 3..o + 7], &qd[o + 3..o + 7]);
+        let a = rot_a(p);
+        let ad = rot_a(pd);
+        let jp = rot_b(p, &self.s);
+        st.point = Kin3 { v: add(&r, &mat_vec(&a, &self.s)), vd: add(&rd, &m34_vec(&jp, pd)), h: scale(2.0, &mat_vec(&ad, &self.s)), jr: 1.0, jp };
+        for k in 0..3 {
+            let ck = col(&self.c, k);
+            let jp = rot_b(p, &ck);
+            st.axes[k] = Kin3 { v: mat_vec(&a, &ck), vd: m34_vec(&jp, pd), h: quad_term(pd, &ck), jr: 0.0, jp };
+        }
+        st
+    }
+}
+
+/// `row += w . dv/dq` for the quantity `k` of the marker state `ms` (row layout as in
+/// `Marker::add_point_jacobian_in`: `None` a full n-row, `Some` a constraint's compressed row).
+#[inline]
+pub fn add_jacobian(bodies: &[Body], ms: &Marker3State, k: &Kin3, w: &V3, row: &mut [f64], layout: Option<&[(usize, usize)]>) {
+    let Some(bi) = ms.body else { return };
+    let start = match layout {
+        None => bodies[bi].offset,
+        Some(l) => l.iter().find(|e| e.0 == bi).expect("the marker's body is in the constraint's layout").1,
+    };
+    if k.jr != 0.0 {
+        for c in 0..3 {
+            row[start + c] += k.jr * w[c];
+        }
+    }
+    if ms.rigid {
+        let g = m34_t_vec(&k.jp, w);
+        for l in 0..4 {
+            row[start + 3 + l] += g[l];
+        }
+    }
+}

@@ -1,0 +1,162 @@
+//! Spatial joints and drivers (docs/spatial-design.md, section 4), one file per kind, each
+//! stated for two markers `i` (`a`, first) and `j` (`b`) that hold when the marker frames
+//! coincide, from the row primitives of `prim.rs`. The model appends one normalization row per
+//! rigid3 body after the joint and driver rows (`normalization.rs`). `ConstraintKind::Spatial`
+//! carries them through the planar machinery (the Jacobian layout, the UK kernels, the
+//! integrators), which is dimension-agnostic on the bodies' slices of `q`.
+
+pub mod cylindrical;
+pub mod distance;
+pub mod driver;
+pub mod fixed;
+pub mod normalization;
+pub mod planar;
+pub mod point_on_line;
+pub mod point_on_plane;
+pub mod prim;
+pub mod prismatic;
+pub mod revolute;
+pub mod spherical;
+pub mod universal;
+
+use crate::body::marker3::{Marker3, Marker3State};
+use crate::body::{Body, Marker};
+use crate::constraint::ConstraintOut;
+use crate::error::{Error, Result};
+
+pub use driver::{RotationDriver, TranslationDriver};
+pub use normalization::Normalization;
+
+/// The two markers of a joint (`i` first).
+#[derive(Debug, Clone)]
+pub struct Pair {
+    pub i: Marker3,
+    pub j: Marker3,
+}
+
+impl Pair {
+    /// Two markers on different bodies, at least one of them not the ground.
+    pub fn new(item: &str, i: Marker3, j: Marker3) -> Result<Pair> {
+        if i.body.is_none() && j.body.is_none() {
+            return Err(Error::invalid(item, "both markers are on the ground (the joint would constrain nothing)"));
+        }
+        if i.body == j.body {
+            return Err(Error::invalid(item, "both markers are on the same body"));
+        }
+        Ok(Pair { i, j })
+    }
+
+    /// Both markers turn with their bodies (or sit on the ground).
+    pub fn oriented(self, item: &str, kind: &str) -> Result<Pair> {
+        self.i.check_oriented(item, kind)?;
+        self.j.check_oriented(item, kind)?;
+        Ok(self)
+    }
+
+    #[inline]
+    pub fn states(&self, bodies: &[Body], q: &[f64], qd: &[f64]) -> (Marker3State, Marker3State) {
+        (self.i.state(bodies, q, qd), self.j.state(bodies, q, qd))
+    }
+}
+
+macro_rules! spatial_kinds {
+    ($($variant:ident($ty:ty)),* $(,)?) => {
+        /// The closed set of spatial constraint kinds.
+        #[derive(Debug, Clone)]
+        pub enum SpatialConstraint {
+            $($variant($ty),)*
+            Rotation(RotationDriver),
+            Translation(TranslationDriver),
+            Normalization(Normalization),
+        }
+
+        impl SpatialConstraint {
+            pub fn row_suffixes(&self) -> &'static [&'static str] {
+                match self {
+                    $(SpatialConstraint::$variant(_) => <$ty>::ROWS,)*
+                    SpatialConstraint::Rotation(_) | SpatialConstraint::Translation(_) | SpatialConstraint::Normalization(_) => &[""],
+                }
+            }
+
+            /// The joint's markers (`None` for a normalization row).
+            pub fn pair(&self) -> Option<&Pair> {
+                match self {
+                    $(SpatialConstraint::$variant(c) => Some(&c.pair),)*
+                    SpatialConstraint::Rotation(c) => Some(&c.pair),
+                    SpatialConstraint::Translation(c) => Some(&c.pair),
+                    SpatialConstraint::Normalization(_) => None,
+                }
+            }
+
+            #[inline]
+            pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
+                match self {
+                    $(SpatialConstraint::$variant(c) => {
+                        let (si, sj) = c.pair.states(bodies, q, qd);
+                        c.eval(bodies, &si, &sj, n, out)
+                    })*
+                    SpatialConstraint::Rotation(c) => c.eval(bodies, t, q, qd, n, out),
+                    SpatialConstraint::Translation(c) => c.eval(bodies, t, q, qd, n, out),
+                    SpatialConstraint::Normalization(c) => c.eval(bodies, q, qd, n, out),
+                }
+            }
+        }
+    };
+}
+
+spatial_kinds!(
+    Spherical(spherical::Spherical),
+    Revolute(revolute::Revolute3),
+    Prismatic(prismatic::Prismatic3),
+    Cylindrical(cylindrical::Cylindrical),
+    Universal(universal::Universal),
+    Fixed(fixed::Fixed),
+    Planar(planar::Planar),
+    Distance(distance::Distance3),
+    PointOnLine(point_on_line::PointOnLine3),
+    PointOnPlane(point_on_plane::PointOnPlane),
+);
+
+impl SpatialConstraint {
+    /// The bodies its rows touch.
+    pub fn bodies(&self) -> [Option<usize>; 2] {
+        match self {
+            SpatialConstraint::Normalization(c) => [Some(c.body), None],
+            _ => {
+                let p = self.pair().expect("a joint has markers");
+                [p.i.body, p.j.body]
+            }
+        }
+    }
+
+    /// The markers as the planar machinery sees them (body and structural pattern).
+    pub fn markers(&self) -> [Option<&Marker>; 2] {
+        match self {
+            SpatialConstraint::Normalization(c) => [Some(&c.base), None],
+            _ => {
+                let p = self.pair().expect("a joint has markers");
+                [Some(&p.i.base), Some(&p.j.base)]
+            }
+        }
+    }
+
+    pub fn scratch_len(&self) -> usize {
+        match self {
+            SpatialConstraint::Rotation(c) => c.motion.scratch_len(),
+            SpatialConstraint::Translation(c) => c.motion.scratch_len(),
+            _ => 0,
+        }
+    }
+
+    pub fn is_driver(&self) -> bool {
+        matches!(self, SpatialConstraint::Rotation(_) | SpatialConstraint::Translation(_))
+    }
+
+    /// The body of the first marker (`None`: the ground).
+    pub fn first_body(&self) -> Option<usize> {
+        self.bodies()[0]
+    }
+}
+
+#[cfg(test)]
+mod tests;

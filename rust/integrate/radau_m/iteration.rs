@@ -1,0 +1,166 @@
+//! RADAU5M's simplified Newton iteration on the stages and its error estimate (filtered onto
+//! the constraints' tangent space near singular configurations).
+
+use super::*;
+
+impl RadauM {
+    /// One Newton attempt of step `h`. `Ok(Some(iterations))` on convergence, `Ok(None)` on
+    /// divergence or slow convergence (`self.st.h` is then the step to retry with).
+    pub(super) fn newton<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64) -> Result<Option<usize>> {
+        let (n, m) = (self.n, self.m);
+        let nm = n + m;
+        let t0 = self.st.t;
+        self.faccon = self.faccon.max(f64::EPSILON).powf(0.8);
+        self.theta = self.theta.abs();
+        let mut dynold = 0.0f64;
+        let mut thqold = 0.0f64;
+        for k in 1..=NIT {
+            self.stages(h);
+            for i in 0..3 {
+                let ok = sys.augmented_residual(t0 + self.c[i] * h, &self.qs[i], &self.vs[i], &self.w[i], &self.ls[i], &mut self.r1, &mut self.r2)?;
+                if !ok {
+                    return Err(Error::argument("method", "RADAU5M needs a system with the acceleration-level residual"));
+                }
+                self.st.stats.nfev += 1;
+                self.res[i][..n].copy_from_slice(&self.r1);
+                self.res[i][n..].copy_from_slice(&self.r2);
+            }
+            if !self.res.iter().all(|r| r.iter().all(|x| x.is_finite())) {
+                let (q, qd) = (&self.qs, &self.vs);
+                self.st.nonfinite = [("q", &q[2]), ("qd", &qd[2])]
+                    .iter()
+                    .find_map(|(w, v)| v.iter().position(|x| !x.is_finite()).map(|i| (*w, i)))
+                    .or(Some(("qdd", 0)));
+                return Ok(None);
+            }
+            if k == 1 && !(self.reuse && h == self.lu_h) {
+                self.refresh_matrices(sys, h)?;
+            }
+            // transformed right-hand sides: -(T^-1 (x) I) R
+            for k2 in 0..nm {
+                let (r0, r1, r2) = (self.res[0][k2], self.res[1][k2], self.res[2][k2]);
+                self.xr[k2] = -(self.ti[0][0] * r0 + self.ti[0][1] * r1 + self.ti[0][2] * r2);
+                self.xc[k2] = -(self.ti[1][0] * r0 + self.ti[1][1] * r1 + self.ti[1][2] * r2);
+                self.xi[k2] = -(self.ti[2][0] * r0 + self.ti[2][1] * r1 + self.ti[2][2] * r2);
+            }
+            let nw = self.newton.as_mut().expect("RADAU5M: init first");
+            nw.solve_real(&mut self.xr);
+            nw.solve_complex(&mut self.xc, &mut self.xi);
+            self.st.stats.newton += 1;
+            // back: (T (x) I) X; the norm of the position and velocity corrections of all stages
+            let mut dyno = 0.0;
+            for k2 in 0..nm {
+                let (x0, x1, x2) = (self.xr[k2], self.xc[k2], self.xi[k2]);
+                for i in 0..3 {
+                    let d = self.t[i][0] * x0 + self.t[i][1] * x1 + self.t[i][2] * x2;
+                    if k2 < n {
+                        self.w[i][k2] += d;
+                    } else {
+                        self.ls[i][k2 - n] += d;
+                    }
+                }
+            }
+            for k2 in 0..n {
+                let (x0, x1, x2) = (self.xr[k2], self.xc[k2], self.xi[k2]);
+                let d: [f64; 3] = std::array::from_fn(|i| self.t[i][0] * x0 + self.t[i][1] * x1 + self.t[i][2] * x2);
+                let s = self.newton_scal(k2);
+                for i in 0..3 {
+                    let dq = h * h * (self.a2[i][0] * d[0] + self.a2[i][1] * d[1] + self.a2[i][2] * d[2]);
+                    let dv = h * (self.a[i][0] * d[0] + self.a[i][1] * d[1] + self.a[i][2] * d[2]);
+                    dyno += (dq / s) * (dq / s) + (h * dv / s) * (h * dv / s);
+                }
+            }
+            let dyno = (dyno / (6 * n) as f64).sqrt();
+            if !dyno.is_finite() {
+                self.st.nonfinite = Some(("qdd", 0));
+                return Ok(None);
+            }
+            if k >= 2 {
+                let thq = dyno / dynold;
+                self.theta = if k == 2 { thq } else { (thq * thqold).sqrt() };
+                thqold = thq;
+                if self.theta < 0.99 {
+                    self.faccon = self.theta / (1.0 - self.theta);
+                    let dyth = self.faccon * dyno * self.theta.powi((NIT - 1 - k) as i32) / self.fnewt;
+                    // with a fixed step there is no smaller step to move to: Newton goes on while
+                    // it contracts (up to NIT iterations) instead of giving up on the prediction
+                    if dyth >= 1.0 && self.ro.step.is_none() {
+                        let qnewt = dyth.clamp(1e-4, 20.0);
+                        self.st.h = 0.8 * h * qnewt.powf(-1.0 / (4.0 + NIT as f64 - 1.0 - k as f64));
+                        return Ok(None);
+                    }
+                } else {
+                    self.st.h = 0.5 * h;
+                    return Ok(None);
+                }
+            }
+            dynold = dyno.max(f64::EPSILON);
+            if self.faccon * dyno <= self.fnewt {
+                self.stages(h);
+                return Ok(Some(k));
+            }
+        }
+        self.st.h = 0.5 * h;
+        Ok(None)
+    }
+
+    /// Hairer's filtered error estimate on the positions (module docs); `second`: the variant
+    /// with a fresh evaluation at the estimated point (first step, after a rejection).
+    pub(super) fn error_estimate<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64, filter: bool) -> Result<f64> {
+        let n = self.n;
+        let (hee1, hee2, hee3) = (rc::DD1 / h, rc::DD2 / h, rc::DD3 / h);
+        // e = f_n + sum_i d_i Z_i / h, Z_i the stage increments
+        for k in 0..n {
+            let zq = |i: usize| self.qs[i][k] - self.q0[k];
+            let zv = |i: usize| self.vs[i][k] - self.v0[k];
+            self.eq[k] = self.v0[k] + hee1 * zq(0) + hee2 * zq(1) + hee3 * zq(2);
+            self.ev[k] = self.a0[k] + hee1 * zv(0) + hee2 * zv(1) + hee3 * zv(2);
+        }
+        let mut err = self.filtered_norm(sys, h, filter);
+        if err >= 1.0 && (self.first || self.reject) {
+            // Hairer's second estimate: f at y_n + x instead of f_n (e_q += x_v, e_v += g(y_n + x) - a_n)
+            let g = h * self.lambda;
+            for k in 0..n {
+                let xq = self.tmp[k];
+                let xv = xq / g - self.eq[k];
+                self.r1[k] = self.q0[k] + xq;
+                // the velocities of the estimated point in the stage-1 buffer (rebuilt below)
+                self.vs[0][k] = self.v0[k] + xv;
+                self.eq[k] += xv;
+            }
+            sys.acc(self.st.t, &self.r1, &self.vs[0], &mut self.xc[..n])?;
+            self.st.stats.nfev += 1;
+            for k in 0..n {
+                self.ev[k] += self.xc[k] - self.a0[k];
+            }
+            err = self.filtered_norm(sys, h, filter);
+            self.stages(h);
+        }
+        Ok(err.max(1e-10))
+    }
+
+    /// `x_q` of the filtered estimate for the bracket in `eq`, `ev` (into `tmp[..n]`) and its
+    /// weighted RMS norm.
+    pub(super) fn filtered_norm<S: SecondOrderSystem>(&mut self, sys: &mut S, h: f64, tangent: bool) -> f64 {
+        let n = self.n;
+        let g = h * self.lambda;
+        let nw = self.newton.as_mut().expect("RADAU5M: init first");
+        nw.filtered_rhs(g, &self.eq, &self.ev, &mut self.tmp);
+        nw.solve_real(&mut self.tmp);
+        if tangent {
+            weigh_error(sys, &mut self.tmp[..n], n, self.kappa_ref);
+        }
+        let mut s = 0.0;
+        for i in 0..n {
+            let v = self.tmp[i] / self.scal(i);
+            s += v * v;
+        }
+        // the velocities' estimate: x_v = x_q / g - e_q (the second-order form of the filter)
+        for i in 0..n {
+            let xv = self.tmp[i] / g - self.eq[i];
+            let sc = self.atol[n + i] + self.rtol * self.v0[i].abs().max(self.vs[2][i].abs());
+            s += (xv / sc) * (xv / sc);
+        }
+        (s / (2 * n) as f64).sqrt()
+    }
+}

@@ -1,0 +1,278 @@
+//! The description of a spatial scene (`"dim": 3`, docs/spatial.md): plain data parsed from the
+//! JSON dict, as `description.rs` is for planar scenes. Validation happens when the model is
+//! built (`spatial::build`, each kind's `from_desc`), not here.
+
+use serde::{Deserialize, Serialize};
+
+use crate::description::MotionDesc;
+
+pub type Vec3 = [f64; 3];
+
+/// Orientation of a rigid body: a unit quaternion `[e0, e1, e2, e3]` (scalar first) or a
+/// rotation matrix (rows; body -> world).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum OrientationDesc {
+    Quaternion([f64; 4]),
+    Matrix([[f64; 3]; 3]),
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Body3Desc {
+    Rigid3(Rigid3Desc),
+    Point3(Point3Desc),
+}
+
+impl Body3Desc {
+    pub fn name(&self) -> &str {
+        match self {
+            Body3Desc::Rigid3(r) => &r.name,
+            Body3Desc::Point3(p) => &p.name,
+        }
+    }
+}
+
+/// A rigid body: coordinates `[r (3), p (4)]`, `r` its centre of mass (world), `p` the Euler
+/// parameters of its body frame.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rigid3Desc {
+    pub name: String,
+    pub mass: f64,
+    /// Inertia tensor about the centre of mass in body axes (3x3 rows, symmetric).
+    pub inertia: [[f64; 3]; 3],
+    /// Centre of mass in the body frame.
+    #[serde(default)]
+    pub com: Vec3,
+    /// Origin of the body frame (world).
+    #[serde(default)]
+    pub position: Vec3,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<OrientationDesc>,
+    /// Velocity of the body frame origin (world).
+    #[serde(default)]
+    pub velocity: Vec3,
+    /// Angular velocity (world components).
+    #[serde(default)]
+    pub angular_velocity: Vec3,
+}
+
+/// A particle: coordinates `r` (3), no orientation.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Point3Desc {
+    pub name: String,
+    pub mass: f64,
+    #[serde(default)]
+    pub position: Vec3,
+    #[serde(default)]
+    pub velocity: Vec3,
+}
+
+/// A frame on a body (or the ground): a point in the body frame and axes `z` (default the
+/// body's `z`) and an optional hint for `x` (its part normal to `z`).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Marker3Desc {
+    pub body: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub z: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x: Option<Vec3>,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PairDesc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub a: Marker3Desc,
+    pub b: Marker3Desc,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Joint3Desc {
+    Spherical(PairDesc),
+    Revolute(PairDesc),
+    Prismatic(PairDesc),
+    Cylindrical(PairDesc),
+    Universal(PairDesc),
+    Fixed(PairDesc),
+    Planar(PairDesc),
+    Distance(DistanceDesc),
+    PointOnLine(PairDesc),
+    PointOnPlane(PairDesc),
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistanceDesc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub a: Marker3Desc,
+    pub b: Marker3Desc,
+    /// Default: the distance at the initial guess.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<f64>,
+}
+
+impl Joint3Desc {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Joint3Desc::Spherical(_) => "spherical",
+            Joint3Desc::Revolute(_) => "revolute",
+            Joint3Desc::Prismatic(_) => "prismatic",
+            Joint3Desc::Cylindrical(_) => "cylindrical",
+            Joint3Desc::Universal(_) => "universal",
+            Joint3Desc::Fixed(_) => "fixed",
+            Joint3Desc::Planar(_) => "planar",
+            Joint3Desc::Distance(_) => "distance",
+            Joint3Desc::PointOnLine(_) => "point_on_line",
+            Joint3Desc::PointOnPlane(_) => "point_on_plane",
+        }
+    }
+
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            Joint3Desc::Distance(d) => d.name.as_deref(),
+            Joint3Desc::Spherical(p)
+            | Joint3Desc::Revolute(p)
+            | Joint3Desc::Prismatic(p)
+            | Joint3Desc::Cylindrical(p)
+            | Joint3Desc::Universal(p)
+            | Joint3Desc::Fixed(p)
+            | Joint3Desc::Planar(p)
+            | Joint3Desc::PointOnLine(p)
+            | Joint3Desc::PointOnPlane(p) => p.name.as_deref(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Driver3Body {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub a: Marker3Desc,
+    pub b: Marker3Desc,
+    pub motion: MotionDesc,
+}
+
+/// Drivers (one row each) between two markers whose `z` axes a joint keeps parallel:
+/// `rotation` of `x_b` about `z_a` from `x_a`, `translation` of `P_b` along `z_a`.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Driver3Desc {
+    Rotation(Driver3Body),
+    Translation(Driver3Body),
+}
+
+impl Driver3Desc {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Driver3Desc::Rotation(_) => "rotation",
+            Driver3Desc::Translation(_) => "translation",
+        }
+    }
+    pub fn body(&self) -> &Driver3Body {
+        match self {
+            Driver3Desc::Rotation(d) | Driver3Desc::Translation(d) => d,
+        }
+    }
+}
+
+/// Components of a force or torque vector: world axes, or the marker's (body's) axes, which
+/// turn with the body.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrameDesc {
+    #[default]
+    World,
+    Body,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Force3Desc {
+    PointForce(PointForce3Desc),
+    Torque(Torque3Desc),
+    SpringDamper(SpringDamper3Desc),
+    RotationalSpringDamper(RotSpring3Desc),
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointForce3Desc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub point: Marker3Desc,
+    pub force: Vec3,
+    #[serde(default)]
+    pub frame: FrameDesc,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Torque3Desc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub body: String,
+    pub torque: Vec3,
+    #[serde(default)]
+    pub frame: FrameDesc,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringDamper3Desc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub a: Marker3Desc,
+    pub b: Marker3Desc,
+    pub stiffness: f64,
+    #[serde(default)]
+    pub damping: f64,
+    /// Default: the distance at the initial guess.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rest_length: Option<f64>,
+}
+
+/// A rotational spring-damper about `z_a` (the axis a revolute or cylindrical joint keeps):
+/// the angle of `x_b` from `x_a`, read within half a turn of `angle0` (`theta - angle0` in
+/// `(-pi, pi]`; no turn counter yet).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotSpring3Desc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub a: Marker3Desc,
+    pub b: Marker3Desc,
+    pub stiffness: f64,
+    #[serde(default)]
+    pub damping: f64,
+    #[serde(default)]
+    pub angle0: f64,
+}
+
+impl Force3Desc {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Force3Desc::PointForce(_) => "point_force",
+            Force3Desc::Torque(_) => "torque",
+            Force3Desc::SpringDamper(_) => "spring_damper",
+            Force3Desc::RotationalSpringDamper(_) => "rotational_spring_damper",
+        }
+    }
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            Force3Desc::PointForce(d) => d.name.as_deref(),
+            Force3Desc::Torque(d) => d.name.as_deref(),
+            Force3Desc::SpringDamper(d) => d.name.as_deref(),
+            Force3Desc::RotationalSpringDamper(d) => d.name.as_deref(),
+        }
+    }
+}

@@ -1,0 +1,176 @@
+//! Spatial force elements (docs/spatial-design.md, section 4), each adding its generalized force
+//! to `Q` through the markers' Jacobians:
+//!
+//! * gravity `m g` at every body's centre of mass (one element per scene, named `gravity`);
+//! * a point force `F` at a marker (world components, or components in the marker's axes that
+//!   turn with the body: `F = A C F'`): `Q = J_P^T F`;
+//! * a torque (world `n`, or body axes `n'`): `Q_p = 2 G^T n'`, `n' = A^T n`;
+//! * a translational spring-damper: `f = k (L - L0) + c Ld` (tension positive), `Q = -f J_L^T`;
+//! * a rotational spring-damper about `z_a`: `theta - theta0` read as
+//!   `atan2(s cos t0 - c sin t0, s sin t0 + c cos t0)` (`s = y_a . x_b`, `c = x_a . x_b`: no jump
+//!   within half a turn of `theta0`), `tau = -k (theta - theta0) - c thetad`, `Q = tau J_theta^T`,
+//!   `J_theta = (c J_s - s J_c) / (s^2 + c^2)`.
+
+use crate::body::marker3::{add_jacobian, Marker3};
+use crate::body::{Body, BodyKind, Marker, MarkerShape};
+use crate::constraint::spatial::prim;
+use crate::spatial::desc::FrameDesc;
+use crate::spatial::rot::{dot, mat_t_vec, mat_vec, norm, rot_a, rot_g, scale, V3};
+
+#[derive(Debug, Clone)]
+pub enum SpatialForce {
+    Gravity { g: V3 },
+    PointForce { point: Marker3, force: V3, frame: FrameDesc },
+    Torque { body: usize, base: Marker, torque: V3, frame: FrameDesc },
+    SpringDamper { a: Marker3, b: Marker3, stiffness: f64, damping: f64, rest_length: f64 },
+    RotationalSpringDamper { a: Marker3, b: Marker3, stiffness: f64, damping: f64, angle0: f64 },
+}
+
+/// `m` and the coordinate offset of a spatial body (`None` for planar kinds).
+fn spatial_mass(b: &Body) -> Option<f64> {
+    match &b.kind {
+        BodyKind::Rigid3(k) => Some(k.mass),
+        BodyKind::Point3(k) => Some(k.mass),
+        _ => None,
+    }
+}
+
+impl SpatialForce {
+    pub fn torque_marker(body: usize) -> Marker {
+        Marker { body: Some(body), angle: 0.0, shape: MarkerShape::Spatial }
+    }
+
+    pub fn markers(&self) -> [Option<&Marker>; 2] {
+        match self {
+            SpatialForce::Gravity { .. } => [None, None],
+            SpatialForce::PointForce { point, .. } => [Some(&point.base), None],
+            SpatialForce::Torque { base, .. } => [Some(base), None],
+            SpatialForce::SpringDamper { a, b, .. } | SpatialForce::RotationalSpringDamper { a, b, .. } => [Some(&a.base), Some(&b.base)],
+        }
+    }
+
+    /// Spring length and its rate, with the unit direction `u = d / L` (`None` at `L = 0`).
+    fn spring(a: &Marker3, b: &Marker3, bodies: &[Body], q: &[f64], qd: &[f64]) -> (f64, f64, Option<V3>, [crate::body::marker3::Marker3State; 2]) {
+        let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
+        let (d, dd, _) = prim::separation(&sa, &sb);
+        let l = norm(&d);
+        if l == 0.0 {
+            return (0.0, 0.0, None, [sa, sb]);
+        }
+        let u = scale(1.0 / l, &d);
+        (l, dot(&u, &dd), Some(u), [sa, sb])
+    }
+
+    /// `(theta - theta0, thetad, s, c, r2)` of a rotational spring.
+    fn angle(a: &Marker3, b: &Marker3, angle0: f64, bodies: &[Body], q: &[f64], qd: &[f64]) -> (f64, f64, [crate::body::marker3::Marker3State; 2], f64, f64, f64) {
+        let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
+        let (s, sd, _) = prim::dot_terms(&sa.axes[1], &sb.axes[0]);
+        let (c, cd, _) = prim::dot_terms(&sa.axes[0], &sb.axes[0]);
+        let r2 = s * s + c * c;
+        let (s0, c0) = angle0.sin_cos();
+        let th = (s * c0 - c * s0).atan2(s * s0 + c * c0);
+        let thd = if r2 > 0.0 { (c * sd - s * cd) / r2 } else { 0.0 };
+        (th, thd, [sa, sb], s, c, r2)
+    }
+
+    /// Add the generalized force to `qv` (length n).
+    #[inline]
+    pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], qv: &mut [f64]) {
+        match self {
+            SpatialForce::Gravity { g } => {
+                for b in bodies {
+                    if let Some(m) = spatial_mass(b) {
+                        for c in 0..3 {
+                            qv[b.offset + c] += m * g[c];
+                        }
+                    }
+                }
+            }
+            SpatialForce::PointForce { point, force, frame } => {
+                let st = point.state(bodies, q, qd);
+                let f = if *frame == FrameDesc::Body && point.rigid {
+                    let o = bodies[point.body.expect("rigid")].offset;
+                    mat_vec(&rot_a(&q[o + 3..o + 7]), &mat_vec(&point.c, force))
+                } else if *frame == FrameDesc::Body {
+                    mat_vec(&point.c, force)
+                } else {
+                    *force
+                };
+                add_jacobian(bodies, &st, &st.point, &f, qv, None);
+            }
+            SpatialForce::Torque { body, torque, frame, .. } => {
+                let o = bodies[*body].offset;
+                let p = &q[o + 3..o + 7];
+                let nb = if *frame == FrameDesc::Body { *torque } else { mat_t_vec(&rot_a(p), torque) };
+                let g = rot_g(p);
+                for l in 0..4 {
+                    qv[o + 3 + l] += 2.0 * (g[0][l] * nb[0] + g[1][l] * nb[1] + g[2][l] * nb[2]);
+                }
+            }
+            SpatialForce::SpringDamper { a, b, stiffness, damping, rest_length } => {
+                let (l, ld, u, [sa, sb]) = Self::spring(a, b, bodies, q, qd);
+                let Some(u) = u else { return };
+                let f = stiffness * (l - rest_length) + damping * ld;
+                add_jacobian(bodies, &sb, &sb.point, &scale(-f, &u), qv, None);
+                add_jacobian(bodies, &sa, &sa.point, &scale(f, &u), qv, None);
+            }
+            SpatialForce::RotationalSpringDamper { a, b, stiffness, damping, angle0 } => {
+                let (th, thd, [sa, sb], s, c, r2) = Self::angle(a, b, *angle0, bodies, q, qd);
+                if !(r2 > 0.0) {
+                    return;
+                }
+                let tau = -stiffness * th - damping * thd;
+                prim::dot_jacobian(bodies, &sa, &sa.axes[1], &sb, &sb.axes[0], tau * c / r2, qv, None);
+                prim::dot_jacobian(bodies, &sa, &sa.axes[0], &sb, &sb.axes[0], -tau * s / r2, qv, None);
+            }
+        }
+    }
+
+    /// Potential energy: gravity `-sum m g . r`, springs `k x^2 / 2`, a world-frame point force
+    /// `-F . P`; 0 for body-frame loads and torques (not conservative in general).
+    pub fn potential(&self, bodies: &[Body], q: &[f64]) -> f64 {
+        let zeros = vec![0.0; q.len()];
+        match self {
+            SpatialForce::Gravity { g } => {
+                let mut v = 0.0;
+                for b in bodies {
+                    if let Some(m) = spatial_mass(b) {
+                        v -= m * (g[0] * q[b.offset] + g[1] * q[b.offset + 1] + g[2] * q[b.offset + 2]);
+                    }
+                }
+                v
+            }
+            SpatialForce::PointForce { point, force, frame } => {
+                if *frame == FrameDesc::World {
+                    -dot(force, &point.state(bodies, q, &zeros).point.v)
+                } else {
+                    0.0
+                }
+            }
+            SpatialForce::Torque { .. } => 0.0,
+            SpatialForce::SpringDamper { a, b, stiffness, rest_length, .. } => {
+                let (l, _, _, _) = Self::spring(a, b, bodies, q, &zeros);
+                0.5 * stiffness * (l - rest_length).powi(2)
+            }
+            SpatialForce::RotationalSpringDamper { a, b, stiffness, angle0, .. } => {
+                let th = Self::angle(a, b, *angle0, bodies, q, &zeros).0;
+                0.5 * stiffness * th * th
+            }
+        }
+    }
+
+    /// `1/2 k Ld^2` of a spring for the motion `v` (0 for the loads).
+    pub fn material_energy(&self, bodies: &[Body], q: &[f64], v: &[f64]) -> f64 {
+        match self {
+            SpatialForce::SpringDamper { a, b, stiffness, .. } => 0.5 * stiffness * Self::spring(a, b, bodies, q, v).1.powi(2),
+            SpatialForce::RotationalSpringDamper { a, b, stiffness, angle0, .. } => 0.5 * stiffness * Self::angle(a, b, *angle0, bodies, q, v).1.powi(2),
+            _ => 0.0,
+        }
+    }
+}
+
+/// The world point of a marker at `q` (inspection).
+pub fn marker_point(m: &Marker3, bodies: &[Body], q: &[f64]) -> V3 {
+    let zeros = vec![0.0; q.len()];
+    m.state(bodies, q, &zeros).point.v
+}
