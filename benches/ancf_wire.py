@@ -42,8 +42,8 @@ H = 1e-4
 
 def ukflex_wire(elements: int):
     s = Scene(gravity=(0.0, -9.81))
-    b = s.beam("wire", length=L, elements=elements, theory="euler-bernoulli", section=Circular(D), density=RHO,
-               youngs_modulus=E, formulation="ancf")
+    b = s.cable("wire", length=L, elements=elements, section=Circular(D), density=RHO,
+               youngs_modulus=E)
     s.revolute(s.ground.point(0.0, 0.0), b.at(0.0), name="pin")
     return s.build()
 

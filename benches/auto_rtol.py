@@ -40,8 +40,8 @@ def spun_cable() -> Scene:
     hub = s.rigid_body("hub", mass=1.0, inertia=0.01)
     s.revolute(s.ground.point(0.0, 0.0), hub.point(0.0, 0.0))
     s.angle_driver(hub.frame(), ukflex.Polynomial([0.0, 0.0, 0.75]))
-    cable = s.beam("beam", length=1.0, elements=4, section=ukflex.Circular(0.005), density=7850.0,
-                   youngs_modulus=2.1e11, formulation="ancf")
+    cable = s.cable("beam", length=1.0, elements=4, section=ukflex.Circular(0.005), density=7850.0,
+                   youngs_modulus=2.1e11)
     s.weld(hub.frame(), cable.at(0.0))
     return s
 

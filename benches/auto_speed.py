@@ -67,7 +67,7 @@ def _tip_off_root_tangent(system, res):
     q = res.q
     p0 = system.beam_point("rod", 0.0, q)
     p1 = system.beam_point("rod", 1.0, q)
-    if system.body_kind("rod") == "ancf_beam":
+    if system.body_kind("rod") == "cable":
         frame = np.arctan2(p1[1] - p0[1], p1[0] - p0[0])  # the chord frame
     else:
         frame = q[system.coordinate_index("rod.theta")]

@@ -105,8 +105,8 @@ _SYSTEMS: Dict[str, Any] = {}
 def _ancf_cantilever():
     uk = _ukflex()
     s = uk.Scene(gravity=(0.0, -9.81))
-    b = s.beam("beam", length=1.0, section=uk.Rectangular(0.02, 0.01), density=7850.0, youngs_modulus=2.1e11,
-               elements=2, formulation="ancf")
+    b = s.cable("beam", length=1.0, section=uk.Rectangular(0.02, 0.01), density=7850.0, youngs_modulus=2.1e11,
+               elements=2)
     s.weld(s.ground.frame(), b.at(0.0), name="clamp")
     return s
 

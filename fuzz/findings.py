@@ -26,8 +26,8 @@ def drv(e: str) -> str:
 
 
 PEND = "sy = ukflex.System(ukflex.scenes.pendulum())\n"
-ANCF = ("s = ukflex.Scene(gravity=(0.0, -9.81)); b = s.beam('beam', length=1.0, section=ukflex.Rectangular(0.02, 0.01), "
-        "density=7850.0, youngs_modulus=2.1e11, elements=2, formulation='ancf'); s.weld(s.ground.frame(), b.at(0.0)); sy = s.build()\n")
+ANCF = ("s = ukflex.Scene(gravity=(0.0, -9.81)); b = s.cable('beam', length=1.0, section=ukflex.Rectangular(0.02, 0.01), "
+        "density=7850.0, youngs_modulus=2.1e11, elements=2); s.weld(s.ground.frame(), b.at(0.0)); sy = s.build()\n")
 CRANK = "sy = ukflex.System(ukflex.scenes.slider_crank(elements=2, strain='nonlinear'))\n"
 CASES = [
  ("1 '(' * 30000 + 't' + ')' * 30000", drv("'(' * 30000 + 't' + ')' * 30000")),

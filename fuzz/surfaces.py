@@ -1127,7 +1127,7 @@ def _check_extreme(case: Dict[str, Any]) -> List[Finding]:
     elif mode == "zero_q":
         q = np.zeros(n)
     t = case["t"]
-    beams = [b for b in s.body_names if s.body_kind(b) in ("beam", "ancf_beam")]
+    beams = [b for b in s.body_names if s.capabilities(b)["beam"]]
     beam = beams[0] if beams else s.body_names[0]
     m = case["method"]
     calls = {

@@ -1,4 +1,4 @@
-"""The ANCF cable (``Scene.beam(..., formulation="ancf")``, rust/body/ancf_cable.rs).
+"""The ANCF cable (``Scene.cable(...)``, rust/body/ancf_cable.rs).
 
 * Rust against the independent NumPy reference (python/ukflex/reference/ancf.py): mass matrix,
   generalized forces (gravity, elastic, damping), tangent stiffness, energies, and the constraint
@@ -34,7 +34,7 @@ def _rel(a, b):
 
 def _cable_scene(elements=3, damping=2e-4, gravity=(0.3, -9.81), angle=0.6):
     s = Scene(gravity=gravity)
-    s.beam("c", length=0.4, elements=elements, section=Circular(0.008), formulation="ancf", damping=damping,
+    s.cable("c", length=0.4, elements=elements, section=Circular(0.008), damping=damping,
            position=(0.1, -0.2), angle=angle, velocity=(0.5, 0.2), angular_velocity=2.0, **STEEL)
     return s
 
@@ -72,8 +72,8 @@ def test_joint_terms_on_cable_markers_match_the_numpy_reference():
     """Every joint kind the reference knows (revolute, weld, prismatic, point-on-line, angle
     driver) on cable markers, including the angle rows' velocity term h_phi."""
     s = Scene(gravity=(0.0, -9.81))
-    a = s.beam("a", length=0.3, elements=2, section=Circular(0.01), formulation="ancf", angle=0.3, **STEEL)
-    b = s.beam("b", length=0.25, elements=3, section=Circular(0.006), formulation="ancf", position=(0.3, 0.1),
+    a = s.cable("a", length=0.3, elements=2, section=Circular(0.01), angle=0.3, **STEEL)
+    b = s.cable("b", length=0.25, elements=3, section=Circular(0.006), position=(0.3, 0.1),
                angle=2.0, **STEEL)
     r = s.rigid_body("r", mass=0.2, inertia=1e-3, position=(0.1, 0.3))
     s.revolute(s.ground.point(0, 0), a.at(0.0))
@@ -113,8 +113,8 @@ def test_tangent_stiffness_matches_central_differences_of_the_core_forces():
 def _cantilever(elements, diameter=0.00635, length=0.3048):
     """A horizontal ANCF cantilever welded to the ground at xi = 0 (no gravity)."""
     s = Scene()
-    b = s.beam("b", length=length, elements=elements, section=Circular(diameter), density=7834.56,
-               youngs_modulus=2.06843e11, formulation="ancf")
+    b = s.cable("b", length=length, elements=elements, section=Circular(diameter), density=7834.56,
+               youngs_modulus=2.06843e11)
     s.weld(s.ground.frame(), b.at(0.0), name="clamp")
     return s, b
 
@@ -226,8 +226,7 @@ def test_large_tip_load_is_accurate_on_coarse_meshes_for_any_slenderness():
 # ------------------------------------------------------------------ dynamics
 def test_free_pendulum_beam_conserves_energy_with_native_dopri5():
     s = Scene(gravity=(0.0, -9.81))
-    rod = s.beam("rod", length=0.5, elements=6, section=Circular(0.01), density=1200.0, youngs_modulus=5e7,
-                 formulation="ancf")
+    rod = s.cable("rod", length=0.5, elements=6, section=Circular(0.01), density=1200.0, youngs_modulus=5e7)
     s.revolute(s.ground.point(0, 0), rod.at(0.0), name="pin")
     system = s.build()
     res = ukflex.simulate(system, 1.0, method="DOPRI5", rtol=1e-10, t_eval=np.linspace(0, 1, 201))
@@ -244,9 +243,9 @@ def test_free_pendulum_beam_conserves_energy_with_native_dopri5():
 def test_ancf_slider_crank_runs_with_small_residuals_and_outputs():
     scene = scenes.slider_crank(formulation="ancf", elements=4)
     coupler = scene.to_dict()["bodies"][1]
-    assert coupler["formulation"] == "ancf" and coupler["theory"] == "euler-bernoulli"
+    assert coupler["kind"] == "cable" and "theory" not in coupler
     system = scene.build()
-    assert system.body_kind("coupler") == "ancf_beam" and system.n_coords == 3 + 4 * 5
+    assert system.body_kind("coupler") == "cable" and system.n_coords == 3 + 4 * 5
     info = system.body_info("coupler")
     assert info["formulation"] == "ancf" and info["elements"] == 4 and info["length"] == pytest.approx(0.3048)
     res = ukflex.simulate(system, 0.01, method="DOPRI5", rtol=1e-9, t_eval=np.linspace(0, 0.01, 51))
@@ -308,11 +307,24 @@ def test_beam_shape_of_an_ancf_beam_maps_its_coordinates_to_position_and_slope()
 
 
 # ------------------------------------------------------------------ bad input
+@pytest.mark.parametrize("field", [dict(theory="timoshenko"), dict(frame="clamped"), dict(rotary_inertia=True),
+                                   dict(elastic=[0.0] * 8), dict(strain="linear"), dict(formulation="ancf")])
+def test_a_cable_description_refuses_the_ffrf_beams_fields(field):
+    item = dict(name="cable", kind="cable", length=0.3, elements=2, section=dict(shape="circular", diameter=0.01),
+                **STEEL, **field)
+    with pytest.raises(InvalidSceneError, match=next(iter(field))) as exc:
+        Scene.from_dict({"bodies": [item]})
+    assert "cable" in str(exc.value)
+
+
+def test_scenes_refuse_a_theory_the_cable_does_not_have():
+    with pytest.raises(InvalidSceneError, match="Euler-Bernoulli"):
+        scenes.slider_crank(formulation="ancf", theory="timoshenko")
+    with pytest.raises(InvalidSceneError, match="formulation"):
+        scenes.slider_crank(formulation="ancff")
+
+
 @pytest.mark.parametrize("change, message", [
-    (dict(theory="timoshenko", poisson_ratio=0.3, shear_factor=0.8), "Euler-Bernoulli"),
-    (dict(frame="clamped"), "frame"),
-    (dict(rotary_inertia=True), "rotary inertia"),
-    (dict(elastic=[0.0] * 8), "elastic does not apply"),
     (dict(length=0.0), "length must be positive"),
     (dict(length=-1.0), "length must be positive"),
     (dict(density=0.0), "density must be positive"),
@@ -322,22 +334,21 @@ def test_beam_shape_of_an_ancf_beam_maps_its_coordinates_to_position_and_slope()
     (dict(elements=4097), "elements must be in 1..=4096"),
     (dict(density=float("nan")), "density must be finite"),
     (dict(damping=-1e-3), "damping must be >= 0"),
-    (dict(formulation="ancff"), "formulation"),
 ])
 def test_bad_input_gives_named_errors(change, message):
-    kw = dict(length=0.3, elements=2, section=Circular(0.01), formulation="ancf", **STEEL)
+    kw = dict(length=0.3, elements=2, section=Circular(0.01), **STEEL)
     kw.update(change)
     with pytest.raises(InvalidSceneError, match=message) as exc:
-        Scene().beam("cable", **kw)
+        Scene().cable("cable", **kw)
     assert "cable" in str(exc.value)
 
 
-def test_ffrf_descriptions_are_unchanged_and_ancf_is_recorded():
+def test_ffrf_descriptions_are_unchanged_and_the_cable_is_its_own_kind():
     d = scenes.slider_crank().to_dict()["bodies"][1]
     assert "formulation" not in d and d["theory"] == "timoshenko"
     a = scenes.slider_crank(formulation="ancf").to_dict()["bodies"][1]
-    assert a["formulation"] == "ancf" and a["theory"] == "euler-bernoulli"
-    assert ukflex.System(scenes.slider_crank(formulation="ancf").to_dict()).body_kind("coupler") == "ancf_beam"
+    assert a["kind"] == "cable" and "theory" not in a and "frame" not in a
+    assert ukflex.System(scenes.slider_crank(formulation="ancf").to_dict()).body_kind("coupler") == "cable"
     assert ukflex.System(scenes.slider_crank().to_dict()).body_info("coupler")["formulation"] == "ffrf"
 
 

@@ -18,8 +18,8 @@ def wire(elements, angle=0.0):
     """A steel wire (1 m, d = 2 mm) of ANCF elements pinned at one end, at rest at ``angle``
     (0: horizontal)."""
     s = Scene(gravity=(0.0, -9.81))
-    b = s.beam("wire", length=1.0, elements=elements, theory="euler-bernoulli", section=Circular(0.002),
-               density=7850.0, youngs_modulus=2.1e11, formulation="ancf", angle=angle)
+    b = s.cable("wire", length=1.0, elements=elements, section=Circular(0.002),
+               density=7850.0, youngs_modulus=2.1e11, angle=angle)
     s.revolute(s.ground.point(0.0, 0.0), b.at(0.0), name="pin")
     return s
 

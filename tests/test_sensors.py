@@ -240,7 +240,7 @@ def test_cantilever_internal_forces_match_statics(theory):
 
 def _ancf_cantilever(tip, solve=True):
     s = Scene()
-    b = s.beam("beam", length=1.0, elements=4, formulation="ancf", section=ukflex.Rectangular(0.02, 0.01),
+    b = s.cable("beam", length=1.0, elements=4, section=ukflex.Rectangular(0.02, 0.01),
                density=7850.0, youngs_modulus=2.1e11)
     s.weld(s.ground.point(0, 0), b.at(0.0), name="clamp")
     s.point_force(b.at(1.0), tip, name="tip")

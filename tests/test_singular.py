@@ -335,8 +335,8 @@ def spun_cable(clamp: str, elements: int = 4) -> Scene:
     hub = s.rigid_body("hub", mass=1.0, inertia=0.01)
     s.revolute(s.ground.point(0.0, 0.0), hub.point(0.0, 0.0))
     s.angle_driver(hub.frame(), ukflex.Polynomial([0.0, 0.0, 0.5]))
-    cable = s.beam("cable", length=1.0, elements=elements, section=ukflex.Circular(0.005), density=7850.0,
-                   youngs_modulus=2.1e11, formulation="ancf")
+    cable = s.cable("cable", length=1.0, elements=elements, section=ukflex.Circular(0.005), density=7850.0,
+                   youngs_modulus=2.1e11)
     if clamp == "weld":
         s.weld(hub.frame(), cable.at(0.0))
     else:
@@ -382,8 +382,8 @@ def test_torque_on_a_cable_does_work_over_many_turns():
     -tau phi is unwrapped from state to state, so its work grows with every turn instead of
     jumping back by 2 pi tau, and the energy balance closes."""
     s = Scene()
-    cable = s.beam("cable", length=0.5, elements=2, section=ukflex.Circular(0.01), density=7850.0,
-                   youngs_modulus=2.1e11, formulation="ancf")
+    cable = s.cable("cable", length=0.5, elements=2, section=ukflex.Circular(0.01), density=7850.0,
+                   youngs_modulus=2.1e11)
     s.revolute(s.ground.point(0.0, 0.0), cable.at(0.0))
     s.torque(cable.at(0.0), 0.2)
     system = s.build()

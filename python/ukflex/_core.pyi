@@ -20,6 +20,8 @@ __all__ = [
     "motion_values",
     "spatial_outputs",
     "dense_eval",
+    "run_options",
+    "check_tolerances",
     "UkflexError",
     "InvalidSceneError",
     "SingularMassError",
@@ -201,7 +203,7 @@ class System:
     def axial_forces(self, body: str, q: _F64) -> _F64:
         """Axial force of each element of a beam at q, shape (elements,)."""
     def body_kind(self, body: str) -> str:
-        """Kind of a body: "rigid", "beam" (FFRF), "ancf_beam" or "point_mass"."""
+        """Kind of a body, as in the description: "rigid", "beam" (FFRF), "cable" (ANCF), "point_mass", "flexible", "rigid3" or "point3"."""
     def elastic_range(self, body: str) -> Tuple[int, int]:
         """(start, stop) of a body's elastic coordinates in q."""
     def body_info(self, body: str) -> Dict[str, Any]:

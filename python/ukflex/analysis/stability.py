@@ -131,8 +131,8 @@ def beam_properties(system: System, body: str) -> Dict[str, Any]:
         ``body`` is unknown or not a beam (a ``KeyError``).
     """
     info = system.body_info(body)
-    if info["kind"] != "beam":
-        beams = [b for b in system.body_names if system.body_kind(b) == "beam"]
+    if not system.capabilities(body)["axial_forces"]:
+        beams = [b for b in system.body_names if system.capabilities(b)["axial_forces"]]
         raise UnknownNameError(f"body {body!r} is not an FFRF beam; FFRF beams are {beams}", "beam", body, beams)
     area, second_moment = _section(system, body)
     return {"length": float(info["length"]), "E": float(info["youngs_modulus"]), "area": area, "I": second_moment,
@@ -276,7 +276,7 @@ def check(
             f"constraint drift ||Phi|| reached {d['max_position']:.3e} (> {drift_threshold:.1e}); use "
             "stabilization=('baumgarte', a, b) or 'projection'"), d["max_position"]))
     for name in s.body_names:
-        if s.body_kind(name) != "beam":
+        if not s.capabilities(name)["axial_forces"]:
             continue
         if s.body_info(name)["frame"] == "pinned-pinned":
             br = buckling_ratio(result, name)

@@ -61,7 +61,7 @@ import numpy as np
 
 from .. import System, scenes, simulate
 from ..reference import CPSystem, ReferenceModel, choose_partition, reduced_accelerations, single_blas_thread, uk_qdd
-from ..run.simulate import time_acceleration
+from ..run.simulate import RUN_OPTIONS, time_acceleration
 from .machine import machine_info, machine_line
 
 __all__ = ["run_fig4", "table1", "run_paper", "machine_info", "PAPER_TABLE1", "PAPER_WINDOW"]
@@ -328,7 +328,7 @@ def table1(
     if mode not in ("quick", "full"):
         raise ValueError(f"mode must be 'quick' or 'full', got {mode!r}")
     stream = stream or sys.stdout
-    atol = 1e-3 * rtol if atol is None else atol
+    atol = RUN_OPTIONS["defaults"]["atol_per_rtol"] * rtol if atol is None else atol
     whole = (mode == "full") if whole is None else whole
     whole_repeats = repeats if whole_repeats is None else whole_repeats
     info = machine_info()

@@ -45,7 +45,9 @@ from typing import Any, Dict, Iterator, List, Optional, Sequence, TextIO, Tuple
 import numpy as np
 
 from .. import System, scenes, simulate
-from ..run.simulate import FORMULATIONS, NATIVE_METHODS
+from ..run.simulate import FORMULATIONS, NATIVE_METHODS, RUN_OPTIONS
+
+ATOL_PER_RTOL = RUN_OPTIONS["defaults"]["atol_per_rtol"]  # the default atol, as simulate
 from .machine import machine_info, machine_line
 
 __all__ = [
@@ -133,7 +135,7 @@ def reference_solution(system, t_end: float, t_eval: np.ndarray, rtol: float = 1
         ``v`` (nt,), ``peak``, ``t_peak``, ``method``, ``check_method``, ``rtol``,
         ``accuracy`` (max |v - v_check|), ``wall_time`` of both runs.
     """
-    atol = 1e-3 * rtol
+    atol = ATOL_PER_RTOL * rtol
     tic = time.perf_counter()
     a = _native(system, "DOPRI5", rtol, atol, t_end, t_eval)
     w1 = time.perf_counter() - tic
@@ -159,7 +161,7 @@ def reference_solution(system, t_end: float, t_eval: np.ndarray, rtol: float = 1
 def run_one(system, formulation: str, method: str, rtol: float, t_end: float, t_eval: np.ndarray,
             ref: Dict[str, Any], budget: Optional[float] = 60.0) -> Dict[str, Any]:
     """One point of the diagram (see the module docstring for the fields)."""
-    atol = 1e-3 * rtol
+    atol = ATOL_PER_RTOL * rtol
     row: Dict[str, Any] = {"formulation": formulation, "method": method, "rtol": rtol, "atol": atol,
                            "status": "ok", "wall_time": float("nan"), "nfev": -1, "njev": -1, "nlu": -1,
                            "err_max": float("nan"), "err_rel": float("nan"), "peak": float("nan"),
@@ -274,7 +276,7 @@ def _run_cases(system, cases, rtols, t_end, t_eval, ref, budget, skip_after_time
         over = False
         for rtol in sorted(rtols, reverse=True):
             if over and skip_after_timeout:
-                row = {"formulation": formulation, "method": method, "rtol": rtol, "atol": 1e-3 * rtol,
+                row = {"formulation": formulation, "method": method, "rtol": rtol, "atol": ATOL_PER_RTOL * rtol,
                        "status": "skipped", "wall_time": float("nan"), "nfev": -1, "njev": -1, "nlu": -1,
                        "err_max": float("nan"), "err_rel": float("nan"), "peak": float("nan"),
                        "peak_err": float("nan"), "t_peak": float("nan"), "drift_end": float("nan"),

@@ -11,7 +11,11 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, TextIO
 
 import numpy as np
 
-RUN_DEFAULTS = {"t_end": 1.0, "method": "auto", "rtol": 1e-6, "atol": None, "formulation": "uk", "samples": 201}
+from .. import _core
+
+#: The CLI's run defaults; rtol is the core's (rust/integrate/options.rs).
+RUN_DEFAULTS = {"t_end": 1.0, "method": "auto", "rtol": _core.run_options()["defaults"]["rtol"], "atol": None,
+                "formulation": "uk", "samples": 201}
 
 
 def _positive_float(text: str) -> float:

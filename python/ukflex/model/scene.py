@@ -344,7 +344,7 @@ class FlexibleBodyRef(BodyRef):
 
 
 MarkerLike = Union[Marker, Dict[str, Any]]
-_REFS = {"rigid": RigidBodyRef, "beam": BeamRef, "ancf_beam": BeamRef, "point_mass": PointMassRef, "flexible": FlexibleBodyRef}
+_REFS = {"rigid": RigidBodyRef, "beam": BeamRef, "cable": BeamRef, "point_mass": PointMassRef, "flexible": FlexibleBodyRef}
 
 
 # --------------------------------------------------------------------------------------------
@@ -469,10 +469,10 @@ class Scene:
         angular_velocity: float = 0.0,
         elastic: Optional[Sequence[float]] = None,
         elastic_rates: Optional[Sequence[float]] = None,
-        formulation: str = "ffrf",
     ) -> BeamRef:
-        """Add a flexible beam of ``elements`` finite elements: floating frame of reference (FFRF,
-        default) or the geometrically exact ANCF cable (``formulation="ancf"``).
+        """Add a flexible beam of ``elements`` finite elements in the floating frame of reference
+        (FFRF: small elastic coordinates on a moving frame, the paper's model).  For large
+        deformation, the geometrically exact cable is :meth:`cable`.
 
         Parameters
         ----------
@@ -485,54 +485,92 @@ class Scene:
         density, youngs_modulus : float
             Material density [kg/m^3] and Young's modulus [N/m^2].
         elements : int
-            Number of finite elements ``N >= 1``; an FFRF beam has ``n_f = 3 N`` elastic
-            coordinates, an ANCF beam ``4 (N + 1)`` nodal coordinates (positions and slopes).
+            Number of finite elements ``N >= 1``; the beam has ``n_f = 3 N`` elastic
+            coordinates.
         theory : {"timoshenko", "euler-bernoulli"}, optional
-            Default: ``"timoshenko"`` for FFRF; the ANCF cable is Euler-Bernoulli (its default;
-            ``"timoshenko"`` is an error).
+            Default: ``"timoshenko"``.
         strain : {"nonlinear", "linear"}, optional
             Strain measure of an FFRF beam's elastic forces.  Default (the core's):
             ``"nonlinear"``, the second-order axial strain ``u' + v'^2 / 2`` averaged over each
             element (a constant axial force per element, free of membrane locking): the axial
             force couples with bending (geometric stiffening), which matters as soon as it is a
             noticeable fraction of the Euler load.  ``"linear"`` is the paper's linear FFRF
-            model.  (The ANCF cable is geometrically exact: no option.)
+            model.
         poisson_ratio, shear_modulus : float, optional
             Exactly one is needed for Timoshenko (``G = E / (2 (1 + nu))``); optional otherwise.
         shear_factor : float, optional
             Shear correction factor ``k``, required for Timoshenko.
         frame : {"pinned-pinned", "clamped"}
-            Reference conditions of the floating frame (FFRF).  An ANCF beam has no floating
-            frame: keep the default (``"clamped"`` is an error; clamp it with a weld).
+            Reference conditions of the floating frame: which nodal coordinates the frame
+            takes out (it is not a boundary condition; clamp a beam with a weld).
         rotary_inertia : bool, optional
             Default: true for Timoshenko, false for Euler-Bernoulli (decided by the core).
         damping : float
             Stiffness-proportional damping coefficient ``beta`` [s].
         position, angle, velocity, angular_velocity
-            Initial guess of the floating frame (origin = undeformed node 1, ``xi = 0``); for an
-            ANCF beam the straight undeformed beam from ``position`` along ``angle``, in the rigid
-            motion of ``velocity`` (of the ``xi = 0`` end) and ``angular_velocity``.
+            Initial guess of the floating frame (origin = undeformed node 1, ``xi = 0``).
         elastic, elastic_rates : (n_f,) sequence, optional
-            Initial elastic coordinates and rates (default zeros; FFRF only).
-        formulation : {"ffrf", "ancf"}
-            ``"ffrf"``: the floating frame of reference with linear elastic coordinates (the
-            paper's model).  ``"ancf"``: the planar ANCF cable (absolute nodal positions and
-            slopes, axial strain ``|r'| - 1`` and curvature ``r' x r'' / |r'|^2``: geometrically
-            exact, constant mass matrix; docs/scene-format.md).
+            Initial elastic coordinates and rates (default zeros).
 
         Returns
         -------
         BeamRef
         """
-        if theory is None:
-            theory = "euler-bernoulli" if formulation == "ancf" else "timoshenko"
-        d = dict(name=name, kind="beam", length=length, elements=elements, theory=theory, density=density,
+        d = dict(name=name, kind="beam", length=length, elements=elements, theory=theory or "timoshenko", density=density,
                  youngs_modulus=youngs_modulus, section=section, frame=frame, damping=damping, position=position,
                  angle=angle, velocity=velocity, angular_velocity=angular_velocity)
         d.update(_given(strain=strain, poisson_ratio=poisson_ratio, shear_modulus=shear_modulus, shear_factor=shear_factor,
                         rotary_inertia=rotary_inertia, elastic=elastic, elastic_rates=elastic_rates))
-        d["formulation"] = formulation  # the core records it only when it is not the default
         return self._add_body(d)
+
+    def cable(
+        self,
+        name: str,
+        *,
+        length: float,
+        section: Any,
+        density: float,
+        youngs_modulus: float,
+        elements: int = 1,
+        damping: float = 0.0,
+        position: Sequence[float] = (0.0, 0.0),
+        angle: float = 0.0,
+        velocity: Sequence[float] = (0.0, 0.0),
+        angular_velocity: float = 0.0,
+    ) -> BeamRef:
+        """Add a geometrically exact planar cable of ``elements`` ANCF elements: absolute nodal
+        positions and slopes (``4 (N + 1)`` coordinates), axial strain ``|r'| - 1`` and curvature
+        ``r' x r'' / |r'|^2``, Euler-Bernoulli, constant mass matrix, no floating frame
+        (docs/scene-format.md).  Right for large deformation and fast rotation, where an FFRF
+        :meth:`beam`'s small elastic coordinates do not hold.
+
+        Parameters
+        ----------
+        name : str
+            Unique body name.
+        length : float
+            Undeformed length [m].
+        section : Circular | Rectangular | CustomSection | dict
+            Cross-section.
+        density, youngs_modulus : float
+            Material density [kg/m^3] and Young's modulus [N/m^2].
+        elements : int
+            Number of elements ``N >= 1``.
+        damping : float
+            Stiffness-proportional damping coefficient ``beta`` [s].
+        position, angle, velocity, angular_velocity
+            The straight undeformed cable from ``position`` (its ``xi = 0`` end) along
+            ``angle``, in the rigid motion of ``velocity`` (of that end) and
+            ``angular_velocity``.
+
+        Returns
+        -------
+        BeamRef
+            Markers at ``xi`` along its axis (``.at(xi)``), as on a beam.
+        """
+        return self._add_body(dict(name=name, kind="cable", length=length, elements=elements, density=density,
+                                   youngs_modulus=youngs_modulus, section=section, damping=damping, position=position,
+                                   angle=angle, velocity=velocity, angular_velocity=angular_velocity))
 
     def flexible_body(
         self,

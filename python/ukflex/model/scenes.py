@@ -121,18 +121,23 @@ def gravity_vector(gravity: Any) -> Optional[Tuple[float, float]]:
     return (gx, gy)
 
 
-def _beam_kind(formulation: str, theory: Optional[str], strain: Optional[str], poisson_ratio: float,
-               shear_factor: float, frame: str = "pinned-pinned") -> Dict[str, Any]:
-    """The :meth:`Scene.beam` options of a scene's beam of ``formulation``: an FFRF beam with
-    ``frame`` and ``strain`` (``None``: the core's default), Timoshenko's material constants where
-    the theory needs them; the ANCF cable (Euler-Bernoulli, no frame, geometrically exact: no
-    strain option; ``theory=None`` means its one theory)."""
+def _beam(s: Scene, name: str, formulation: str, theory: Optional[str], strain: Optional[str], poisson_ratio: float,
+          shear_factor: float, frame: str = "pinned-pinned", rotary_inertia: Optional[bool] = None, **common: Any):
+    """A scene's beam of ``formulation``: an FFRF :meth:`Scene.beam` with ``frame`` and ``strain``
+    (``None``: the core's default), Timoshenko's material constants where the theory needs them;
+    or the ANCF :meth:`Scene.cable` (Euler-Bernoulli, no frame, geometrically exact: the FFRF
+    options do not apply, and a theory or rotary inertia it does not have is refused)."""
     if formulation == "ancf":
-        return {"formulation": "ancf", "theory": theory}
-    kw: Dict[str, Any] = {"formulation": formulation, "theory": theory, "frame": frame, "strain": strain}
+        if theory not in (None, "euler-bernoulli") or rotary_inertia:
+            raise InvalidSceneError("formulation: the ANCF cable is an Euler-Bernoulli beam without rotary inertia; "
+                                    f"theory={theory!r}, rotary_inertia={rotary_inertia!r} need formulation='ffrf'")
+        return s.cable(name, **common)
+    if formulation != "ffrf":
+        raise InvalidSceneError(f"formulation must be 'ffrf' or 'ancf', got {formulation!r}")
+    kw: Dict[str, Any] = {"theory": theory, "frame": frame, "strain": strain, "rotary_inertia": rotary_inertia}
     if theory in (None, "timoshenko"):  # None: the FFRF beam's default theory, Timoshenko
         kw.update(poisson_ratio=poisson_ratio, shear_factor=shear_factor)
-    return kw
+    return s.beam(name, **common, **kw)
 
 
 def _round_beam(s: Scene, name: str, length: float, elements: int, theory: str, diameter: float, density: float,
@@ -140,9 +145,8 @@ def _round_beam(s: Scene, name: str, length: float, elements: int, theory: str, 
                 strain: Optional[str] = None, **options: Any):
     """A beam of circular section (the paper's coupler; FFRF: pinned-pinned frame);
     ``poisson_ratio`` and ``shear_factor`` go to Timoshenko beams only."""
-    return s.beam(name, length=length, elements=elements, section=Circular(diameter), density=density,
-                  youngs_modulus=youngs_modulus, **options,
-                  **_beam_kind(formulation, theory, strain, poisson_ratio, shear_factor))
+    return _beam(s, name, formulation, theory, strain, poisson_ratio, shear_factor, length=length, elements=elements,
+                 section=Circular(diameter), density=density, youngs_modulus=youngs_modulus, **options)
 
 
 @_checked
@@ -350,8 +354,8 @@ def four_bar(
         )
         cp_start, cp_end = cp.point(0, 0), cp.point(b, 0)
     else:
-        cp = s.beam(
-            "coupler",
+        cp = _beam(
+            s, "coupler", formulation or "ffrf", theory, None, STEEL["poisson_ratio"], STEEL["shear_factor"],
             length=b,
             elements=elements,
             section=Rectangular(0.01, 0.005),
@@ -359,7 +363,6 @@ def four_bar(
             youngs_modulus=STEEL["youngs_modulus"],
             position=A,
             angle=th_b,
-            **_beam_kind(formulation or "ffrf", theory, None, STEEL["poisson_ratio"], STEEL["shear_factor"]),
         )
         cp_start, cp_end = cp.at(0.0), cp.at(1.0)
     rk = s.rigid_body(
@@ -403,15 +406,14 @@ def cantilever(
     mat = {"density": density, "youngs_modulus": youngs_modulus, "poisson_ratio": poisson_ratio,
            "shear_factor": shear_factor}
     s = Scene(gravity=gravity_vector(gravity))
-    b = s.beam(
-        "beam",
+    b = _beam(
+        s, "beam", formulation, theory, strain, mat["poisson_ratio"], mat["shear_factor"], frame="clamped",
         length=length,
         elements=elements,
         section=section if section is not None else Rectangular(0.02, 0.01),
         density=mat["density"],
         youngs_modulus=mat["youngs_modulus"],
         damping=damping,
-        **_beam_kind(formulation, theory, strain, mat["poisson_ratio"], mat["shear_factor"], frame="clamped"),
     )
     s.weld(s.ground.frame(), b.at(0.0), name="clamp")
     if tuple(tip_force) != (0.0, 0.0):
@@ -492,10 +494,9 @@ def spin_up(
     c = (T / (2.0 * math.pi)) ** 2
     s.angle_driver(hub.frame(), f"{w / T!r} * ({u}^2 / 2 + {c!r} * (cos({2.0 * math.pi / T!r} * {u}) - 1)) + {w!r} * (t - {u})",
                    name="spin")
-    beam = s.beam("beam", length=length, elements=elements, density=SPIN_UP["density"],
-                  youngs_modulus=SPIN_UP["youngs_modulus"],
-                  section=CustomSection(SPIN_UP["area"], SPIN_UP["second_moment"]),
-                  **_beam_kind(formulation, theory, strain, STEEL["poisson_ratio"], STEEL["shear_factor"], frame="clamped"))
+    beam = _beam(s, "beam", formulation, theory, strain, STEEL["poisson_ratio"], STEEL["shear_factor"], frame="clamped",
+                 length=length, elements=elements, density=SPIN_UP["density"], youngs_modulus=SPIN_UP["youngs_modulus"],
+                 section=CustomSection(SPIN_UP["area"], SPIN_UP["second_moment"]))
     s.weld(hub.frame(), beam.at(0.0), name="clamp")
     return s
 
@@ -521,9 +522,9 @@ def flexible_pendulum(
     ANCF cable (``formulation="ancf"``).  Body ``rod``; joint ``pivot`` at ``xi = 0``.
     """
     s = Scene(gravity=gravity_vector(gravity))
-    rod = s.beam("rod", length=length, elements=elements, section=Circular(diameter), density=density,
-                 youngs_modulus=youngs_modulus, angle=angle,
-                 **_beam_kind(formulation, theory, strain, STEEL["poisson_ratio"], STEEL["shear_factor"], frame="clamped"))
+    rod = _beam(s, "rod", formulation, theory, strain, STEEL["poisson_ratio"], STEEL["shear_factor"], frame="clamped",
+                length=length, elements=elements, section=Circular(diameter), density=density,
+                youngs_modulus=youngs_modulus, angle=angle)
     s.revolute(s.ground.point(0.0, 0.0), rod.at(0.0), name="pivot")
     return s
 

@@ -301,6 +301,10 @@ class System:
         self.constraint_names: List[str] = list(core.constraint_names)
         self.body_kind = core.body_kind
         self.body_info = core.body_info
+        #: what a body can be asked (a dict of booleans: beam, elastic, elastic_coordinates,
+        #: axial_forces, named_markers, oriented, nodal_deformation, damped), from the core's
+        #: kinds, so that no Python code keeps lists of kinds
+        self.capabilities = core.body_capabilities
         self.axial_forces = core.axial_forces
 
     # ------------------------------------------------------------------------------ settings

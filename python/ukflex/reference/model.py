@@ -18,7 +18,7 @@ core (which precomputes body-level inertia shape integrals):
 * ``K_ff`` is assembled element by element from the strain energy (paper eq. 8) by quadrature
   of the derivatives of the shape functions (6)-(7).
 
-ANCF cables (beams with ``"formulation": "ancf"``) come from :mod:`.ancf` (element by element at
+ANCF cables (bodies of kind ``"cable"``) come from :mod:`.ancf` (element by element at
 every call; constant mass matrix, no velocity terms); their marker angles follow the tangent, so
 the angle rows of the constraints carry its velocity term ``h_phi``.
 
@@ -527,9 +527,7 @@ class ReferenceModel:
                            q0=np.r_[_vec2(bd.get("position")), float(bd.get("angle", 0.0))],
                            qd0=np.r_[_vec2(bd.get("velocity")),
                                      float(bd.get("angular_velocity", 0.0))])
-            elif kind == "beam" and bd.get("formulation", "ffrf") == "ancf":
-                if bd.get("theory") != "euler-bernoulli":
-                    raise ModelError(f"beam {name!r}: the ANCF cable is Euler-Bernoulli")
+            elif kind == "cable":
                 a, I = section_properties(bd["section"])
                 E, rho = float(bd["youngs_modulus"]), float(bd["density"])
                 b = _Cable(name=name, offset=off, length=float(bd["length"]), elements=int(bd.get("elements", 1)),

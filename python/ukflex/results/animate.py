@@ -19,7 +19,6 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .outputs import BEAM_KINDS
 
 __all__ = ["MechanismDrawer", "animate", "snapshots"]
 
@@ -74,7 +73,7 @@ class MechanismDrawer:
                 xi = np.linspace(0.0, 1.0, k)
                 S = np.array([np.asarray(system.beam_shape(name, float(x))[0]) for x in xi])  # (k, 2, n_f)
                 self._beam_S[name] = (xi * self._length[name], S)
-            elif kind == "ancf_beam":
+            elif kind == "cable":
                 info = system.body_info(name)
                 self._length[name] = float(info["length"])
                 self._cable_xi[name] = np.linspace(0.0, 1.0, max(2, points_per_element * int(info["elements"])) + 1)
@@ -125,7 +124,7 @@ class MechanismDrawer:
 
     def body_polyline(self, q: np.ndarray, name: str) -> np.ndarray:
         """World points (k, 2) drawing body ``name`` at ``q``."""
-        if self.bodies[name] == "ancf_beam":
+        if self.bodies[name] == "cable":
             return self._cable_points(q, name, self._cable_xi[name])
         r, R = self._frame(q, name)
         if self.bodies[name] == "point_mass":
@@ -158,7 +157,7 @@ class MechanismDrawer:
         body = m["body"]
         if body == GROUND:
             return np.asarray(m["point"], dtype=float)
-        if self.bodies[body] == "ancf_beam":
+        if self.bodies[body] == "cable":
             return self._cable_points(q, body, [float(m["xi"])])[0]
         r, R = self._frame(q, body)
         if self.bodies[body] == "flexible":
@@ -229,7 +228,7 @@ class _Scene2D:
             ax.plot(gp[:, 0], gp[:, 1], "^", color="0.3", ms=9, zorder=1)
         self.lines = {}
         for k, (name, kind) in enumerate(drawer.bodies.items()):
-            lw = 2.5 if kind in BEAM_KINDS else 4.0
+            lw = 2.5 if drawer.system.capabilities(name)["beam"] else 4.0
             (ln,) = ax.plot([], [], "-", lw=lw, color=self.COLORS[k % len(self.COLORS)], label=name,
                             solid_capstyle="round", zorder=2, marker="o" if kind in ("rigid", "point_mass") else None,
                             ms=8 if kind == "point_mass" else 3)
@@ -252,7 +251,7 @@ class _Scene2D:
 
 def _title(res, deform_scale: float, title: Optional[str]) -> str:
     base = title or "ukflex"
-    if any(res.system.body_kind(name) in BEAM_KINDS for name in res.system.body_names):
+    if any(res.system.capabilities(name)["beam"] for name in res.system.body_names):
         base += f" (elastic displacements x{deform_scale:g})" if deform_scale != 1.0 else " (true scale)"
     return base
 

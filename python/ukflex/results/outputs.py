@@ -30,10 +30,9 @@ import numpy as np
 
 from .sensors import SENSOR_HELP, Sensors, parse_xi
 
-__all__ = ["evaluate", "validate", "default_outputs", "beam_names", "OUTPUT_HELP", "BEAM_KINDS"]
+__all__ = ["evaluate", "validate", "default_outputs", "beam_names", "OUTPUT_HELP"]
 
 #: Body kinds that are beams (``System.body_kind``): FFRF and ANCF.
-BEAM_KINDS = ("beam", "ancf_beam")
 
 OUTPUT_HELP = (
     "t, a coordinate (crank.theta), d:<coordinate> (rate), residual.position|velocity|acceleration, energy, "
@@ -80,7 +79,7 @@ def validate(system, expr: str) -> None:
 
 def beam_names(system) -> List[str]:
     """Names of the system's beams, in declaration order."""
-    return [b for b in system.body_names if system.body_kind(b) in BEAM_KINDS]
+    return [b for b in system.body_names if system.capabilities(b)["beam"]]
 
 
 def _beam_length(system, body: str) -> float:

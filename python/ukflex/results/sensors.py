@@ -281,7 +281,7 @@ class Sensors:
         m = cls._INTERNAL.match(e)
         if m:
             what, body, xi_text = m.groups()
-            if body not in system.body_names or system.body_kind(body) not in ("beam", "ancf_beam"):
+            if body not in system.body_names or not system.capabilities(body)["beam"]:
                 raise ValueError(f"output {expr!r}: {body!r} is not a beam")
             return ("internal", what, body, parse_xi(expr, xi_text))
         return None

@@ -38,6 +38,8 @@ from typing import Any, Dict, Optional
 
 import numpy as np
 
+from .. import _core
+
 #: the chooser's constants (one place): amplitude budget per rtol and its cap, fewest steps per run
 PHASE_PER_RTOL = 20.0
 PHASE_CAP = 1.0
@@ -235,7 +237,7 @@ def _lowest_per_body(system, omega, shapes, elastic, q) -> Dict[str, Optional[fl
     M = system.M_sparse(q) if sparse else np.asarray(system.M(q))
     out: Dict[str, Optional[float]] = {}
     for body in system.body_names:
-        if system.body_kind(body) in ("rigid", "point_mass"):
+        if not system.capabilities(body)["elastic"]:
             continue
         sl = system.body_slice(body)
         if sparse:
@@ -258,7 +260,7 @@ def _has_damping(system) -> bool:
 
 def _has_elastic_potential(system) -> bool:
     """Whether any mode can store strain or spring energy: a flexible body or a spring."""
-    if any(system.body_kind(b) not in ("rigid", "point_mass") for b in system.body_names):
+    if any(system.capabilities(b)["elastic"] for b in system.body_names):
         return True
     return any(f.get("kind") == "spring_damper" and float(f.get("stiffness", 0.0)) > 0.0
                for f in system.description.get("forces", []))
@@ -303,8 +305,7 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
     span = float(t_end) - float(t0)
     if not (math.isfinite(span) and span > 0.0):
         raise ValueError(f"t_end must be finite and greater than t0 = {t0}, got {t_end!r}")
-    if not (math.isfinite(rtol) and rtol > 0.0):
-        raise ValueError(f"rtol must be positive and finite, got {rtol!r}")
+    _core.check_tolerances(rtol, [0.0], 1)  # the one tolerance rule (rust/integrate/options.rs)
     if system.n_dof == 0:
         return MethodChoice("DOPRI5", reason="no degrees of freedom: the motion is prescribed")
     if not _has_elastic_potential(system):  # leave out what a scene does not need

@@ -31,10 +31,18 @@ from .stabilization import configure, segment_bounds
 __all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "time_acceleration", "DenseSolution"]
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
-#: Integrators that run entirely in Rust with the GIL released (``System.integrate``):
-#: Dormand-Prince 5(4) with dense output, and Radau IIA order 5 with the Rust Jacobian.
-NATIVE_METHODS = ("DOPRI5", "RADAU5", "GENALPHA", "RADAU5M")
-_NATIVE_OPTIONS = ("first_step", "max_step", "projection_tol", "rho_inf", "step", "jacobian", "newton_local_error", "linear_solver")
+#: The native methods' run options as the core defines them (``rust/integrate/options.rs``):
+#: method names, the options each takes, the defaults.  Nothing here restates them.
+RUN_OPTIONS: Dict[str, Any] = _core.run_options()
+#: Integrators that run entirely in Rust with the GIL released (``System.integrate``).
+NATIVE_METHODS = tuple(RUN_OPTIONS["native_methods"])
+#: The core's options that :func:`simulate` does not take as its own keywords: passed through
+#: to ``System.integrate`` (``simulate(..., rho_inf=0.8)``), each refused by the methods that do
+#: not take it.
+_OWN_KEYWORDS = ("rtol", "atol", "t_eval", "max_steps", "max_nfev", "max_wall_time", "min_step", "dense",
+                 "drift_limit", "on_drift", "monitor_singular")
+_NATIVE_OPTIONS_OF = {m: tuple(o for o in RUN_OPTIONS["options"][m] if o not in _OWN_KEYWORDS) for m in NATIVE_METHODS}
+_NATIVE_OPTIONS = tuple(sorted({o for opts in _NATIVE_OPTIONS_OF.values() for o in opts}))
 #: ``solve_ivp`` solver options passed through on the scipy paths.
 _SCIPY_OPTIONS = ("first_step", "max_step", "jac", "jac_sparsity", "lband", "uband")
 FORMULATIONS = ("uk", "uk-numpy", "cp")
@@ -77,7 +85,7 @@ def _check_options(method: Any, formulation: str, options: Dict[str, Any]) -> No
     if method == "auto":
         valid = sorted(set(_NATIVE_OPTIONS) | set(_SCIPY_OPTIONS))
     elif method in NATIVE_METHODS:
-        valid = sorted(_NATIVE_OPTIONS)
+        valid = sorted(_NATIVE_OPTIONS_OF[method])
     else:
         valid = sorted(_SCIPY_OPTIONS)
     unknown = sorted(set(options) - set(valid))
@@ -104,7 +112,7 @@ def simulate(
     scene_or_system: Union[Scene, System, Dict[str, Any]],
     t_end: Optional[float] = None,
     method: Union[str, type] = "auto",
-    rtol: float = 1e-6,
+    rtol: float = RUN_OPTIONS["defaults"]["rtol"],
     atol: Union[None, float, ArrayLike] = None,
     t_eval: Optional[ArrayLike] = None,
     formulation: str = "uk",
@@ -311,19 +319,20 @@ def simulate(
     t_end_f = real("t_end", t_end)
     if t_end_f <= t0:
         raise InvalidArgumentError("t_end", f"must be greater than t0 = {t0}, got {t_end!r}")
-    rtol = positive("rtol", rtol)
+    rtol = real("rtol", rtol)
+    _core.check_tolerances(rtol, [0.0], 1)  # the one tolerance rule (rust/integrate/options.rs)
     if rtol < RTOL_MIN:  # as solve_ivp does: below it the error norm divides by rounding
         warnings.warn(f"rtol = {rtol:g} is below {RTOL_MIN:.3g} (100 x machine epsilon); using {RTOL_MIN:.3g}",
                       UserWarning, stacklevel=2)
         rtol = RTOL_MIN
     if atol is None:
-        atol_v: Any = 1e-3 * rtol
+        atol_v: Any = RUN_OPTIONS["defaults"]["atol_per_rtol"] * rtol
     elif np.ndim(atol) == 0 and not isinstance(atol, np.ma.MaskedArray):
-        atol_v = positive("atol", atol)
+        atol_v = real("atol", atol)
+        _core.check_tolerances(rtol, [atol_v], 1)
     else:
         atol_v = real_array("atol", atol, (2 * n,))
-        if np.any(atol_v <= 0):
-            raise InvalidArgumentError("atol", "entries must be positive")
+        _core.check_tolerances(rtol, atol_v, 2 * n)
     t_eval_v: Optional[np.ndarray] = None
     if t_eval is not None:
         t_eval_v = real_array("t_eval", t_eval)
@@ -552,7 +561,7 @@ _NATIVE_PROJECTION_PER_ATOL = float(_core.PROJECTION_PER_ATOL)
 _PROJECTION_MOVE_LIMIT = float(_core.PROJECTION_MOVE_LIMIT)
 
 #: smallest relative tolerance (solve_ivp's own floor: 100 x machine epsilon)
-RTOL_MIN = 100 * float(np.finfo(float).eps)
+RTOL_MIN = RUN_OPTIONS["defaults"]["rtol_min"]
 
 #: scipy paths (about 0.1 ms of Python per step): after this many steps, and at each doubling,
 #: the pace so far is extrapolated to t_end ...
