@@ -181,61 +181,7 @@ impl PySystem {
             Ok(r) => r.map_err(to_py)?,
             Err(_) => return Err(SolverError::new_err("internal error in the ukflex core (a bug: please report it)")),
         };
-        let nt = sol.t.len();
-        let dim = sol.dim;
-        let mut yt = vec![0.0; dim * nt];
-        for k in 0..nt {
-            for i in 0..dim {
-                yt[i * nt + k] = sol.y[k * dim + i];
-            }
-        }
-        let d = PyDict::new(py);
-        d.set_item("t", PyArray1::from_vec(py, sol.t))?;
-        d.set_item("y", mat(py, yt, dim, nt)?)?;
-        d.set_item("status", sol.status)?;
-        d.set_item("message", sol.message)?;
-        match &sol.failure {
-            None => d.set_item("failure", py.None())?,
-            Some(f) => {
-                let fd = PyDict::new(py);
-                fd.set_item("cause", &f.cause)?;
-                fd.set_item("t", f.t)?;
-                fd.set_item("stage", &f.stage)?;
-                fd.set_item("index", f.index)?;
-                d.set_item("failure", fd)?;
-            }
-        }
-        match sol.dense {
-            None => d.set_item("dense", py.None())?,
-            Some(rec) => {
-                let (nseg, w) = (rec.meta.len() / 3, rec.width());
-                let dd = PyDict::new(py);
-                dd.set_item("part_len", rec.part_len.clone())?;
-                dd.set_item("meta", mat(py, rec.meta, nseg, 3)?)?;
-                dd.set_item("data", mat(py, rec.data, nseg, w)?)?;
-                d.set_item("dense", dd)?;
-            }
-        }
-        d.set_item("nfev", sol.stats.nfev)?;
-        d.set_item("njev", sol.stats.njev)?;
-        d.set_item("nlu", sol.stats.nlu)?;
-        d.set_item("naccept", sol.stats.naccept)?;
-        d.set_item("nreject", sol.stats.nreject)?;
-        d.set_item("newton_iterations", sol.stats.newton)?;
-        d.set_item("jac_evals", jac_evals)?;
-        d.set_item("wall_time", wall)?;
-        d.set_item("singular", passages_list(py, &sol.singular)?)?;
-        match sol.drift {
-            None => d.set_item("drift", py.None())?,
-            Some(r) => {
-                let dd = PyDict::new(py);
-                dd.set_item("t_first", r.t_first)?;
-                dd.set_item("max_residual", r.max_residual)?;
-                dd.set_item("t_max", r.t_max)?;
-                d.set_item("drift", dd)?;
-            }
-        }
-        Ok(d)
+        solution_dict(py, sol, jac_evals, wall)
     }
 
     /// For each column `v` of `shapes` (n, k): `1/2 v^T K_m v` summed over the bodies' material
@@ -487,4 +433,63 @@ impl PySystem {
         d.set_item("velocities_ok", c.velocities_ok)?;
         Ok(d)
     }
+}
+
+/// A native run's `Solution` as the dict `System.integrate` returns (see its docs).
+fn solution_dict<'py>(py: Python<'py>, sol: crate::integrate::Solution, jac_evals: usize, wall: f64) -> PyResult<Bound<'py, PyDict>> {
+    let nt = sol.t.len();
+    let dim = sol.dim;
+    let mut yt = vec![0.0; dim * nt];
+    for k in 0..nt {
+        for i in 0..dim {
+            yt[i * nt + k] = sol.y[k * dim + i];
+        }
+    }
+    let d = PyDict::new(py);
+    d.set_item("t", PyArray1::from_vec(py, sol.t))?;
+    d.set_item("y", mat(py, yt, dim, nt)?)?;
+    d.set_item("status", sol.status)?;
+    d.set_item("message", sol.message)?;
+    match &sol.failure {
+        None => d.set_item("failure", py.None())?,
+        Some(f) => {
+            let fd = PyDict::new(py);
+            fd.set_item("cause", &f.cause)?;
+            fd.set_item("t", f.t)?;
+            fd.set_item("stage", &f.stage)?;
+            fd.set_item("index", f.index)?;
+            d.set_item("failure", fd)?;
+        }
+    }
+    match sol.dense {
+        None => d.set_item("dense", py.None())?,
+        Some(rec) => {
+            let (nseg, w) = (rec.meta.len() / 3, rec.width());
+            let dd = PyDict::new(py);
+            dd.set_item("part_len", rec.part_len.clone())?;
+            dd.set_item("meta", mat(py, rec.meta, nseg, 3)?)?;
+            dd.set_item("data", mat(py, rec.data, nseg, w)?)?;
+            d.set_item("dense", dd)?;
+        }
+    }
+    d.set_item("nfev", sol.stats.nfev)?;
+    d.set_item("njev", sol.stats.njev)?;
+    d.set_item("nlu", sol.stats.nlu)?;
+    d.set_item("naccept", sol.stats.naccept)?;
+    d.set_item("nreject", sol.stats.nreject)?;
+    d.set_item("newton_iterations", sol.stats.newton)?;
+    d.set_item("jac_evals", jac_evals)?;
+    d.set_item("wall_time", wall)?;
+    d.set_item("singular", passages_list(py, &sol.singular)?)?;
+    match sol.drift {
+        None => d.set_item("drift", py.None())?,
+        Some(r) => {
+            let dd = PyDict::new(py);
+            dd.set_item("t_first", r.t_first)?;
+            dd.set_item("max_residual", r.max_residual)?;
+            dd.set_item("t_max", r.t_max)?;
+            d.set_item("drift", dd)?;
+        }
+    }
+    Ok(d)
 }
