@@ -73,6 +73,32 @@ pub struct RankTolerance {
     pub atol: f64,
 }
 
+/// Spatial models without an explicit `rcond`: singular values at or below
+/// `DRIFT_RANK_FACTOR max|Phi|` (relative to `sigma_max`) are dropped as well, because off the
+/// constraint manifold a redundant row's singular value grows with `|Phi|` (measured at most
+/// 6e-3 `max|Phi|` relative on A04 for drifts 1e-12..1e-4: a margin of 180; a well-posed
+/// mechanism whose smallest relative singular value is `s` keeps full rank while
+/// `max|Phi| < s`; docs/spatial-design.md, section 5; docs/spatial.md).
+pub const DRIFT_RANK_FACTOR: f64 = 1.0;
+
+impl RankTolerance {
+    /// The relative tolerance in force: `rcond` when set; otherwise `max(m, n) eps`, raised to
+    /// `DRIFT_RANK_FACTOR drift` for a spatial model (`drift = max|Phi|` at the state).
+    pub fn rcond_at(&self, n: usize, m: usize, drift: Option<f64>) -> f64 {
+        let floor = (n.max(m) as f64) * f64::EPSILON;
+        match (self.rcond, drift) {
+            (Some(r), _) => r,
+            (None, Some(d)) if d.is_finite() => floor.max(DRIFT_RANK_FACTOR * d),
+            _ => floor,
+        }
+    }
+
+    /// This tolerance with `rcond` resolved (`rcond_at`).
+    pub fn resolved(&self, n: usize, m: usize, drift: Option<f64>) -> RankTolerance {
+        RankTolerance { rcond: Some(self.rcond_at(n, m, drift)), atol: self.atol }
+    }
+}
+
 impl Default for RankTolerance {
     fn default() -> Self {
         RankTolerance { rcond: None, atol: 0.0 }
