@@ -83,6 +83,9 @@ pub struct Data {
     /// Which factorization is current (set by `uk::factor_constraints`).
     pub factored_with: Factored,
     pub tolerance: RankTolerance,
+    /// Spatial models: `max |Phi_i|` at the last `dynamics::constraints` (the state's drift,
+    /// which sets the default rank tolerance, `uk::dense`); `None` for planar models.
+    pub spatial_drift: Option<f64>,
     pub stabilization: Stabilization,
     pub rank_info: RankInfo,
     /// The UK path asked for at build, and the sparse workspace when it is used.
@@ -145,6 +148,7 @@ impl Data {
             svd_backend: SvdBackend::default(),
             factored_with: Factored::None,
             tolerance: RankTolerance::default(),
+            spatial_drift: crate::spatial::is_spatial(model).then_some(0.0),
             stabilization: Stabilization::None,
             rank_info: RankInfo::default(),
             uk_solver: solver,

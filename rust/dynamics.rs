@@ -59,6 +59,8 @@ pub fn apply_finv_sparse(model: &Model, bodies: &[BodyData], v: &mut [f64]) {
 /// Constraint terms: `A` (in segment form, `data.ajac`; also the dense `data.jac` when that
 /// exists), `Phi_t`, `gamma`, and `Phi` when `with_phi`. O(nnz(A)): no pass over `m x n`.
 pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], with_phi: bool) {
+    // spatial rows compute their value anyway: keep it, it sets the rank tolerance (uk::dense)
+    let with_phi = with_phi || data.spatial_drift.is_some();
     for (k, c) in model.constraints.iter().enumerate() {
         let rows = c.rows();
         let r0 = c.row;
@@ -73,6 +75,9 @@ pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]
             scratch: &mut data.motion_scratch,
         };
         c.eval(&model.bodies, t, q, qd, width, out);
+    }
+    if let Some(d) = data.spatial_drift.as_mut() {
+        *d = data.phi.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
     }
     if data.dense_jac {
         // entries outside the pattern were zeroed at allocation and are never written

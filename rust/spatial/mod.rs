@@ -15,3 +15,11 @@ pub mod desc;
 pub mod force;
 pub mod outputs;
 pub mod rot;
+
+use crate::body::BodyKind;
+use crate::model::Model;
+
+/// A model built from a `"dim": 3` description (its bodies are spatial kinds).
+pub fn is_spatial(model: &Model) -> bool {
+    model.bodies.iter().any(|b| matches!(b.kind, BodyKind::Rigid3(_) | BodyKind::Point3(_)))
+}

@@ -24,7 +24,7 @@ pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
         col.copy_from_slice(&data.jac[i * n..(i + 1) * n]);
         apply_finv_sparse(model, &data.bodies, col);
     }
-    let rcond = data.tolerance.rcond.unwrap_or((n.max(m) as f64) * f64::EPSILON);
+    let rcond = data.tolerance.rcond_at(n, m, data.spatial_drift);
     let atol = data.tolerance.atol;
     let backend = if data.qrj.is_some() { data.svd_backend } else { SvdBackend::Faer };
     match backend {
@@ -158,7 +158,7 @@ pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
         if !tmp.svd_of_r() {
             return Err(Error::Solver("Jacobi SVD of A F^-T did not converge".into()));
         }
-        let rcond = data.tolerance.rcond.unwrap_or((n.max(m) as f64) * f64::EPSILON);
+        let rcond = data.tolerance.rcond_at(n, m, data.spatial_drift);
         data.rank_info = rank_decision(n.min(m), |j| tmp.sigma(j), rcond, data.tolerance.atol);
     }
     Ok(data.rank_info)

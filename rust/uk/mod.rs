@@ -64,7 +64,8 @@ pub fn free_acceleration(model: &Model, data: &mut Data) {
 /// Needs `m > 0` and the mass factor of `dynamics::factor_mass`.
 pub fn factor_constraints(model: &Model, data: &mut Data) -> Result<()> {
     if let Some(sp) = data.sparse.as_mut() {
-        if let Some(info) = sp.factor(model, &data.bodies, &data.ajac, &data.tolerance) {
+        let tol = data.tolerance.resolved(model.n, model.m, data.spatial_drift);
+        if let Some(info) = sp.factor(model, &data.bodies, &data.ajac, &tol) {
             data.factored_with = Factored::SparseGram;
             data.rank_info = info;
             return Ok(());

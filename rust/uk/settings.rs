@@ -73,6 +73,37 @@ pub struct RankTolerance {
     pub atol: f64,
 }
 
+/// Spatial models without an explicit `rcond`: singular values at or below
+/// `min(DRIFT_RANK_FACTOR max|Phi|, DRIFT_RANK_CAP)` (relative to `sigma_max`) are dropped as
+/// well, because off the constraint manifold a redundant row's singular value grows with `|Phi|`
+/// (measured at most 6e-3 `max|Phi|` relative on A04 for drifts 1e-12..1e-4: a margin of 180;
+/// docs/spatial-design.md, section 5; docs/spatial.md).
+pub const DRIFT_RANK_FACTOR: f64 = 1.0;
+/// The most the drift raises the relative rank tolerance: a well-posed mechanism whose smallest
+/// relative singular value is above it keeps full rank at any state (an inconsistent initial
+/// guess included); A04's redundant value stays below it up to a drift of 1e-3, the default
+/// run's drift bound.
+pub const DRIFT_RANK_CAP: f64 = 1e-5;
+
+impl RankTolerance {
+    /// The relative tolerance in force: `rcond` when set; otherwise `max(m, n) eps`, raised to
+    /// `min(DRIFT_RANK_FACTOR drift, DRIFT_RANK_CAP)` for a spatial model (`drift = max|Phi|` at
+    /// the state).
+    pub fn rcond_at(&self, n: usize, m: usize, drift: Option<f64>) -> f64 {
+        let floor = (n.max(m) as f64) * f64::EPSILON;
+        match (self.rcond, drift) {
+            (Some(r), _) => r,
+            (None, Some(d)) if d.is_finite() => floor.max((DRIFT_RANK_FACTOR * d).min(DRIFT_RANK_CAP)),
+            _ => floor,
+        }
+    }
+
+    /// This tolerance with `rcond` resolved (`rcond_at`).
+    pub fn resolved(&self, n: usize, m: usize, drift: Option<f64>) -> RankTolerance {
+        RankTolerance { rcond: Some(self.rcond_at(n, m, drift)), atol: self.atol }
+    }
+}
+
 impl Default for RankTolerance {
     fn default() -> Self {
         RankTolerance { rcond: None, atol: 0.0 }

@@ -20,7 +20,8 @@ def outputs(system: Any, t: Any, q: Any = None, qd: Any = None, reactions: bool 
     ``rotation`` (nt, 3, 3), ``omega`` (world), ``omega_body``; ``reactions[name]`` -> dict with
     ``force``, ``torque`` (world, on the first marker's body about that marker's point) and
     ``force_joint``, ``torque_joint`` (the first marker's axes), from the minimum-norm
-    multipliers at the system's rank tolerance; ``momentum`` (nt, 3) and ``angular_momentum``
+    multipliers at the system's rank tolerance (``System.set_rank_tolerance`` if set, else the
+    default, tied to each state's drift); ``momentum`` (nt, 3) and ``angular_momentum``
     (about the origin); ``kinetic_energy``, ``potential_energy``, ``energy``; ``driver_values``."""
     if q is None:
         res = t
@@ -29,7 +30,9 @@ def outputs(system: Any, t: Any, q: Any = None, qd: Any = None, reactions: bool 
     t = np.atleast_1d(np.asarray(t, dtype=float))
     q = np.atleast_2d(np.asarray(q, dtype=float))
     qd = np.atleast_2d(np.asarray(qd, dtype=float))
-    tol = getattr(system, "_spatial_rank_tolerance", (None, 0.0))
+    # the System's own rank tolerance when one was set; else the kernel's default, which for a
+    # spatial model rises with the state's drift (docs/spatial.md, redundant constraints)
+    tol = getattr(system, "_settings", {}).get("set_rank_tolerance", (None, 0.0))
     raw = _core.spatial_outputs(json.dumps(system.description), t, q, qd, reactions, tol[0], tol[1])
     b = raw["bodies"]
     bodies = {}

@@ -1,0 +1,21 @@
+"""Per-call UK kernel on the spatial slider-crank (and A04, the heavy top), timed inside Rust
+(System.time_acceleration: best of batches, per call) and from Python (System.qdd).
+Run: .venv/bin/python benches/spatial_kernel.py"""
+import sys, pathlib, time
+import numpy as np
+import ukflex
+from ukflex.reference import spatial as sp
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
+from test_spatial import to_description  # noqa: E402
+
+for name, model in [("slider_crank", sp.scenes.slider_crank()), ("bricard", sp.scenes.bricard()),
+                    ("heavy_top", sp.scenes.heavy_top(spin=30.0)), ("flyball", sp.scenes.flyball_governor())]:
+    system = ukflex.System(to_description(model))
+    q, qd = system.q0, system.qd0
+    rust = system.time_acceleration(0.1, q, qd, 20000, 7) * 1e6
+    reps = 20000
+    t0 = time.perf_counter()
+    for _ in range(reps):
+        system.qdd(0.1, q, qd)
+    py = (time.perf_counter() - t0) / reps * 1e6
+    print(f"{name:13s} n={system.n_coords:3d} m={system.n_constraints:3d}  Rust {rust:7.2f} us/call   Python System.qdd {py:7.2f} us/call")
