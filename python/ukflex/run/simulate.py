@@ -89,6 +89,11 @@ def _check_options(method: Any, formulation: str, options: Dict[str, Any]) -> No
     else:
         valid = sorted(_SCIPY_OPTIONS)
     unknown = sorted(set(options) - set(valid))
+    elsewhere = [o for o in unknown if o in _NATIVE_OPTIONS]  # an option of other native methods
+    if method in NATIVE_METHODS and elsewhere:
+        o = elsewhere[0]
+        takers = " and ".join(m for m in NATIVE_METHODS if o in _NATIVE_OPTIONS_OF[m])
+        raise UnknownOptionError(o, f"applies to {takers} only, not to {method}; {method} takes {valid}", valid)
     if unknown:
         common = ["t_span", "t_eval", "rtol", "atol", "events", "dense_output", "args", "max_steps", "max_nfev",
                   "max_wall_time", "min_step", "q0", "qd0", "progress"]
