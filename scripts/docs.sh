@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Build the documentation site into _site/ (git-ignored; open _site/index.html), warnings as errors.
 # Sets up .venv and builds the extension if needed (autodoc imports ukflex), installs the docs
-# requirements from PyPI, runs the tutorials whose code changed (their figures: docs/site/_figures/).
+# requirements from PyPI, runs the pages whose code changed (their figures: docs/site/_figures/;
+# delete that folder to run every page again, e.g. after a change of the library).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x .venv/bin/python ] || bash scripts/setup-venv.sh

@@ -34,7 +34,7 @@ suppress_warnings = ["misc.highlighting_failure"]
 
 autodoc_member_order = "bysource"
 autodoc_default_options = {"members": True}
-autodoc_typehints = "signature"
+autodoc_typehints = "none"  # the numpydoc sections carry the types; ArrayLike would expand into a page of Unions
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 napoleon_use_param = False  # types as text: "(n_f,) sequence" is a shape, not a name to link
