@@ -3,7 +3,7 @@
 Every page's ```python blocks run in order as one script in a temporary directory, with the
 runner the site's build uses (docs/site/_ext/tutorials.py), so what the site shows is what
 runs here; the pages check their own results (closed forms, references, other models) with
-asserts, and every figure a page shows must be written by its code. About 45 s in all on the
+asserts, and every figure a page shows must be written by its code. About 30 s in all on the
 2-core development machine (the Dask sweep's cluster start is a quarter of it).
 """
 
