@@ -4,7 +4,7 @@ Every page's ```python blocks run in order as one script in a temporary director
 runner the site's build uses (docs/site/_ext/tutorials.py), so what the site shows is what
 runs here; the pages check their own results (closed forms, references, other models) with
 asserts, and every figure a page shows must be written by its code. About 30 s in all on the
-2-core development machine (the Dask sweep's cluster start is a quarter of it).
+2-core development machine (the Dask sweep, cluster start included, is almost half of it).
 """
 
 import importlib.util

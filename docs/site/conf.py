@@ -2,6 +2,14 @@
 
 The source directory is ``docs/``: the measurement pages (``docs/*.md``) are included where
 they are, as "Background"; the site's own pages live in ``docs/site/``.
+
+Why Sphinx (with MyST and autodoc + napoleon) rather than MkDocs: the docstrings are numpydoc
+(``Parameters`` / ``Returns`` sections, ``:class:`` and ``:func:`` roles), which autodoc and
+napoleon render as they are written, and ``-W`` turns every broken reference, bad docstring
+markup and missing page into an error; MyST reads the existing Markdown pages unchanged,
+including their GitHub-style section anchors; it is what NumPy, SciPy and most of the
+scientific Python ecosystem use, so readers know the layout and ``objects.inv`` lets other
+projects link ukflex's API.
 """
 
 import sys
