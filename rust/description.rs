@@ -220,9 +220,12 @@ pub struct RigidDesc {
     pub angular_velocity: f64,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+/// Beam theory of an FFRF beam. Default: Timoshenko (shear deformation and rotary inertia: the
+/// paper's coupler).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum BeamTheory {
+    #[default]
     Timoshenko,
     EulerBernoulli,
 }
@@ -239,10 +242,13 @@ pub enum Strain {
     Nonlinear,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+/// Reference conditions of an FFRF beam's floating frame (which nodal coordinates the frame takes
+/// out; not a boundary condition). Default: pinned-pinned (the chord frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReferenceConditions {
     /// u_1 = v_1 = 0, v_{N+1} = 0 (the paper's choice).
+    #[default]
     PinnedPinned,
     /// u_1 = v_1 = psi_1 = 0 (cantilever frame).
     Clamped,
@@ -264,6 +270,7 @@ pub struct BeamDesc {
     pub length: f64,
     #[serde(default = "one")]
     pub elements: usize,
+    #[serde(default)]
     pub theory: BeamTheory,
     /// Default: nonlinear (the physically right answer at speed).
     #[serde(default)]
@@ -277,6 +284,7 @@ pub struct BeamDesc {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shear_factor: Option<f64>,
     pub section: SectionDesc,
+    #[serde(default)]
     pub frame: ReferenceConditions,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotary_inertia: Option<bool>,

@@ -68,6 +68,24 @@ impl Error {
     }
 }
 
+/// `x` with `p` significant digits as Python's `format(x, ".{p}g")` writes it (messages that
+/// name a figure read alike from Rust and from Python).
+pub fn fmt_g(x: f64, p: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return if x == 0.0 { "0".into() } else { format!("{x}") };
+    }
+    let p = p.max(1);
+    let sci = format!("{:.*e}", p - 1, x);
+    let (mant, exp) = sci.split_once('e').expect("exponent");
+    let exp: i32 = exp.parse().expect("integer exponent");
+    let strip = |s: &str| if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s.to_string() };
+    if exp < -4 || exp >= p as i32 {
+        format!("{}e{}{:02}", strip(mant), if exp < 0 { '-' } else { '+' }, exp.abs())
+    } else {
+        strip(&format!("{:.*}", (p as i32 - 1 - exp).max(0) as usize, x))
+    }
+}
+
 /// Up to 20 names, then how many there are.
 pub fn listing(names: &[String]) -> String {
     if names.len() <= 20 {

@@ -32,6 +32,9 @@ pub struct Model {
     pub m: usize,
     pub coordinate_names: Vec<String>,
     pub constraint_row_names: Vec<String>,
+    /// The scene's length scale [m] (`scale::length_scale`; 1 m for a model not built from a
+    /// description).
+    pub length_scale: f64,
     /// Initial guess from the description.
     pub q0: Vec<f64>,
     pub qd0: Vec<f64>,
@@ -40,6 +43,14 @@ pub struct Model {
 impl Model {
     /// Parse and validate a JSON scene description (`docs/scene-format.md`).
     pub fn from_json(text: &str) -> Result<Model> {
+        let mut model = Self::build_json(text)?;
+        let desc: Value = serde_json::from_str(text).map_err(|e| Error::Description(e.to_string()))?;
+        model.length_scale = crate::scale::length_scale(&desc);
+        crate::scale::check_lengths(&desc, model.length_scale)?;
+        Ok(model)
+    }
+
+    fn build_json(text: &str) -> Result<Model> {
         if let Some(model) = crate::spatial::build::model_if_spatial(text)? {
             return Ok(model);
         }
@@ -75,7 +86,11 @@ impl Model {
         for x in &d.forces {
             b.add_force(x)?;
         }
-        b.finish()
+        let mut model = b.finish()?;
+        let desc = item_to_json(d)?;
+        model.length_scale = crate::scale::length_scale(&desc);
+        crate::scale::check_lengths(&desc, model.length_scale)?;
+        Ok(model)
     }
 
     pub fn body_index(&self, name: &str) -> Option<usize> {
@@ -417,6 +432,7 @@ impl ModelBuilder {
             gravity: self.gravity,
             coordinate_names: self.coordinate_names,
             constraint_row_names: row_names,
+            length_scale: 1.0,
             q0: self.q0,
             qd0: self.qd0,
         })

@@ -30,6 +30,7 @@ __all__ = [
     "ExpressionError",
     "MemoryLimitError",
     "PROJECTION_PER_ATOL",
+    "RESOLUTION",
     "PROJECTION_MOVE_LIMIT",
     "normal_weight",
     "BudgetError",
@@ -41,6 +42,9 @@ PROJECTION_PER_ATOL: float
 #: Away from singular configurations a step whose projection moves the state by more than this
 #: many tolerance units is retried shorter.
 PROJECTION_MOVE_LIMIT: float
+#: positions are resolved to this fraction of the scene's length scale, angles to this many
+#: radians (rust/scale.rs)
+RESOLUTION: float
 def normal_weight(kappa: float, kappa_ref: float) -> float:
     """Weight of the part of an error estimate across the constraints: min(1, kappa / kappa_ref)^2."""
 
@@ -191,6 +195,9 @@ class System:
     def body_names(self) -> List[str]: ...
     @property
     def body_slices(self) -> Dict[str, Tuple[int, int]]: ...
+    @property
+    def length_scale(self) -> float: ...
+    def check_state(self, t: float, q: _F64, qd: _F64) -> None: ...
     @property
     def coordinate_names(self) -> List[str]: ...
     @property

@@ -281,6 +281,7 @@ pub fn build(text: &str) -> Result<Model> {
         gravity: None,
         coordinate_names: b.names,
         constraint_row_names: row_names,
+        length_scale: 1.0,
         q0: b.q0,
         qd0: b.qd0,
     })

@@ -460,7 +460,7 @@ class Scene:
         poisson_ratio: Optional[float] = None,
         shear_modulus: Optional[float] = None,
         shear_factor: Optional[float] = None,
-        frame: str = "pinned-pinned",
+        frame: Optional[str] = None,
         rotary_inertia: Optional[bool] = None,
         damping: float = 0.0,
         position: Sequence[float] = (0.0, 0.0),
@@ -488,7 +488,7 @@ class Scene:
             Number of finite elements ``N >= 1``; the beam has ``n_f = 3 N`` elastic
             coordinates.
         theory : {"timoshenko", "euler-bernoulli"}, optional
-            Default: ``"timoshenko"``.
+            Default (the core's): ``"timoshenko"``.
         strain : {"nonlinear", "linear"}, optional
             Strain measure of an FFRF beam's elastic forces.  Default (the core's):
             ``"nonlinear"``, the second-order axial strain ``u' + v'^2 / 2`` averaged over each
@@ -500,9 +500,10 @@ class Scene:
             Exactly one is needed for Timoshenko (``G = E / (2 (1 + nu))``); optional otherwise.
         shear_factor : float, optional
             Shear correction factor ``k``, required for Timoshenko.
-        frame : {"pinned-pinned", "clamped"}
+        frame : {"pinned-pinned", "clamped"}, optional
             Reference conditions of the floating frame: which nodal coordinates the frame
-            takes out (it is not a boundary condition; clamp a beam with a weld).
+            takes out (it is not a boundary condition; clamp a beam with a weld).  Default (the
+            core's): ``"pinned-pinned"``.
         rotary_inertia : bool, optional
             Default: true for Timoshenko, false for Euler-Bernoulli (decided by the core).
         damping : float
@@ -516,11 +517,11 @@ class Scene:
         -------
         BeamRef
         """
-        d = dict(name=name, kind="beam", length=length, elements=elements, theory=theory or "timoshenko", density=density,
-                 youngs_modulus=youngs_modulus, section=section, frame=frame, damping=damping, position=position,
+        d = dict(name=name, kind="beam", length=length, elements=elements, density=density,
+                 youngs_modulus=youngs_modulus, section=section, damping=damping, position=position,
                  angle=angle, velocity=velocity, angular_velocity=angular_velocity)
-        d.update(_given(strain=strain, poisson_ratio=poisson_ratio, shear_modulus=shear_modulus, shear_factor=shear_factor,
-                        rotary_inertia=rotary_inertia, elastic=elastic, elastic_rates=elastic_rates))
+        d.update(_given(theory=theory, frame=frame, strain=strain, poisson_ratio=poisson_ratio, shear_modulus=shear_modulus,
+                        shear_factor=shear_factor, rotary_inertia=rotary_inertia, elastic=elastic, elastic_rates=elastic_rates))
         return self._add_body(d)
 
     def cable(

@@ -122,7 +122,7 @@ def gravity_vector(gravity: Any) -> Optional[Tuple[float, float]]:
 
 
 def _beam(s: Scene, name: str, formulation: str, theory: Optional[str], strain: Optional[str], poisson_ratio: float,
-          shear_factor: float, frame: str = "pinned-pinned", rotary_inertia: Optional[bool] = None, **common: Any):
+          shear_factor: float, frame: Optional[str] = None, rotary_inertia: Optional[bool] = None, **common: Any):
     """A scene's beam of ``formulation``: an FFRF :meth:`Scene.beam` with ``frame`` and ``strain``
     (``None``: the core's default), Timoshenko's material constants where the theory needs them;
     or the ANCF :meth:`Scene.cable` (Euler-Bernoulli, no frame, geometrically exact: the FFRF

@@ -93,29 +93,6 @@ class InitialCorrection:
         )
 
 
-def length_scale(description: Dict[str, Any]) -> float:
-    """The scene's length scale [m]: the largest body dimension -- beam lengths, centre-of-mass
-    and marker offsets on bodies (not on the ground: those place the mechanism) and distance
-    lengths; 1 m for a scene without any. A spring's rest length is a force parameter, not a
-    size (0 is usual), so it does not count."""
-    sizes: List[float] = []
-    for b in description.get("bodies", []):
-        for key in ("length",):
-            if isinstance(b.get(key), (int, float)):
-                sizes.append(abs(float(b[key])))
-        if isinstance(b.get("com"), (list, tuple)):
-            sizes.extend(abs(float(v)) for v in b["com"])
-    for section in ("joints", "drivers", "forces"):
-        for item in description.get(section, []):
-            for key, v in item.items():
-                if key == "length" and isinstance(v, (int, float)):
-                    sizes.append(abs(float(v)))
-                elif isinstance(v, dict) and v.get("body", "ground") != "ground":
-                    sizes.extend(abs(float(x)) for x in (v.get("point") or []) if isinstance(x, (int, float)))
-    sizes = [s for s in sizes if np.isfinite(s) and s > 0.0]
-    return max(sizes) if sizes else 1.0
-
-
 class System:
     """A compiled multibody system (Rust core) with a consistent initial state.
 
@@ -234,8 +211,7 @@ class System:
                 "stiffnesses, initial velocities and their units"
             ) from exc
 
-        scale = length_scale(self.description)
-        self._check_lengths(scale)
+        scale = self.length_scale
         if correct:
             # a tolerance in metres must not be coarser than the scene itself (a 1e-30 m rod
             # would be "corrected" onto the pivot): 1e-9 of the length scale when that is tighter
@@ -252,8 +228,7 @@ class System:
             self.initial_correction = InitialCorrection(
                 0, rp, rp, rv, rv, np.zeros(self.n_coords), np.zeros(self.n_coords), [], self.coordinate_names
             )
-        self._check_resolution(self.q0)
-        self._check_conditioning(scale)
+        core.check_state(self.t0, self.q0, self.qd0)  # rust/scale.rs: resolution, mass conditioning
         try:  # energies are outputs of every run: they must be representable at the start
             core.kinetic_energy(self.q0, self.qd0)
             core.potential_energy(self.q0)
@@ -578,98 +553,15 @@ class System:
         return ", ".join(f"{self.constraint_names[i]} = {residual[i]:.3e}" for i in order)
 
     #: positions must be resolved by double precision to this fraction of the scene's length scale
-    RESOLUTION = 1e-9
+    #: (the core's rule, ``rust/scale.rs``; the initial correction's tolerance is never coarser)
+    RESOLUTION = _core.RESOLUTION
 
-    def _check_resolution(self, q: np.ndarray) -> None:
-        """Refuse a state whose positions are too far from the origin for double precision to
-        resolve the mechanism: at 1e17 m a coordinate moves in steps of 16 m, the constraints
-        read zero whatever the motion, and a run would "succeed" with garbage."""
-        scale = length_scale(self.description)
-        eps = np.finfo(float).eps
-        angles = [i for i, c in enumerate(self.coordinate_names) if c.endswith(".theta")]
-        if angles:
-            k = int(angles[int(np.argmax(np.abs(q[angles])))])
-            if abs(float(q[k])) * eps > self.RESOLUTION:
-                raise InvalidSceneError(
-                    f"{self.coordinate_names[k]} = {q[k]:.3g} rad: double precision resolves angles there only to "
-                    f"{np.spacing(abs(float(q[k]))):.2g} rad (resolving {self.RESOLUTION:g} rad needs |angle| <= "
-                    f"{self.RESOLUTION / eps:.3g} rad); give the angle modulo 2 pi"
-                )
-        idx = [i for i, c in enumerate(self.coordinate_names) if c.endswith((".x", ".y"))]
-        if not idx:
-            return
-        far = int(idx[int(np.argmax(np.abs(q[idx])))])
-        r = abs(float(q[far]))
-        if r * np.finfo(float).eps > self.RESOLUTION * scale:
-            raise InvalidSceneError(
-                f"{self.coordinate_names[far]} = {q[far]:.3g} m is {r / scale:.2g} times the scene's length scale "
-                f"{scale:.3g} m: double precision resolves positions there only to {np.spacing(r):.2g} m "
-                f"(resolving {self.RESOLUTION:g} of the length scale needs |r| <= "
-                f"{self.RESOLUTION * scale / np.finfo(float).eps:.3g} m); place the origin near the mechanism"
-            )
-
-    #: largest length scale [m]: beyond it squares of positions and velocities (energies, the
-    #: centripetal terms) overflow double precision; it is a unit mistake
-    MAX_LENGTH_SCALE = 1e150
-
-    def _check_lengths(self, scale: float) -> None:
-        """Refuse a scene too large for double precision, and a distance constraint shorter than
-        the scene resolves: its direction (the row of ``A``) is rounding noise and the correction
-        would put the two points on top of each other."""
-        if scale > self.MAX_LENGTH_SCALE:
-            raise InvalidSceneError(
-                f"the scene's length scale {scale:.3g} m is beyond {self.MAX_LENGTH_SCALE:g} m: squares of positions "
-                "and velocities overflow double precision there; check the units"
-            )
-        for j in self.description.get("joints", []):
-            length = j.get("length")
-            if j.get("kind") == "distance" and isinstance(length, (int, float)) and 0.0 < length < self.RESOLUTION * scale:
-                raise InvalidSceneError(
-                    f"joint '{j.get('name', 'distance')}': length = {length:.3g} m is below what the scene resolves "
-                    f"({self.RESOLUTION:g} of its length scale {scale:.3g} m = {self.RESOLUTION * scale:.3g} m): the "
-                    "rod's direction is undefined there; use a revolute joint for coincident points"
-                )
-
-    #: largest problem (m * n * min(m, n)) for which a rank-deficient start is cross-checked
-    #: against the unweighted Jacobian at build (a dense SVD: ~1 s at this size)
-    CONDITIONING_CHECK_WORK = 2e9
-
-    def _check_conditioning(self, scale: float) -> None:
-        """Refuse masses so disparate that the UK solve cannot tell independent constraints from
-        redundant ones: the rank of ``A M^-1/2`` at the start must equal the rank of ``A`` (columns
-        equilibrated, so units do not matter). Only a rank-deficient solve needs the check."""
-        m, n = self.n_constraints, self.n_coords
-        if m == 0:
-            return
-        info = self.core.rank_info(self.t0, self.q0, self.qd0, exact=False)
-        if info["rank"] >= m or m * n * min(m, n) > self.CONDITIONING_CHECK_WORK:
-            return
-        A = np.asarray(self.core.A(self.q0), dtype=float)
-        dead = [self.constraint_names[i] for i in np.flatnonzero(~np.any(A != 0.0, axis=1))]
-        if dead:
-            raise InvalidSceneError(
-                f"constraint row(s) {', '.join(dead)} are degenerate at the start: their gradient vanishes (e.g. a "
-                "distance between coincident points, whose direction is undefined); use a revolute joint for "
-                "coincident points, or check the lengths and their units"
-            )
-        norms = np.linalg.norm(A, axis=0)
-        norms[norms == 0.0] = 1.0
-        sv = np.linalg.svd(A / norms, compute_uv=False)
-        rank_a = int(np.sum(sv > max(m, n) * np.finfo(float).eps * sv[0])) if sv.size and sv[0] > 0 else 0
-        if rank_a <= info["rank"]:
-            return  # the redundancy is the constraints' own
-        d = np.diag(np.asarray(self.core.M(self.q0), dtype=float)).copy()
-        rot = np.array([c.endswith(".theta") for c in self.coordinate_names])
-        d[rot] /= scale ** 2  # rotational inertia as a mass at the length scale
-        lo, hi = int(np.argmin(d)), int(np.argmax(d))
-        raise InvalidSceneError(
-            f"the masses span too many orders of magnitude for double precision: the {m} constraints are "
-            f"independent (rank {rank_a} of A at the start) but the mass-weighted UK solve resolves only rank "
-            f"{info['rank']}; the mass matrix ranges from {d[lo]:.3g} kg ({self.coordinate_names[lo]}"
-            + (f", inertia / {scale:.3g} m^2" if rot[lo] else "") + f") to {d[hi]:.3g} kg ({self.coordinate_names[hi]}"
-            + (f", inertia / {scale:.3g} m^2" if rot[hi] else "") + "); check tiny bodies (lengths, masses, inertias) "
-            "and their units"
-        )
+    @property
+    def length_scale(self) -> float:
+        """The scene's length scale [m]: the largest body dimension (beam lengths, centre-of-mass
+        and marker offsets on bodies, distance lengths; 1 m for a scene without any), from the
+        core (``rust/scale.rs``); tolerances in metres are read against it."""
+        return self.core.length_scale
 
     def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations, max_wall_time=None):
         held = self._held_mask(hold)

@@ -25,7 +25,7 @@ from ..errors import (DriftWarning, IntegrationFailure, InvalidArgumentError, No
 from ..arguments import count, positive, real, real_array
 from ..results.simulation import SimulationResult
 from ..model.scene import Scene
-from ..model.system import System, length_scale
+from ..model.system import System
 from .stabilization import configure, segment_bounds
 
 __all__ = ["simulate", "METHODS", "NATIVE_METHODS", "FORMULATIONS", "as_system", "time_acceleration", "DenseSolution"]
@@ -470,7 +470,7 @@ DRIFT_OF_SCALE = 1e-2
 def drift_limit(system: System, rtol: float, atol: Any) -> float:
     """The drift bound of a run at ``rtol``, ``atol`` on ``||Phi||``:
     ``min(DRIFT_FACTOR (rtol L + atol), DRIFT_OF_SCALE L)``, ``L`` the scene's length scale."""
-    scale = length_scale(system.description)
+    scale = system.length_scale
     return min(DRIFT_FACTOR * (rtol * scale + float(np.min(atol))), DRIFT_OF_SCALE * scale)
 
 
