@@ -18,7 +18,6 @@ Exudyn (``pip install exudyn``, tested with 1.13.6) is imported on first use.
 from __future__ import annotations
 
 import time
-import warnings
 from typing import Dict, Optional, Sequence
 
 import numpy as np
@@ -74,11 +73,11 @@ def build(description: Dict, tracked: Sequence, output_period: float) -> Built:
                                                   initialVelocities=list(b.get("velocity", [0, 0, 0])) + list(pd)))
             J = np.asarray(b["inertia"], float)
             bodies[b["name"]] = mbs.AddObject(ii.ObjectRigidBody(
-                physicsMass=b["mass"], physicsInertia=[J[0, 0], J[1, 1], J[2, 2], J[1, 2], J[0, 2], J[0, 1]], nodeNumber=node))
+                mass=b["mass"], inertia=[J[0, 0], J[1, 1], J[2, 2], J[1, 2], J[0, 2], J[0, 1]], nodeNumber=node))
         elif b["kind"] == "point3":
             node = mbs.AddNode(ii.NodePoint(referenceCoordinates=list(b["position"]),
                                             initialVelocities=list(b.get("velocity", [0, 0, 0]))))
-            bodies[b["name"]] = mbs.AddObject(ii.ObjectMassPoint(physicsMass=b["mass"], nodeNumber=node))
+            bodies[b["name"]] = mbs.AddObject(ii.ObjectMassPoint(mass=b["mass"], nodeNumber=node))
         else:
             raise NotImplementedError(f"body kind {b['kind']}")
         if any(g):
@@ -136,13 +135,11 @@ def settings(t_end: float, h: float, output_period: float, rho_inf: float = 0.9,
     ti.newton.useModifiedNewton = modified_newton
     ti.newton.relativeTolerance = newton_rtol
     ti.newton.absoluteTolerance = newton_atol
-    s.linearSolverType = getattr(exu.LinearSolverType, solver)
-    s.linearSolverSettings.ignoreSingularJacobian = ignore_singular
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
-        s.solutionSettings.writeSolutionToFile = False
-        s.solutionSettings.sensorsWritePeriod = output_period
-    s.displayComputationTime = False
+    s.linearSolver.solverType = getattr(exu.LinearSolverType, solver)
+    s.linearSolver.ignoreSingularJacobian = ignore_singular
+    s.solution.file.write = False
+    s.solution.sensors.writePeriod = output_period
+    s.show.computationTime = False
     return s
 
 
