@@ -26,7 +26,13 @@ four-bar), and a RADAU5M step costs about ``RADAU_COST_RATIO`` = 1.6 DOPRI5 step
 ``h omega_max > 0.5 x 1.6`` RADAU5M is the cheaper way to the requested accuracy: the chooser
 takes it with that fixed step (projection on; Newton to ``min(100 rtol, 1e-3)``), which damps
 the fast modes instead of resolving them.  Otherwise (rigid systems, soft or slow flexible ones)
-it takes native DOPRI5 at the user's tolerances.  GENALPHA (second order) runs when the user
+it takes native DOPRI5 at the user's tolerances, unless overdamped modes make it stiff: stiff
+dampers turn a mode into a fast decay ``omega (zeta + sqrt(zeta^2 - 1))`` that holds DOPRI5 to
+``h <= 3.3`` over it (its stability interval on the negative real axis) while the motion moves at
+the slow rate ``omega (zeta - sqrt(zeta^2 - 1))``; when the step that motion needs (the rule above
+on the slow rates) exceeds 1.6 such explicit steps, adaptive RADAU5M at the user's tolerances
+(:func:`_overdamped_choice`; MBS benchmark A05, whose undamped frequencies stop at 404 rad/s while
+its dampers decay at 8.1e3 1/s).  GENALPHA (second order) runs when the user
 gives its own options (``rho_inf``, ``newton_local_error``).  See docs/integrators.md.
 """
 
@@ -380,9 +386,6 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
     phase = min(PHASE_CAP, PHASE_PER_RTOL * rtol)
     y = min(RADAU_MAX_STEP_OMEGA, (phase / (RADAU_DECAY * omega_c * span)) ** 0.2)
     h = min(y / omega_c, span / MIN_STEPS)
-    damped = _overdamped_choice(system, t0, q, qd, omega, shapes, shares, phase, span)
-    if damped is not None:
-        return damped
     if h * omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:
         floor: Dict[str, Any] = {}
         if omega.size >= system.n_dof:  # every mode known (small systems): the floor
@@ -401,6 +404,9 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
                     f"{h * omega_max:.3g}/omega_max ({omega_max:.4g} rad/s), beyond what an explicit method may take "
                     f"(~{EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:g}/omega_max at equal cost): Radau IIA (order 5, "
                     "L-stable) damps the fast modes instead of resolving them" + said))
+    damped = _overdamped_choice(system, t0, q, qd, omega, shapes, shares, phase, span)
+    if damped is not None:  # after the fixed-step rule: the scenes it takes keep their tuned step
+        return damped
     return MethodChoice(
         "DOPRI5", omega_elastic=omega_c, omega_max=omega_max,
         reason=(f"not stiff at this tolerance: the step {h:.3g} s that resolves the lowest elastic mode "
