@@ -19,7 +19,8 @@ the same accuracy, timed around the whole solve call in one run.
 
 Medians of interleaved repetitions (every configuration once per repetition, alternating order).
 
-    python benches/peers/spatial_side_by_side.py --repeat 3      # writes benches/data/spatial_side_by_side.csv
+    python benches/peers/spatial_side_by_side.py --repeat 3      # ~100 s; writes benches/data/spatial_side_by_side.csv
+    python benches/peers/spatial_side_by_side.py --a05-reference # ~2.5 min: A05's slider height over 10 s, both codes
 """
 
 from __future__ import annotations
@@ -82,15 +83,39 @@ def exudyn_run(scene, name: str, t_end: float, t_out: np.ndarray, h: float, solv
                               ignore_singular=solver == "EigenDense")
 
 
+def a05_reference(t_end: float = 10.0) -> None:
+    """A05's slider height over ``t_end``: ukflex DOPRI5 at rtol 1e-12, Exudyn at h = 5e-4 and
+    2.5e-4 s and Richardson's extrapolation of the two, ukflex's default run (docs/spatial.md)."""
+    scene = spatial_scenes.flyball_governor()
+    t = np.linspace(0.0, t_end, int(round(t_end / DT)) + 1)
+    ref = ukflex_run(scene, "flyball_governor", t_end, t, method="DOPRI5", rtol=1e-12, atol=1e-14)
+    z = ref["p"][:, 2]
+    marks = [i for i, ti in enumerate(t) if ti in (0.5, 1.0, 2.0, 5.0, 10.0)]
+    show = lambda v: " ".join(f"{v[i]:.10f}" for i in marks)  # noqa: E731
+    print(f"A05 s(t) at {[float(t[i]) for i in marks]} s")
+    print(f"  ukflex DOPRI5 rtol 1e-12 ({ref['wall']:.0f} s): {show(z)}")
+    default = ukflex_run(scene, "flyball_governor", t_end, t)
+    print(f"  ukflex default ({default['method']}, {default['wall']:.2f} s): {np.abs(default['p'][:, 2] - z).max():.2e} m off")
+    runs = [exudyn_run(scene, "flyball_governor", t_end, t, h, "EigenSparse") for h in (5e-4, 2.5e-4)]
+    for h, r in zip((5e-4, 2.5e-4), runs):
+        print(f"  Exudyn h {h:g} ({r['wall']:.1f} s): {show(r['p'][:, 2])}, {np.abs(r['p'][:, 2] - z).max():.2e} m off")
+    rich = (4 * runs[1]["p"][:, 2] - runs[0]["p"][:, 2]) / 3
+    print(f"  Richardson's extrapolation of Exudyn: {np.abs(rich - z).max():.2e} m off")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--a05-reference", action="store_true", help="only A05's converged slider height over 10 s (~2.5 min)")
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--out", default=os.path.join(DATA, "spatial_side_by_side.csv"))
     args = ap.parse_args(argv)
     if not HAVE_EXUDYN:
         print("exudyn is not installed (`pip install exudyn`, tested with 1.13.6)", file=sys.stderr)
         return 2
+    if args.a05_reference:
+        a05_reference()
+        return 0
     start = time.perf_counter()
     rows = []
     for name in args.scenes.split(","):
