@@ -7,6 +7,7 @@ Rust core (``ukflex._core``, private) + Python API:
 * :func:`simulate` -- time integration with ``scipy.integrate.solve_ivp``;
 * :func:`sweep` -- parameter sweeps (serial, a process pool or Dask), a DataFrame per sweep;
 * :mod:`ukflex.scenes` -- built-in scenes (the paper's slider-crank, pendulums, ...);
+  :mod:`ukflex.spatial_scenes` -- the spatial benchmarks (A04, A05, the spatial slider-crank);
 * :mod:`ukflex.stability` -- diagnostics of runs (rank loss, drift, buckling, FFRF validity);
   stabilization is :func:`simulate`'s ``stabilization=``;
 * :mod:`ukflex.benchmarks` -- the paper's reproduction and the work-precision bench (``ukflex
@@ -54,6 +55,7 @@ from .run.simulate import simulate
 from .run.sweep import sweep
 from .model import scenes
 from .model.spatial import SpatialScene
+from .model import spatial_scenes
 from .results.spatial import outputs as spatial_outputs
 
 #: Public modules of the rooms, loaded on first use: ``ukflex.fe`` (flexible bodies from FE
@@ -109,6 +111,7 @@ __all__ = [
     "simulate",
     "sweep",
     "scenes",
+    "spatial_scenes",
     "UkflexError",
     "InvalidSceneError",
     "SingularMassError",

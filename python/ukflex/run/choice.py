@@ -26,7 +26,13 @@ four-bar), and a RADAU5M step costs about ``RADAU_COST_RATIO`` = 1.6 DOPRI5 step
 ``h omega_max > 0.5 x 1.6`` RADAU5M is the cheaper way to the requested accuracy: the chooser
 takes it with that fixed step (projection on; Newton to ``min(100 rtol, 1e-3)``), which damps
 the fast modes instead of resolving them.  Otherwise (rigid systems, soft or slow flexible ones)
-it takes native DOPRI5 at the user's tolerances.  GENALPHA (second order) runs when the user
+it takes native DOPRI5 at the user's tolerances, unless overdamped modes make it stiff: stiff
+dampers turn a mode into a fast decay ``omega (zeta + sqrt(zeta^2 - 1))`` that holds DOPRI5 to
+``h <= 3.3`` over it (its stability interval on the negative real axis) while the motion moves at
+the slow rate ``omega (zeta - sqrt(zeta^2 - 1))``; when the step that motion needs (the rule above
+on the slow rates) exceeds 1.6 such explicit steps, adaptive RADAU5M at the user's tolerances
+(:func:`_overdamped_choice`; MBS benchmark A05, whose undamped frequencies stop at 404 rad/s while
+its dampers decay at 8.1e3 1/s).  GENALPHA (second order) runs when the user
 gives its own options (``rho_inf``, ``newton_local_error``).  See docs/integrators.md.
 """
 
@@ -61,6 +67,9 @@ NEWTON_MAX_RTOL = 1e-3
 #: steps (nonlinear FFRF coupler N = 4: 17 us against 6 UK calls of ~1.7 us)
 EXPLICIT_STEP_OMEGA = 0.5
 RADAU_COST_RATIO = 1.6
+#: DOPRI5's stability interval on the negative real axis, ``h |lambda| <= 3.3`` (its step control
+#: settles at 3.15 on A05's fastest overdamped decay, 8.1e3 1/s: 5 103 steps over 2 s)
+DOPRI5_REAL_STABILITY = 3.3
 #: GENALPHA by hand (``newton_local_error``): the fraction of the local error estimate at which
 #: Newton may stop (2.3 instead of 3.2-4.4 iterations per step on the paper scene, the same
 #: answer; docs/integrators.md) ...
@@ -155,14 +164,7 @@ def transient_floor(system, t0: float, q: np.ndarray, qd: np.ndarray, omega: np.
     excite = np.asarray(system.qdd(t0, q, qd)) - _rigidified_acceleration(system, t0, q, qd, M)
     w, phi = omega[fast], shapes[:, fast]
     amp = np.abs(phi.T @ (M @ excite)) / w ** 2
-    # each mode's damping ratio: -phi^T M dqdd/dqd phi / (2 omega), by a difference along the mode
-    # (gyroscopic terms, skew, drop out); the physical motion decays as exp(lambda t). Undamped
-    # scenes leave it out.
-    zeta = np.zeros(w.size)
-    for k in (range(w.size) if _has_damping(system) else ()):
-        eps = 1e-6 * max(1.0, float(np.abs(qd).max())) / max(float(np.abs(phi[:, k]).max()), 1e-300)
-        dq = (np.asarray(system.qdd(t0, q, qd + eps * phi[:, k])) - np.asarray(system.qdd(t0, q, qd - eps * phi[:, k]))) / (2 * eps)
-        zeta[k] = max(0.0, -float(phi[:, k] @ (M @ dq)) / (2.0 * w[k]))
+    zeta = damping_ratios(system, t0, q, qd, w, phi, M)  # the physical motion decays as exp(lambda t)
     lam = w * (-zeta + np.sqrt(zeta * zeta - 1.0 + 0j))  # under-damped: the oscillating root; over: the slow one
     z = lam * h
     steps = max(1, int(math.ceil(span / h)))
@@ -249,6 +251,31 @@ def _lowest_per_body(system, omega, shapes, elastic, q) -> Dict[str, Optional[fl
     return out
 
 
+def damping_ratios(system, t0: float, q: np.ndarray, qd: np.ndarray, omega: np.ndarray, shapes: np.ndarray,
+                   M: np.ndarray) -> np.ndarray:
+    """Each mode's damping ratio ``zeta_k = -phi_k^T M dqdd/dqd phi_k / (2 omega_k)`` (mass-normalized
+    ``phi_k``), by a central difference of the acceleration along the mode's velocity (gyroscopic
+    terms, skew, drop out); zeros for an undamped scene and for modes with ``omega_k <= 0``."""
+    zeta = np.zeros(omega.size)
+    if not _has_damping(system):
+        return zeta
+    for k in np.flatnonzero(omega > 0.0):
+        eps = 1e-6 * max(1.0, float(np.abs(qd).max())) / max(float(np.abs(shapes[:, k]).max()), 1e-300)
+        dq = (np.asarray(system.qdd(t0, q, qd + eps * shapes[:, k])) - np.asarray(system.qdd(t0, q, qd - eps * shapes[:, k]))) / (2 * eps)
+        zeta[k] = max(0.0, -float(shapes[:, k] @ (M @ dq)) / (2.0 * omega[k]))
+    return zeta
+
+
+def overdamped_roots(omega: np.ndarray, zeta: np.ndarray):
+    """``(fast, slow)``: the decay rates ``omega (zeta +- sqrt(zeta^2 - 1))`` of each overdamped mode
+    (``zeta > 1``; its motion is ``exp(-slow t)`` once ``exp(-fast t)`` has died out); ``omega``
+    for the others."""
+    over = zeta > 1.0
+    root = np.sqrt(np.maximum(zeta * zeta - 1.0, 0.0))
+    w = np.abs(omega)
+    return np.where(over, w * (zeta + root), w), np.where(over, w * (zeta - root), w)
+
+
 def _has_damping(system) -> bool:
     """Whether any body or force of the scene dissipates (a damping coefficient, a modal body's
     damping matrix ``d_ff``)."""
@@ -298,6 +325,41 @@ def local_newton_ok(h: float, omega_max: float) -> bool:
     return h * omega_max >= LOCAL_NEWTON_MIN_STEP_OMEGA
 
 
+def _overdamped_choice(system, t0, q, qd, omega, shapes, shares, phase, span) -> Optional[MethodChoice]:
+    """Adaptive RADAU5M when overdamped modes make an explicit step short: stiff dampers (MBS
+    benchmark A05: spring-dampers with ``C = 4e4`` N s/m) turn a mode of frequency ``omega`` and
+    damping ratio ``zeta > 1`` into a fast decay ``omega (zeta + sqrt(zeta^2 - 1))`` that bounds
+    DOPRI5's step to ``DOPRI5_REAL_STABILITY`` over it, and a slow one ``omega (zeta - sqrt(zeta^2 -
+    1))``, the motion left to resolve. The undamped frequencies miss both. When the step that the
+    motion needs (the rule of the fixed-step choice, on the modes' slow rates) exceeds
+    ``RADAU_COST_RATIO`` explicit steps, Radau IIA with its own error control is cheaper: the fast
+    decays die out within a step (L-stable) and its error estimate sees them die. Small systems
+    (every mode known) only; ``None`` otherwise."""
+    if omega.size < system.n_dof or not _has_damping(system):
+        return None
+    qd0 = system.qd0 if qd is None else np.asarray(qd, dtype=float)
+    zeta = damping_ratios(system, t0, q, qd0, omega, shapes, np.asarray(system.M(q)))
+    over = zeta > 1.0
+    if not over.any():
+        return None
+    fast, slow = overdamped_roots(omega, zeta)
+    omega_m = lowest_elastic_frequency(system, np.where(omega > 0.0, slow, omega), shapes, shares, q)
+    if omega_m is None:
+        return None
+    y = min(RADAU_MAX_STEP_OMEGA, (phase / (RADAU_DECAY * omega_m * span)) ** 0.2)
+    h = min(y / omega_m, span / MIN_STEPS)
+    h_explicit = DOPRI5_REAL_STABILITY / float(fast[over].max())
+    if h <= RADAU_COST_RATIO * h_explicit:
+        return None
+    k = int(np.argmax(np.where(over, fast, 0.0)))
+    return MethodChoice(
+        "RADAU5M", omega_elastic=omega_m, omega_max=float(fast[over].max()),
+        reason=(f"stiff by damping: the mode at {omega[k]:.4g} rad/s is overdamped (zeta {zeta[k]:.3g}): it decays at "
+                f"{fast[k]:.4g} 1/s, which holds an explicit step to {h_explicit:.2g} s, while the motion "
+                f"(slowest elastic rate {omega_m:.4g} 1/s) needs only ~{h:.2g} s: Radau IIA (L-stable) with its own "
+                "step control"))
+
+
 def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.ndarray] = None,
                   qd: Optional[np.ndarray] = None, deadline: Optional[float] = None) -> MethodChoice:
     """The integrator ``method="auto"`` runs for ``system`` over ``[t0, t_end]`` at ``rtol``
@@ -342,6 +404,9 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
                     f"{h * omega_max:.3g}/omega_max ({omega_max:.4g} rad/s), beyond what an explicit method may take "
                     f"(~{EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:g}/omega_max at equal cost): Radau IIA (order 5, "
                     "L-stable) damps the fast modes instead of resolving them" + said))
+    damped = _overdamped_choice(system, t0, q, qd, omega, shapes, shares, phase, span)
+    if damped is not None:  # after the fixed-step rule: the scenes it takes keep their tuned step
+        return damped
     return MethodChoice(
         "DOPRI5", omega_elastic=omega_c, omega_max=omega_max,
         reason=(f"not stiff at this tolerance: the step {h:.3g} s that resolves the lowest elastic mode "

@@ -1,0 +1,113 @@
+"""The spatial benchmarks of issue 30 as built-in scenes (``ukflex.spatial_scenes``): the builders
+against the independent NumPy reference, MBS benchmark A05 (the stiff flyball governor) with
+``method="auto"`` (an implicit method, the reference's slider height), and one short Exudyn run per
+scene against ukflex (skipped without Exudyn, like tests/test_exudyn_peer.py). docs/spatial.md
+lists the figures; benches/peers/spatial_side_by_side.py is the timing study."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ukflex
+from ukflex import spatial_scenes
+from ukflex.reference import spatial as sp
+
+PEERS = Path(__file__).resolve().parents[1] / "benches" / "peers"
+
+
+@pytest.mark.parametrize("name", ["flyball_governor", "slider_crank"])
+def test_builders_give_the_reference_state_and_accelerations(name):
+    """Same coordinates, same consistent start (the slider-crank's velocities from the joints,
+    in closed form here, by the reference's mass-metric projection there) and the same
+    accelerations as the reference's scene."""
+    model = getattr(sp.scenes, name)()
+    q0, qd0 = sp.scenes.slider_crank_state(model) if name == "slider_crank" else sp.uk.correct_initial_state(model)[:2]
+    system = ukflex.System(getattr(spatial_scenes, name)())
+    assert np.abs(system.initial_correction.dq).max() == 0.0          # the scene is consistent as built
+    assert np.abs(system.initial_correction.dqd).max() < 1e-14
+    np.testing.assert_allclose(system.q0, q0, atol=1e-14)
+    np.testing.assert_allclose(system.qd0, qd0, atol=1e-11)
+    ref = sp.uk.accelerations(model, 0.0, q0, qd0)
+    assert np.abs(system.qdd(0.0, system.q0, system.qd0) - ref).max() < 1e-10 * max(1.0, np.abs(ref).max())
+
+
+def test_bricard_builder_gives_the_reference_motion_and_its_redundancy():
+    """A04: the rods' body frames differ from the reference's (another turn about each rod), so
+    the centres of mass and their accelerations are compared; 35 rows of rank 34 (one
+    redundant constraint, one degree of freedom) with the default tolerance."""
+    model = sp.scenes.bricard()
+    q0, qd0, _ = sp.uk.correct_initial_state(model)
+    system = ukflex.System(spatial_scenes.bricard())
+    com = [system.coordinate_index(f"rod{k}.{c}") for k in range(1, 6) for c in "xyz"]
+    ref = sp.uk.accelerations(model, 0.0, q0, qd0)
+    np.testing.assert_allclose(system.q0[com], q0[com], atol=1e-14)
+    np.testing.assert_allclose(system.qdd(0.0, system.q0, system.qd0)[com], ref[com], atol=1e-10)
+    assert np.abs(ref[com]).max() > 1.0
+    assert system.n_constraints == 35 and system.rank_info(0.0, system.q0, system.qd0, True)["rank"] == 34
+
+
+#: A05's slider height s at 0.05, 0.1, 0.15, 0.2 s by the NumPy reference (scipy Radau, rtol 1e-11,
+#: point masses on spherical joints, 8 decimals; 0.1 s to 10: docs/spatial-design.md, section 8)
+A05_REFERENCE = [0.50610090, 0.5238364756, 0.55116081, 0.58507981]
+
+
+def test_a05_auto_picks_an_implicit_method_and_reproduces_the_reference():
+    """The flyball governor's dampers (C = 4e4 N s/m) make modes overdamped (zeta 4.3 and 10)
+    whose fast decay (8.1e3 1/s) bounds an explicit step; the undamped frequencies (at most
+    404 rad/s) do not show it. auto takes adaptive RADAU5M; its slider height follows the
+    reference's to its tolerance."""
+    system = ukflex.System(spatial_scenes.flyball_governor())
+    t = np.array([0.0, 0.05, 0.1, 0.15, 0.2])
+    res = ukflex.simulate(system, 0.2, t_eval=t, rtol=1e-9)
+    assert res.method == "RADAU5M" and "options" in res.extra["auto"]
+    assert res.extra["auto"]["options"] == {}                    # its own step control
+    assert "overdamped" in res.extra["auto"]["reason"]
+    assert res.extra["auto"]["omega_max"] > 8e3
+    s = res.q[system.coordinate_index("slider.z")]
+    assert abs(s[2] - A05_REFERENCE[1]) < 5e-10
+    np.testing.assert_allclose(s[1:], A05_REFERENCE, atol=1e-8)   # 8 decimals
+    default = ukflex.simulate(ukflex.System(spatial_scenes.flyball_governor()), 0.2, t_eval=t)
+    assert default.method == "RADAU5M"
+    assert np.abs(default.q[system.coordinate_index("slider.z")] - s).max() < 1e-6
+
+
+def test_the_other_benchmarks_stay_explicit():
+    """Rigid mechanisms without springs: DOPRI5, no frequency analysis."""
+    for name in ("bricard", "slider_crank"):
+        res = ukflex.simulate(ukflex.System(getattr(spatial_scenes, name)()), 0.05)
+        assert res.method == "DOPRI5", name
+
+
+@pytest.fixture(scope="module")
+def exudyn_spatial():
+    pytest.importorskip("exudyn")
+    sys.path.insert(0, str(PEERS))
+    try:
+        import exudyn_spatial as mod
+        yield mod
+    finally:
+        sys.path.remove(str(PEERS))
+
+
+@pytest.mark.parametrize("name, h, tol", [("flyball_governor", 1e-3, 2e-7), ("slider_crank", 5e-4, 1e-6)])
+def test_exudyn_converges_to_ukflex(exudyn_spatial, name, h, tol):
+    """Exudyn's generalized-alpha (its own rigid bodies, joints and spring-dampers from the same
+    description) at h and h/2 over 0.5 s: its error against ukflex (DOPRI5, rtol 1e-11) falls
+    fourfold (second order) to within ``tol`` (measured 1.9e-7 m, 8.8e-7 m), and Richardson's
+    extrapolation of the two lands within 2e-8 m."""
+    scene = getattr(spatial_scenes, name)()
+    body, local, _ = spatial_scenes.TRACKED[name]
+    t = np.linspace(0.0, 0.5, 51)
+    system = ukflex.System(scene)
+    res = ukflex.simulate(system, 0.5, t_eval=t, method="DOPRI5", rtol=1e-11, atol=1e-13)
+    out = ukflex.spatial_outputs(system, res)["bodies"][body]
+    p = out["position"] + np.einsum("nij,j->ni", out["rotation"], np.asarray(local))
+    coarse, fine = (exudyn_spatial.run(scene.to_dict(), (body, local), 0.5, step, t) for step in (h, h / 2))
+    assert coarse["ok"] and fine["ok"]
+    e1, e2 = (np.linalg.norm(r["p"] - p, axis=1).max() for r in (coarse, fine))
+    assert e2 < tol and 3.5 < e1 / e2 < 4.5, (e1, e2)
+    assert np.linalg.norm((4 * fine["p"] - coarse["p"]) / 3 - p, axis=1).max() < 2e-8
