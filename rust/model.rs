@@ -97,6 +97,20 @@ impl Model {
         self.bodies.iter().position(|b| b.name == name)
     }
 
+    /// The body-frame points at which joints, drivers and forces attach to rigid body `bi`
+    /// (in item order, repeats included): what draws it (`Body::outline`).
+    pub fn attachments(&self, bi: usize) -> Vec<[f64; 2]> {
+        let markers = self.constraints.iter().flat_map(|c| c.markers()).chain(self.forces.iter().flat_map(|f| f.markers()));
+        markers
+            .flatten()
+            .filter(|m| m.body == Some(bi))
+            .filter_map(|m| match m.shape {
+                crate::body::marker::MarkerShape::Rigid(p) => Some(p),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Any body with stiffness-proportional damping (the scene is then truly stiff).
     pub fn has_damping(&self) -> bool {
         self.bodies.iter().any(|b| b.capabilities().damped)

@@ -281,3 +281,26 @@ def test_stability_and_crosscheck_commands(tmp_path):
     assert "### euler-bernoulli" in r.stdout and "| CP, partition every call |" in r.stdout
     bad = studies_cli("crosscheck", "nope")
     assert bad.returncode == 2 and "invalid choice" in bad.stderr
+
+
+def test_every_body_kind_draws_itself_from_the_core():
+    """The drawing asks the core (``System.core.outline``): a rigid crank is the star from its
+    centre of mass to its two attachment points (the bar from pivot to tip), a point mass its
+    position, and a spatial body is refused by name (the 3D animation draws it)."""
+    s = ukflex.Scene()
+    crank = s.rigid_body("crank", mass=1.0, inertia=0.1, com=(0.05, 0.0), angle=0.3)
+    bob = s.point_mass("bob", mass=1.0, position=(0.1 * np.cos(0.3), 0.1 * np.sin(0.3) - 0.2))
+    s.revolute(s.ground.point(0.0, 0.0), crank.point(0.0, 0.0))
+    s.distance(crank.point(0.1, 0.0), bob.point(), length=0.2)
+    system = s.build()
+    q = system.q0
+    d = MechanismDrawer(system)
+    c, sn = np.cos(q[2]), np.sin(q[2])
+    com, pivot, tip = [0.05 * c, 0.05 * sn], [0.0, 0.0], [0.1 * c, 0.1 * sn]
+    np.testing.assert_allclose(d.body_polyline(q, "crank"), [com, pivot, com, com, tip, com], atol=1e-15)
+    np.testing.assert_allclose(d.body_polyline(q, "bob"), [q[3:5]], atol=0)
+    np.testing.assert_allclose(d.joint_positions(q), [[0.0, 0.0]], atol=1e-15)  # the revolute only
+    three = ukflex.SpatialScene()
+    three.rigid_body("top", mass=1.0, inertia=[1.0, 1.0, 1.0])
+    with pytest.raises(ukflex.InvalidArgumentError, match="planar"):
+        ukflex.System(three).core.outline("top", ukflex.System(three).q0)

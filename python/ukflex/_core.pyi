@@ -112,6 +112,10 @@ class System:
         constant mass matrix and the stiffness at the undeformed guess, each (n_b, n_b)."""
     def tangent_stiffness(self, body: str, q: _F64) -> _F64:
         """-dQ_el/dq_b of beam or flexible body ``body``'s elastic forces at q (n,), shape (n_b, n_b)."""
+    def outline(self, body: str, q: _F64, deform_scale: float = 1.0, points_per_element: int = 8) -> _F64:
+        """World points (k, 2) drawing planar body `body` at `q`, elastic displacements magnified."""
+    def marker_points(self, q: _F64, deform_scale: float = 1.0) -> Dict[str, List[Optional[_F64]]]:
+        """World points of every joint's and driver's markers at `q`: {name: [a or None, b or None]}."""
     def beam_point(self, body: str, xi: float, q: _F64) -> _F64:
         """Rows x, y (world), u, v (displacement in the beam frame; ANCF: the chord frame of
         the ends), psi of the axis point at xi; shape (5,) for q (n,), (5, nt) for q (n, nt)."""

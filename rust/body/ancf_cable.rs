@@ -563,6 +563,23 @@ impl AncfCable {
         let d = [r[0] - r0[0], r[1] - r0[1]];
         [r[0], r[1], dot2(c, d) - xi * self.length, cross(c, d), cross(c, t).atan2(dot2(c, t))]
     }
+
+    /// The axis points that draw it (`outline.rs`), `per_element` samples per element.
+    pub fn outline_points(&self, per_element: usize) -> Vec<super::marker::MarkerShape> {
+        super::outline::axis_samples(per_element, self.elements).map(|xi| super::marker::MarkerShape::Cable(self.point(xi))).collect()
+    }
+
+    /// World position of the axis point `xi` with its displacement from the chord of the ends
+    /// (`chord_displacement`) magnified by `s`, in the chord frame.
+    pub fn drawn_point(&self, xi: f64, q: &[f64], s: f64) -> [f64; 2] {
+        let p = self.chord_displacement(xi, q);
+        let n = 4 * self.elements;
+        let ch = [q[n] - q[0], q[n + 1] - q[1]];
+        let len = dot2(ch, ch).sqrt();
+        let c = [ch[0] / len, ch[1] / len];
+        let (x, y) = (xi * self.length + s * p[2], s * p[3]);
+        [q[0] + c[0] * x - c[1] * y, q[1] + c[1] * x + c[0] * y]
+    }
 }
 
 /// Axis point of a cable: `r = S e`, `v = S e_dot`, `h = 0` (linear in `e`); frame angle

@@ -393,6 +393,11 @@ impl Beam {
         }
         PointShape { x: xi * self.length, y: 0.0, entries }
     }
+
+    /// The axis points that draw it (`outline.rs`), `per_element` samples per element.
+    pub fn outline_points(&self, per_element: usize) -> Vec<super::marker::MarkerShape> {
+        super::outline::axis_samples(per_element, self.elements).map(|xi| super::marker::MarkerShape::Beam(self.point_shape(xi))).collect()
+    }
 }
 
 /// Workspace of a beam: the floating frame's (`FfrfData`) and the elements' axial forces.

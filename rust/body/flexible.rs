@@ -505,3 +505,17 @@ impl Flexible {
         m.insert("damping".into(), self.d_ff.is_some().into());
     }
 }
+
+impl Flexible {
+    /// The interface points that draw it (`outline.rs`), in declaration order and closed; its
+    /// frame's origin when it has none.
+    pub fn outline_points(&self) -> Vec<super::marker::MarkerShape> {
+        use super::marker::MarkerShape::Beam;
+        let mut out: Vec<_> = self.markers.iter().map(|(_, ps)| Beam(ps.clone())).collect();
+        match out.first().cloned() {
+            Some(first) => out.push(first),
+            None => out.push(Beam(PointShape { x: 0.0, y: 0.0, entries: Vec::new() })),
+        }
+        out
+    }
+}

@@ -83,7 +83,7 @@ impl Body {
         m
     }
 
-    fn not_a(&self, what: &str) -> Error {
+    pub(super) fn not_a(&self, what: &str) -> Error {
         Error::argument("body", format!("body '{}' ({}) is not {what}", self.name, self.kind_name()))
     }
 

@@ -20,6 +20,7 @@ pub mod marker;
 pub mod flexible;
 pub mod inspect;
 pub mod marker3;
+pub mod outline;
 pub mod point3;
 pub mod point_mass;
 pub mod rigid;

@@ -152,3 +152,17 @@ impl Rigid {
         m.insert("com".into(), self.com.to_vec().into());
     }
 }
+
+impl Rigid {
+    /// The body-frame points that draw it (`outline.rs`): its centre of mass alone, a bar
+    /// symmetric about it through one attachment point, or a star from it to every attachment.
+    pub fn outline_points(&self, attach: &[[f64; 2]]) -> Vec<super::marker::MarkerShape> {
+        use super::marker::MarkerShape::Rigid as P;
+        let c = self.com;
+        match attach {
+            [] => vec![P(c)],
+            [p] => vec![P(*p), P([2.0 * c[0] - p[0], 2.0 * c[1] - p[1]])],
+            _ => attach.iter().flat_map(|p| [P(c), P(*p), P(c)]).collect(),
+        }
+    }
+}

@@ -1,12 +1,14 @@
 """Headless drawings and GIF animations of a simulated mechanism.
 
-Beams are drawn as their deformed axis, ``r(x) = R + A(theta) (x e_1 + s S(x) q_f)`` sampled
-along the beam from the element shape functions (``System.beam_shape``), with an optional
-magnification ``s`` of the elastic displacement (``deform_scale``); an ANCF beam as its axis points
-(``System.beam_point``), their displacement from the chord of the ends magnified by ``s``.  Rigid bodies are drawn as
-lines from their centre of mass to every point where a joint, driver or force attaches to them
-(a crank becomes a bar from its pivot to its tip); joints are circles, ground attachments
-triangles, and ground lines of point-on-line and prismatic joints dashed lines.
+Every body kind draws itself in the core (``System.core.outline``, ``rust/body/outline.rs``):
+beams as their deformed axis, ``r(x) = R + A(theta) (x e_1 + s S(x) q_f)`` sampled along the
+beam from the element shape functions, with an optional magnification ``s`` of the elastic
+displacement (``deform_scale``); an ANCF beam as its axis points, their displacement from the
+chord of the ends magnified by ``s``; a flexible body through its interface points.  Rigid
+bodies are drawn as lines from their centre of mass to every point where a joint, driver or
+force attaches to them (a crank becomes a bar from its pivot to its tip); joints are circles,
+ground attachments triangles, and ground lines of point-on-line and prismatic joints dashed
+lines.
 
 Rendering uses matplotlib's Agg canvas directly (no pyplot, no display needed) and Pillow (a
 matplotlib dependency) to write the GIF.
@@ -46,6 +48,10 @@ def _markers_of(description: Dict[str, Any]) -> List[Tuple[str, Dict[str, Any], 
 class MechanismDrawer:
     """World-frame geometry of every body for a given ``q``.
 
+    Each body kind draws itself in the core (``System.core.outline``: a beam's or cable's axis,
+    a flexible body's interface points, a rigid body's star from its centre of mass to its
+    attachment points, a point mass; ``rust/body/outline.rs``), so this class knows no kinds.
+
     Parameters
     ----------
     system : ukflex.System
@@ -58,124 +64,23 @@ class MechanismDrawer:
     def __init__(self, system, deform_scale: float = 1.0, points_per_element: int = 8):
         self.system = system
         self.scale = float(deform_scale)
-        desc = system.description
+        self.points_per_element = int(points_per_element)
         #: name -> kind ("rigid", "beam", ...), in declaration order
         self.bodies = {name: system.body_kind(name) for name in system.body_names}
-        self.markers = _markers_of(desc)
-        self._beam_S: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
-        self._cable_xi: Dict[str, np.ndarray] = {}
-        self._length: Dict[str, float] = {}
-        for name, kind in self.bodies.items():
-            if kind == "beam":
-                info = system.body_info(name)
-                self._length[name] = float(info["length"])
-                k = max(2, points_per_element * int(info["elements"])) + 1
-                xi = np.linspace(0.0, 1.0, k)
-                S = np.array([np.asarray(system.beam_shape(name, float(x))[0]) for x in xi])  # (k, 2, n_f)
-                self._beam_S[name] = (xi * self._length[name], S)
-            elif kind == "cable":
-                info = system.body_info(name)
-                self._length[name] = float(info["length"])
-                self._cable_xi[name] = np.linspace(0.0, 1.0, max(2, points_per_element * int(info["elements"])) + 1)
-        # flexible bodies: drawn through their interface points (declaration order, closed),
-        # each with its displacement rows
-        self._flex: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
-        for b in desc["bodies"]:
-            if b.get("kind") == "flexible" and b["markers"]:
-                pts = np.array([m["point"] for m in b["markers"]], dtype=float)
-                disp = np.array([m["displacement"] for m in b["markers"]], dtype=float)  # (k, 2, n_f)
-                self._flex[b["name"]] = (pts, disp)
-        self._marker_S: Dict[int, np.ndarray] = {}
-        for i, (_, m, _) in enumerate(self.markers):
-            body = m["body"]
-            if body != GROUND and self.bodies[body] == "beam":
-                self._marker_S[i] = np.asarray(system.beam_shape(body, float(m["xi"]))[0])
-        # rigid bodies: the attachment points in the body frame and the centre of mass
-        self._rigid_points: Dict[str, np.ndarray] = {}
-        self._com: Dict[str, np.ndarray] = {}
-        for b in desc["bodies"]:
-            name = b["name"]
-            if self.bodies[name] == "rigid":
-                self._com[name] = np.asarray(system.body_info(name)["com"], dtype=float)
-                pts = [tuple(m["point"]) for _, m, _ in self.markers if m["body"] == name and "point" in m]
-                uniq = []
-                for p in pts:
-                    if all(math.hypot(p[0] - u[0], p[1] - u[1]) > 1e-12 for u in uniq):
-                        uniq.append(p)
-                self._rigid_points[name] = np.array(uniq, dtype=float).reshape(-1, 2)
-
-    def _frame(self, q: np.ndarray, name: str):
-        """(position (2,), rotation matrix (2, 2)) of body ``name``'s frame at ``q``."""
-        qb = q[self.system.body_slice(name)]
-        if self.bodies[name] == "point_mass":  # a particle: no orientation
-            return qb[:2], np.eye(2)
-        c, s = math.cos(qb[2]), math.sin(qb[2])
-        return qb[:2], np.array([[c, -s], [s, c]])
-
-    def _cable_points(self, q: np.ndarray, name: str, xi: Sequence[float]) -> np.ndarray:
-        """World points (k, 2) of an ANCF beam's axis at ``xi``: the chord frame of its ends plus
-        the magnified displacement from the chord."""
-        p = np.array([self.system.beam_point(name, float(x), q) for x in (0.0, 1.0, *xi)])
-        e = p[1, :2] - p[0, :2]
-        e /= np.linalg.norm(e)
-        R = np.array([[e[0], -e[1]], [e[1], e[0]]])
-        local = np.column_stack([np.asarray(xi) * self._length[name] + self.scale * p[2:, 2], self.scale * p[2:, 3]])
-        return p[0, :2] + local @ R.T
+        self.markers = _markers_of(system.description)
+        #: the joints in the order of the core's constraints (joints first, then drivers)
+        self._joints = list(system.description.get("joints") or [])
 
     def body_polyline(self, q: np.ndarray, name: str) -> np.ndarray:
         """World points (k, 2) drawing body ``name`` at ``q``."""
-        if self.bodies[name] == "cable":
-            return self._cable_points(q, name, self._cable_xi[name])
-        r, R = self._frame(q, name)
-        if self.bodies[name] == "point_mass":
-            return r[None, :]
-        if self.bodies[name] == "flexible":
-            pts, disp = self._flex[name]
-            local = pts + self.scale * (disp @ q[self.system.elastic_slice(name)])
-            return r + np.vstack([local, local[:1]]) @ R.T
-        if self.bodies[name] == "beam":
-            x, S = self._beam_S[name]
-            disp = S @ q[self.system.elastic_slice(name)]  # (k, 2)
-            local = np.column_stack([x + self.scale * disp[:, 0], self.scale * disp[:, 1]])
-            return r + local @ R.T
-        com = self._com[name]
-        pts = self._rigid_points[name]
-        if pts.shape[0] == 0:
-            local = com[None, :]
-        elif pts.shape[0] == 1:  # one attachment: a bar symmetric about the centre of mass
-            local = np.array([pts[0], 2.0 * com - pts[0]])
-        else:
-            seq = []
-            for p in pts:  # a star: com -> p -> com -> next point ...
-                seq += [com, p, com]
-            local = np.array(seq)
-        return r + local @ R.T
-
-    def marker_position(self, q: np.ndarray, i: int) -> np.ndarray:
-        """World position (2,) of marker ``i`` (index into ``self.markers``)."""
-        _, m, _ = self.markers[i]
-        body = m["body"]
-        if body == GROUND:
-            return np.asarray(m["point"], dtype=float)
-        if self.bodies[body] == "cable":
-            return self._cable_points(q, body, [float(m["xi"])])[0]
-        r, R = self._frame(q, body)
-        if self.bodies[body] == "flexible":
-            pts, disp = self._flex[body]
-            k = int(np.argmin(np.sum((pts - np.asarray(m["point"], dtype=float)) ** 2, axis=1)))
-            return r + R @ (pts[k] + self.scale * disp[k] @ q[self.system.elastic_slice(body)])
-        if i in self._marker_S:
-            d = self._marker_S[i] @ q[self.system.elastic_slice(body)]
-            local = np.array([m["xi"] * self._length[body] + self.scale * d[0], self.scale * d[1]])
-        else:
-            local = np.asarray(m.get("point", (0.0, 0.0)), dtype=float)
-        return r + R @ local
+        return np.asarray(self.system.core.outline(name, np.asarray(q, dtype=float), self.scale,
+                                                   self.points_per_element))
 
     def joint_positions(self, q: np.ndarray) -> np.ndarray:
         """World positions (k, 2) of the joints' first markers (revolute, weld) and of points on lines."""
-        out = [self.marker_position(q, i) for i, (kind, _, role) in enumerate(self.markers)
-               if (kind in ("revolute", "weld") and role == "a") or (kind == "point_on_line" and role == "point")]
-        return np.array(out).reshape(-1, 2)
+        points = list(self.system.core.marker_points(np.asarray(q, dtype=float), self.scale).values())
+        out = [p[0] for j, p in zip(self._joints, points) if j["kind"] in ("revolute", "weld", "point_on_line")]
+        return np.array(out, dtype=float).reshape(-1, 2)
 
     def ground_points(self) -> np.ndarray:
         pts = [m["point"] for kind, m, role in self.markers
@@ -227,11 +132,11 @@ class _Scene2D:
         if gp.size:
             ax.plot(gp[:, 0], gp[:, 1], "^", color="0.3", ms=9, zorder=1)
         self.lines = {}
-        for k, (name, kind) in enumerate(drawer.bodies.items()):
-            lw = 2.5 if drawer.system.capabilities(name)["beam"] else 4.0
-            (ln,) = ax.plot([], [], "-", lw=lw, color=self.COLORS[k % len(self.COLORS)], label=name,
-                            solid_capstyle="round", zorder=2, marker="o" if kind in ("rigid", "point_mass") else None,
-                            ms=8 if kind == "point_mass" else 3)
+        for k, name in enumerate(drawer.bodies):
+            can = drawer.system.capabilities(name)
+            (ln,) = ax.plot([], [], "-", lw=2.5 if can["beam"] else 4.0, color=self.COLORS[k % len(self.COLORS)],
+                            label=name, solid_capstyle="round", zorder=2, marker=None if can["elastic"] else "o",
+                            ms=3 if can["oriented"] else 8)
             self.lines[name] = ln
         (self.joints,) = ax.plot([], [], "o", ms=6, mfc="white", mec="k", mew=1.2, zorder=3)
         self.text = ax.text(0.02, 0.96, "", transform=ax.transAxes, va="top", fontsize=9)
@@ -344,7 +249,7 @@ def snapshots(
             p = drawer.body_polyline(res.q[:, i], name)
             ax.plot(p[:, 0], p[:, 1], "-", color=_Scene2D.COLORS[c % len(_Scene2D.COLORS)], alpha=alpha,
                     lw=2.0, label=name if k == len(idx) - 1 else None,
-                    marker="o" if drawer.bodies[name] == "point_mass" else None, ms=7)
+                    marker=None if drawer.system.capabilities(name)["oriented"] else "o", ms=7)
     sc.text.set_text("t = " + ", ".join(f"{res.t[i]:.3g}" for i in idx) + " s")
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()

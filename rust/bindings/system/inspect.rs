@@ -72,6 +72,46 @@ impl PySystem {
         mat(py, k, nb, nb)
     }
 
+    /// World points (k, 2) drawing planar body `body` at `q` (animation): a beam's axis, a
+    /// cable's axis, a flexible body's interface points (closed), a rigid body's star from its
+    /// centre of mass to the points where joints and forces attach, a point mass's position;
+    /// elastic displacements magnified by `deform_scale` in the body's reference frame
+    /// (`rust/body/outline.rs`).
+    #[pyo3(signature = (body, q, deform_scale=1.0, points_per_element=8))]
+    fn outline<'py>(&self, py: Python<'py>, body: &str, q: Vector<'py>, deform_scale: f64, points_per_element: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        crate::body::outline::check_drawing(deform_scale, points_per_element).map_err(to_py)?;
+        let bi = self.body(body)?;
+        let mut qv = vec![0.0; self.model.n];
+        read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
+        let attach = self.model.attachments(bi);
+        let pts = self.model.bodies[bi].outline(&qv, deform_scale, points_per_element, &attach).map_err(to_py)?;
+        let flat: Vec<f64> = pts.iter().flatten().copied().collect();
+        finite_out("outline", &flat).map_err(to_py)?;
+        mat(py, flat, pts.len(), 2)
+    }
+
+    /// World points of every joint's and driver's markers at `q` (animation), in the order of
+    /// `constraint_names`' items: `{name: [point a or None, point b or None]}` (a point-on-line's
+    /// point and line, a coordinate driver's point), elastic displacements magnified by
+    /// `deform_scale`.
+    #[pyo3(signature = (q, deform_scale=1.0))]
+    fn marker_points<'py>(&self, py: Python<'py>, q: Vector<'py>, deform_scale: f64) -> PyResult<Bound<'py, PyDict>> {
+        crate::body::outline::check_drawing(deform_scale, 1).map_err(to_py)?;
+        if self.model.bodies.iter().any(|b| matches!(b.kind, crate::body::BodyKind::Rigid3(_) | crate::body::BodyKind::Point3(_))) {
+            return Err(arg_err("marker_points", "planar scenes only (a spatial scene is drawn by the 3D animation)"));
+        }
+        let mut qv = vec![0.0; self.model.n];
+        read_into("q", &q.as_array(), &mut qv).map_err(to_py)?;
+        let d = PyDict::new(py);
+        for c in &self.model.constraints {
+            let pts: Vec<Option<[f64; 2]>> = c.markers().iter()
+                .map(|m| m.map(|m| crate::body::outline::marker_point(&self.model.bodies, m, &qv, deform_scale)))
+                .collect();
+            d.set_item(&c.name, pts)?;
+        }
+        Ok(d)
+    }
+
     /// Axis point `xi` of beam `body` at the states `q`: an array (5,) for q of shape (n,), or
     /// (5, nt) for q of shape (n, nt) (time along the last axis, as `SimulationResult.q`), with
     /// rows x, y (world position), u, v (displacement
