@@ -35,9 +35,9 @@ def _controller() -> Any:
     if _CONTROLLER is None:
         import numpy  # noqa: F401  (make sure the libraries are loaded before they are listed)
         import scipy.linalg  # noqa: F401
-        from threadpoolctl import ThreadpoolController
+        from ..errors import require
 
-        _CONTROLLER = ThreadpoolController()
+        _CONTROLLER = require("threadpoolctl", "limiting BLAS threads", extra="sweep").ThreadpoolController()
     return _CONTROLLER
 
 
