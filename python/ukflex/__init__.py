@@ -18,6 +18,7 @@ from .errors import (
     BudgetError,
     ExpressionError,
     InconsistentInitialStateError,
+    InitialCorrectionWarning,
     InvalidArgumentError,
     InvalidSceneError,
     MissingDependencyError,
@@ -55,6 +56,7 @@ from .run.sweep import sweep
 from .model import scenes
 from .model.spatial import SpatialScene
 from .results.spatial import outputs as spatial_outputs
+from .results.vtk import export_vtk
 
 #: Public modules of the rooms, loaded on first use: ``ukflex.fe`` (flexible bodies from FE
 #: data, :mod:`ukflex.model.fe`) and ``ukflex.stability`` (diagnostics of runs,
@@ -87,6 +89,7 @@ __all__ = [
     "Scene",
     "SpatialScene",
     "spatial_outputs",
+    "export_vtk",
     "Marker",
     "RigidBodyRef",
     "PointMassRef",
@@ -123,4 +126,5 @@ __all__ = [
     "UnknownOptionError",
     "UnknownNameError",
     "SingularConfigurationWarning",
+    "InitialCorrectionWarning",
 ]
