@@ -112,6 +112,13 @@ def test_initial_correction_warns_when_it_moves_a_driven_coordinate():
     assert len(rec) == 1
     assert rec[0].message.moves["crank_speed"] == pytest.approx(-math.pi / 2, abs=1e-12)
     assert system.q0[system.coordinate_index("crank.theta")] == pytest.approx(0.0, abs=1e-12)
+    # an unnamed driver is named as the core names it
+    s = ukflex.Scene()
+    crank = s.rigid_body("crank", mass=1.0, inertia=0.1, com=(0.05, 0.0), angle=0.3)
+    s.revolute(s.ground.point(0, 0), crank.point(0, 0))
+    s.angle_driver(crank.frame(), ukflex.ConstantSpeed(1.0))
+    with pytest.warns(ukflex.InitialCorrectionWarning, match="angle_driver0' by -0.3 rad"):
+        s.build()
     # below the tolerance: no warning
     d["drivers"][0]["motion"]["initial"] = math.pi / 2 - 0.5 * ukflex.System.DRIVEN_MOVE_TOL
     with warnings.catch_warnings():

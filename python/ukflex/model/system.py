@@ -682,7 +682,7 @@ class System:
         by driver name: planar drivers' rows are ``driven value - f(t)`` (so ``Phi(t0, q)`` plus a
         constant); spatial rotation drivers' rows are ``sin(theta - f)``, so their angle is the
         core's (``driver_values`` of :func:`ukflex.spatial_outputs`)."""
-        names = [d["name"] for d in self.description.get("drivers") or []]
+        names = list(self.core.driver_names)  # the core's names (declaration order; defaults for unnamed drivers)
         if not names:
             return {}
         q = np.asarray(q, dtype=float)
@@ -701,7 +701,7 @@ class System:
         if not before:
             return
         scale = length_scale(self.description)
-        kinds = {d["name"]: d.get("kind") for d in self.description.get("drivers") or []}
+        kinds = dict(zip(self.core.driver_names, (d.get("kind") for d in self.description.get("drivers") or [])))
         moves, parts = {}, []
         for name, b in before.items():
             move = after[name] - b
