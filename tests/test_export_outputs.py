@@ -249,3 +249,15 @@ def test_export_vtk_of_a_spatial_scene(tmp_path):
         assert np.allclose(m.points[0], out["position"][k], atol=1e-14)  # the centre of mass
         assert np.allclose(m.points[1], 0.0, atol=1e-9)  # the pivot, on the ground's point
         assert np.allclose(m.point_data["z_axis"][0], out["rotation"][k][:, 2], atol=1e-14)
+
+
+def test_from_mesh_reports_progress_by_stage():
+    seen = []
+    fe.from_mesh(_rect(4, 1), thickness=0.01, interfaces=_ends(), modes=2, progress=seen.append, **STEEL)
+    assert seen == [fe.FE_STAGES["assembled"], fe.FE_STAGES["reduced"], 1.0]
+    seen.clear()
+    fe.from_mesh(_rect(4, 1), thickness=0.01, interfaces=_ends(), modes=2, strain="nonlinear", progress=seen.append,
+                 **STEEL)
+    assert seen == sorted(seen) and seen[-2:] == [fe.FE_STAGES["nonlinear"], 1.0] and len(seen) == 4
+    with pytest.raises(ukflex.InvalidArgumentError, match="progress"):
+        fe.from_mesh(_rect(2, 1), thickness=0.01, interfaces=_ends(), modes=2, progress=True, **STEEL)
