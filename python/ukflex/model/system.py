@@ -677,7 +677,7 @@ class System:
     #: drivers) raises an :class:`ukflex.errors.InitialCorrectionWarning`.
     DRIVEN_MOVE_TOL = 1e-3
 
-    def driven_values(self, q: np.ndarray) -> Dict[str, float]:
+    def _driven_values(self, q: np.ndarray) -> Dict[str, float]:
         """The coordinate each driver holds at ``q``, up to the driver's value at ``t0`` (rad or m),
         by driver name: planar drivers' rows are ``driven value - f(t)`` (so ``Phi(t0, q)`` plus a
         constant); spatial rotation drivers' rows are ``sin(theta - f)``, so their angle is the
@@ -697,7 +697,7 @@ class System:
     def _warn_driven_moves(self, q_guess: np.ndarray, q: np.ndarray) -> None:
         """Warn once (:class:`InitialCorrectionWarning`) naming every driver whose driven
         coordinate the correction moved by more than :data:`DRIVEN_MOVE_TOL`."""
-        before, after = self.driven_values(q_guess), self.driven_values(q)
+        before, after = self._driven_values(q_guess), self._driven_values(q)
         if not before:
             return
         scale = length_scale(self.description)
