@@ -611,7 +611,9 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_
     """Reduce a flexible body (e.g. nodal, with its frame fixed by reference conditions) to its
     ``modes`` lowest eigenmodes of ``(K_ff, M_ff)``: every invariant is projected on the basis
     (``k3``/``k4`` too).  ``info["frequencies"]`` holds the frequencies (rad/s) of the reduced
-    model, ``info["modes"]`` the basis (n_f of ``data``, n_f of the result).
+    model, ``info["modes"]`` the basis (n_f of ``data``, n_f of the result); of mesh data
+    (:func:`from_mesh`) also the mesh, ``info["nodal_modes"]`` (2N, n_f of the result) and the
+    ``stress_modes`` on the new basis (for :mod:`ukflex.results.fields`).
 
     ``modal_derivatives`` (needs ``k3``, i.e. nonlinear strain data) adds the static modal
     derivatives ``K^-1 k3(phi_i, phi_j)``, ``i <= j``, of the kept modes (``True``) or of the
@@ -655,10 +657,15 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_
         d_ff = (d_ff if d_ff is not None else 0.0) + np.diag(2.0 * damping_ratio * w)
     markers = {name: InterfacePoint(pt.point, np.asarray(pt.displacement) @ p, None if pt.rotation is None else np.asarray(pt.rotation) @ p)
                for name, pt in data.markers.items()}
+    info: Dict[str, Any] = {"frequencies": w, "modes": p}
+    if "stress_modes" in data.info:  # mesh data (fe.from_mesh): its nodal fields on the new basis
+        nodal = np.asarray(data.info.get("nodal_modes", data.info["modes"]), dtype=float)
+        info.update({k: data.info[k] for k in ("points", "cells", "nodes")},
+                    nodal_modes=nodal @ p, stress_modes=np.asarray(data.info["stress_modes"], dtype=float) @ p)
     return FlexibleData(mass=data.mass, inertia=data.inertia, com=data.com, s_bar=np.asarray(data.s_bar) @ p,
                         s_u0=p.T @ np.asarray(data.s_u0), s_ju0=p.T @ np.asarray(data.s_ju0), s_tilde=_antisym(proj(data.s_tilde)),
                         m_ff=np.eye(n_r), k_ff=np.diag(lam), d_ff=d_ff, m_ff_tr=proj(data.m_ff_tr), k3=k3, k4=k4,
-                        markers=markers, info={"frequencies": w, "modes": p})
+                        markers=markers, info=info)
 
 
 def _antisym(a: np.ndarray) -> np.ndarray:

@@ -33,16 +33,16 @@ def check_mesh_data(system: Any, body: str, data: Any) -> np.ndarray:
     info = getattr(data, "info", None)
     if not isinstance(info, dict) or any(k not in info for k in ("cells", "nodes", "modes", "stress_modes")):
         raise InvalidArgumentError("data", f"the data of body {body!r} must be the FlexibleData that ukflex.fe.from_mesh "
-                                   "returned (its info holds the mesh, the nodal modes and their stress shapes)")
+                                   "(or fe.reduce of it) returned: its info holds the mesh, the nodal modes and their "
+                                   "stress shapes")
     entry = next(b for b in system.description["bodies"] if b["name"] == body)
     k_ff = np.asarray(entry["k_ff"], dtype=float)
     if np.shape(data.k_ff) != k_ff.shape or not np.allclose(np.asarray(data.k_ff, dtype=float), k_ff, rtol=1e-12, atol=0.0):
         raise InvalidArgumentError("data", f"the data given for body {body!r} is not the one the body was built from "
                                    "(its stiffness k_ff differs)")
-    modes = np.asarray(info["modes"], dtype=float)
+    modes = np.asarray(info.get("nodal_modes", info["modes"]), dtype=float)  # fe.reduce: nodal_modes
     if modes.shape != (2 * np.asarray(info["nodes"]).shape[0], k_ff.shape[0]):
-        raise InvalidArgumentError("data", f"the modes of body {body!r} are not nodal ({modes.shape}); give the data of "
-                                   "ukflex.fe.from_mesh itself (fe.reduce keeps no nodal modes)")
+        raise InvalidArgumentError("data", f"the modes of body {body!r} are not nodal ({modes.shape})")
     return modes
 
 
@@ -56,7 +56,8 @@ def modal_fields(system: Any, result: Any, body: str, data: Any) -> Dict[str, np
     body : str
         A flexible body of the system.
     data : FlexibleData
-        What :func:`ukflex.fe.from_mesh` returned for it (checked: same ``k_ff``).
+        What :func:`ukflex.fe.from_mesh` (or :func:`ukflex.fe.reduce` of it) returned for it
+        (checked: same ``k_ff``).
 
     Returns
     -------
