@@ -35,9 +35,9 @@ def _controller() -> Any:
     if _CONTROLLER is None:
         import numpy  # noqa: F401  (make sure the libraries are loaded before they are listed)
         import scipy.linalg  # noqa: F401
-        from ..errors import require
+        from threadpoolctl import ThreadpoolController
 
-        _CONTROLLER = require("threadpoolctl", "limiting BLAS threads", extra="sweep").ThreadpoolController()
+        _CONTROLLER = ThreadpoolController()
     return _CONTROLLER
 
 

@@ -13,13 +13,9 @@ import numpy as np
 
 def run(model, q0, qd0, t_end, h):
     """Positions and rotation matrices of every body at ``t_end`` (dicts by body name)."""
-    from ...errors import require
-
-    exu = require("exudyn", "the Exudyn peer runs", extra="peers")
-    items = require("exudyn.itemInterface", "the Exudyn peer runs", extra="peers")
-    LoadMassProportional, MarkerBodyMass, MarkerBodyPosition = items.LoadMassProportional, items.MarkerBodyMass, items.MarkerBodyPosition
-    NodeRigidBodyEP, ObjectGround, ObjectJointSpherical, ObjectRigidBody = (items.NodeRigidBodyEP, items.ObjectGround,
-                                                                           items.ObjectJointSpherical, items.ObjectRigidBody)
+    import exudyn as exu
+    from exudyn.itemInterface import (LoadMassProportional, MarkerBodyMass, MarkerBodyPosition,
+                                      NodeRigidBodyEP, ObjectGround, ObjectJointSpherical, ObjectRigidBody)
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
     ground = mbs.AddObject(ObjectGround())
