@@ -19,6 +19,7 @@ from .errors import (
     BudgetError,
     ExpressionError,
     InconsistentInitialStateError,
+    InitialCorrectionWarning,
     InvalidArgumentError,
     InvalidSceneError,
     MissingDependencyError,
@@ -57,6 +58,7 @@ from .model import scenes
 from .model.spatial import SpatialScene
 from .model import spatial_scenes
 from .results.spatial import outputs as spatial_outputs
+from .results.vtk import export_vtk
 
 #: Public modules of the rooms, loaded on first use: ``ukflex.fe`` (flexible bodies from FE
 #: data, :mod:`ukflex.model.fe`) and ``ukflex.stability`` (diagnostics of runs,
@@ -89,6 +91,7 @@ __all__ = [
     "Scene",
     "SpatialScene",
     "spatial_outputs",
+    "export_vtk",
     "Marker",
     "RigidBodyRef",
     "PointMassRef",
@@ -126,4 +129,5 @@ __all__ = [
     "UnknownOptionError",
     "UnknownNameError",
     "SingularConfigurationWarning",
+    "InitialCorrectionWarning",
 ]

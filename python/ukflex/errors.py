@@ -40,6 +40,7 @@ __all__ = [
     "SingularConfigurationWarning",
     "BucklingWarning",
     "ModelValidityWarning",
+    "InitialCorrectionWarning",
 ]
 
 UkflexError = core.UkflexError
@@ -202,3 +203,21 @@ class BucklingWarning(StabilityWarning):
 
 class ModelValidityWarning(StabilityWarning):
     """The linear-elastic FFRF model (small deformations) is outside its range of validity."""
+
+
+class InitialCorrectionWarning(UserWarning):
+    """The initial-state correction moved a driven coordinate (the angle of an angle or rotation
+    driver, the position of a coordinate or translation driver) by more than
+    :data:`ukflex.System.DRIVEN_MOVE_TOL`: the guess and the driver's value at ``t0`` disagree
+    (e.g. a body placed at 90 degrees and ``ConstantSpeed(omega)`` without ``initial=``), and the
+    correction moved the mechanism to the driver's value.
+
+    Attributes
+    ----------
+    moves : dict
+        Driver name -> the move of its driven coordinate (rad or m; value after minus guess).
+    """
+
+    def __init__(self, message: str, moves=None):
+        super().__init__(message)
+        self.moves = dict(moves or {})

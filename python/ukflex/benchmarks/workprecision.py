@@ -527,7 +527,9 @@ def _figure(size):
 
 
 def _draw_lines(ax, rows, key, color_of, style_of, label_of, budget):
-    from matplotlib.transforms import blended_transform_factory
+    from ..errors import require
+
+    blended_transform_factory = require("matplotlib.transforms", "the work-precision plot (--no-plot skips it)").blended_transform_factory
 
     lines: Dict[Tuple, List[Dict[str, Any]]] = {}
     for r in rows:

@@ -205,6 +205,8 @@ def _cmd_export(args: argparse.Namespace) -> int:
     if args.output not in (None, "-"):
         _writable_file(args.output, "-o")
     scene = SCENES[args.scene](**_parse_params(args.param))
+    if args.vtk is not None:
+        return _export_vtk_run(scene, args)
     doc = _scene_summary(SCENES[args.scene])
     params = " ".join(f"--param {p}" for p in args.param)
     text = dumps(scene, name=args.scene, description=doc,
@@ -217,6 +219,19 @@ def _cmd_export(args: argparse.Namespace) -> int:
         with open(args.output, "w", encoding="utf-8") as fh:
             fh.write(text)
         print(f"wrote {args.output}")
+    return 0
+
+
+def _export_vtk_run(scene: Any, args: argparse.Namespace) -> int:
+    """``ukflex export NAME --vtk FILE.pvd``: run the scene (--t-end, --method, --rtol, --samples)
+    and write the run for ParaView (docs/outputs.md)."""
+    from ..results.vtk import export_vtk
+    from ..run.simulate import simulate
+
+    system = scene.build()
+    res = simulate(system, args.t_end, method=args.method, rtol=args.rtol,
+                   t_eval=np.linspace(system.t0, system.t0 + args.t_end, args.samples))
+    print(f"wrote {export_vtk(system, res, args.vtk)} ({res.t.size} output times)")
     return 0
 
 
@@ -273,4 +288,8 @@ def _add_list_export_parsers(sub) -> None:
     p.add_argument("--t-end", type=_positive_float, default=0.1, help="[solver] t_end to write (default 0.1)")
     p.add_argument("--method", default="auto", help="[solver] method to write (default auto)")
     p.add_argument("--rtol", type=_positive_float, default=1e-6, help="[solver] rtol to write (default 1e-6)")
+    p.add_argument("--vtk", default=None, metavar="FILE.pvd",
+                   help="instead, run the scene (--t-end, --method, --rtol) and write it for ParaView: FILE.pvd "
+                        "and FILE/*.vtu (docs/outputs.md)")
+    p.add_argument("--samples", type=_positive_int, default=101, help="output times of the --vtk run (default 101)")
     p.set_defaults(func=_cmd_export)

@@ -26,14 +26,15 @@ rotation about it).  Reduction (``frame``):
 
 from __future__ import annotations
 
+import os
 import reprlib
-from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import scipy.linalg as sla
 
 from ..arguments import count, non_negative, positive, real, real_array
-from ..errors import InvalidArgumentError
+from ..errors import InvalidArgumentError, require
 from .flexible import FlexibleData, InterfacePoint
 
 __all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices", "reduce"]
@@ -265,8 +266,6 @@ def _invariants(x: np.ndarray, mm: np.ndarray, m_scalar: np.ndarray, phi: np.nda
 def _mesh_basis(points: np.ndarray, cells: np.ndarray, order: int) -> Tuple[Any, np.ndarray, np.ndarray]:
     """scikit-fem vector basis of the mesh, the permutation ``perm`` (node dof ``j`` = scikit-fem
     dof ``perm[j]``; node dofs ``x_1, y_1, x_2, ...``) and the node coordinates (N, 2)."""
-    from ..errors import require
-
     skfem = require("skfem", "ukflex.fe.from_mesh", extra="fe")
     if order not in (1, 2) or isinstance(order, bool):
         raise InvalidArgumentError("order", f"order must be 1 (P1/Q1) or 2 (P2/Q2), got {order!r}")
@@ -280,16 +279,56 @@ def _mesh_basis(points: np.ndarray, cells: np.ndarray, order: int) -> Tuple[Any,
     else:
         raise InvalidArgumentError("cells", "cells must be triangles (E, 3) or quadrilaterals (E, 4)")
     basis = skfem.Basis(mesh, skfem.ElementVector(scalar))
-    # vector dofs by location: row 0 the x component, row 1 the y component (vertices, then edge
-    # midpoints, then cell interiors)
+    per_node = _node_dofs(basis, order)  # (2, N)
+    nodes = np.ascontiguousarray(basis.doflocs[:, per_node[0]].T)
+    return basis, per_node.T.ravel(), nodes
+
+
+def _node_dofs(basis: Any, order: int) -> np.ndarray:
+    """The dofs of a (vector or scalar) scikit-fem basis by node, (components, N): vertices,
+    then (order 2) edge midpoints, then cell interiors (the node order of :func:`_mesh_basis`)."""
     groups = [basis.nodal_dofs]
     if order == 2:
         groups.append(basis.facet_dofs)
         if getattr(basis, "interior_dofs", None) is not None and basis.interior_dofs.size:
             groups.append(basis.interior_dofs)
-    per_node = np.hstack(groups)  # (2, N)
-    nodes = np.ascontiguousarray(basis.doflocs[:, per_node[0]].T)
-    return basis, per_node.T.ravel(), nodes
+    return np.hstack(groups)
+
+
+def _stress_modes(basis: Any, perm: np.ndarray, phi: np.ndarray, order: int, lam: float, mu: float) -> np.ndarray:
+    """Plane-stress stress shapes of the columns of ``phi`` at the nodes, (N, 3, n_f):
+    ``sigma_xx, sigma_yy, sigma_xy`` (body frame) of each mode, recovered at the nodes from the
+    stresses at the element's superconvergent points (order 2: the 2 x 2 Gauss points of a Q2
+    quad, the 3-point rule of a P2 triangle), fitted by the element of one order less (bilinear,
+    linear) and evaluated at the element's nodes; order 1: the element's mean stress. Each node
+    takes the mean over the elements around it."""
+    skfem = require("skfem", "ukflex.fe.from_mesh (stress shapes)", extra="fe")
+    elem = basis.elem.elem  # the scalar element
+    reduced = skfem.Basis(basis.mesh, basis.elem, intorder=2)  # same dofs, the reduced points
+    g, _ = _mode_gradients(reduced, perm, phi)
+    sig = _stress(0.5 * (g + np.swapaxes(g, 1, 2)), lam, mu)  # (r, 2, 2, E, Q)
+    comps = np.stack([sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1]], axis=1)  # (r, 3, E, Q)
+    x = np.asarray(reduced.X).T  # (Q, 2) reference coordinates of the points
+    local = np.asarray(elem.doflocs, dtype=float)  # (n_loc, 2) reference coordinates of the nodes
+    if order == 1:
+        fit = np.full((local.shape[0], x.shape[0]), 1.0 / x.shape[0])
+    else:
+        quad = basis.mesh.t.shape[0] == 4
+
+        def monomials(p: np.ndarray) -> np.ndarray:
+            cols = [np.ones(len(p)), p[:, 0], p[:, 1]] + ([p[:, 0] * p[:, 1]] if quad else [])
+            return np.column_stack(cols)
+
+        fit = monomials(local) @ np.linalg.inv(monomials(x))  # (n_loc, Q)
+    at_nodes = np.einsum("lq,rceq->elcr", fit, comps)  # (E, n_loc, 3, r)
+    scalar = basis.with_element(elem)
+    node_dofs = _node_dofs(scalar, order)[0]
+    node_of = np.empty(scalar.N, dtype=np.int64)
+    node_of[node_dofs] = np.arange(node_dofs.size)
+    idx = node_of[np.asarray(scalar.element_dofs).T]  # (E, n_loc)
+    out = np.zeros((node_dofs.size, 3, phi.shape[1]))
+    np.add.at(out, idx.ravel(), at_nodes.reshape(-1, 3, phi.shape[1]))
+    return out / np.bincount(idx.ravel(), minlength=node_dofs.size)[:, None, None]
 
 
 def _mesh_arrays(points: Any, cells: Any) -> Tuple[np.ndarray, np.ndarray]:
@@ -348,9 +387,9 @@ def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickne
     bending: shear locking).  ``order=2``: quadratic triangles (P2, 6 nodes) / biquadratic quads
     (Q2, 9 nodes), which represent pure bending exactly; the nodes are the mesh points followed by
     the edge midpoints (and, for Q2, the cell centres)."""
-    import skfem
-    from skfem.helpers import dot
-    from skfem.models.elasticity import linear_elasticity
+    skfem = require("skfem", "ukflex.fe.plane_stress_mesh_matrices", extra="fe")
+    dot = require("skfem.helpers", "ukflex.fe.plane_stress_mesh_matrices", extra="fe").dot
+    linear_elasticity = require("skfem.models.elasticity", "ukflex.fe.plane_stress_mesh_matrices", extra="fe").linear_elasticity
 
     thickness, density, youngs_modulus, poisson_ratio = _material(thickness, density, youngs_modulus, poisson_ratio)
     basis, perm, nodes = _mesh_basis(points, cells, order)
@@ -365,21 +404,69 @@ def plane_stress_mesh_matrices(points: np.ndarray, cells: np.ndarray, *, thickne
     return mm[np.ix_(perm, perm)], kk[np.ix_(perm, perm)], nodes
 
 
+#: Fractions of :func:`from_mesh`'s work done after each stage (its ``progress``), measured on a
+#: Q2 mesh of 2322 dofs (docs/flexible-bodies.md: 9 % assembly, 91 % the dense eigen solve).
+FE_STAGES = {"assembled": 0.1, "reduced": 0.95, "nonlinear": 0.98}
+
+
+def _is_skfem_mesh(mesh: Any) -> bool:
+    return type(mesh).__module__.split(".")[0] == "skfem" and hasattr(mesh, "p") and hasattr(mesh, "t")
+
+
+def _mesh_input(mesh: Any, cells: Any) -> Tuple[Any, Any]:
+    """Points (N, 2|3) and cells (E, 3|4) of what :func:`from_mesh` takes: points with
+    ``cells``, a mesh file (read by meshio), a ``meshio.Mesh`` (every triangle block, or every
+    quad block, joined) or a planar scikit-fem mesh (its vertices ``p`` and cells ``t``)."""
+    if cells is not None:
+        return mesh, cells
+    if isinstance(mesh, (str, os.PathLike)):
+        meshio = require("meshio", "ukflex.fe.from_mesh (reading a mesh file)", extra="fe")
+        try:
+            mesh = meshio.read(mesh)
+        except Exception as exc:  # meshio's ReadError, a missing file, ...
+            raise InvalidArgumentError("mesh", f"cannot read the mesh file {str(mesh)!r}: {type(exc).__name__}: {exc}") from exc
+    if _is_skfem_mesh(mesh):
+        p, t = np.asarray(mesh.p), np.asarray(mesh.t)
+        if p.ndim != 2 or p.shape[0] != 2 or t.ndim != 2 or t.shape[0] not in (3, 4):
+            raise InvalidArgumentError("mesh", f"expected a planar scikit-fem mesh of triangles or quads (MeshTri, "
+                                       f"MeshQuad), got {type(mesh).__name__} with p {p.shape}, t {t.shape}")
+        # a quadratic-geometry mesh (MeshTri2, MeshQuad2) lists its vertices first, then the
+        # edge (and cell) points its cells do not index: the part is meshed with straight edges
+        nv = int(t.max()) + 1
+        return p[:, :nv].T, t.T
+    if not hasattr(mesh, "cells") or not hasattr(mesh, "points"):
+        raise InvalidArgumentError("mesh", "expected a mesh file, a meshio.Mesh, a scikit-fem mesh (MeshTri, MeshQuad) "
+                                   f"or points with cells=, got {type(mesh).__name__}")
+    kinds = sorted({c.type for c in mesh.cells if c.type in ("triangle", "quad")})
+    if not kinds:
+        raise InvalidArgumentError("mesh", "the mesh has no triangle or quad cells (found: "
+                                   f"{sorted({c.type for c in mesh.cells})})")
+    if len(kinds) > 1:
+        raise InvalidArgumentError("mesh", "the mesh mixes triangles and quads; give one kind of cell")
+    return mesh.points, np.vstack([np.asarray(c.data) for c in mesh.cells if c.type == kinds[0]])
+
+
 def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: float, poisson_ratio: float,
               interfaces: Mapping[str, Interface], modes: int = 4, frame: str = "mean-axis",
               fixed: Optional[Sequence[Tuple[str, str]]] = None, damping_ratio: float = 0.0,
               cells: Optional[np.ndarray] = None, order: int = 1, strain: str = "linear",
-              modal_derivatives: Union[bool, int] = False) -> FlexibleData:
+              modal_derivatives: Union[bool, int] = False,
+              progress: Optional[Callable[[float], None]] = None) -> FlexibleData:
     """A :class:`FlexibleData` of a planar part meshed with triangles or quads.
 
-    ``mesh``: a path of any meshio-readable file, a ``meshio.Mesh``, or a points array (N, 2|3)
-    with ``cells``.  The part is plane stress of ``thickness``; ``order`` 1 (P1/Q1) or 2 (P2/Q2,
+    ``mesh``: a path of any meshio-readable file, a ``meshio.Mesh`` (its triangle or quad
+    blocks), a planar scikit-fem mesh (``skfem.MeshTri``, ``MeshQuad``; of a quadratic-geometry
+    ``MeshTri2``/``MeshQuad2`` the vertices, i.e. straight edges), or a points array (N, 2|3)
+    with ``cells``.  A missing scikit-fem or meshio raises :class:`ukflex.MissingDependencyError`.  The part is plane stress of ``thickness``; ``order`` 1 (P1/Q1) or 2 (P2/Q2,
     free of the bending locking of linear elements; see :func:`plane_stress_mesh_matrices`).
     An interface is a node index, a list of them, or a callable taking the (N, 2) node
     coordinates (with ``order=2`` the mid-edge nodes too) and returning a boolean mask or indices
     (e.g. ``lambda p: np.isclose(p[:, 0], 0.0)``: every node of the left edge).  See
-    :func:`from_nodal` for the rest.  ``info["points"]``, ``info["cells"]`` keep the mesh and
-    ``info["nodes"]`` all nodes (for drawing).
+    :func:`from_nodal` for the rest.  ``info["points"]``, ``info["cells"]`` keep the mesh,
+    ``info["nodes"]`` all nodes (for drawing) and ``info["stress_modes"]`` (N, 3, n_f) the
+    plane-stress stress shape of each mode at the nodes (``sigma_xx, sigma_yy, sigma_xy``, body
+    frame, recovered from the element's superconvergent points; for
+    :func:`ukflex.results.fields.modal_fields` and the VTK export).
 
     ``strain="nonlinear"``: the body also gets ``k3``, ``k4``, the plane-stress Green-Lagrange
     strain energy ``int t E:C:E / 2 dA`` (``E = (grad u + grad u^T + grad u^T grad u) / 2``)
@@ -389,6 +476,11 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
     adds the static modal derivatives of the Green-Lagrange energy, ``K^-1 k3(phi_i, phi_j)``,
     to the basis: without them the bending modes of a slender part cannot shorten and the
     reduced part locks (docs/flexible-bodies.md).
+
+    ``progress``: a callable, as :func:`ukflex.simulate`'s, called with the fraction of the
+    build done (in [0, 1]) after each stage: assembly (``FE_STAGES["assembled"]``), the eigen
+    solve of the reduction (``"reduced"``), the nonlinear tensors (``"nonlinear"``, with
+    ``strain="nonlinear"``) and the stress shapes (1.0).
     """
     if strain not in ("linear", "nonlinear"):
         raise InvalidArgumentError("strain", f"expected 'linear' or 'nonlinear', got {strain!r}")
@@ -397,26 +489,15 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
     if modal_derivatives is not False and frame == "mean-axis":
         raise InvalidArgumentError("modal_derivatives", "modal derivatives need a frame fixed by reference conditions "
                                    "(frame='fixed' or 'craig-bampton'): the free-free static problem is singular")
-    if cells is None:
-        if isinstance(mesh, str):
-            import meshio
-
-            try:
-                mesh = meshio.read(mesh)
-            except Exception as exc:  # meshio's ReadError, a missing file, ...
-                raise InvalidArgumentError("mesh", f"cannot read the mesh file {mesh!r}: {type(exc).__name__}: {exc}") from exc
-        if not hasattr(mesh, "cells") or not hasattr(mesh, "points"):
-            raise InvalidArgumentError("mesh", f"expected a mesh file, a meshio.Mesh or points with cells=, got {type(mesh).__name__}")
-        blocks = [c for c in mesh.cells if c.type in ("triangle", "quad")]
-        if not blocks:
-            raise InvalidArgumentError("mesh", "the mesh has no triangle or quad cells")
-        points, cells = mesh.points, blocks[0].data
-    else:
-        points = mesh
+    points, cells = _mesh_input(mesh, cells)
     if not isinstance(interfaces, Mapping):
         raise InvalidArgumentError("interfaces", f"expected a dict name -> node index, indices or selector, got {type(interfaces).__name__}")
+    if progress is not None and not callable(progress):
+        raise InvalidArgumentError("progress", f"expected a callable progress(fraction) or None, got {type(progress).__name__}")
+    done = progress or (lambda fraction: None)
     mm, kk, nodes = plane_stress_mesh_matrices(points, cells, thickness=thickness, density=density,
                                                youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, order=order)
+    done(FE_STAGES["assembled"])
     resolved = {}
     for name, spec in interfaces.items():
         if callable(spec):
@@ -434,6 +515,7 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             resolved[name] = spec
     data = from_nodal(nodes, mm, kk, interfaces=resolved, modes=modes, frame=frame, fixed=fixed,
                       damping_ratio=damping_ratio)
+    done(FE_STAGES["reduced"])
     if strain == "nonlinear":
         basis, perm, _ = _mesh_basis(points, cells, order)
         lam_ps, mu = _plane_stress_lame(youngs_modulus, poisson_ratio)
@@ -458,7 +540,12 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             data = _data_from_basis(nodes, mm, kk, _scalar_mass(mm), iface, phi, damping_ratio)
             data.info["frequencies"] = freq
         data.k3, data.k4 = _green_lagrange_tensors(basis, perm, phi, thickness, lam_ps, mu)
-    data.info.update(points=points, cells=np.asarray(cells), nodes=nodes)
+        done(FE_STAGES["nonlinear"])
+    basis, perm, _ = _mesh_basis(points, cells, order)
+    lam_ps, mu = _plane_stress_lame(*_material(thickness, density, youngs_modulus, poisson_ratio)[2:])
+    data.info.update(points=points, cells=np.asarray(cells), nodes=nodes,
+                     stress_modes=_stress_modes(basis, perm, data.info["modes"], order, lam_ps, mu))
+    done(1.0)
     return data
 
 
@@ -505,8 +592,9 @@ def _green_lagrange_md_loads(basis: Any, perm: np.ndarray, phi: np.ndarray, thic
                              mu: float) -> np.ndarray:
     """Node loads ``k3(., phi_a, phi_b)`` (2N, m (m + 1) / 2), ``a <= b``, of the Green-Lagrange
     energy: ``int t grad N_i : (C:sym(G_a^T G_b) + G_b sigma_a + G_a sigma_b)``."""
-    import skfem
-    from skfem.helpers import ddot, grad
+    skfem = require("skfem", "ukflex.fe.from_mesh (modal derivatives)", extra="fe")
+    helpers = require("skfem.helpers", "ukflex.fe.from_mesh (modal derivatives)", extra="fe")
+    ddot, grad = helpers.ddot, helpers.grad
 
     g, _ = _mode_gradients(basis, perm, phi)
     sig = _stress(0.5 * (g + np.swapaxes(g, 1, 2)), lam, mu)
@@ -531,7 +619,9 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_
     """Reduce a flexible body (e.g. nodal, with its frame fixed by reference conditions) to its
     ``modes`` lowest eigenmodes of ``(K_ff, M_ff)``: every invariant is projected on the basis
     (``k3``/``k4`` too).  ``info["frequencies"]`` holds the frequencies (rad/s) of the reduced
-    model, ``info["modes"]`` the basis (n_f of ``data``, n_f of the result).
+    model, ``info["modes"]`` the basis (n_f of ``data``, n_f of the result); of mesh data
+    (:func:`from_mesh`) also the mesh, ``info["nodal_modes"]`` (2N, n_f of the result) and the
+    ``stress_modes`` on the new basis (for :mod:`ukflex.results.fields`).
 
     ``modal_derivatives`` (needs ``k3``, i.e. nonlinear strain data) adds the static modal
     derivatives ``K^-1 k3(phi_i, phi_j)``, ``i <= j``, of the kept modes (``True``) or of the
@@ -575,10 +665,15 @@ def reduce(data: FlexibleData, modes: int, damping_ratio: float = 0.0, *, modal_
         d_ff = (d_ff if d_ff is not None else 0.0) + np.diag(2.0 * damping_ratio * w)
     markers = {name: InterfacePoint(pt.point, np.asarray(pt.displacement) @ p, None if pt.rotation is None else np.asarray(pt.rotation) @ p)
                for name, pt in data.markers.items()}
+    info: Dict[str, Any] = {"frequencies": w, "modes": p}
+    if "stress_modes" in data.info:  # mesh data (fe.from_mesh): its nodal fields on the new basis
+        nodal = np.asarray(data.info.get("nodal_modes", data.info["modes"]), dtype=float)
+        info.update({k: data.info[k] for k in ("points", "cells", "nodes")},
+                    nodal_modes=nodal @ p, stress_modes=np.asarray(data.info["stress_modes"], dtype=float) @ p)
     return FlexibleData(mass=data.mass, inertia=data.inertia, com=data.com, s_bar=np.asarray(data.s_bar) @ p,
                         s_u0=p.T @ np.asarray(data.s_u0), s_ju0=p.T @ np.asarray(data.s_ju0), s_tilde=_antisym(proj(data.s_tilde)),
                         m_ff=np.eye(n_r), k_ff=np.diag(lam), d_ff=d_ff, m_ff_tr=proj(data.m_ff_tr), k3=k3, k4=k4,
-                        markers=markers, info={"frequencies": w, "modes": p})
+                        markers=markers, info=info)
 
 
 def _antisym(a: np.ndarray) -> np.ndarray:

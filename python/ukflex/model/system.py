@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import reprlib
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
@@ -18,7 +19,7 @@ import numpy as np
 
 from ..arguments import real
 from .description import normalize
-from ..errors import (InconsistentInitialStateError, InvalidArgumentError, InvalidSceneError, NonFiniteError,
+from ..errors import (InconsistentInitialStateError, InitialCorrectionWarning, InvalidArgumentError, InvalidSceneError, NonFiniteError,
                      UnknownNameError, core as _core)
 
 __all__ = ["System", "InitialCorrection"]
@@ -563,6 +564,50 @@ class System:
         core (``rust/scale.rs``); tolerances in metres are read against it."""
         return self.core.length_scale
 
+    #: A driven coordinate moved by the initial correction by more than this (rad for angle and
+    #: rotation drivers; times the scene's length scale, m, for coordinate and translation
+    #: drivers) raises an :class:`ukflex.errors.InitialCorrectionWarning`.
+    DRIVEN_MOVE_TOL = 1e-3
+
+    def _driven_values(self, q: np.ndarray) -> Dict[str, float]:
+        """The coordinate each driver holds at ``q``, up to the driver's value at ``t0`` (rad or m),
+        by driver name: planar drivers' rows are ``driven value - f(t)`` (so ``Phi(t0, q)`` plus a
+        constant); spatial rotation drivers' rows are ``sin(theta - f)``, so their angle is the
+        core's (``driver_values`` of :func:`ukflex.spatial_outputs`)."""
+        names = list(self.core.driver_names)  # the core's names (declaration order; defaults for unnamed drivers)
+        if not names:
+            return {}
+        q = np.asarray(q, dtype=float)
+        if self.description.get("dim") == 3:  # one value per constraint item
+            raw = _core.spatial_outputs(json.dumps(self.description), np.array([self.t0]), q[None, :],
+                                        np.zeros((1, q.size)), False, None, 0.0)
+            values, items = np.asarray(raw["driver_values"])[0], list(raw["reaction_names"])
+        else:  # one value per row (a planar driver has one row, named as the driver)
+            values, items = np.asarray(self.core.phi(self.t0, q), dtype=float), self.constraint_names
+        return {name: float(values[items.index(name)]) for name in names if name in items}
+
+    def _warn_driven_moves(self, q_guess: np.ndarray, q: np.ndarray) -> None:
+        """Warn once (:class:`InitialCorrectionWarning`) naming every driver whose driven
+        coordinate the correction moved by more than :data:`DRIVEN_MOVE_TOL`."""
+        before, after = self._driven_values(q_guess), self._driven_values(q)
+        if not before:
+            return
+        scale = length_scale(self.description)
+        kinds = dict(zip(self.core.driver_names, (d.get("kind") for d in self.description.get("drivers") or [])))
+        moves, parts = {}, []
+        for name, b in before.items():
+            move = after[name] - b
+            angular = kinds[name] in ("angle", "rotation")
+            if abs(move) > self.DRIVEN_MOVE_TOL * (1.0 if angular else scale):
+                moves[name] = move
+                parts.append(f"driver '{name}' by {move:+.4g} rad ({np.degrees(move):+.4g} degrees)" if angular
+                             else f"driver '{name}' by {move:+.4g} m")
+        if moves:
+            warnings.warn(InitialCorrectionWarning(
+                "the initial-state correction moved driven coordinates to the drivers' values at t0: " + "; ".join(parts)
+                + ". The initial guess disagrees with the driver: give the driver's initial value (e.g. "
+                "ConstantSpeed(speed, initial=angle)) or place the body where the driver starts", moves), stacklevel=4)
+
     def _correct(self, q_guess, qd_guess, hold, position_tol, velocity_tol, max_iterations, max_wall_time=None):
         held = self._held_mask(hold)
         rigid = hold is not None and "elastic" in ([hold] if isinstance(hold, str) else list(hold))
@@ -587,6 +632,7 @@ class System:
                 residuals=vres,
             )
         q, qd = np.asarray(c["q"]), np.asarray(c["qd"])
+        self._warn_driven_moves(q_guess, q)
         report = InitialCorrection(
             iterations=int(c["iterations"]),
             position_residual_before=float(c["position_residual_before"]),

@@ -1,0 +1,93 @@
+"""Displacement and stress fields of modal (FE) bodies at their nodes, per output time
+(docs/outputs.md, "Fields of modal bodies").
+
+A node of a flexible body built by :func:`ukflex.fe.from_mesh` with body-frame position ``u0``
+is at ``r = R + A(theta) (u0 + Phi q_f)`` (``Phi`` its rows of the nodal modes); its plane-stress
+stress is ``sigma = sum_k q_k sigma_k`` with the stress shapes ``sigma_k`` of the modes,
+computed once when the body is built (``info["stress_modes"]``).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Dict
+
+import numpy as np
+
+from ..errors import InvalidArgumentError
+
+__all__ = ["modal_fields", "von_mises"]
+
+
+def von_mises(stress: np.ndarray) -> np.ndarray:
+    """Plane-stress von Mises stress of ``stress[..., 3]`` = ``(sigma_xx, sigma_yy, sigma_xy)``:
+    ``sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2)``."""
+    sxx, syy, sxy = stress[..., 0], stress[..., 1], stress[..., 2]
+    return np.sqrt(np.maximum(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy, 0.0))
+
+
+def check_mesh_data(system: Any, body: str, data: Any) -> np.ndarray:
+    """The nodal modes (2N, n_f) of ``data`` after checking that it is the mesh data of ``body``
+    (built by :func:`ukflex.fe.from_mesh`, same ``k_ff`` as the body in the system)."""
+    if system.body_kind(body) != "flexible":
+        raise InvalidArgumentError("body", f"body {body!r} is a {system.body_kind(body)}, not a flexible (modal) body")
+    info = getattr(data, "info", None)
+    if not isinstance(info, dict) or any(k not in info for k in ("cells", "nodes", "modes", "stress_modes")):
+        raise InvalidArgumentError("data", f"the data of body {body!r} must be the FlexibleData that ukflex.fe.from_mesh "
+                                   "(or fe.reduce of it) returned: its info holds the mesh, the nodal modes and their "
+                                   "stress shapes")
+    entry = next(b for b in system.description["bodies"] if b["name"] == body)
+    k_ff = np.asarray(entry["k_ff"], dtype=float)
+    if np.shape(data.k_ff) != k_ff.shape or not np.allclose(np.asarray(data.k_ff, dtype=float), k_ff, rtol=1e-12, atol=0.0):
+        raise InvalidArgumentError("data", f"the data given for body {body!r} is not the one the body was built from "
+                                   "(its stiffness k_ff differs)")
+    modes = np.asarray(info.get("nodal_modes", info["modes"]), dtype=float)  # fe.reduce: nodal_modes
+    if modes.shape != (2 * np.asarray(info["nodes"]).shape[0], k_ff.shape[0]):
+        raise InvalidArgumentError("data", f"the modes of body {body!r} are not nodal ({modes.shape})")
+    return modes
+
+
+def modal_fields(system: Any, result: Any, body: str, data: Any) -> Dict[str, np.ndarray]:
+    """Nodal fields of the modal body ``body`` over the result's output times.
+
+    Parameters
+    ----------
+    system : ukflex.System
+    result : SimulationResult, or positions ``q`` (n,) or (n, nt)
+    body : str
+        A flexible body of the system.
+    data : FlexibleData
+        What :func:`ukflex.fe.from_mesh` (or :func:`ukflex.fe.reduce` of it) returned for it
+        (checked: same ``k_ff``).
+
+    Returns
+    -------
+    dict
+        ``nodes`` (N, 2) body frame, ``cells`` (E, 3|4) (the mesh's vertex indices);
+        ``position`` (nt, N, 2) world; ``displacement`` (nt, N, 2) world, rigid + elastic, from
+        the node's undeformed place at the system's initial state (``R0 + A0 u0``, frame of
+        ``system.q0``); ``elastic`` (nt, N, 2)
+        the elastic displacement ``A Phi q_f`` in the world frame; ``stress`` (nt, N, 3)
+        ``sigma_xx, sigma_yy, sigma_xy`` in the body frame (plane stress, Pa); ``von_mises``
+        (nt, N).
+    """
+    modes = check_mesh_data(system, body, data)
+    q = np.asarray(result.q if hasattr(result, "q") else result, dtype=float)
+    if q.ndim == 1:
+        q = q[:, None]
+    frame = q[system.body_slice(body)][:3]  # (3, nt): x, y, theta
+    qf = q[system.elastic_slice(body)]  # (n_f, nt)
+    nodes = np.asarray(data.info["nodes"], dtype=float)
+    local_el = np.einsum("nf,ft->tn", modes, qf).reshape(qf.shape[1], -1, 2)  # (nt, N, 2) body frame
+    c, s = np.cos(frame[2]), np.sin(frame[2])
+    rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (nt, 2, 2)
+    elastic = np.einsum("tij,tnj->tni", rot, local_el)
+    rigid = np.einsum("tij,nj->tni", rot, nodes)
+    position = frame[:2].T[:, None, :] + rigid + elastic
+    q0 = np.asarray(system.q0, dtype=float)
+    f0 = q0[system.body_slice(body)][:3]
+    c0, s0 = np.cos(f0[2]), np.sin(f0[2])
+    reference = f0[:2] + nodes @ np.array([[c0, -s0], [s0, c0]]).T  # undeformed, at the system's q0
+    stress = np.einsum("nkf,ft->tnk", np.asarray(data.info["stress_modes"], dtype=float), qf)
+    return {"nodes": nodes, "cells": np.asarray(data.info["cells"]), "position": position,
+            "displacement": position - reference[None], "elastic": elastic, "stress": stress,
+            "von_mises": von_mises(stress)}
