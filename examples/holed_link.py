@@ -11,7 +11,8 @@ import os
 
 import numpy as np
 
-from ukflex import ConstantSpeed, Scene, fe, scenefile
+from ukflex import ConstantSpeed, Scene, fe
+from ukflex.model import scenefile
 
 L, LB, OMEGA = 0.1524, 0.3048, 124.8
 W, T = 0.024, 0.004  # link height and thickness [m]
