@@ -144,11 +144,11 @@ def test_initial_correction_warns_for_a_spatial_rotation_driver():
     with pytest.warns(ukflex.InitialCorrectionWarning, match="spin") as rec:
         ukflex.System(scene(1.0))
     assert rec[0].message.moves["spin"] == pytest.approx(-1.0, abs=1e-9)
-    # 2 rad off: the row sin(theta - f) also vanishes at theta = f + pi, where the correction
-    # lands (docs/outputs.md); the warning says how far it moved
+    # 2 rad off (more than a quarter turn): corrected onto the driver's angle, not onto the
+    # opposite branch theta = f + pi where the former row sin(theta - f) also vanished
     with pytest.warns(ukflex.InitialCorrectionWarning, match="spin") as rec:
         ukflex.System(scene(2.0))
-    assert rec[0].message.moves["spin"] == pytest.approx(math.pi - 2.0, abs=1e-9)
+    assert rec[0].message.moves["spin"] == pytest.approx(-2.0, abs=1e-9)
 
 
 # ------------------------------------------------------------------------- modal body fields

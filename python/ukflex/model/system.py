@@ -592,7 +592,7 @@ class System:
         before, after = self._driven_values(q_guess), self._driven_values(q)
         if not before:
             return
-        scale = length_scale(self.description)
+        scale = self.length_scale
         kinds = dict(zip(self.core.driver_names, (d.get("kind") for d in self.description.get("drivers") or [])))
         moves, parts = {}, []
         for name, b in before.items():

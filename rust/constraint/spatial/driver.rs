@@ -2,10 +2,12 @@
 //! `Motion` (`f, f', f''`):
 //!
 //! * rotation of `x_j` about `z_i` from `x_i`: with `s = y_i . x_j`, `c = x_i . x_j`,
-//!   `Phi = s cos f - c sin f` (`= rho sin(theta - f)`), `Phi_q = cos f J_s - sin f J_c`,
-//!   `Phi_t = -f' w` (`w = s sin f + c cos f`),
-//!   `gamma = -(cos f h_s - sin f h_c) + 2 f' (sin f sd + cos f cd) + f'' w + f'^2 Phi`.
-//!   No angle is computed: the row is smooth through `theta = +-pi` and any number of turns.
+//!   `rho^2 = s^2 + c^2` (1 on the joint), the angle `theta = atan2(s, c)` and
+//!   `Phi = wrap(theta - f)` = `atan2(s cos f - c sin f, s sin f + c cos f)`, the angle error
+//!   wrapped to the nearest turn: smooth through any number of turns, with one root per turn
+//!   (the former row `rho sin(theta - f)` also vanished at `theta = f + pi`, where a correction
+//!   from a guess more than a quarter turn off landed). `Phi_q = (c J_s - s J_c) / rho^2`,
+//!   `Phi_t = -f'`, `gamma = f'' - (c h_s - s h_c) / rho^2 + 2 (c sd - s cd)(s sd + c cd) / rho^4`.
 //! * translation of `P_j` along `z_i`: `Phi = z_i . d - f`, `Phi_t = -f'`, `gamma = -h + f''`.
 
 use super::{prim, Pair};
@@ -27,20 +29,19 @@ impl RotationDriver {
         let (xi, yi, xj) = (&si.axes[0], &si.axes[1], &sj.axes[0]);
         let (s, sd, hs) = prim::dot_terms(yi, xj);
         let (c, cd, hc) = prim::dot_terms(xi, xj);
-        let phi = s * cf - c * sf;
-        let w = s * sf + c * cf;
+        let rho2 = s * s + c * c;
         let layout = Some(out.layout);
         let row = &mut out.jac[0..n];
-        prim::dot_jacobian(bodies, &si, yi, &sj, xj, cf, row, layout);
-        prim::dot_jacobian(bodies, &si, xi, &sj, xj, -sf, row, layout);
+        prim::dot_jacobian(bodies, &si, yi, &sj, xj, c / rho2, row, layout);
+        prim::dot_jacobian(bodies, &si, xi, &sj, xj, -s / rho2, row, layout);
         if let Some(p) = out.phi.as_deref_mut() {
-            p[0] = phi;
+            p[0] = (s * cf - c * sf).atan2(s * sf + c * cf);
         }
-        out.phi_t[0] = -fd * w;
-        out.gamma[0] = -(cf * hs - sf * hc) + 2.0 * fd * (sf * sd + cf * cd) + fdd * w + fd * fd * phi;
+        out.phi_t[0] = -fd;
+        out.gamma[0] = fdd - (c * hs - s * hc) / rho2 + 2.0 * (c * sd - s * cd) * (s * sd + c * cd) / (rho2 * rho2);
     }
 
-    /// The driven angle `f + atan2(Phi, w)` at `(t, q)` (continuous while `|theta - f| < pi`).
+    /// The driven angle `f + Phi` at `(t, q)` (continuous while `|theta - f| < pi`).
     pub fn angle(&self, bodies: &[Body], t: f64, q: &[f64], scratch: &mut [f64]) -> f64 {
         let zero = vec![0.0; q.len()];
         let (si, sj) = self.pair.states(bodies, q, &zero);
