@@ -16,7 +16,9 @@
 //! `tests/integrators.rs`). `integrate` drives a stepper to `t_end`, writes outputs at the
 //! accepted steps or at requested times (dense output), and calls the system's `post_step` hook
 //! after every accepted step -- the place for a projection onto the constraint manifold; when
-//! the hook changes `y` the stepper re-evaluates `f` there (`Stepper::restart_at`).
+//! the hook changes `y` the stepper re-evaluates `f` there (`Stepper::restart_at`). The same
+//! loop, for every method, reports progress when asked (`Progress`: every k accepted steps or
+//! every so many seconds; `integrate_observed`).
 
 // Hairer's constants are kept with all their printed digits; index loops mirror the papers.
 #![allow(clippy::excessive_precision, clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
