@@ -200,3 +200,23 @@ def test_docs_max_wall_time_example_stops_on_wall_time():
     # the step budget's own stop, as the docs say: t_end = 1e9 cannot be reached within max_steps
     res = ukflex.simulate(system, 1e9, method="RK45", max_wall_time=0.5)
     assert res.stop["cause"] == "max_steps" and "cannot suffice" in res.message
+
+
+def test_readme_cli_examples_run_as_documented(capsys, tmp_path, monkeypatch):
+    # README, "Command line and scene files": the quick ones as written (outputs into tmp_path;
+    # the slider-crank one is test_energy_verdict_of_the_readme_example_is_not_a_false_gain;
+    # paper and bench: tests/test_api.py, tests/test_cli.py with shorter settings)
+    block = (ROOT / "README.md").read_text().split("## Command line and scene files")[1].split("```")[1]
+    lines = [ln.split("#")[0].strip() for ln in block.splitlines()]
+    pend = [ln for ln in lines if ln.startswith("ukflex run pendulum")][0]
+    assert pend == "ukflex run pendulum --t-end 2 --method DOP853 --plot rod.theta --plot energy"
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    code, out, err = run_cli(capsys, *pend.split()[1:], "--out", tmp_path / "p")
+    assert code == 0 and (tmp_path / "p" / "pendulum.png").exists(), err
+    assert "balance closes" in out  # a conservative pendulum at DOP853
+    export = [ln for ln in lines if ln.startswith("ukflex export")][0]
+    assert export == "ukflex export four_bar > my_scene.toml"
+    code, out, err = run_cli(capsys, "export", "four_bar", "-o", tmp_path / "my_scene.toml")
+    assert code == 0, err
+    code, out, err = run_cli(capsys, "run", tmp_path / "my_scene.toml", "--no-plot", "--out", tmp_path / "f")
+    assert code == 0 and "scene four_bar" in out, err
