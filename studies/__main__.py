@@ -76,8 +76,14 @@ def _cmd_crosscheck(args: argparse.Namespace) -> int:
 
 
 def _cmd_geometric(args: argparse.Namespace) -> int:
+    import importlib.util
+
     from .geometric import run_geometric
 
+    if not args.no_plot and importlib.util.find_spec("matplotlib") is None:  # say so before the whole study
+        print("python -m studies geometric: error: the study's plots need matplotlib, which is not installed: "
+              "pip install matplotlib, or --no-plot", file=sys.stderr)
+        return 2
     run_geometric(args.out, quick=args.quick, models=args.models, elements=args.elements, cases=args.cases,
                   exudyn_data=args.exudyn_data, checks=not args.no_checks, cost=not args.no_cost,
                   plot=not args.no_plot, log=(lambda msg: None) if args.silent else

@@ -88,7 +88,7 @@ def test_run_scene_file_end_to_end(tiny, tmp_path):
     r = ukflex_cli("run", tiny, "--out", out, "--animate")
     assert r.returncode == 0, r.stderr
     assert r.stderr == ""  # piped: no progress line
-    assert "scene tiny" in r.stdout and "DOP853 rtol=1e-06" in r.stdout and "max ||Phi||" in r.stdout
+    assert "scene tiny" in r.stdout and "settings: method DOP853, rtol 1e-06" in r.stdout and "max ||Phi||" in r.stdout
     for f in ("tiny.csv", "tiny.npz", "tiny_outputs.csv", "tiny.png", "tiny.gif"):
         assert (out / f).stat().st_size > 0, f
     data = np.genfromtxt(out / "tiny.csv", delimiter=",", names=True)
@@ -111,7 +111,7 @@ def test_run_command_line_overrides_file(tiny, tmp_path):
     r = ukflex_cli("run", tiny, "--out", tmp_path, "--method", "RK45", "--t-end", "0.002", "--samples", "5",
                    "--plot", "beam.theta", "--no-plot")
     assert r.returncode == 0, r.stderr
-    assert "RK45 rtol=1e-06" in r.stdout
+    assert "settings: method RK45, rtol 1e-06" in r.stdout and "\nRK45 (uk): status 0" in r.stdout
     head, o = read_csv(tmp_path / "tiny_outputs.csv")
     assert head == ["t", "beam.theta"] and o["t"][-1] == pytest.approx(0.002)
     assert not (tmp_path / "tiny.png").exists()
@@ -184,10 +184,10 @@ def test_export_then_run(tmp_path):
     r = ukflex_cli("run", p, "--out", tmp_path, "--no-plot")
     assert r.returncode == 0, r.stderr
     assert "scene slider_crank: n = 12 coordinates" in r.stdout
-    assert "method auto -> RADAU5M: stiff" in r.stdout  # the exported file runs the default chooser
+    assert "\nauto: RADAU5M, fixed step" in r.stdout  # the exported file runs the default chooser
     r = ukflex_cli("run", "pendulum", "--t-end", "0.1", "--out", tmp_path / "p", "--no-plot")
     assert r.returncode == 0, r.stderr
-    assert "method auto -> DOPRI5: no elastic mode" in r.stdout
+    assert "\nauto: DOPRI5 (no elastic mode" in r.stdout
 
 
 def test_help_of_every_command():
@@ -218,7 +218,7 @@ def test_progress_only_on_a_terminal():
 
     assert cli.Progress(stream=io.StringIO()).callback("x", 1.0) is None  # piped: quiet
     s = Tty()
-    p = cli.Progress(stream=s, delay=0.0, interval=0.0)
+    p = cli.Progress(stream=s, delay=0.0, interval=0.0, use_tqdm=False)
     cb = p.callback("run", 0.1)
     cb(0.05)
     assert "t = 0.05 / 0.1 s ( 50.0 %)" in s.getvalue()

@@ -81,7 +81,7 @@ def test_unwritable_output_fails_before_running(cwd, capsys):
     (["run", "pendulum", "--samples", "1e11"], "not an integer"),
     (["run", "pendulum", "--samples", "100000000000"], "too large"),
     (["run", "pendulum", "--frames", "99999999999"], "too large"),
-    (["run", "pendulum", "--method", "nope"], "invalid choice"),
+    (["run", "pendulum", "--method", "nope"], "unknown method 'nope'"),
     (["run", "no_such_scene"], "neither a built-in scene"),
     (["run", "missing.toml"], "cannot read"),
     (["run", "/dev/zero"], "not a regular file (a device)"),

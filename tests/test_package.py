@@ -48,7 +48,7 @@ def no_matplotlib(monkeypatch):
 def _check(exc_info, what):
     msg = str(exc_info.value)
     assert isinstance(exc_info.value, ImportError) and isinstance(exc_info.value, ukflex.UkflexError)
-    assert "ukflex[plot]" in msg and what in msg
+    assert "ukflex's extra [plot]" in msg and "pip install " in msg and what in msg
 
 
 def test_library_imports_without_matplotlib(no_matplotlib):
@@ -79,16 +79,16 @@ def test_every_plot_entry_point_names_the_missing_matplotlib(no_matplotlib, tmp_
     _check(e, "contour")
 
 
-def test_cli_run_without_matplotlib_fails_before_running(no_matplotlib, tmp_path, capsys):
+def test_cli_run_without_matplotlib_fails_before_running_only_when_asked_to_animate(no_matplotlib, tmp_path, capsys):
     from ukflex.cli import main
 
-    assert main(["run", "pendulum", "--t-end", "0.05", "--out", str(tmp_path / "o")]) == 2
+    assert main(["run", "pendulum", "--t-end", "0.05", "--animate", "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "ukflex[plot]" in err[0] and "--no-plot" in err[0]
+    assert len(err) == 1 and "ukflex's extra [plot]" in err[0] and "--animate" in err[0]
     assert not (tmp_path / "o" / "pendulum.csv").exists()  # nothing ran
-    # without a plot the run needs no matplotlib
+    # the default plot is skipped with a note (tests/test_cli_truth.py); --no-plot needs no note
     assert main(["run", "pendulum", "--t-end", "0.05", "--no-plot", "--out", str(tmp_path / "p")]) == 0
-    assert (tmp_path / "p" / "pendulum.csv").exists()
+    assert (tmp_path / "p" / "pendulum.csv").exists() and "note:" not in capsys.readouterr().out
 
 
 def test_blas_threads_context():

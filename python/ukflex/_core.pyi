@@ -4,7 +4,7 @@ tests/test_stubs.py checks these against the compiled module: every name, parame
 parameter kind and default must match.
 """
 
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union, final
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -159,12 +159,17 @@ class System:
         drift_limit: Optional[float] = None,
         on_drift: str = "stop",
         monitor_singular: bool = True,
+        progress: Optional[Callable[[float], Any]] = None,
+        progress_steps: int = 100,
+        progress_interval: float = 0.5,
     ) -> Dict[str, Any]:
         """Native integration; dict with t (nt,), y (2n, nt), status, message, failure (None or
         cause, t, stage, index), statistics, dense (None or meta (nseg, 3), data, part_len),
         singular (the singular passages), drift (None or t_first, max_residual, t_max).
         linear_solver: how GENALPHA and RADAU5M factor their Newton matrices ("auto", "dense",
-        "sparse": band LU after a fill-reducing order, docs/scale.md)."""
+        "sparse": band LU after a fill-reducing order, docs/scale.md).
+        progress: progress(t) every progress_steps accepted steps or progress_interval seconds
+        (the run takes the GIL only then); an exception it raises ends the run and is raised."""
     def project(
         self, t: float, q: _F64, qd: _F64, tol: float = 1e-12, max_iter: int = 20
     ) -> Tuple[_F64, _F64, Dict[str, Any]]:

@@ -77,7 +77,8 @@ class InconsistentInitialStateError(UkflexError):  # type: ignore[misc, valid-ty
 
 class MissingDependencyError(UkflexError, ImportError):  # type: ignore[misc, valid-type]
     """An optional dependency is not installed (matplotlib for plots, pandas/dask for sweeps);
-    the message names the feature and the ``pip install 'ukflex[extra]'`` that provides it."""
+    the message names the feature, the package to install and ukflex's extra that holds it
+    (``[project.optional-dependencies]`` of pyproject.toml)."""
 
 
 def require(module: str, what: str, extra: str = "plot") -> Any:
@@ -90,7 +91,7 @@ def require(module: str, what: str, extra: str = "plot") -> Any:
     except ImportError:
         pkg = {"PIL": "pillow", "skfem": "scikit-fem"}.get(module.split(".")[0], module.split(".")[0])
         raise MissingDependencyError(
-            f"{what} needs {pkg!r}, which is not installed: pip install 'ukflex[{extra}]' (or {pkg} alone)"
+            f"{what} needs {pkg!r}, which is not installed: pip install {pkg} (one of ukflex's extra [{extra}])"
         ) from None
 
 

@@ -16,7 +16,9 @@
 //! `tests/integrators.rs`). `integrate` drives a stepper to `t_end`, writes outputs at the
 //! accepted steps or at requested times (dense output), and calls the system's `post_step` hook
 //! after every accepted step -- the place for a projection onto the constraint manifold; when
-//! the hook changes `y` the stepper re-evaluates `f` there (`Stepper::restart_at`).
+//! the hook changes `y` the stepper re-evaluates `f` there (`Stepper::restart_at`). The same
+//! loop, for every method, reports progress when asked (`Progress`: every k accepted steps or
+//! every so many seconds; `integrate_observed`).
 
 // Hairer's constants are kept with all their printed digits; index loops mirror the papers.
 #![allow(clippy::excessive_precision, clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
@@ -430,6 +432,51 @@ pub fn integrate<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut 
 /// `Solution::dense` (recorded after the post-step hook, so that it reproduces the `t_eval`
 /// outputs exactly).
 pub fn integrate_dense<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut S, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, dense: bool) -> Result<Solution> {
+    integrate_observed(stepper, sys, t0, y0, t_end, t_eval, dense, None)
+}
+
+/// Progress reports of a native run, the same for every method (`integrate_observed` calls
+/// `tick` after every accepted step): `report(t)` with the time of the accepted step, once
+/// `every_steps` steps or `interval` seconds of wall time have passed since the last report.
+/// An `Err` from `report` ends the run there (a failure with that error's cause: the caller
+/// stops a run this way, e.g. on Ctrl-C). A run without one pays one `None` check per step.
+pub struct Progress<'a> {
+    every_steps: usize,
+    interval: f64,
+    report: &'a mut dyn FnMut(f64) -> Result<()>,
+    steps: usize,
+    last: std::time::Instant,
+}
+
+impl<'a> Progress<'a> {
+    /// Reports every `every_steps` accepted steps (at least 1) or every `interval` seconds
+    /// (positive; infinite: by steps only), whichever comes first.
+    pub fn new(every_steps: usize, interval: f64, report: &'a mut dyn FnMut(f64) -> Result<()>) -> Result<Self> {
+        if every_steps == 0 {
+            return Err(Error::argument("progress_steps", "must be at least 1"));
+        }
+        if !(interval > 0.0) {
+            return Err(Error::argument("progress_interval", format!("must be positive, got {interval}")));
+        }
+        Ok(Progress { every_steps, interval, report, steps: 0, last: std::time::Instant::now() })
+    }
+
+    /// One accepted step at `t`: report it if it is due.
+    #[inline]
+    fn tick(&mut self, t: f64) -> Result<()> {
+        self.steps += 1;
+        if self.steps >= self.every_steps || self.last.elapsed().as_secs_f64() >= self.interval {
+            self.steps = 0;
+            self.last = std::time::Instant::now();
+            (self.report)(t)?;
+        }
+        Ok(())
+    }
+}
+
+/// `integrate_dense` with progress reports (`Progress`) after the accepted steps.
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_observed<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut S, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, dense: bool, mut progress: Option<&mut Progress<'_>>) -> Result<Solution> {
     let dim = y0.len();
     if dim != 2 * sys.n() {
         return Err(Error::Shape { what: "y0".into(), expected: 2 * sys.n(), got: dim });
@@ -532,6 +579,9 @@ pub fn integrate_dense<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys:
                 }
             }
             t_good = t;
+            if let Some(p) = progress.as_deref_mut() {
+                p.tick(t)?;
+            }
         }
         Ok(())
     };
@@ -596,6 +646,12 @@ fn weigh_error<S: SecondOrderSystem + ?Sized>(sys: &mut S, e: &mut [f64], n: usi
 /// Convenience: run `method` on the UK system of `model` with a workspace `data`.
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_uk(model: &Model, data: Data, method: Method, opts: Options, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, projection: Option<ProjectionTolerance>, jacobian: Differences, dense: bool) -> Result<(Solution, usize, usize)> {
+    integrate_uk_observed(model, data, method, opts, t0, y0, t_end, t_eval, projection, jacobian, dense, None)
+}
+
+/// `integrate_uk` with progress reports after the accepted steps (`Progress`).
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_uk_observed(model: &Model, data: Data, method: Method, opts: Options, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, projection: Option<ProjectionTolerance>, jacobian: Differences, dense: bool, progress: Option<&mut Progress<'_>>) -> Result<(Solution, usize, usize)> {
     let mut sys = UkSystem::new(model, data);
     sys.projection = projection;
     sys.jws.scheme = jacobian;
@@ -604,22 +660,22 @@ pub fn integrate_uk(model: &Model, data: Data, method: Method, opts: Options, t0
             let mut st = Dopri5::new(2 * model.n, opts)?;
             // projects with the factorization of its last stage
             st.projection = sys.projection.take();
-            integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
+            integrate_observed(&mut st, &mut sys, t0, y0, t_end, t_eval, dense, progress)?
         }
         Method::Radau5 => {
             let mut st = Radau5::new(model.n, opts)?;
-            integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
+            integrate_observed(&mut st, &mut sys, t0, y0, t_end, t_eval, dense, progress)?
         }
         Method::GenAlpha(mut go) => {
             // the method projects with the factorization of its own last kernel call
             go.projection = sys.projection.take();
             let mut st = GenAlpha::new(model.n, model.m, opts, go)?;
-            integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
+            integrate_observed(&mut st, &mut sys, t0, y0, t_end, t_eval, dense, progress)?
         }
         Method::RadauM(mut ro) => {
             ro.projection = sys.projection.take();
             let mut st = RadauM::new(model.n, model.m, opts, ro)?;
-            integrate_dense(&mut st, &mut sys, t0, y0, t_end, t_eval, dense)?
+            integrate_observed(&mut st, &mut sys, t0, y0, t_end, t_eval, dense, progress)?
         }
     };
     Ok((sol, sys.jac_full_evals, sys.jac_cheap_evals))

@@ -53,6 +53,9 @@ def _build_parser() -> argparse.ArgumentParser:
                "  ukflex bench work-precision --out results/wp --quick\n"
                "\nRun 'ukflex COMMAND --help' for the options of a command.",
     )
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"ukflex {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for add in (_add_run_parser, _add_list_export_parsers, _add_paper_parser, _add_bench_parsers):

@@ -113,25 +113,37 @@ def _str_list(choices: Sequence[str]) -> Callable[[str], List[str]]:
 
 
 class Progress:
-    """Simulated time / end time on one terminal line (stderr), only when it is a terminal.
+    """Simulated time / end time on stderr, only when it is a terminal (or ``--progress``): a
+    tqdm bar when tqdm is installed (the [sweep] extra), else one plain line
+    ``LABEL: t = T / T_END s (P %), E s elapsed``.
 
-    ``callback(label, t_end)`` returns a ``progress(t)`` function for :func:`ukflex.simulate`;
-    the line appears after ``delay`` seconds (short runs stay quiet) and is refreshed at most
-    every ``interval`` seconds; it is cleared when ``t`` reaches ``t_end`` or by :meth:`done`.
+    ``callback(label, t_end)`` returns a ``progress(t)`` function for :func:`ukflex.simulate`
+    (native runs call it from Rust every 100 steps or 0.5 s); the display appears after
+    ``delay`` seconds (short runs stay quiet) and is refreshed at most every ``interval``
+    seconds; it is cleared when ``t`` reaches ``t_end`` or by :meth:`done`. ``use_tqdm=False``
+    keeps the plain line.
     """
 
     def __init__(self, enabled: Optional[bool] = None, stream: Optional[TextIO] = None, delay: float = 0.5,
-                 interval: float = 0.2):
+                 interval: float = 0.2, use_tqdm: Optional[bool] = None):
         self.stream = stream or sys.stderr
         if enabled is None:
             enabled = bool(getattr(self.stream, "isatty", lambda: False)())
         self.enabled = enabled
         self.delay, self.interval = delay, interval
+        if use_tqdm is None:
+            import importlib.util
+
+            use_tqdm = importlib.util.find_spec("tqdm") is not None
+        self.use_tqdm = use_tqdm
         self._shown = False
+        self._bar: Any = None
 
     def callback(self, label: str, t_end: float) -> Optional[Callable[[float], None]]:
         if not self.enabled:
             return None
+        if self.use_tqdm:
+            return self._tqdm_callback(label, t_end)
         start = time.perf_counter()
         last = [start]
 
@@ -151,7 +163,26 @@ class Progress:
 
         return progress
 
+    def _tqdm_callback(self, label: str, t_end: float) -> Callable[[float], None]:
+        from tqdm import tqdm
+
+        bar = tqdm(total=t_end, desc=label, file=self.stream, delay=self.delay, mininterval=self.interval,
+                   leave=False, dynamic_ncols=True,
+                   bar_format="{desc}: t = {n:.6g} / {total:g} s |{bar}| {percentage:3.0f}% [{elapsed}<{remaining}]")
+        self._bar = bar
+
+        def progress(t: float) -> None:
+            if t >= t_end:
+                self.done()
+                return
+            bar.update(min(t, t_end) - bar.n)
+
+        return progress
+
     def done(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
         if self._shown:
             self.stream.write("\r" + " " * 79 + "\r")
             self.stream.flush()
@@ -167,6 +198,18 @@ def _add_progress_option(p: argparse.ArgumentParser) -> None:
     g.add_argument("--progress", dest="progress", action="store_true", default=None,
                    help="always show progress on stderr (default: only when stderr is a terminal)")
     g.add_argument("--no-progress", dest="progress", action="store_false", help="never show progress")
+
+
+def _method(text: str) -> str:
+    """A ``--method`` value: any case, as :func:`ukflex.simulate` takes it (its one rule), returned
+    in the spelling the docs use (``dop853`` -> ``DOP853``)."""
+    from ..errors import InvalidArgumentError
+    from ..run.simulate import _method_name
+
+    try:
+        return str(_method_name(text))
+    except InvalidArgumentError as exc:
+        raise argparse.ArgumentTypeError(str(exc.args[0] if exc.args else exc)) from None
 
 
 def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[str, Any]]) -> None:
@@ -191,10 +234,10 @@ def _add_integrator_options(p: argparse.ArgumentParser, defaults: Optional[Dict[
 
     d = defaults or {}
     p.add_argument("--t-end", type=_positive_float, default=d.get("t_end"), help="end time [s]" + hint("t_end"))
-    p.add_argument("--method", default=d.get("method"), choices=["auto"] + list(METHODS) + native,
-                   help=f"integrator: auto (chosen from the natural frequencies, docs/integrators.md), a scipy "
-                        f"solve_ivp method or a native Rust integrator ({', '.join(native)})"
-                        + hint("method"))
+    p.add_argument("--method", default=d.get("method"), type=_method, metavar="METHOD",
+                   help=f"integrator, any case: auto (chosen from the natural frequencies, docs/integrators.md), a "
+                        f"scipy solve_ivp method ({', '.join(METHODS)}) or a native Rust integrator "
+                        f"({', '.join(native)})" + hint("method"))
     p.add_argument("--rtol", type=_positive_float, default=d.get("rtol"), help="relative tolerance" + hint("rtol"))
     p.add_argument("--atol", type=_positive_float, default=d.get("atol"), help="absolute tolerance" + hint("atol"))
     p.add_argument("--formulation", default=d.get("formulation"), choices=FORMULATIONS,

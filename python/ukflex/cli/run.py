@@ -33,6 +33,21 @@ def _parse_params(items: Sequence[str]) -> Dict[str, Any]:
     return params
 
 
+def _build_scene(name: str, params: Sequence[str]):
+    """Built-in scene ``name`` with its ``--param KEY=VALUE`` arguments; an unknown KEY is refused
+    with the scene's parameter names (``UnknownNameError``)."""
+    from ..errors import UnknownNameError
+    from ..model.scenes import SCENES, scene_parameters
+
+    fn = SCENES[name]
+    kwargs = _parse_params(params)
+    valid = [p for p, _ in scene_parameters(fn)]
+    for key in kwargs:
+        if key not in valid:
+            raise UnknownNameError.of(f"parameter of scene '{name}'", key, valid)
+    return fn(**kwargs)
+
+
 def _load_scene(scene: str, params: Sequence[str]):
     """(name, System, solver settings, output settings, source) for a built-in name or a scene file.
 
@@ -44,7 +59,7 @@ def _load_scene(scene: str, params: Sequence[str]):
 
     looks_like_file = scene.endswith(".toml") or os.sep in scene or os.path.exists(scene)
     if scene in SCENES and not os.path.exists(scene):
-        system = SCENES[scene](**_parse_params(params)).build()
+        system = _build_scene(scene, params).build()
         return scene, system, {}, {}, "builtin:" + " ".join([scene] + list(params))
     if not looks_like_file:
         raise SceneFileError(f"{scene!r} is neither a built-in scene ({', '.join(SCENES)}) nor a scene file")
@@ -106,6 +121,29 @@ def _plot_outputs(path: str, name: str, t: np.ndarray, labels: Sequence[str], va
     fig.savefig(path, dpi=130)
 
 
+def _settings_line(solver: Dict[str, Any]) -> str:
+    """The run's settings as the user gave them (command line, then the scene file, then the
+    defaults), e.g. ``settings: method auto, rtol 1e-08, atol 1e-3 rtol, formulation uk, 201 samples``."""
+    from ..run.simulate import RUN_OPTIONS
+
+    atol = solver["atol"]
+    shown = (f"{RUN_OPTIONS['defaults']['atol_per_rtol']:g} rtol" if atol is None
+             else f"{atol:g}" if isinstance(atol, (int, float)) else str(atol))
+    return (f"settings: method {solver['method']}, rtol {solver['rtol']:g}, atol {shown}, formulation "
+            f"{solver['formulation']}, t_end {solver['t_end']:g} s, {solver['samples']} samples")
+
+
+def _auto_line(auto: Dict[str, Any]) -> str:
+    """What ``method="auto"`` derived from the settings (``res.extra["auto"]``), named as such:
+    ``auto: RADAU5M, fixed step 8.2e-05 s, Newton tol 1e-05 (reason ...)``."""
+    derived = [str(auto["method"])]
+    if auto.get("step") is not None:
+        derived.append(f"fixed step {auto['step']:.3g} s")
+    if auto.get("rtol") is not None:
+        derived.append(f"Newton tol {auto['rtol']:g}")
+    return f"auto: {', '.join(derived)} ({auto['reason']})"
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from ..results import outputs
     from ..run.simulate import simulate
@@ -127,10 +165,17 @@ def _cmd_run(args: argparse.Namespace) -> int:
     deform_scale = args.deform_scale if args.deform_scale is not None else file_output.get("deform_scale", 1.0)
     fps = args.fps if args.fps is not None else file_output.get("fps", 25)
     frames = args.frames if args.frames is not None else file_output.get("frames", 150)
-    if not args.no_plot or animate:  # matplotlib is optional: say so before the run, not after it
-        from ..errors import require
+    from ..errors import MissingDependencyError, require
 
-        require("matplotlib", "the output plot and the animation (--no-plot, without --animate, skips both)")
+    plot = not args.no_plot
+    if animate:  # asked for by name: without matplotlib it fails now, before the run
+        require("matplotlib", "the animation (--animate)")
+    elif plot:  # the default plot is skipped without matplotlib (a base install), with a note
+        try:
+            require("matplotlib", "the output plot")
+        except MissingDependencyError as exc:
+            print(f"note: no plot: {exc} (--no-plot skips it quietly)")
+            plot = False
     out = args.out or _default_out(args.scene, name, args.param, source)
     _writable_dir(out, "output folder")
     with open(os.path.join(out, _SOURCE_MARK), "w", encoding="utf-8") as fh:
@@ -148,10 +193,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
                        progress=prog.callback(name, solver["t_end"]), **extra)
     finally:
         prog.done()
-    print(f"{res.method} rtol={res.rtol:g} ({res.formulation}): status {res.status} ({res.message}); nfev {res.nfev}, "
-          f"njev {res.njev}, nlu {res.nlu}; integration {res.wall_time:.3f} s")
+    print(_settings_line(solver))
     if "auto" in res.extra:
-        print(f"method auto -> {res.method}: {res.extra['auto']['reason']}")
+        print(_auto_line(res.extra["auto"]))
+    print(f"{res.method} ({res.formulation}): status {res.status} ({res.message}); nfev {res.nfev}, "
+          f"njev {res.njev}, nlu {res.nlu}; integration {res.wall_time:.3f} s")
     print(f"max ||Phi|| = {res.max_residual('position'):.3e}, max ||A qd + Phi_t|| = "
           f"{res.max_residual('velocity'):.3e}, max ||A qdd - b|| = {res.max_residual('acceleration'):.3e}")
     print(res.sensors.energy_line())
@@ -165,9 +211,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
         print(f"{x}: min {np.min(v):.6g}, max {np.max(v):.6g}, final {v[-1]:.6g}")
     _write_outputs_csv(base + "_outputs.csv", res.t, exprs, [v for _, v in evaluated])
     written.append(base + "_outputs.csv")
-    if not args.no_plot:
+    if plot:
+        auto = " (auto)" if "auto" in res.extra else ""
         _plot_outputs(base + ".png", name, res.t, [lab for lab, _ in evaluated], [v for _, v in evaluated],
-                      f"{res.method}, rtol {res.rtol:g}, {res.formulation}")
+                      f"{res.method}{auto}, rtol {solver['rtol']:g}, {res.formulation}")
         written.append(base + ".png")
     if animate:
         from ..results.animate import animate as write_gif
@@ -204,7 +251,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
     if args.output not in (None, "-"):
         _writable_file(args.output, "-o")
-    scene = SCENES[args.scene](**_parse_params(args.param))
+    scene = _build_scene(args.scene, args.param)
     if args.vtk is not None:
         return _export_vtk_run(scene, args)
     doc = _scene_summary(SCENES[args.scene])

@@ -48,6 +48,10 @@ _SCIPY_OPTIONS = ("first_step", "max_step", "jac", "jac_sparsity", "lband", "uba
 FORMULATIONS = ("uk", "uk-numpy", "cp")
 #: Every method name, looked up case-insensitively ("dopri5", "radau" and "Radau" work).
 _METHOD_BY_KEY = {m.upper(): m for m in METHODS + NATIVE_METHODS + ("auto",)}
+#: A native run reports ``progress(t)`` every this many accepted steps ...
+NATIVE_PROGRESS_STEPS = 100
+#: ... or every this many seconds of wall time, whichever comes first.
+NATIVE_PROGRESS_INTERVAL = 0.5
 #: Default work budgets: step attempts and right-hand-side evaluations of one run.
 DEFAULT_MAX_STEPS = 1_000_000
 DEFAULT_MAX_NFEV = 20_000_000
@@ -194,8 +198,12 @@ def simulate(
     partition : optional
         Passed to the ``"cp"`` reference integrator.
     progress : callable, optional
-        ``progress(t)`` after every accepted step of a scipy method, once at the end of a native
-        run.  Keep it cheap; used by the CLI's progress display.
+        ``progress(t)`` after every accepted step of a scipy method; during a native run, from
+        Rust, every ``NATIVE_PROGRESS_STEPS`` (100) accepted steps or ``NATIVE_PROGRESS_INTERVAL``
+        (0.5 s) of wall time, whichever comes first (the run takes the GIL only then); and once
+        at the end with the last time.  An exception it raises ends the run and propagates (so
+        does Ctrl-C during a native run with a progress callback).  Keep it cheap; used by the
+        CLI's progress display.
     events : callable or list of callables, optional
         ``event(t, y[, *args])`` with ``solve_ivp``'s attributes ``terminal`` (bool or a count)
         and ``direction``; roots are located on the dense output of each step (scipy: by
@@ -291,6 +299,8 @@ def simulate(
         raise InvalidArgumentError(
             "method", f"native method {method!r} integrates the Rust UK formulation only, not {formulation!r}")
     _check_options(method, formulation, options)
+    if progress is not None and not callable(progress):
+        raise InvalidArgumentError("progress", f"must be None or a callable progress(t), got {progress!r:.60}")
     if on_drift not in ("stop", "warn"):
         raise InvalidArgumentError("on_drift", f"must be 'stop' or 'warn', got {on_drift!r}")
     if max_wall_time is not None and not isinstance(scene_or_system, System):
@@ -425,7 +435,7 @@ def simulate(
         if label is not None:  # "none" and Baumgarte: no projection (the native methods project by default)
             options.setdefault("projection_tol", 0.0 if proj_tol is None else proj_tol)
         res = _simulate_native(system, method, t0, t_end_f, y0, rtol, atol_v, t_eval_v, options, budget, ev_list,
-                               dense_output, guard)
+                               dense_output, guard, progress)
         if progress is not None and res.t.size:
             progress(float(res.t[-1]))
     elif formulation != "uk":
@@ -1062,7 +1072,8 @@ def _native_events(sol: DenseSolution, events: List[Callable], t0: float, y0: np
     return t_events, y_events, None
 
 
-def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options, budget, events, dense, guard):
+def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options, budget, events, dense, guard,
+                     progress=None):
     """Run a native Rust integrator (``System.integrate``: all steps in Rust, GIL released).
 
     Dense output is recorded in Rust during the run; events are located on it afterwards and a
@@ -1085,7 +1096,8 @@ def _simulate_native(system, method, t0, t_end, y0, rtol, atol, t_eval, options,
                            max_wall_time=None if budget.deadline is None else max(budget.remaining(), 1e-9),
                            min_step=budget.min_step,
                            dense=bool(dense or events), drift_limit=guard.limit,
-                           on_drift="stop" if guard.stop else "warn", **kwargs)
+                           on_drift="stop" if guard.stop else "warn", progress=progress,
+                           progress_steps=NATIVE_PROGRESS_STEPS, progress_interval=NATIVE_PROGRESS_INTERVAL, **kwargs)
     t, y, status, message = np.asarray(out["t"]), np.asarray(out["y"]), int(out["status"]), str(out["message"])
     stop = None
     if out["failure"] is not None:

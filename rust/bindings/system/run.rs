@@ -13,7 +13,7 @@ use crate::correct::{self, CorrectOptions};
 use crate::data::{Data, Stabilization};
 use crate::error::Error;
 use crate::integrate::singular::{Passage, SingularMonitor};
-use crate::integrate::{integrate_uk, LinearSolver, Method, NewtonMatrices, RunPlan, RunRequest, UkSystem};
+use crate::integrate::{integrate_uk_observed, LinearSolver, Progress, Method, NewtonMatrices, RunPlan, RunRequest, UkSystem};
 use crate::jacobian::{assemble_first_order, Differences};
 
 #[pymethods]
@@ -80,7 +80,12 @@ impl PySystem {
     /// or a dict cause, t, stage, index), nfev, njev, nlu, naccept, nreject, jac_evals (UK calls
     /// inside Jacobians), wall_time [s], dense (None, or a dict meta (nseg, 3), data
     /// (nseg, width), part_len).
-    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=None, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None, linear_solver="auto", drift_limit=None, on_drift="stop", monitor_singular=true))]
+    ///
+    /// progress: None or a callable `progress(t)`, called from the run (which takes the GIL
+    /// only then) with the time of an accepted step every `progress_steps` accepted steps or
+    /// every `progress_interval` seconds of wall time, whichever comes first; an exception it
+    /// raises (or a pending Ctrl-C) ends the run and is raised here.
+    #[pyo3(signature = (t0, y0, t_end, method="RADAU5", rtol=1e-6, atol=None, t_eval=None, first_step=None, max_step=None, max_steps=1_000_000, projection_tol=None, rho_inf=None, step=None, jacobian="structured", max_nfev=None, max_wall_time=None, min_step=0.0, dense=false, newton_local_error=None, linear_solver="auto", drift_limit=None, on_drift="stop", monitor_singular=true, progress=None, progress_steps=100, progress_interval=0.5))]
     #[allow(clippy::too_many_arguments)]
     fn integrate<'py>(
         &self,
@@ -108,7 +113,17 @@ impl PySystem {
         drift_limit: Option<f64>,
         on_drift: &str,
         monitor_singular: bool,
+        progress: Option<Py<PyAny>>,
+        progress_steps: usize,
+        progress_interval: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if let Some(cb) = &progress {
+            if !cb.bind(py).is_callable() {
+                return Err(arg_err("progress", "must be None or a callable progress(t)"));
+            }
+        }
+        // the checks of the settings (the report itself is set up inside the run)
+        Progress::new(progress_steps, progress_interval, &mut |_| Ok(())).map_err(to_py)?;
         let (t0, t_end) = (t0.0, t_end.0);
         let n = self.model.n;
         let request = RunRequest {
@@ -166,17 +181,32 @@ impl PySystem {
         };
         let hint = "implicit methods factor dense n x n matrices here; use method='DOPRI5' for a system this large, linear_solver='sparse', or raise memory_limit";
         Error::check_memory("the implicit integrator's n x n matrices", implicit, limit, hint).map_err(to_py)?;
+        // an exception of the progress callback (or a pending signal), raised after the run
+        let mut raised: Option<PyErr> = None;
         let result = py.detach(|| {
             catch_unwind(AssertUnwindSafe(|| {
                 let mut data = data;
                 data.tolerance = tolerance;
                 data.stabilization = stabilization;
                 data.svd_backend = backend;
+                // the GIL is taken only when a report is due
+                let mut report = |t: f64| -> Result<(), Error> {
+                    let Some(cb) = &progress else { return Ok(()) };
+                    Python::attach(|py| cb.call1(py, (t,)).and_then(|_| py.check_signals())).map_err(|e| {
+                        raised = Some(e);
+                        Error::Budget { what: "interrupted".into(), message: "the run was stopped by its progress callback".into() }
+                    })
+                };
+                let mut observer = Progress::new(progress_steps, progress_interval, &mut report)?;
                 let tic = std::time::Instant::now();
-                let r = integrate_uk(model, data, method, opts, t0, &y, t_end, t_eval.as_deref(), projection, jacobian, dense);
+                let watch = if progress.is_some() { Some(&mut observer) } else { None };
+                let r = integrate_uk_observed(model, data, method, opts, t0, &y, t_end, t_eval.as_deref(), projection, jacobian, dense, watch);
                 r.map(|(sol, full, cheap)| (sol, full + cheap, tic.elapsed().as_secs_f64()))
             }))
         });
+        if let Some(e) = raised {
+            return Err(e);
+        }
         let (sol, jac_evals, wall) = match result {
             Ok(r) => r.map_err(to_py)?,
             Err(_) => return Err(SolverError::new_err("internal error in the ukflex core (a bug: please report it)")),
