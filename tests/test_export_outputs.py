@@ -63,10 +63,10 @@ def test_a_missing_optional_dependency_names_its_extra(monkeypatch, tmp_path):
     m = _rect(2, 1)
     kw = dict(thickness=0.01, interfaces=_ends(), modes=2, **STEEL)
     monkeypatch.setitem(sys.modules, "skfem", None)  # import skfem -> ImportError
-    with pytest.raises(ukflex.MissingDependencyError, match=r"scikit-fem.*ukflex\[fe\]"):
+    with pytest.raises(ukflex.MissingDependencyError, match=r"scikit-fem.*extra \[fe\]"):
         fe.from_mesh(m.p.T, cells=m.t.T, **kw)
     monkeypatch.setitem(sys.modules, "meshio", None)
-    with pytest.raises(ukflex.MissingDependencyError, match=r"'meshio'.*ukflex\[fe\]"):
+    with pytest.raises(ukflex.MissingDependencyError, match=r"'meshio'.*extra \[fe\]"):
         fe.from_mesh(str(tmp_path / "part.msh"), **kw)
     system = scenes.pendulum().build()
     res = ukflex.simulate(system, 0.01, method="DOPRI5", t_eval=[0.0, 0.01])

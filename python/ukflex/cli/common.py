@@ -143,7 +143,12 @@ class Progress:
         if not self.enabled:
             return None
         if self.use_tqdm:
-            return self._tqdm_callback(label, t_end)
+            try:
+                from tqdm import tqdm
+            except ImportError:  # told to use tqdm, but it is not there: the plain line
+                self.use_tqdm = False
+            else:
+                return self._tqdm_callback(tqdm, label, t_end)
         start = time.perf_counter()
         last = [start]
 
@@ -163,9 +168,7 @@ class Progress:
 
         return progress
 
-    def _tqdm_callback(self, label: str, t_end: float) -> Callable[[float], None]:
-        from tqdm import tqdm
-
+    def _tqdm_callback(self, tqdm: Any, label: str, t_end: float) -> Callable[[float], None]:
         bar = tqdm(total=t_end, desc=label, file=self.stream, delay=self.delay, mininterval=self.interval,
                    leave=False, dynamic_ncols=True,
                    bar_format="{desc}: t = {n:.6g} / {total:g} s |{bar}| {percentage:3.0f}% [{elapsed}<{remaining}]")
