@@ -95,7 +95,8 @@ macro_rules! spatial_kinds {
                 }
             }
 
-            #[inline]
+            /// Out of line: the planar constraint loop (`dynamics::constraints`) keeps its code.
+            #[inline(never)]
             pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
                 match self {
                     $(SpatialConstraint::$variant(c) => {
