@@ -1,6 +1,7 @@
 """Per-call UK kernel on the spatial slider-crank (and A04, the heavy top, the flyball
-governor), timed inside Rust (System.time_acceleration: best of batches, per call) and from
-Python (System.qdd).
+governor), timed inside Rust (System.time_acceleration: best of batches, per call), as the
+process CPU time of those calls (time.process_time around them: what a loaded machine does not
+inflate by preemption), and from Python (System.qdd).
 Run: .venv/bin/python benches/spatial_kernel.py
      .venv/bin/python benches/spatial_kernel.py --export   (rewrites benches/data/spatial/*.json,
      the descriptions the criterion bench `cargo bench --bench spatial` reads)"""
@@ -26,10 +27,12 @@ if "--export" in sys.argv:
 for name, make in SCENES:
     system = ukflex.System(to_description(make()))
     q, qd = system.q0, system.qd0
+    c0 = time.process_time()
     rust = system.time_acceleration(0.1, q, qd, 20000, 7) * 1e6
+    cpu = (time.process_time() - c0) / (7 * 20000) * 1e6
     reps = 20000
     t0 = time.perf_counter()
     for _ in range(reps):
         system.qdd(0.1, q, qd)
     py = (time.perf_counter() - t0) / reps * 1e6
-    print(f"{name:13s} n={system.n_coords:3d} m={system.n_constraints:3d}  Rust {rust:7.2f} us/call   Python System.qdd {py:7.2f} us/call")
+    print(f"{name:13s} n={system.n_coords:3d} m={system.n_constraints:3d}  Rust {rust:7.2f} us/call (CPU {cpu:7.2f})   Python System.qdd {py:7.2f} us/call")
