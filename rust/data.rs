@@ -185,7 +185,7 @@ impl Data {
         self.svd_v = Mat::zeros(m, k);
         self.coeff = vec![0.0; k];
         self.mem = MemBuffer::new(req);
-        self.qrj = if m > 0 && m <= n { Some(QrJacobi::new(n, m)) } else { None };
+        self.qrj = if m > 0 && m <= n { Some(QrJacobi::with_unit_columns(n, m, &crate::uk::dense::unit_columns(model))) } else { None };
         self.dense_ready = true;
         Ok(())
     }

@@ -14,6 +14,9 @@ use crate::error::{check_finite_item, Error, Result};
 use crate::spatial::desc::Marker3Desc;
 use crate::spatial::rot::{add, col, frame_from_z, m34_t_vec, m34_vec, mat_vec, norm, quad_term, rot_a, rot_b, scale, sub, M3, M34, V3};
 
+/// Every axis (`Marker3::state_axes`).
+pub const ALL_AXES: u8 = 0b111;
+
 #[derive(Debug, Clone)]
 pub struct Marker3 {
     pub base: Marker,
@@ -100,12 +103,22 @@ impl Marker3 {
         Ok(())
     }
 
-    /// Kinematics at `(q, qd)`.
+    /// Kinematics at `(q, qd)`, every axis.
     #[inline]
     pub fn state(&self, bodies: &[Body], q: &[f64], qd: &[f64]) -> Marker3State {
+        self.state_axes(bodies, q, qd, ALL_AXES)
+    }
+
+    /// Kinematics at `(q, qd)` of the point and of the axes in `axes` (bit `k`: axis `k`); the
+    /// other axes are left zero. A joint kind names the axes its rows read (`AXES`), so that a
+    /// spherical joint computes no axis at all.
+    #[inline]
+    pub fn state_axes(&self, bodies: &[Body], q: &[f64], qd: &[f64], axes: u8) -> Marker3State {
         let mut st = Marker3State { body: self.body, rigid: self.rigid, ..Default::default() };
         for k in 0..3 {
-            st.axes[k].v = col(&self.c, k);
+            if axes & (1 << k) != 0 {
+                st.axes[k].v = col(&self.c, k);
+            }
         }
         let Some(bi) = self.body else {
             st.point.v = self.s;
@@ -126,6 +139,9 @@ impl Marker3 {
         let jp = rot_b(p, &self.s);
         st.point = Kin3 { v: add(&r, &mat_vec(&a, &self.s)), vd: add(&rd, &m34_vec(&jp, pd)), h: scale(2.0, &mat_vec(&ad, &self.s)), jr: 1.0, jp };
         for k in 0..3 {
+            if axes & (1 << k) == 0 {
+                continue;
+            }
             let ck = col(&self.c, k);
             let jp = rot_b(p, &ck);
             st.axes[k] = Kin3 { v: mat_vec(&a, &ck), vd: m34_vec(&jp, pd), h: quad_term(pd, &ck), jr: 0.0, jp };

@@ -17,6 +17,11 @@ use crate::error::{check_finite_item, positive, Error, Result};
 use crate::spatial::desc::{OrientationDesc, Rigid3Desc};
 use crate::spatial::rot::{cross, dot, mat_vec, p_from_matrix, rot_a, rot_e, rot_g, M3, V3};
 
+/// The body coordinate onto which `F^-1` maps the normalization row: `F^-1 [0, 2 p]^T =
+/// e_6 / sqrt k` (`finv`: `G p = 0`, `p . 2 p / (2 |p|^2) = 1`), the unit row of
+/// docs/spatial-design.md, section 3.
+pub const NORMALIZATION_COORD: usize = 6;
+
 #[derive(Debug, Clone)]
 pub struct Rigid3 {
     pub mass: f64,

@@ -9,6 +9,8 @@ use faer::linalg::svd::svd;
 use faer::Par;
 
 use super::settings::{Factored, RankInfo, SvdBackend};
+use crate::constraint::spatial::SpatialConstraint;
+use crate::constraint::ConstraintKind;
 use crate::data::Data;
 use crate::dynamics::{apply_finv_sparse, apply_finvt};
 use crate::error::{Error, Result};
@@ -59,6 +61,21 @@ pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
     Ok(())
 }
 
+/// The columns of `B^T = F^-1 A^T` that are multiples of unit vectors, as `(row of A, coordinate)`:
+/// the spatial rigid bodies' normalization rows (`Normalization::unit_coordinate`). The QR of
+/// `B^T` skips them (`QrJacobi::with_unit_columns`): the normalization rows are eliminated in
+/// closed form (docs/spatial-design.md, section 3).
+pub fn unit_columns(model: &Model) -> Vec<(usize, usize)> {
+    model
+        .constraints
+        .iter()
+        .filter_map(|c| match &c.kind {
+            ConstraintKind::Spatial(SpatialConstraint::Normalization(nr)) => Some((c.row, nr.unit_coordinate(&model.bodies))),
+            _ => None,
+        })
+        .collect()
+}
+
 /// Above this many constraint rows `exact_rank_info` keeps the sparse path's certified bounds
 /// instead of running the dense SVD (at m = 256, n ~ 400 that SVD takes ~10 ms; at m = 2048 it
 /// takes seconds and 100 MB).
@@ -96,7 +113,7 @@ fn jacobi_of_r(model: &Model, data: &mut Data) -> Result<()> {
     let mut s = data.svd_s.column_vector_mut();
     for j in 0..k {
         s[j] = qrj.sigma(j);
-        data.svd_v.col_as_slice_mut(j).copy_from_slice(qrj.v_col(j));
+        qrj.v_col_into(j, data.svd_v.col_as_slice_mut(j));
     }
     data.factored_with = Factored::Jacobi;
     Ok(())
@@ -231,4 +248,56 @@ pub(super) fn correct_residual(model: &Model, data: &mut Data) {
     }
     data.qdd.copy_from_slice(&data.y);
     apply_finvt(model, &data.bodies, &mut data.qdd);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::correct::{correct, CorrectOptions};
+    use crate::linalg::small_svd::QrJacobi;
+    use crate::uk;
+
+    /// The normalization rows eliminated in the QR (`unit_columns`) give the accelerations,
+    /// multipliers and rank of the plain QR of `B^T` on the spatial slider-crank (certified
+    /// full-rank path) and on Bricard's mechanism (rank 34 of 35: the Jacobi SVD of the permuted
+    /// `R`, and the default path), at a consistent state and off it.
+    #[test]
+    fn eliminated_normalization_rows_change_nothing() {
+        let scenes = [
+            (include_str!("../../benches/data/spatial/slider_crank.json"), 20, SvdBackend::Auto),
+            (include_str!("../../benches/data/spatial/bricard.json"), 34, SvdBackend::QrJacobi),
+            (include_str!("../../benches/data/spatial/bricard.json"), 34, SvdBackend::Auto),
+        ];
+        for (json, rank, backend) in scenes {
+            let model = Model::from_json(json).unwrap();
+            let (n, m) = (model.n, model.m);
+            assert_eq!(unit_columns(&model).len(), model.bodies.len(), "one normalization row per rigid3 body");
+            let fresh = || {
+                let mut d = Data::new(&model);
+                d.ensure_dense(&model).unwrap();
+                d.svd_backend = backend;
+                d
+            };
+            let (mut data, mut plain) = (fresh(), fresh());
+            plain.qrj = Some(QrJacobi::new(n, m));
+            let opts = CorrectOptions { hold: vec![false; n], rigid: false, position_tol: 1e-12, velocity_tol: 1e-10, max_iterations: 50 };
+            let c = correct(&model, &mut data, 0.0, &model.q0, &model.qd0, &opts).unwrap();
+            for (k, scale) in [(0usize, 0.0), (1, 1e-7)] {
+                let q: Vec<f64> = c.q.iter().enumerate().map(|(i, x)| x + scale * ((i * 7 + k) as f64).sin()).collect();
+                uk::acceleration(&model, &mut data, 0.0, &q, &c.qd).unwrap();
+                uk::acceleration(&model, &mut plain, 0.0, &q, &c.qd).unwrap();
+                assert_eq!(data.rank_info.rank, rank);
+                assert_eq!(plain.rank_info.rank, rank);
+                assert_eq!(data.factored_with, plain.factored_with);
+                let amax = plain.qdd.iter().fold(1.0f64, |a, x| a.max(x.abs()));
+                let lmax = plain.lambda.iter().fold(1.0f64, |a, x| a.max(x.abs()));
+                for i in 0..n {
+                    assert!((data.qdd[i] - plain.qdd[i]).abs() < 1e-12 * amax, "qdd[{i}] {} vs {}", data.qdd[i], plain.qdd[i]);
+                }
+                for i in 0..m {
+                    assert!((data.lambda[i] - plain.lambda[i]).abs() < 1e-10 * lmax, "lambda[{i}] {} vs {}", data.lambda[i], plain.lambda[i]);
+                }
+            }
+        }
+    }
 }

@@ -13,6 +13,8 @@ pub struct Distance3 {
 
 impl Distance3 {
     pub const ROWS: &'static [&'static str] = &[""];
+    /// The marker axes its rows read (none).
+    pub const AXES: [u8; 2] = [0, 0];
 
     #[inline]
     pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, n: usize, out: &mut ConstraintOut) {

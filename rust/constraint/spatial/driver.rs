@@ -21,9 +21,12 @@ pub struct RotationDriver {
 }
 
 impl RotationDriver {
+    /// The marker axes its row reads (`x_i`, `y_i`; `x_j`).
+    pub const AXES: [u8; 2] = [0b011, 0b001];
+
     #[inline]
     pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
-        let (si, sj) = self.pair.states(bodies, q, qd);
+        let (si, sj) = self.pair.states_axes(bodies, q, qd, Self::AXES);
         let (f, fd, fdd) = self.motion.eval(t, out.scratch);
         let (sf, cf) = f.sin_cos();
         let (xi, yi, xj) = (&si.axes[0], &si.axes[1], &sj.axes[0]);
@@ -60,9 +63,12 @@ pub struct TranslationDriver {
 }
 
 impl TranslationDriver {
+    /// The marker axes its row reads (`z_i`).
+    pub const AXES: [u8; 2] = [0b100, 0];
+
     #[inline]
     pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
-        let (si, sj) = self.pair.states(bodies, q, qd);
+        let (si, sj) = self.pair.states_axes(bodies, q, qd, Self::AXES);
         let (f, fd, fdd) = self.motion.eval(t, out.scratch);
         let a = &si.axes[2];
         let (v, _, h) = prim::dot2_terms(a, &si, &sj);

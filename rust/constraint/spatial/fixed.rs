@@ -12,6 +12,8 @@ pub struct Fixed {
 
 impl Fixed {
     pub const ROWS: &'static [&'static str] = &["x", "y", "z", "xz", "yz", "xy"];
+    /// The marker axes its rows read (x_i, y_i; y_j, z_j).
+    pub const AXES: [u8; 2] = [0b011, 0b110];
 
     #[inline]
     pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, n: usize, out: &mut ConstraintOut) {

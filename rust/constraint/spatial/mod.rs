@@ -19,7 +19,7 @@ pub mod revolute;
 pub mod spherical;
 pub mod universal;
 
-use crate::body::marker3::{Marker3, Marker3State};
+use crate::body::marker3::{Marker3, Marker3State, ALL_AXES};
 use crate::body::{Body, Marker};
 use crate::constraint::ConstraintOut;
 use crate::error::{Error, Result};
@@ -55,7 +55,14 @@ impl Pair {
 
     #[inline]
     pub fn states(&self, bodies: &[Body], q: &[f64], qd: &[f64]) -> (Marker3State, Marker3State) {
-        (self.i.state(bodies, q, qd), self.j.state(bodies, q, qd))
+        self.states_axes(bodies, q, qd, [ALL_AXES; 2])
+    }
+
+    /// The states with only the axes a kind reads (`AXES`: bit `k` of `axes[0]` for axis `k`
+    /// of `i`, of `axes[1]` for `j`).
+    #[inline]
+    pub fn states_axes(&self, bodies: &[Body], q: &[f64], qd: &[f64], axes: [u8; 2]) -> (Marker3State, Marker3State) {
+        (self.i.state_axes(bodies, q, qd, axes[0]), self.j.state_axes(bodies, q, qd, axes[1]))
     }
 }
 
@@ -88,11 +95,12 @@ macro_rules! spatial_kinds {
                 }
             }
 
-            #[inline]
+            /// Out of line: the planar constraint loop (`dynamics::constraints`) keeps its code.
+            #[inline(never)]
             pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
                 match self {
                     $(SpatialConstraint::$variant(c) => {
-                        let (si, sj) = c.pair.states(bodies, q, qd);
+                        let (si, sj) = c.pair.states_axes(bodies, q, qd, <$ty>::AXES);
                         c.eval(bodies, &si, &sj, n, out)
                     })*
                     SpatialConstraint::Rotation(c) => c.eval(bodies, t, q, qd, n, out),

@@ -13,6 +13,13 @@ pub struct Normalization {
 }
 
 impl Normalization {
+    /// The coordinate `c` with `F^-1 A_n^T = e_c / sqrt k`: the rigid body's factor maps its
+    /// normalization row onto one unit vector (`Rigid3::NORMALIZATION_COORD`), so the UK
+    /// kernel eliminates the row in closed form (`uk::dense::unit_columns`).
+    pub fn unit_coordinate(&self, bodies: &[Body]) -> usize {
+        bodies[self.body].offset + crate::body::rigid3::NORMALIZATION_COORD
+    }
+
     #[inline]
     pub fn eval(&self, bodies: &[Body], q: &[f64], qd: &[f64], _n: usize, out: &mut ConstraintOut) {
         let o = bodies[self.body].offset;

@@ -12,6 +12,8 @@ pub struct PointOnLine3 {
 
 impl PointOnLine3 {
     pub const ROWS: &'static [&'static str] = &["xd", "yd"];
+    /// The marker axes its rows read (x_i, y_i).
+    pub const AXES: [u8; 2] = [0b011, 0];
 
     #[inline]
     pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, n: usize, out: &mut ConstraintOut) {

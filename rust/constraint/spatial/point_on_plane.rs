@@ -12,6 +12,8 @@ pub struct PointOnPlane {
 
 impl PointOnPlane {
     pub const ROWS: &'static [&'static str] = &[""];
+    /// The marker axes its rows read (z_i).
+    pub const AXES: [u8; 2] = [0b100, 0];
 
     #[inline]
     pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, n: usize, out: &mut ConstraintOut) {

@@ -12,6 +12,8 @@ pub struct Prismatic3 {
 
 impl Prismatic3 {
     pub const ROWS: &'static [&'static str] = &["xz", "yz", "xd", "yd", "xy"];
+    /// The marker axes its rows read (x_i, y_i; y_j, z_j).
+    pub const AXES: [u8; 2] = [0b011, 0b110];
 
     #[inline]
     pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, n: usize, out: &mut ConstraintOut) {

@@ -12,6 +12,8 @@ pub struct Spherical {
 
 impl Spherical {
     pub const ROWS: &'static [&'static str] = &["x", "y", "z"];
+    /// The marker axes its rows read (none).
+    pub const AXES: [u8; 2] = [0, 0];
 
     #[inline]
     pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, n: usize, out: &mut ConstraintOut) {

@@ -12,6 +12,8 @@ pub struct Universal {
 
 impl Universal {
     pub const ROWS: &'static [&'static str] = &["x", "y", "z", "xy"];
+    /// The marker axes its rows read (x_i; y_j).
+    pub const AXES: [u8; 2] = [0b001, 0b010];
 
     #[inline]
     pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, n: usize, out: &mut ConstraintOut) {
