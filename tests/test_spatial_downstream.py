@@ -307,8 +307,21 @@ def test_rotational_spring_counts_turns_beyond_half_a_turn():
     assert np.abs(e["springs"]).max() > 0.5 * k * (2.9 * np.pi) ** 2  # the potential of three half-turns
     assert np.ptp(e["total"]) < 1e-8 * np.abs(e["total"]).max()
     # the native and the scipy integrators agree
-    res2 = ukflex.simulate(_driven_rotor(spring=(k, 0.0), omega0=w0), t[-1], method="DOP853", rtol=1e-10, t_eval=t)
+    system2 = _driven_rotor(spring=(k, 0.0), omega0=w0)
+    res2 = ukflex.simulate(system2, t[-1], method="DOP853", rtol=1e-10, t_eval=t)
     np.testing.assert_allclose(res2.q, res.q, atol=1e-6)
+    # the System counts on its workspace from call to call: walked along the run to the
+    # wound-up state of t = T/4, the spring pulls back from 3 pi (angular acceleration -k theta / J),
+    # and a sensors pass over another history leaves that count alone
+    k4 = 200
+    assert abs(theta[k4] - 3 * np.pi) < 1e-6
+    for j in range(k4 + 1):
+        before = system2.qdd(t[j], res2.q[:, j], res2.qd[:, j])
+    p, pdd = res2.q[3:7, k4], before[3:7]
+    alpha_z = 2 * (-p[3] * pdd[0] - p[2] * pdd[1] + p[1] * pdd[2] + p[0] * pdd[3])  # (2 E(p) pdd)_z
+    np.testing.assert_allclose(alpha_z, -k * theta[k4] / J, rtol=1e-6)
+    ukflex.spatial_outputs(system2, [0.0], system2.q0, system2.qd0)
+    np.testing.assert_array_equal(system2.qdd(t[k4], res2.q[:, k4], res2.qd[:, k4]), before)
 
 
 # ---------------------------------------------------------------------------------------------

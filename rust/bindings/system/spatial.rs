@@ -51,28 +51,33 @@ impl PySystem {
             // the history's own turn count: from its first state (within half a turn of each
             // rotational spring's angle0), then state to state; the workspace's is kept for later calls
             let saved = std::mem::replace(&mut ws.data.turns, vec![f64::NAN; nf]);
-            for k in 0..nt {
-                let (qk, qdk) = (&qs[k * n..(k + 1) * n], &qds[k * n..(k + 1) * n]);
-                outputs::body_outputs(model, qk, qdk, &mut bo[k * nb * bw..(k + 1) * nb * bw]);
-                if reactions {
-                    outputs::reactions(model, &mut ws.data, ts[k], qk, qdk, &mut rx[k * nc * rw..(k + 1) * nc * rw])?;
+            let mut pass = || -> Result<(), Error> {
+                for k in 0..nt {
+                    let (qk, qdk) = (&qs[k * n..(k + 1) * n], &qds[k * n..(k + 1) * n]);
+                    outputs::body_outputs(model, qk, qdk, &mut bo[k * nb * bw..(k + 1) * nb * bw]);
+                    if reactions {
+                        outputs::reactions(model, &mut ws.data, ts[k], qk, qdk, &mut rx[k * nc * rw..(k + 1) * nc * rw])?;
+                    }
+                    mo[6 * k..6 * k + 6].copy_from_slice(&outputs::momentum(model, qk, qdk));
+                    let bek = &mut be[k * nb * 3..(k + 1) * nb * 3];
+                    sensors::energies_into(model, &mut ws.data, qk, qdk, bek, &mut fp[k * nf..(k + 1) * nf]);
+                    outputs::gravity_energies(model, qk, &mut gravity);
+                    for (i, g) in gravity.iter().enumerate() {
+                        bek[3 * i + 2] = *g;
+                    }
+                    outputs::count_turns(model, &ws.data.turns, &mut fp[k * nf..(k + 1) * nf]);
+                    outputs::force_powers(model, &ws.data.turns, qk, qdk, &mut v, &mut fw[k * nf..(k + 1) * nf]);
+                    ke[k] = dynamics::kinetic_energy(model, &mut ws.data, qk, qdk);
+                    // spatial bodies carry no strain and no body gravity: the force elements' potentials
+                    pe[k] = fp[k * nf..(k + 1) * nf].iter().sum();
+                    dp[k] = sensors::dissipation_power(model, &mut ws.data, qk, qdk, &mut v, &mut f);
+                    dv[k * nc..(k + 1) * nc].copy_from_slice(&outputs::driver_values(model, ts[k], qk, &mut scratch));
                 }
-                mo[6 * k..6 * k + 6].copy_from_slice(&outputs::momentum(model, qk, qdk));
-                let bek = &mut be[k * nb * 3..(k + 1) * nb * 3];
-                sensors::energies_into(model, &mut ws.data, qk, qdk, bek, &mut fp[k * nf..(k + 1) * nf]);
-                outputs::gravity_energies(model, qk, &mut gravity);
-                for (i, g) in gravity.iter().enumerate() {
-                    bek[3 * i + 2] = *g;
-                }
-                outputs::count_turns(model, &ws.data.turns, &mut fp[k * nf..(k + 1) * nf]);
-                outputs::force_powers(model, &ws.data.turns, qk, qdk, &mut v, &mut fw[k * nf..(k + 1) * nf]);
-                ke[k] = dynamics::kinetic_energy(model, &mut ws.data, qk, qdk);
-                // spatial bodies carry no strain and no body gravity: the force elements' potentials
-                pe[k] = fp[k * nf..(k + 1) * nf].iter().sum();
-                dp[k] = sensors::dissipation_power(model, &mut ws.data, qk, qdk, &mut v, &mut f);
-                dv[k * nc..(k + 1) * nc].copy_from_slice(&outputs::driver_values(model, ts[k], qk, &mut scratch));
-            }
+                Ok(())
+            };
+            let pass = pass();
             ws.data.turns = saved;
+            pass?;
             for (what, x) in [("spatial body outputs", &bo), ("spatial reactions", &rx), ("spatial energies", &be), ("spatial force potentials", &fp), ("spatial force powers", &fw), ("spatial dissipation power", &dp)] {
                 finite_out(what, x)?;
             }
