@@ -86,6 +86,10 @@ pub struct Data {
     /// Spatial models: `max |Phi_i|` at the last `dynamics::constraints` (the state's drift,
     /// which sets the default rank tolerance, `uk::dense`); `None` for planar models.
     pub spatial_drift: Option<f64>,
+    /// Per force element: the angle `theta - angle0` a spatial rotational spring-damper read at
+    /// the last evaluation, continuous over any number of turns (NaN until its first reading;
+    /// `spatial::force`); unused by the other elements.
+    pub turns: Vec<f64>,
     pub stabilization: Stabilization,
     pub rank_info: RankInfo,
     /// The UK path asked for at build, and the sparse workspace when it is used.
@@ -149,6 +153,7 @@ impl Data {
             factored_with: Factored::None,
             tolerance: RankTolerance::default(),
             spatial_drift: crate::spatial::is_spatial(model).then_some(0.0),
+            turns: vec![f64::NAN; model.forces.len()],
             stabilization: Stabilization::None,
             rank_info: RankInfo::default(),
             uk_solver: solver,

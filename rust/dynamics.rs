@@ -18,8 +18,8 @@ pub fn mass_and_forces(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
     for (body, bd) in model.bodies.iter().zip(data.bodies.iter_mut()) {
         body.mass_and_forces(bd, q, qd, model.gravity, &mut data.force);
     }
-    for f in &model.forces {
-        f.add_to(&model.bodies, q, qd, &mut data.force);
+    for (f, turn) in model.forces.iter().zip(data.turns.iter_mut()) {
+        f.add_to(&model.bodies, q, qd, turn, &mut data.force);
     }
 }
 

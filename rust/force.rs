@@ -76,9 +76,10 @@ impl Force {
         }
     }
 
-    /// Add this force's generalized force to `qvec` (length n).
+    /// Add this force's generalized force to `qvec` (length n). `turn`: the element's slot of
+    /// `Data::turns` (a spatial rotational spring's continuous angle; the others ignore it).
     #[inline]
-    pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], qvec: &mut [f64]) {
+    pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], turn: &mut f64, qvec: &mut [f64]) {
         match &self.kind {
             ForceKind::PointForce { point, force } => {
                 let s = point.state(bodies, q, qd);
@@ -102,7 +103,7 @@ impl Force {
                 a.add_point_jacobian(bodies, &sa, [-f * e[0], -f * e[1]], qvec);
                 b.add_point_jacobian(bodies, &sb, [f * e[0], f * e[1]], qvec);
             }
-            ForceKind::Spatial(f) => f.add_to(bodies, q, qd, qvec),
+            ForceKind::Spatial(f) => f.add_to(bodies, q, qd, turn, qvec),
         }
     }
 

@@ -18,7 +18,6 @@ __all__ = [
     "item_name",
     "beam_elastic_dofs",
     "motion_values",
-    "spatial_outputs",
     "dense_eval",
     "run_options",
     "check_tolerances",
@@ -189,6 +188,9 @@ class System:
     def sensors(self, t: _F64, q: _F64, qd: _F64, reactions: bool = True) -> Dict[str, Any]:
         """Reactions (nt, items, 6), body energies (nt, bodies, 3), force potentials, dissipation power."""
         ...
+    def spatial_outputs(self, t: _F64, q: Any, qd: Any, reactions: bool = True) -> Dict[str, Any]:
+        """Spatial outputs at stored states: bodies (nt, bodies, 25), reactions (nt, items, 13), momentum, energies, force potentials and powers, dissipation power, driver values (ukflex.spatial_outputs, res.sensors)."""
+        ...
     def beam_internal_forces(self, body: str, xi: _F64, q: _F64) -> _F64:
         """(nt, nx, 5): N, V, M, eps, kappa at the axis points xi."""
         ...
@@ -260,9 +262,6 @@ def item_name(section: str, kind: str, name: Optional[str], index: int) -> str:
 
 def motion_values(motion_json: str, t: _F64) -> _F64:
     """(f, f', f'') of a driver motion at the times t, shape (3, nt)."""
-    ...
-def spatial_outputs(description_json: str, t: _F64, q: Any, qd: Any, reactions: bool = True, rcond: Optional[float] = None, atol: float = 0.0) -> Dict[str, Any]:
-    """Spatial outputs (bodies, reactions, momentum, energies, driver values) at stored states (ukflex.spatial_outputs)."""
     ...
 def beam_elastic_dofs(elements: int, frame: str) -> int:
     """Number of elastic coordinates of a beam."""

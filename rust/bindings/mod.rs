@@ -5,7 +5,6 @@
 
 mod scene;
 mod sensors;
-mod spatial;
 mod system;
 
 use numpy::ndarray::ArrayView1;
@@ -299,7 +298,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dense_eval, m)?)?;
     m.add_function(wrap_pyfunction!(run_options, m)?)?;
     m.add_function(wrap_pyfunction!(check_tolerances, m)?)?;
-    m.add_function(wrap_pyfunction!(spatial::spatial_outputs, m)?)?;
     m.add("UkflexError", py.get_type::<UkflexError>())?;
     m.add("InvalidSceneError", py.get_type::<InvalidSceneError>())?;
     m.add("SingularMassError", py.get_type::<SingularMassError>())?;

@@ -30,6 +30,20 @@ pub(super) fn read_states(obj: &Bound<'_, PyAny>, n: usize, what: &str) -> PyRes
     Ok((flat, rows))
 }
 
+/// A history of states `(t, q, qd)` (`t` (nt,), `q`, `qd` (nt, n) or (n,)) as row-major `Vec`s
+/// and `nt`, checked for matching lengths and finite values.
+#[allow(clippy::type_complexity)]
+pub(super) fn read_history(t: &Vector<'_>, q: &Bound<'_, PyAny>, qd: &Bound<'_, PyAny>, n: usize) -> PyResult<(Vec<f64>, Vec<f64>, Vec<f64>, usize)> {
+    let (qs, nt) = read_states(q, n, "q")?;
+    let (qds, nt2) = read_states(qd, n, "qd")?;
+    let ts: Vec<f64> = t.as_array().iter().copied().collect();
+    if nt2 != nt || ts.len() != nt {
+        return Err(arg_err("t", format!("t, q and qd must hold the same number of states, got {}, {nt} and {nt2}", ts.len())));
+    }
+    crate::error::check_finite("t", &ts).map_err(to_py)?;
+    Ok((ts, qs, qds, nt))
+}
+
 /// `(f, f', f'')` of a driver motion (a description dict as JSON) at the times `t`, shape
 /// (3, nt). The same code as a driver's row: parse errors are `ExpressionError`.
 #[pyfunction]

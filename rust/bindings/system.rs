@@ -2,6 +2,7 @@
 
 mod inspect;
 mod run;
+mod spatial;
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;

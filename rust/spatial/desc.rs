@@ -40,7 +40,9 @@ impl Body3Desc {
 pub struct Rigid3Desc {
     pub name: String,
     pub mass: f64,
-    /// Inertia tensor about the centre of mass in body axes (3x3 rows, symmetric).
+    /// Inertia tensor about the centre of mass in body axes (3x3 rows, symmetric), or its three
+    /// principal moments `[Ixx, Iyy, Izz]` (a diagonal tensor: the short form of scene files).
+    #[serde(deserialize_with = "inertia_matrix")]
     pub inertia: [[f64; 3]; 3],
     /// Centre of mass in the body frame.
     #[serde(default)]
@@ -56,6 +58,21 @@ pub struct Rigid3Desc {
     /// Angular velocity (world components).
     #[serde(default)]
     pub angular_velocity: Vec3,
+}
+
+/// An inertia given as a 3x3 matrix or as its three principal moments (a diagonal matrix).
+fn inertia_matrix<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[[f64; 3]; 3], D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Inertia {
+        Matrix([[f64; 3]; 3]),
+        Principal([f64; 3]),
+    }
+    match Inertia::deserialize(d) {
+        Ok(Inertia::Matrix(m)) => Ok(m),
+        Ok(Inertia::Principal([a, b, c])) => Ok([[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]]),
+        Err(_) => Err(serde::de::Error::custom("inertia must be a 3x3 matrix (rows) or its 3 principal moments [Ixx, Iyy, Izz]")),
+    }
 }
 
 /// A particle: coordinates `r` (3), no orientation.

@@ -7,14 +7,19 @@
 //! * a torque (world `n`, or body axes `n'`): `Q_p = 2 G^T n'`, `n' = A^T n`;
 //! * a translational spring-damper: `f = k (L - L0) + c Ld` (tension positive), `Q = -f J_L^T`;
 //! * a rotational spring-damper about `z_a`: `theta - theta0` read as
-//!   `atan2(s cos t0 - c sin t0, s sin t0 + c cos t0)` (`s = y_a . x_b`, `c = x_a . x_b`: no jump
-//!   within half a turn of `theta0`), `tau = -k (theta - theta0) - c thetad`, `Q = tau J_theta^T`,
+//!   `w = atan2(s cos t0 - c sin t0, s sin t0 + c cos t0)` (`s = y_a . x_b`, `c = x_a . x_b`)
+//!   and counted over turns: the first reading is `w` (within half a turn of `theta0`), every
+//!   later one the value `prev + wrap(w - prev)` nearest the previous reading (the workspace's
+//!   `Data::turns`, as Chrono's rotational spring-damper counts its turns from call to call; a
+//!   native run starts from a fresh workspace), so the spring winds up through any number of
+//!   turns; `tau = -k (theta - theta0) - c thetad`, `Q = tau J_theta^T`,
 //!   `J_theta = (c J_s - s J_c) / (s^2 + c^2)`.
 
 use crate::body::marker3::{add_jacobian, Marker3};
 use crate::body::{Body, BodyKind, Marker, MarkerShape};
 use crate::constraint::spatial::prim;
 use crate::spatial::desc::FrameDesc;
+use crate::constraint::rows::wrap_angle;
 use crate::spatial::rot::{dot, mat_t_vec, mat_vec, norm, rot_a, rot_g, scale, V3};
 
 #[derive(Debug, Clone)]
@@ -36,6 +41,17 @@ fn spatial_mass(b: &Body) -> Option<f64> {
 }
 
 impl SpatialForce {
+    /// The element's kind as the description names it (`gravity` for the scene's gravity).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            SpatialForce::Gravity { .. } => "gravity",
+            SpatialForce::PointForce { .. } => "point_force",
+            SpatialForce::Torque { .. } => "torque",
+            SpatialForce::SpringDamper { .. } => "spring_damper",
+            SpatialForce::RotationalSpringDamper { .. } => "rotational_spring_damper",
+        }
+    }
+
     pub fn torque_marker(body: usize) -> Marker {
         Marker { body: Some(body), angle: 0.0, shape: MarkerShape::Spatial }
     }
@@ -61,21 +77,31 @@ impl SpatialForce {
         (l, dot(&u, &dd), Some(u), [sa, sb])
     }
 
-    /// `(theta - theta0, thetad, s, c, r2)` of a rotational spring.
-    fn angle(a: &Marker3, b: &Marker3, angle0: f64, bodies: &[Body], q: &[f64], qd: &[f64]) -> (f64, f64, [crate::body::marker3::Marker3State; 2], f64, f64, f64) {
+    /// `(theta - theta0, thetad, s, c, r2)` of a rotational spring: read within half a turn of
+    /// `theta0` (`turn = None`, or its first reading), else counted from the previous reading
+    /// `*turn`, which it updates.
+    #[allow(clippy::type_complexity)]
+    fn angle(a: &Marker3, b: &Marker3, angle0: f64, bodies: &[Body], q: &[f64], qd: &[f64], turn: Option<&mut f64>) -> (f64, f64, [crate::body::marker3::Marker3State; 2], f64, f64, f64) {
         let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
         let (s, sd, _) = prim::dot_terms(&sa.axes[1], &sb.axes[0]);
         let (c, cd, _) = prim::dot_terms(&sa.axes[0], &sb.axes[0]);
         let r2 = s * s + c * c;
         let (s0, c0) = angle0.sin_cos();
-        let th = (s * c0 - c * s0).atan2(s * s0 + c * c0);
+        let mut th = (s * c0 - c * s0).atan2(s * s0 + c * c0);
+        if let Some(prev) = turn {
+            if prev.is_finite() {
+                th = *prev + wrap_angle(th - *prev);
+            }
+            *prev = th;
+        }
         let thd = if r2 > 0.0 { (c * sd - s * cd) / r2 } else { 0.0 };
         (th, thd, [sa, sb], s, c, r2)
     }
 
-    /// Add the generalized force to `qv` (length n).
+    /// Add the generalized force to `qv` (length n); `turn`: the rotational spring's count
+    /// (`Data::turns`).
     #[inline]
-    pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], qv: &mut [f64]) {
+    pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], turn: &mut f64, qv: &mut [f64]) {
         match self {
             SpatialForce::Gravity { g } => {
                 for b in bodies {
@@ -115,7 +141,7 @@ impl SpatialForce {
                 add_jacobian(bodies, &sa, &sa.point, &scale(f, &u), qv, None);
             }
             SpatialForce::RotationalSpringDamper { a, b, stiffness, damping, angle0 } => {
-                let (th, thd, [sa, sb], s, c, r2) = Self::angle(a, b, *angle0, bodies, q, qd);
+                let (th, thd, [sa, sb], s, c, r2) = Self::angle(a, b, *angle0, bodies, q, qd, Some(turn));
                 if !(r2 > 0.0) {
                     return;
                 }
@@ -126,20 +152,22 @@ impl SpatialForce {
         }
     }
 
-    /// Potential energy: gravity `-sum m g . r`, springs `k x^2 / 2`, a world-frame point force
-    /// `-F . P`; 0 for body-frame loads and torques (not conservative in general).
+    /// The potential `k (theta - theta0)^2 / 2` of a rotational spring-damper at its counted angle
+    /// `turn` (`Data::turns` after an evaluation); `None` for the other elements.
+    pub fn counted_potential(&self, turn: f64) -> Option<f64> {
+        match self {
+            SpatialForce::RotationalSpringDamper { stiffness, .. } if turn.is_finite() => Some(0.5 * stiffness * turn * turn),
+            _ => None,
+        }
+    }
+
+    /// Potential energy: gravity `-sum m g . r`, springs `k x^2 / 2` (a rotational spring read
+    /// within half a turn of `angle0`: `counted_potential` has the counted one), a world-frame
+    /// point force `-F . P`; 0 for body-frame loads and torques (not conservative in general).
     pub fn potential(&self, bodies: &[Body], q: &[f64]) -> f64 {
         let zeros = vec![0.0; q.len()];
         match self {
-            SpatialForce::Gravity { g } => {
-                let mut v = 0.0;
-                for b in bodies {
-                    if let Some(m) = spatial_mass(b) {
-                        v -= m * (g[0] * q[b.offset] + g[1] * q[b.offset + 1] + g[2] * q[b.offset + 2]);
-                    }
-                }
-                v
-            }
+            SpatialForce::Gravity { g } => bodies.iter().map(|b| gravity_energy(g, b, q)).sum(),
             SpatialForce::PointForce { point, force, frame } => {
                 if *frame == FrameDesc::World {
                     -dot(force, &point.state(bodies, q, &zeros).point.v)
@@ -153,7 +181,7 @@ impl SpatialForce {
                 0.5 * stiffness * (l - rest_length).powi(2)
             }
             SpatialForce::RotationalSpringDamper { a, b, stiffness, angle0, .. } => {
-                let th = Self::angle(a, b, *angle0, bodies, q, &zeros).0;
+                let th = Self::angle(a, b, *angle0, bodies, q, &zeros, None).0;
                 0.5 * stiffness * th * th
             }
         }
@@ -163,10 +191,15 @@ impl SpatialForce {
     pub fn material_energy(&self, bodies: &[Body], q: &[f64], v: &[f64]) -> f64 {
         match self {
             SpatialForce::SpringDamper { a, b, stiffness, .. } => 0.5 * stiffness * Self::spring(a, b, bodies, q, v).1.powi(2),
-            SpatialForce::RotationalSpringDamper { a, b, stiffness, angle0, .. } => 0.5 * stiffness * Self::angle(a, b, *angle0, bodies, q, v).1.powi(2),
+            SpatialForce::RotationalSpringDamper { a, b, stiffness, angle0, .. } => 0.5 * stiffness * Self::angle(a, b, *angle0, bodies, q, v, None).1.powi(2),
             _ => 0.0,
         }
     }
+}
+
+/// Gravity potential `-m g . r` of one body (0 for planar kinds).
+pub fn gravity_energy(g: &V3, b: &Body, q: &[f64]) -> f64 {
+    spatial_mass(b).map_or(0.0, |m| -m * (g[0] * q[b.offset] + g[1] * q[b.offset + 1] + g[2] * q[b.offset + 2]))
 }
 
 /// The world point of a marker at `q` (inspection).

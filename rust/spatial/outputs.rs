@@ -14,7 +14,9 @@ use crate::body::{BodyKind, Rigid3};
 use crate::constraint::ConstraintKind;
 use crate::data::Data;
 use crate::error::Result;
+use crate::force::ForceKind;
 use crate::model::Model;
+use crate::spatial::force::{gravity_energy, SpatialForce};
 use crate::spatial::rot::{cross, dot, mat_t_vec, mat_vec, rot_a, rot_g, scale, sub};
 use crate::uk;
 
@@ -24,8 +26,13 @@ pub const BODY_COLUMNS: [&str; 22] = [
 ];
 /// Number of numbers per body: the columns above and `R20, R21, R22`.
 pub const BODY_WIDTH: usize = 25;
-/// Columns of one constraint's reaction row.
-pub const REACTION_COLUMNS: [&str; 12] = ["fx", "fy", "fz", "tx", "ty", "tz", "fx_joint", "fy_joint", "fz_joint", "tx_joint", "ty_joint", "tz_joint"];
+/// Columns of one constraint's reaction row: the wrench in world axes, in the first marker's
+/// axes, and the power of the item's constraint forces on the whole system (`-lambda^T A qd`:
+/// zero for a joint on the velocity manifold, the input power of a driver).
+pub const REACTION_COLUMNS: [&str; REACTION_WIDTH] =
+    ["fx", "fy", "fz", "tx", "ty", "tz", "fx_joint", "fy_joint", "fz_joint", "tx_joint", "ty_joint", "tz_joint", "power"];
+/// Number of numbers per constraint (`REACTION_COLUMNS`).
+pub const REACTION_WIDTH: usize = 13;
 
 /// Per body (`BODY_WIDTH` numbers): centre of mass, its velocity, unit quaternion, angular
 /// velocity in world and body axes, rotation matrix (rows). Point masses: identity rotation,
@@ -94,13 +101,15 @@ pub fn momentum(model: &Model, q: &[f64], qd: &[f64]) -> [f64; 6] {
 }
 
 /// For each constraint (model order) `REACTION_COLUMNS` numbers into `out`; normalization rows
-/// and planar kinds: zeros. Solves the UK acceleration at `(t, q, qd)` for the multipliers.
+/// and planar kinds: zero wrenches. Solves the UK acceleration at `(t, q, qd)` for the multipliers.
 pub fn reactions(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> Result<()> {
     uk::acceleration(model, data, t, q, qd)?;
     let zeros = vec![0.0; model.n];
     for (k, c) in model.constraints.iter().enumerate() {
-        let o = &mut out[12 * k..12 * k + 12];
+        let o = &mut out[REACTION_WIDTH * k..REACTION_WIDTH * (k + 1)];
         o.fill(0.0);
+        // -lambda^T A qd, as the planar sensors (`sensors::reactions_into`)
+        o[12] = -(c.row..c.row + c.rows()).map(|r| data.lambda[r] * data.ajac.row_dot(r, qd)).sum::<f64>();
         let ConstraintKind::Spatial(sc) = &c.kind else { continue };
         let Some(pair) = sc.pair() else { continue };
         let (target, sign) = match pair.i.body {
@@ -171,3 +180,45 @@ pub fn driver_values(model: &Model, t: f64, q: &[f64], scratch: &mut [f64]) -> V
         .collect()
 }
 
+
+/// The power `qd . Q_f` of each force element (model order) at `(q, qd)` into `out`
+/// (`model.forces.len()`): a load's work rate (a torque or a body-frame force has no potential
+/// in general, so its work is the integral of this), a spring-damper's `-(k x + c xd) xd`.
+/// `turns`: the workspace's counted spring angles at this state (`Data::turns`, read only);
+/// `scratch`: n numbers.
+pub fn force_powers(model: &Model, turns: &[f64], q: &[f64], qd: &[f64], scratch: &mut [f64], out: &mut [f64]) {
+    for ((f, o), turn) in model.forces.iter().zip(out.iter_mut()).zip(turns) {
+        scratch.fill(0.0);
+        f.add_to(&model.bodies, q, qd, &mut turn.clone(), scratch);
+        *o = dot_n(scratch, qd);
+    }
+}
+
+/// Replace the rotational springs' potentials in `potentials` (one per force element, as
+/// `sensors::energies_into` wrote them: read within half a turn) by their counted ones.
+pub fn count_turns(model: &Model, turns: &[f64], potentials: &mut [f64]) {
+    for ((f, p), turn) in model.forces.iter().zip(potentials.iter_mut()).zip(turns) {
+        if let ForceKind::Spatial(sf) = &f.kind {
+            if let Some(v) = sf.counted_potential(*turn) {
+                *p = v;
+            }
+        }
+    }
+}
+
+/// Each body's gravity potential `-m g . r` (the scene's `gravity` element; 0 without one) into
+/// `out` (`model.bodies.len()`).
+pub fn gravity_energies(model: &Model, q: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for f in &model.forces {
+        if let ForceKind::Spatial(SpatialForce::Gravity { g }) = &f.kind {
+            for (b, o) in model.bodies.iter().zip(out.iter_mut()) {
+                *o += gravity_energy(g, b, q);
+            }
+        }
+    }
+}
+
+fn dot_n(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}

@@ -12,6 +12,7 @@ from typing import Any, Callable, Dict, Sequence
 
 import numpy as np
 
+from . import spatial as cli_spatial
 from .common import (RUN_DEFAULTS, UserError, _FMT, _add_integrator_options, _add_progress_option,
                      _positive_float, _positive_int, _progress_from, _safe_name, _writable_dir, _writable_file)
 
@@ -205,7 +206,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     base = os.path.join(out, name)
     res.to_csv(base + ".csv")
     res.save_npz(base + ".npz")
-    written = [base + ".csv", base + ".npz"]
+    written = [base + ".csv", base + ".npz"] + cli_spatial.write_outputs(res, base)
     evaluated = [outputs.evaluate(res, x) for x in exprs]
     for x, (_, v) in zip(exprs, evaluated):
         print(f"{x}: min {np.min(v):.6g}, max {np.max(v):.6g}, final {v[-1]:.6g}")
@@ -251,15 +252,22 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
     if args.output not in (None, "-"):
         _writable_file(args.output, "-o")
-    scene = _build_scene(args.scene, args.param)
-    if args.vtk is not None:
-        return _export_vtk_run(scene, args)
-    doc = _scene_summary(SCENES[args.scene])
-    params = " ".join(f"--param {p}" for p in args.param)
-    text = dumps(scene, name=args.scene, description=doc,
-                 solver={"t_end": args.t_end, "method": args.method, "rtol": args.rtol},
-                 header=f"ukflex scene file: built-in scene '{args.scene}' (ukflex export {args.scene}"
-                        f"{' ' + params if params else ''}).\nFormat: docs/scene-format.md; run with: ukflex run FILE")
+    if args.scene not in SCENES and args.vtk is not None:  # a scene file run for ParaView
+        from ..model.scenefile import load
+
+        return _export_vtk_run(load(args.scene).scene, args)
+    if args.scene not in SCENES:  # a scene file (planar or spatial): written back validated
+        text = cli_spatial.export_text(args.scene)
+    else:
+        scene = _build_scene(args.scene, args.param)
+        if args.vtk is not None:
+            return _export_vtk_run(scene, args)
+        doc = _scene_summary(SCENES[args.scene])
+        params = " ".join(f"--param {p}" for p in args.param)
+        text = dumps(scene, name=args.scene, description=doc,
+                     solver={"t_end": args.t_end, "method": args.method, "rtol": args.rtol},
+                     header=f"ukflex scene file: built-in scene '{args.scene}' (ukflex export {args.scene}"
+                            f"{' ' + params if params else ''}).\nFormat: docs/scene-format.md; run with: ukflex run FILE")
     if args.output in (None, "-"):
         sys.stdout.write(text)
     else:
@@ -328,7 +336,7 @@ def _add_list_export_parsers(sub) -> None:
     p = sub.add_parser("export", help="write a built-in scene as a TOML scene file",
                        description="Write built-in scene NAME (with --param arguments) as a TOML scene file, "
                                    "to stdout or -o FILE.")
-    p.add_argument("scene", metavar="NAME", choices=sorted(SCENES), help=f"built-in scene ({', '.join(SCENES)})")
+    p.add_argument("scene", metavar="NAME", type=cli_spatial.export_source, help=f"built-in scene ({', '.join(SCENES)}) or a .toml scene file")
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                    help="scene function argument, e.g. --param elements=4 (repeatable)")
     p.add_argument("-o", "--output", default=None, help="output file (default stdout)")

@@ -1,8 +1,10 @@
 """TOML scene files: a scene description plus initial-state, solver and output settings.
 
 A scene file is the description of ``docs/scene-format.md`` written in TOML, one to one
-(``gravity``, ``[[bodies]]``, ``[[joints]]``, ``[[drivers]]``, ``[[forces]]``), plus four
-optional tables:
+(``dim``, ``gravity``, ``[[bodies]]``, ``[[joints]]``, ``[[drivers]]``, ``[[forces]]``), plus four
+optional tables. ``dim = 3`` makes it a spatial scene (:class:`ukflex.SpatialScene`,
+docs/spatial.md: ``rigid3`` and ``point3`` bodies, markers as frames, 3-vector gravity);
+absent or ``2``: planar. The tables:
 
 ``[scene]``
     ``name`` (default: the file name without extension), ``description``.
@@ -57,6 +59,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 from .. import arguments
 from ..errors import InvalidArgumentError, InvalidSceneError
 from .scene import Scene
+from .spatial import SpatialScene
 
 try:  # Python >= 3.11
     import tomllib as _toml
@@ -69,7 +72,7 @@ except ImportError:  # pragma: no cover - Python 3.9/3.10
 __all__ = ["SceneFile", "SceneFileError", "load", "loads", "dumps", "dump"]
 
 ITEM_ARRAYS = ("bodies", "joints", "drivers", "forces")
-TOP_KEYS = ("gravity",) + ITEM_ARRAYS + ("scene", "initial", "solver", "output")
+TOP_KEYS = ("dim", "gravity") + ITEM_ARRAYS + ("scene", "initial", "solver", "output")
 SCENE_KEYS = ("name", "description")
 INITIAL_KEYS = ("correct", "hold", "position_tol", "velocity_tol", "max_iterations", "t0")
 SOLVER_KEYS = ("t_end", "method", "rtol", "atol", "formulation", "samples", "max_step", "first_step")
@@ -97,8 +100,8 @@ class SceneFile:
         ``[scene] name`` or the file name without extension.
     description : str
         ``[scene] description`` (may be empty).
-    scene : Scene
-        The validated scene.
+    scene : Scene or SpatialScene
+        The validated scene (a :class:`ukflex.SpatialScene` for a file with ``dim = 3``).
     initial : dict
         Keyword arguments for :class:`ukflex.System` (``hold`` already mapped: ``"none"`` -> None).
     solver : dict
@@ -110,7 +113,7 @@ class SceneFile:
     path: str
     name: str
     description: str
-    scene: Scene
+    scene: Union[Scene, SpatialScene]
     initial: Dict[str, Any] = field(default_factory=dict)
     solver: Dict[str, Any] = field(default_factory=dict)
     output: Dict[str, Any] = field(default_factory=dict)
@@ -194,7 +197,7 @@ def _loads(text: str, path: str) -> SceneFile:
     solver = _solver(path, _table(path, data, "solver"))
     output = _output(path, _table(path, data, "output"))
 
-    description = {k: copy.deepcopy(data[k]) for k in ("gravity",) + ITEM_ARRAYS if k in data}
+    description = {k: copy.deepcopy(data[k]) for k in ("dim", "gravity") + ITEM_ARRAYS if k in data}
     for key in ITEM_ARRAYS:  # "kind" selects the entry's schema: name the entry if it is not a string
         items = description.get(key)
         for i, item in enumerate(items if isinstance(items, list) else []):
@@ -352,7 +355,14 @@ def _array_lines(text: str, key: str) -> List[int]:
     return [i + 1 for i, line in enumerate(text.splitlines()) if pat.match(line)]
 
 
-def _scene(path: str, text: str, description: Dict[str, Any]) -> Scene:
+def _scene(path: str, text: str, description: Dict[str, Any]) -> Union[Scene, SpatialScene]:
+    dim = description.get("dim", 2)
+    if isinstance(dim, bool) or dim != 2:  # spatial (dim = 3; any other value: the core names it)
+        try:
+            return SpatialScene.from_dict(description)
+        except InvalidSceneError as exc:
+            raise SceneFileError(f"{path}: {exc}") from None
+    description.pop("dim", None)
     try:
         scene = Scene.from_dict(description)
         scene.validate()
@@ -414,7 +424,7 @@ def _is_np_number(v: Any) -> bool:
 
 
 def dumps(
-    scene: Union[Scene, Dict[str, Any]],
+    scene: Union[Scene, SpatialScene, Dict[str, Any]],
     *,
     name: Optional[str] = None,
     description: Optional[str] = None,
@@ -428,11 +438,13 @@ def dumps(
     ``loads(dumps(scene)).scene.to_dict() == scene.to_dict()`` (floats are written with
     ``repr``, so they round-trip exactly).
     """
-    d = scene.to_dict() if isinstance(scene, Scene) else copy.deepcopy(scene)
+    d = scene.to_dict() if isinstance(scene, (Scene, SpatialScene)) else copy.deepcopy(scene)
     lines: List[str] = []
     if header:
         lines += [f"# {h}" if h else "#" for h in header.splitlines()]
         lines.append("")
+    if d.get("dim", 2) != 2:
+        lines.append(f"dim = {_value(d['dim'])}")
     if d.get("gravity") is not None:
         lines.append(f"gravity = {_value(d['gravity'])}")
         lines.append("")
@@ -458,7 +470,7 @@ def dumps(
     return "\n".join(lines).rstrip() + "\n"
 
 
-def dump(path: Union[str, "os.PathLike[str]"], scene: Union[Scene, Dict[str, Any]], **kwargs: Any) -> None:
+def dump(path: Union[str, "os.PathLike[str]"], scene: Union[Scene, SpatialScene, Dict[str, Any]], **kwargs: Any) -> None:
     """Write :func:`dumps` output to ``path``."""
     with open(os.fspath(path), "w", encoding="utf-8") as fh:
         fh.write(dumps(scene, **kwargs))

@@ -210,6 +210,17 @@ class SpatialScene:
     def to_dict(self) -> Dict[str, Any]:
         return copy.deepcopy(self._d)
 
+    @classmethod
+    def from_dict(cls, description: Dict[str, Any]) -> "SpatialScene":
+        """A spatial scene from its description dict (``"dim": 3``; a TOML scene file's tables),
+        validated whole by the core (named :class:`ukflex.InvalidSceneError`)."""
+        _, d = normalize_spatial(dict(description))
+        scene = cls.__new__(cls)
+        scene._d = {"dim": d.get("dim", 3), "gravity": d.get("gravity", [0.0, 0.0, 0.0]),
+                    **{k: list(d.get(k) or []) for k in ("bodies", "joints", "drivers", "forces")}}
+        scene.ground = SpatialBodyRef("ground")
+        return scene
+
     def validate(self) -> None:
         """Build the description in the core (every rule is the core's; named errors)."""
         normalize_spatial(self._d)

@@ -191,7 +191,12 @@ def animate(
         Number of frames written.
     """
     from ..errors import require
+    from .spatial import is_spatial
 
+    if is_spatial(res.system):  # a spatial run: matplotlib 3D (animate3d.py)
+        from .animate3d import animate3d
+
+        return animate3d(res, path, fps=fps, frames=frames, title=title, size=size, dpi=dpi)
     require("matplotlib", "the animation (a GIF)")
     Image = require("PIL.Image", "the animation (a GIF)")
     if res.t.size == 0:

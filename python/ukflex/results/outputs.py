@@ -28,7 +28,8 @@ from typing import List, Tuple
 
 import numpy as np
 
-from .sensors import SENSOR_HELP, Sensors, parse_xi
+from .sensors import SENSOR_HELP, parse_xi
+from .spatial import SPATIAL_SENSOR_HELP, is_spatial, sensors_class
 
 __all__ = ["evaluate", "validate", "default_outputs", "beam_names", "OUTPUT_HELP"]
 
@@ -37,6 +38,7 @@ __all__ = ["evaluate", "validate", "default_outputs", "beam_names", "OUTPUT_HELP
 OUTPUT_HELP = (
     "t, a coordinate (crank.theta), d:<coordinate> (rate), residual.position|velocity|acceleration, energy, "
     "u(BEAM, XI), v(BEAM, XI) [optionally /L], psi(BEAM, XI), x(BEAM, XI), y(BEAM, XI), " + SENSOR_HELP
+    + "; spatial scenes: " + SPATIAL_SENSOR_HELP
 )
 
 _BEAM_EXPR = re.compile(r"^(u|v|psi|x|y)\(\s*([^,()\s]+)\s*,\s*([^()\s]+)\s*\)\s*(/\s*L)?$")
@@ -53,7 +55,7 @@ def _parse(system, expr: str):
         if kind not in _RESIDUALS:
             raise ValueError(f"output {expr!r}: residual kind must be one of {_RESIDUALS}")
         return ("residual", kind)
-    sensor = Sensors.parse(system, e)
+    sensor = sensors_class(system).parse(system, e)
     if sensor is not None:
         return ("sensor", sensor)
     m = _BEAM_EXPR.match(e)
@@ -127,7 +129,10 @@ def evaluate(res, expr: str) -> Tuple[str, np.ndarray]:
 
 def default_outputs(system) -> List[str]:
     """Outputs plotted when none are chosen: each beam's midpoint deflection ``v(B, 0.5)/L``,
-    or the angles of the first (up to four) bodies of a rigid scene."""
+    or the angles of the first (up to four) bodies of a rigid scene; for a spatial scene the
+    first body's centre of mass and the total energy."""
+    if is_spatial(system):
+        return [f"position({system.body_names[0]}).{c}" for c in "xyz"] + ["energy.total"]
     beams = beam_names(system)
     if beams:
         return [f"v({b}, 0.5)/L" for b in beams]

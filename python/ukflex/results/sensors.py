@@ -94,6 +94,9 @@ class Sensors:
     """Sensors of one :class:`ukflex.SimulationResult` (``res.sensors``), computed once on first
     use and cached."""
 
+    #: Columns of :meth:`reaction` (the spatial sensors have their own).
+    reaction_columns = REACTION_COLUMNS
+
     def __init__(self, res):
         self.result = res
         self.system = res.system
@@ -256,7 +259,7 @@ class Sensors:
         out: Dict[str, np.ndarray] = {}
         for j in self.joint_names:
             r = self.reaction(j)
-            for c in REACTION_COLUMNS:
+            for c in self.reaction_columns:
                 out[f"reaction({j}).{c}"] = r[c]
         for d in self.driver_names:
             out[f"work({d})"] = self.driver_work(d)
@@ -287,10 +290,6 @@ class Sensors:
         """A parsed sensor expression (see ``SENSOR_HELP``), ``None`` if ``expr`` is not one;
         ``ValueError`` naming the problem if it is one with a wrong argument."""
         e = expr.strip()
-        if e in ("work.drivers", "work.external", "dissipated", "balance"):
-            return ("scalar", e)
-        if e.startswith("energy.") and e[7:] in ("kinetic", "strain", "gravity", "springs", "loads", "total"):
-            return ("energy", e[7:])
         m = cls._REACTION.match(e)
         if m:
             if m.group(2) not in REACTION_COLUMNS:
@@ -299,6 +298,21 @@ class Sensors:
             if m.group(1) not in items:
                 raise ValueError(f"output {expr!r}: unknown joint or driver {m.group(1)!r}; joints and drivers are {items}")
             return ("reaction", m.group(1), m.group(2))
+        m = cls._INTERNAL.match(e)
+        if m:
+            what, body, xi_text = m.groups()
+            if body not in system.body_names or not system.capabilities(body)["beam"]:
+                raise ValueError(f"output {expr!r}: {body!r} is not a beam")
+            return ("internal", what, body, parse_xi(expr, xi_text))
+        return cls._parse_common(system, e, expr)
+
+    @classmethod
+    def _parse_common(cls, system, e: str, expr: str) -> Optional[Tuple[Any, ...]]:
+        """The expressions planar and spatial sensors share: energies, work, balance."""
+        if e in ("work.drivers", "work.external", "dissipated", "balance"):
+            return ("scalar", e)
+        if e.startswith("energy.") and e[7:] in ("kinetic", "strain", "gravity", "springs", "loads", "total"):
+            return ("energy", e[7:])
         m = cls._WORK.match(e)
         if m:
             drivers = list(system.core.driver_names)
@@ -312,12 +326,6 @@ class Sensors:
             if m.group(2) not in ("kinetic", "strain", "gravity"):
                 raise ValueError(f"output {expr!r}: body energies are kinetic, strain, gravity")
             return ("body_energy", m.group(1), m.group(2))
-        m = cls._INTERNAL.match(e)
-        if m:
-            what, body, xi_text = m.groups()
-            if body not in system.body_names or not system.capabilities(body)["beam"]:
-                raise ValueError(f"output {expr!r}: {body!r} is not a beam")
-            return ("internal", what, body, parse_xi(expr, xi_text))
         return None
 
     def evaluate(self, p: Tuple[Any, ...]) -> Tuple[str, np.ndarray]:

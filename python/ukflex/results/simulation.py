@@ -162,10 +162,11 @@ class SimulationResult:
 
     @property
     def sensors(self):
-        """Reactions, energies, work, beam internal forces (:class:`ukflex.results.sensors.Sensors`)."""
-        from .sensors import Sensors
+        """Reactions, energies, work, beam internal forces (:class:`ukflex.results.sensors.Sensors`;
+        a spatial run's: :class:`ukflex.results.spatial.SpatialSensors`)."""
+        from .spatial import sensors_of
 
-        return self.__dict__.setdefault("_sensors", Sensors(self))
+        return self.__dict__.setdefault("_sensors", sensors_of(self))
 
     # ------------------------------------------------------------------------------ access
     def coordinate(self, name: str) -> np.ndarray:

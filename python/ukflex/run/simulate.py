@@ -25,6 +25,7 @@ from ..errors import (DriftWarning, IntegrationFailure, InvalidArgumentError, No
 from ..arguments import count, positive, real, real_array
 from ..results.simulation import SimulationResult
 from ..model.scene import Scene
+from ..model.spatial import SpatialScene
 from ..model.system import System
 from .stabilization import configure, segment_bounds
 
@@ -63,9 +64,9 @@ def as_system(scene_or_system: Union[Scene, System, Dict[str, Any]], **build_opt
         if build_options:
             raise TypeError("build options cannot be applied to an already built System")
         return scene_or_system
-    if isinstance(scene_or_system, (Scene, dict)):
+    if isinstance(scene_or_system, (Scene, SpatialScene, dict)):
         return System(scene_or_system, **build_options)
-    raise TypeError(f"expected a Scene, a description dict or a System, got {type(scene_or_system).__name__}")
+    raise TypeError(f"expected a Scene, a SpatialScene, a description dict or a System, got {type(scene_or_system).__name__}")
 
 
 # ------------------------------------------------------------------------------ argument checks

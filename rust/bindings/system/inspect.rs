@@ -5,7 +5,7 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::super::sensors::read_states;
+use super::super::sensors::{read_history, read_states};
 use super::super::{arg_err, array, finite_out, json_to_py, mat, read_into, to_py, Real, Vector};
 use super::PySystem;
 use crate::dynamics;
@@ -159,13 +159,7 @@ impl PySystem {
     #[pyo3(signature = (t, q, qd, reactions=true))]
     fn sensors<'py>(&self, py: Python<'py>, t: Vector<'py>, q: &Bound<'py, PyAny>, qd: &Bound<'py, PyAny>, reactions: bool) -> PyResult<Bound<'py, PyDict>> {
         let n = self.model.n;
-        let (qs, nt) = read_states(q, n, "q")?;
-        let (qds, nt2) = read_states(qd, n, "qd")?;
-        let ts: Vec<f64> = t.as_array().iter().copied().collect();
-        if nt2 != nt || ts.len() != nt {
-            return Err(arg_err("t", format!("t, q and qd must hold the same number of states, got {}, {nt} and {nt2}", ts.len())));
-        }
-        crate::error::check_finite("t", &ts).map_err(to_py)?;
+        let (ts, qs, qds, nt) = read_history(&t, q, qd, n)?;
         let (nc, nb, nf) = (self.model.constraints.len(), self.model.bodies.len(), self.model.forces.len());
         let mut rx = vec![0.0; if reactions { nt * nc * 6 } else { 0 }];
         let mut be = vec![0.0; nt * nb * 3];
