@@ -572,15 +572,14 @@ class System:
     def _driven_values(self, q: np.ndarray) -> Dict[str, float]:
         """The coordinate each driver holds at ``q``, up to the driver's value at ``t0`` (rad or m),
         by driver name: planar drivers' rows are ``driven value - f(t)`` (so ``Phi(t0, q)`` plus a
-        constant); spatial rotation drivers' rows are ``sin(theta - f)``, so their angle is the
-        core's (``driver_values`` of :func:`ukflex.spatial_outputs`)."""
+        constant); a spatial rotation driver's row is its angle error wrapped to the nearest turn,
+        so its angle is the core's (``driver_values`` of :func:`ukflex.spatial_outputs`)."""
         names = list(self.core.driver_names)  # the core's names (declaration order; defaults for unnamed drivers)
         if not names:
             return {}
         q = np.asarray(q, dtype=float)
         if self.description.get("dim") == 3:  # one value per constraint item
-            raw = _core.spatial_outputs(json.dumps(self.description), np.array([self.t0]), q[None, :],
-                                        np.zeros((1, q.size)), False, None, 0.0)
+            raw = self.core.spatial_outputs(np.array([self.t0]), q[None, :], np.zeros((1, q.size)), False)
             values, items = np.asarray(raw["driver_values"])[0], list(raw["reaction_names"])
         else:  # one value per row (a planar driver has one row, named as the driver)
             values, items = np.asarray(self.core.phi(self.t0, q), dtype=float), self.constraint_names

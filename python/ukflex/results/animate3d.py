@@ -91,14 +91,12 @@ def animate3d(res: Any, path: str, fps: int = 25, frames: int = 150, title: Opti
     Image = require("PIL.Image", "the animation (a GIF)")
     if res.t.size == 0:
         raise ValueError("the result has no output times to animate")
-    from matplotlib.figure import Figure
+    from .plotting import figure
 
     idx = np.unique(np.linspace(0, res.t.size - 1, min(int(frames), res.t.size)).round().astype(int))
     drawer = SpatialDrawer(res)
-    fig = Figure(figsize=size, dpi=dpi)
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    canvas = FigureCanvasAgg(fig)
+    fig = figure(size, "the animation (a GIF)", dpi=dpi)  # an Agg canvas
+    canvas = fig.canvas
     ax = fig.add_subplot(1, 1, 1, projection="3d")
     centre, half = drawer.bounds(idx)
     ax.set_xlim(centre[0] - half, centre[0] + half)
