@@ -74,10 +74,11 @@ def _nan_results() -> None:
 
 
 def _unresolved_positions() -> None:
-    """No resolution check of the corrected state: a mechanism 1e17 m from the origin builds."""
+    """No check of the corrected state (resolution, conditioning): a mechanism 1e17 m from the
+    origin builds."""
     from ukflex.model import system as system_module
 
-    system_module.System._check_resolution = lambda self, q: None
+    system_module.System._check_state = lambda self: None
 
 
 def _shared_settings() -> None:

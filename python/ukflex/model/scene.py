@@ -16,7 +16,12 @@ Example
 >>> s = Scene(gravity=(0.0, -9.81))
 >>> crank = s.rigid_body("crank", mass=0.04, inertia=8e-5, com=(0.0762, 0.0))
 >>> s.revolute(s.ground.point(0, 0), crank.point(0, 0))
+'revolute0'
 >>> s.angle_driver(crank.frame(), ConstantSpeed(124.8))
+'angle_driver0'
+>>> system = s.build()
+>>> system.coordinate_names, system.n_dof
+(['crank.x', 'crank.y', 'crank.theta'], 0)
 """
 
 from __future__ import annotations

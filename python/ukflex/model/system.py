@@ -229,7 +229,7 @@ class System:
             self.initial_correction = InitialCorrection(
                 0, rp, rp, rv, rv, np.zeros(self.n_coords), np.zeros(self.n_coords), [], self.coordinate_names
             )
-        core.check_state(self.t0, self.q0, self.qd0)  # rust/scale.rs: resolution, mass conditioning
+        self._check_state()
         try:  # energies are outputs of every run: they must be representable at the start
             core.kinetic_energy(self.q0, self.qd0)
             core.potential_energy(self.q0)
@@ -556,6 +556,12 @@ class System:
     #: positions must be resolved by double precision to this fraction of the scene's length scale
     #: (the core's rule, ``rust/scale.rs``; the initial correction's tolerance is never coarser)
     RESOLUTION = _core.RESOLUTION
+
+    def _check_state(self) -> None:
+        """Refuse a corrected start double precision cannot resolve (positions or angles far from
+        the origin, masses too disparate for the rank decision): the core's rules,
+        ``rust/scale.rs``."""
+        self.core.check_state(self.t0, self.q0, self.qd0)
 
     @property
     def length_scale(self) -> float:

@@ -128,7 +128,7 @@ class SimulationResult:
         Examples
         --------
         >>> out = system.integrate(system.t0, system.y0, 0.1, "DOPRI5")      # doctest: +SKIP
-        >>> res = SimulationResult.from_trajectory(system, out["t"], out["y"], method="DOPRI5",
+        >>> res = SimulationResult.from_trajectory(system, out["t"], out["y"], method="DOPRI5",  # doctest: +SKIP
         ...                                        nfev=out["nfev"], status=out["status"])
         """
         n = system.n_coords
