@@ -13,13 +13,14 @@ use crate::body::BodyData;
 use crate::error::Result;
 use crate::model::Model;
 
-/// Per-body mass blocks and generalized forces at `(q, qd)` (forces do not depend on `t`).
-pub fn mass_and_forces(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
+/// Per-body mass blocks and generalized forces at `(t, q, qd)` (`t`: the loads that are
+/// functions of time; the mass blocks and body forces do not depend on it).
+pub fn mass_and_forces(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) {
     for (body, bd) in model.bodies.iter().zip(data.bodies.iter_mut()) {
         body.mass_and_forces(bd, q, qd, model.gravity, &mut data.force);
     }
     for f in &model.forces {
-        f.add_to(&model.bodies, q, qd, &mut data.force);
+        f.add_to(&model.bodies, t, q, qd, &mut data.load_scratch, &mut data.force);
     }
 }
 
@@ -138,7 +139,8 @@ pub fn tangent_into(model: &Model, data: &Data, q: &[f64], qd: &[f64], k: &mut [
 
 /// Kinetic energy `1/2 qd^T M qd` from the body blocks (calls `mass_and_forces` at `(q, qd)`).
 pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) -> f64 {
-    mass_and_forces(model, data, q, qd);
+    // the mass blocks alone are read: the loads' time does not matter
+    mass_and_forces(model, data, 0.0, q, qd);
     model.bodies.iter().zip(&data.bodies).map(|(b, bd)| b.kinetic_energy(bd, qd)).sum()
 }
 
@@ -167,7 +169,7 @@ pub fn velocity_jacobians_into(model: &Model, data: &mut Data, t: f64, q: &[f64]
     for j in 0..n {
         let s = 1e-3 * qd[j].abs().max(1.0);
         v[j] = qd[j] + s;
-        mass_and_forces(model, data, q, v);
+        mass_and_forces(model, data, t, q, v);
         constraints(model, data, t, q, v, false);
         for i in 0..n {
             c[i * n + j] = -data.force[i];
@@ -176,7 +178,7 @@ pub fn velocity_jacobians_into(model: &Model, data: &mut Data, t: f64, q: &[f64]
             bv[r * n + j] = data.gamma[r];
         }
         v[j] = qd[j] - s;
-        mass_and_forces(model, data, q, v);
+        mass_and_forces(model, data, t, q, v);
         constraints(model, data, t, q, v, false);
         for i in 0..n {
             c[i * n + j] = (c[i * n + j] + data.force[i]) / (2.0 * s);

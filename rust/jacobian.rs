@@ -217,7 +217,7 @@ impl StructuredJacobian {
         use crate::linalg::lu::{lu_cm, lu_cm_solve}; // the saddle-point matrix is symmetric: row- and column-major alike
         let (n, m) = (model.n, model.m);
         let nm = n + m;
-        dynamics::mass_and_forces(model, data, q, qd);
+        dynamics::mass_and_forces(model, data, t, q, qd);
         dynamics::dense_mass_into(model, data, &mut self.m_dense);
         dynamics::stiffness_into(model, data, q, qd, &mut self.k);
         data.ensure_dense_jac()?;

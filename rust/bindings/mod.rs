@@ -3,6 +3,7 @@
 //! arrays, and never lets a panic cross into Python. `system.rs`: the compiled `System`;
 //! `scene.rs`: the item-by-item scene checker used by the Python `Scene` builder.
 
+mod callables;
 mod scene;
 mod sensors;
 mod spatial;
@@ -114,6 +115,10 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Real {
 }
 
 pub(crate) fn to_py(e: Error) -> PyErr {
+    // a load's Python callable failed (its NaN stopped the computation): raise what it raised
+    if let Some(pending) = callables::take_pending() {
+        return pending;
+    }
     let msg = e.to_string();
     match e {
         Error::Description(_) | Error::InvalidProperty { .. } | Error::UnknownBody { .. } => InvalidSceneError::new_err(msg),

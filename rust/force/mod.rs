@@ -1,5 +1,14 @@
 //! Applied forces other than gravity (which is a body-level term in `dynamics.rs`).
-//! Each adds its generalized force `J^T F` to `Q` (paper eqs. 34-37).
+//! Each adds its generalized force `J^T F` to `Q` (paper eqs. 34-37). The constant loads and
+//! the spring-damper are here; each further kind has its file (docs/loads.md): loads that are
+//! functions of time and state (`load.rs`, their values in `value.rs`), motors (`motor.rs`),
+//! rotational spring-dampers (`rotational_spring.rs`), bushings (`bushing.rs`).
+
+pub mod bushing;
+pub mod load;
+pub mod motor;
+pub mod rotational_spring;
+pub mod value;
 
 use crate::body::{Body, Marker};
 use crate::constraint::BuildContext;
@@ -17,6 +26,11 @@ pub enum ForceKind {
     SpringDamper { a: Marker, b: Marker, stiffness: f64, damping: f64, rest_length: f64 },
     /// Spatial force elements, gravity included (`spatial/force.rs`).
     Spatial(crate::spatial::force::SpatialForce),
+    /// A force or torque that is a function of time and state (`load.rs`).
+    Load(Box<load::Load>),
+    Motor(Box<motor::Motor>),
+    RotationalSpringDamper(Box<rotational_spring::RotationalSpringDamper>),
+    Bushing(Box<bushing::Bushing>),
 }
 
 #[derive(Debug, Clone)]
@@ -29,8 +43,10 @@ impl Force {
     /// Write the defaults this force resolved into its description (a spring-damper's rest
     /// length taken at the initial guess).
     pub fn fill_defaults(&self, d: &mut ForceDesc) {
-        if let (ForceKind::SpringDamper { rest_length: r, .. }, ForceDesc::SpringDamper { rest_length, .. }) = (&self.kind, d) {
-            *rest_length = Some(*r);
+        match (&self.kind, d) {
+            (ForceKind::SpringDamper { rest_length: r, .. }, ForceDesc::SpringDamper { rest_length, .. }) => *rest_length = Some(*r),
+            (ForceKind::RotationalSpringDamper(r), ForceDesc::RotationalSpringDamper { rest_angle, .. }) => *rest_angle = Some(r.rest_angle),
+            _ => {}
         }
     }
 
@@ -62,6 +78,13 @@ impl Force {
                     rest_length: non_negative(item, "rest_length", rest_length)?,
                 }
             }
+            ForceDesc::PointLoad { point, fx, fy, .. } => ForceKind::Load(Box::new(load::Load::force(ctx, item, point, fx, fy)?)),
+            ForceDesc::TorqueLoad { frame, torque, .. } => ForceKind::Load(Box::new(load::Load::torque(ctx, item, frame, torque)?)),
+            ForceDesc::Motor { a, b, torque, rotor_inertia, .. } => ForceKind::Motor(Box::new(motor::Motor::from_desc(ctx, item, a, b.as_ref(), torque, *rotor_inertia)?)),
+            ForceDesc::RotationalSpringDamper { a, b, stiffness, damping, rest_angle, .. } => {
+                ForceKind::RotationalSpringDamper(Box::new(rotational_spring::RotationalSpringDamper::from_desc(ctx, item, a, b.as_ref(), *stiffness, *damping, *rest_angle)?))
+            }
+            ForceDesc::Bushing { a, b, stiffness, damping, .. } => ForceKind::Bushing(Box::new(bushing::Bushing::from_desc(ctx, item, a, b, *stiffness, *damping)?)),
         };
         Ok(Force { name, kind })
     }
@@ -73,12 +96,61 @@ impl Force {
             ForceKind::Torque { frame, .. } => [Some(frame), None],
             ForceKind::SpringDamper { a, b, .. } => [Some(a), Some(b)],
             ForceKind::Spatial(f) => f.markers(),
+            ForceKind::Load(l) => [Some(l.marker()), None],
+            ForceKind::Motor(m) => [Some(&m.a), Some(&m.b)],
+            ForceKind::RotationalSpringDamper(r) => [Some(&r.a), Some(&r.b)],
+            ForceKind::Bushing(b) => [Some(&b.a), Some(&b.b)],
+        }
+    }
+
+    /// The coordinates this force's values read besides its markers' (a load of another
+    /// body's angle; the points of `x(BODY, XI)` quantities are in `read_points`): they couple
+    /// in the sparse Newton matrices' pattern.
+    pub fn read_coords(&self) -> Vec<usize> {
+        self.values().into_iter().flat_map(|v| v.coords()).collect()
+    }
+
+    /// The markers of the point quantities this force's values read.
+    pub fn read_points(&self) -> Vec<&Marker> {
+        self.values().into_iter().flat_map(|v| v.points()).collect()
+    }
+
+    fn values(&self) -> Vec<&value::Value> {
+        match &self.kind {
+            ForceKind::Load(l) => match l.as_ref() {
+                load::Load::Force { f, .. } => f.iter().collect(),
+                load::Load::Torque { tau, .. } => vec![tau],
+            },
+            ForceKind::Motor(m) => vec![&m.torque],
+            _ => Vec::new(),
+        }
+    }
+
+    /// The values of this force (the loads' components, a motor's torque), mutable: where
+    /// callables are attached.
+    pub fn values_mut(&mut self) -> Vec<&mut value::Value> {
+        match &mut self.kind {
+            ForceKind::Load(l) => match l.as_mut() {
+                load::Load::Force { f, .. } => f.iter_mut().collect(),
+                load::Load::Torque { tau, .. } => vec![tau],
+            },
+            ForceKind::Motor(m) => vec![&mut m.torque],
+            _ => Vec::new(),
+        }
+    }
+
+    /// Evaluation scratch this force needs (`Data::load_scratch`).
+    pub fn scratch_len(&self) -> usize {
+        match &self.kind {
+            ForceKind::Load(l) => l.scratch_len(),
+            ForceKind::Motor(m) => m.torque.scratch_len(),
+            _ => 0,
         }
     }
 
     /// Add this force's generalized force to `qvec` (length n).
     #[inline]
-    pub fn add_to(&self, bodies: &[Body], q: &[f64], qd: &[f64], qvec: &mut [f64]) {
+    pub fn add_to(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], scratch: &mut [f64], qvec: &mut [f64]) {
         match &self.kind {
             ForceKind::PointForce { point, force } => {
                 let s = point.state(bodies, q, qd);
@@ -103,6 +175,10 @@ impl Force {
                 b.add_point_jacobian(bodies, &sb, [f * e[0], f * e[1]], qvec);
             }
             ForceKind::Spatial(f) => f.add_to(bodies, q, qd, qvec),
+            ForceKind::Load(l) => l.add_to(bodies, t, q, qd, scratch, qvec),
+            ForceKind::Motor(m) => m.add_to(bodies, t, q, qd, scratch, qvec),
+            ForceKind::RotationalSpringDamper(r) => r.add_to(bodies, q, qd, qvec),
+            ForceKind::Bushing(b) => b.add_to(bodies, q, qd, qvec),
         }
     }
 
@@ -120,8 +196,10 @@ impl Force {
                 let ldot = (d[0] * (sa.v[0] - sb.v[0]) + d[1] * (sa.v[1] - sb.v[1])) / l;
                 0.5 * stiffness * ldot * ldot
             }
-            ForceKind::PointForce { .. } | ForceKind::Torque { .. } => 0.0,
+            ForceKind::PointForce { .. } | ForceKind::Torque { .. } | ForceKind::Load(_) | ForceKind::Motor(_) => 0.0,
             ForceKind::Spatial(f) => f.material_energy(bodies, q, v),
+            ForceKind::RotationalSpringDamper(r) => r.material_energy(bodies, q, v),
+            ForceKind::Bushing(b) => b.material_energy(bodies, q, v),
         }
     }
 
@@ -146,6 +224,12 @@ impl Force {
                 -torque * frame.state(bodies, q, &zeros).phi
             }
             ForceKind::Spatial(f) => f.potential(bodies, q),
+            ForceKind::RotationalSpringDamper(r) => r.potential(bodies, q),
+            ForceKind::Bushing(b) => b.potential(bodies, q),
+            // a load that is a function has no potential unless it is constant; a motor's work
+            // is input, not stored (sensors: `external_work`)
+            ForceKind::Load(l) => l.potential(bodies, q).unwrap_or(0.0),
+            ForceKind::Motor(_) => 0.0,
         }
     }
 }
