@@ -16,6 +16,7 @@ use crate::model::Model;
 /// Per-body mass blocks and generalized forces at `(t, q, qd)` (`t`: the loads that are
 /// functions of time; the mass blocks and body forces do not depend on it).
 pub fn mass_and_forces(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) {
+    data.t_forces = t;
     for (body, bd) in model.bodies.iter().zip(data.bodies.iter_mut()) {
         body.mass_and_forces(bd, q, qd, model.gravity, &mut data.force);
     }
@@ -114,20 +115,35 @@ pub fn dense_mass_into(model: &Model, data: &Data, m: &mut [f64]) {
 }
 
 /// The stiffness part of `tangent_into` alone (n x n, overwritten).
-pub fn stiffness_into(model: &Model, data: &Data, q: &[f64], qd: &[f64], k: &mut [f64]) {
+pub fn stiffness_into(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], k: &mut [f64]) {
     let n = model.n;
     k.fill(0.0);
     for (body, bd) in model.bodies.iter().zip(&data.bodies) {
         let o = body.offset;
         body.tangent(bd, q, qd, &mut |i, j, v| k[(o + i) * n + o + j] += v, &mut |_, _, _| {});
     }
+    add_force_stiffness(model, data, q, qd, &mut |i, j, v| k[i * n + j] += v);
+}
+
+/// The analytic position stiffness of the force elements that have one (`Force::add_stiffness`:
+/// loads and motors whose values are expressions or tables), at `q`, `qd` and the time of the
+/// last `mass_and_forces`.
+pub fn add_force_stiffness(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], add: &mut dyn FnMut(usize, usize, f64)) {
+    if data.load_rows.is_empty() {
+        return;
+    }
+    let t = data.t_forces;
+    for f in model.forces.iter().filter(|f| f.has_stiffness()) {
+        f.add_stiffness(&model.bodies, t, q, qd, &mut data.load_scratch, &mut data.load_rows, add);
+    }
 }
 
 /// The stiffness `k = -dQ/dq` and damping `c = -dQ/dqd` that the bodies know analytically
 /// (elastic tangent stiffness and strain-rate damping; not the inertial velocity terms, the
-/// gravity or the force elements), n x n row-major, overwritten. For implicit methods'
-/// iteration matrices.
-pub fn tangent_into(model: &Model, data: &Data, q: &[f64], qd: &[f64], k: &mut [f64], c: &mut [f64]) {
+/// gravity or the force elements), plus the loads' analytic position stiffness
+/// (`add_force_stiffness`), n x n row-major, overwritten. For implicit methods' iteration
+/// matrices.
+pub fn tangent_into(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], k: &mut [f64], c: &mut [f64]) {
     let n = model.n;
     k.fill(0.0);
     c.fill(0.0);
@@ -135,6 +151,7 @@ pub fn tangent_into(model: &Model, data: &Data, q: &[f64], qd: &[f64], k: &mut [
         let o = body.offset;
         body.tangent(bd, q, qd, &mut |i, j, v| k[(o + i) * n + o + j] += v, &mut |i, j, v| c[(o + i) * n + o + j] += v);
     }
+    add_force_stiffness(model, data, q, qd, &mut |i, j, v| k[i * n + j] += v);
 }
 
 /// Kinetic energy `1/2 qd^T M qd` from the body blocks (calls `mass_and_forces` at `(q, qd)`).

@@ -5,7 +5,8 @@
 //!
 //! `H = [M + g_c C + g_k K, A^T; A - g_c db/dqd, 0]`
 //!
-//! (`K = -dQ/dq` the bodies' analytic stiffness, `C = -dQ/dqd`). Every block is local:
+//! (`K = -dQ/dq` the bodies' analytic stiffness and the loads' (`Force::add_stiffness`),
+//! `C = -dQ/dqd`). Every block is local:
 //! `M`, `K`, `C` couple a body's own coordinates (dense for rigid, FFRF and modal bodies; an
 //! ANCF cable's within an element, `Body::coupling_halfwidth`) and the coordinates of a force
 //! element's markers; a constraint row depends on its markers' coordinates only
@@ -329,14 +330,16 @@ pub fn fill_mass(model: &Model, data: &Data, s: &mut Structure) {
     }
 }
 
-/// The bodies' analytic stiffness `K` (as `dynamics::stiffness_into`).
-pub fn fill_stiffness(model: &Model, data: &Data, q: &[f64], qd: &[f64], s: &mut Structure) {
+/// The bodies' and the loads' analytic stiffness `K` (as `dynamics::stiffness_into`).
+pub fn fill_stiffness(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], s: &mut Structure) {
     s.k.fill(0.0);
     let (p, out) = (&s.pattern, &mut s.k);
     for (body, bd) in model.bodies.iter().zip(&data.bodies) {
         let o = body.offset;
         body.tangent(bd, q, qd, &mut |i, j, v| out[p.find(o + i, o + j)] += v, &mut |_, _, _| {});
     }
+    // within the clique of the force's markers and what it reads (`force_coords`)
+    crate::dynamics::add_force_stiffness(model, data, q, qd, &mut |i, j, v| out[p.find(i, j)] += v);
 }
 
 /// `A`'s structural entries from the segment form of the last `dynamics::constraints`.

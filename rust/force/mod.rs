@@ -139,6 +139,60 @@ impl Force {
         }
     }
 
+    /// Whether [`Force::add_stiffness`] adds anything (a load or motor whose value is an
+    /// expression or a table).
+    pub fn has_stiffness(&self) -> bool {
+        self.values().iter().any(|v| v.has_gradient())
+    }
+
+    /// `add(i, j, K_ij)` of this force's analytic position stiffness `K = -dQ/dq`: for the loads
+    /// and motors whose value is an expression or a table, `-J^T dF/dq` from the symbolic
+    /// gradient (the change of the application point's Jacobian with `q`, `(dJ^T/dq) F`, is
+    /// left out, as for the constant loads). `rows` is a `2 n` scratch, `scratch` the force's
+    /// evaluation scratch. Nothing for the other kinds.
+    pub fn add_stiffness(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], scratch: &mut [f64], rows: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        let n = q.len();
+        let (p, r) = rows[..2 * n].split_at_mut(n);
+        match &self.kind {
+            ForceKind::Load(l) => {
+                let env = value::Env { bodies, t, q, qd, local: [0.0; 2] };
+                match l.as_ref() {
+                    load::Load::Force { point, f } => {
+                        for (c, v) in f.iter().enumerate().filter(|(_, v)| v.has_gradient()) {
+                            r.fill(0.0);
+                            v.add_position_gradient(&env, scratch, r);
+                            p.fill(0.0);
+                            let mut w = [0.0; 2];
+                            w[c] = 1.0;
+                            point.add_point_jacobian(bodies, &point.state(bodies, q, qd), w, p);
+                            outer(p, r, add);
+                        }
+                    }
+                    load::Load::Torque { frame, tau } if tau.has_gradient() => {
+                        r.fill(0.0);
+                        tau.add_position_gradient(&env, scratch, r);
+                        p.fill(0.0);
+                        frame.add_angle_jacobian(bodies, &frame.state(bodies, q, qd), 1.0, p);
+                        outer(p, r, add);
+                    }
+                    load::Load::Torque { .. } => {}
+                }
+            }
+            ForceKind::Motor(m) if m.torque.has_gradient() => {
+                let (sa, sb, local) = motor::relative(bodies, &m.a, &m.b, q, qd);
+                r.fill(0.0);
+                let [d_angle, _] = m.torque.add_position_gradient(&value::Env { bodies, t, q, qd, local }, scratch, r);
+                m.a.add_angle_jacobian(bodies, &sa, d_angle, r);
+                m.b.add_angle_jacobian(bodies, &sb, -d_angle, r);
+                p.fill(0.0);
+                m.a.add_angle_jacobian(bodies, &sa, 1.0, p);
+                m.b.add_angle_jacobian(bodies, &sb, -1.0, p);
+                outer(p, r, add);
+            }
+            _ => {}
+        }
+    }
+
     /// Evaluation scratch this force needs (`Data::load_scratch`).
     pub fn scratch_len(&self) -> usize {
         match &self.kind {
@@ -231,5 +285,60 @@ impl Force {
             ForceKind::Load(l) => l.potential(bodies, q).unwrap_or(0.0),
             ForceKind::Motor(_) => 0.0,
         }
+    }
+}
+
+/// `add(i, j, -p_i r_j)` over the non-zeros of `p` and `r`: `K = -dQ/dq` of `Q = p F`,
+/// `dF/dq = r`.
+fn outer(p: &[f64], r: &[f64], add: &mut dyn FnMut(usize, usize, f64)) {
+    for (i, &pi) in p.iter().enumerate().filter(|(_, x)| **x != 0.0) {
+        for (j, &rj) in r.iter().enumerate().filter(|(_, x)| **x != 0.0) {
+            add(i, j, -pi * rj);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::data::Data;
+    use crate::dynamics;
+    use crate::model::Model;
+
+    #[test]
+    fn analytic_load_stiffness_matches_differences() {
+        // point-mass and rigid-frame Jacobians are constant: -dQ/dq is exactly -J^T dF/dq
+        let text = r#"{"bodies": [
+            {"kind": "point_mass", "name": "m", "mass": 1.0, "position": [1.0, 0.5]},
+            {"kind": "rigid", "name": "w", "mass": 2.0, "inertia": 0.1, "angle": 0.3, "position": [0.2, -0.4]}],
+          "forces": [
+            {"kind": "point_load", "point": {"body": "m"},
+             "fx": "-200 * (m.x - 1) - 3 * m.y^2 + sin(t) * w.theta + d:m.x",
+             "fy": {"of": "m.x", "x": [0, 0.5, 1.5, 2], "y": [0, 1, -1, 3]}},
+            {"kind": "motor", "a": {"body": "w"}, "torque": "-5 * angle^2 + 0.3 * w + y(w, 0) * x(w, 0)"},
+            {"kind": "torque_load", "frame": {"body": "w"}, "torque": "m.x * w.theta"}]}"#;
+        let model = Model::from_json(text).unwrap();
+        let mut data = Data::new(&model);
+        let n = model.n;
+        let q: Vec<f64> = model.q0.iter().enumerate().map(|(i, x)| x + 0.01 * (i as f64 + 1.0)).collect();
+        let qd: Vec<f64> = (0..n).map(|i| 0.3 - 0.1 * i as f64).collect();
+        let t = 0.7;
+        let mut k = vec![0.0; n * n];
+        dynamics::mass_and_forces(&model, &mut data, t, &q, &qd);
+        dynamics::stiffness_into(&model, &mut data, &q, &qd, &mut k);
+        let mut qv = q.clone();
+        let h = 1e-6;
+        for j in 0..n {
+            qv[j] = q[j] + h;
+            dynamics::mass_and_forces(&model, &mut data, t, &qv, &qd);
+            let fp = data.force.clone();
+            qv[j] = q[j] - h;
+            dynamics::mass_and_forces(&model, &mut data, t, &qv, &qd);
+            qv[j] = q[j];
+            for i in 0..n {
+                let fd = -(fp[i] - data.force[i]) / (2.0 * h);
+                assert!((k[i * n + j] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "K[{i}][{j}] = {} vs {fd}", k[i * n + j]);
+            }
+        }
+        assert!(k[0] == 200.0 && k[4 * n + 4] != 0.0 && k[4 * n] != 0.0, "{k:?}");
     }
 }

@@ -273,13 +273,58 @@ impl Value {
         }
     }
 
-    /// Scratch this value needs to evaluate.
+    /// Scratch this value needs to evaluate (with its gradient: [`Value::add_position_gradient`]).
     pub fn scratch_len(&self) -> usize {
         match self {
-            Value::Expr(e) => e.inputs.len() + e.f.scratch_len(),
+            Value::Expr(e) => 2 * e.inputs.len() + e.f.scratch_len(),
             Value::Callable(c) => c.inputs.len(),
             _ => 0,
         }
+    }
+
+    /// Whether the value depends on the positions through a known derivative (an expression
+    /// or a table; a callable's derivative is unknown: the differences of the Jacobian see it).
+    pub fn has_gradient(&self) -> bool {
+        matches!(self, Value::Expr(_) | Value::Table(_))
+    }
+
+    /// `row += dF/dq` (row spans `q`) through the positions the value reads (coordinates and
+    /// points), from the expression's symbolic gradient or the table's slope; returns
+    /// `dF/d local` (the element's own quantities: a motor adds `dF/d angle` itself). The rates'
+    /// derivatives are not here (the velocity Jacobian differences them exactly).
+    pub fn add_position_gradient(&self, env: &Env, scratch: &mut [f64], row: &mut [f64]) -> [f64; 2] {
+        let mut local = [0.0; 2];
+        let mut put = |i: Input, g: f64, points: &[Marker], row: &mut [f64]| match i {
+            Input::Coord(j) => row[j] += g,
+            Input::Point { k, axis, rate: false } => {
+                let s = points[k].state(env.bodies, env.q, env.qd);
+                let mut w = [0.0; 2];
+                w[axis] = g;
+                points[k].add_point_jacobian(env.bodies, &s, w, row);
+            }
+            Input::Local(k) => local[k] += g,
+            _ => {}
+        };
+        match self {
+            Value::Expr(e) => {
+                let k = e.inputs.len();
+                let (x, rest) = scratch.split_at_mut(k);
+                let (grad, buf) = rest.split_at_mut(k);
+                for (xi, &i) in x.iter_mut().zip(&e.inputs) {
+                    *xi = env.get(i, &e.points);
+                }
+                e.f.eval_gradient(x, buf, grad);
+                for (&i, &g) in e.inputs.iter().zip(grad.iter()) {
+                    put(i, g, &e.points, row);
+                }
+            }
+            Value::Table(t) => {
+                let (_, slope) = t.eval(env.get(t.input, &[]));
+                put(t.input, slope, &[], row);
+            }
+            _ => {}
+        }
+        local
     }
 
     /// The coordinates (positions or rates) the value reads.

@@ -289,7 +289,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         // `uk::acceleration` / `augmented_residual` left the body blocks and A of (q, qd) in `data`
         self.ready = false;
         sparse_newton::fill_mass(self.model, &self.data, s);
-        sparse_newton::fill_stiffness(self.model, &self.data, q, qd, s);
+        sparse_newton::fill_stiffness(self.model, &mut self.data, q, qd, s);
         sparse_newton::fill_a(&self.data, s);
         Ok(true)
     }
