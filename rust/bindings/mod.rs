@@ -27,7 +27,7 @@ create_exception!(ukflex, InvalidSceneError, UkflexError, "Malformed or non-phys
 create_exception!(ukflex, SingularMassError, UkflexError, "The mass matrix is not positive definite.");
 create_exception!(ukflex, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
 create_exception!(ukflex, SolverError, UkflexError, "A solver kernel failed.");
-create_exception!(ukflex, ExpressionError, InvalidSceneError, "A driver's motion expression does not parse; `position` is the 0-based character index.");
+create_exception!(ukflex, ExpressionError, InvalidSceneError, "An expression (a driver's motion, a load) does not parse or names an unknown state quantity; `position` is the 0-based character index.");
 create_exception!(ukflex, MemoryLimitError, UkflexError, "An allocation would exceed the System's memory limit (refused before allocating).");
 create_exception!(ukflex, BudgetError, SolverError, "A work budget (max_wall_time, ...) ran out before the work was done (e.g. the initial-state correction of a build).");
 
