@@ -368,3 +368,23 @@ damping = 0.001
     # the DC motor against a hinge damper: w_inf = k V / (k^2 + c R)
     res = ukflex.simulate(system, 120.0, method="DOPRI5", rtol=1e-10, atol=1e-12, t_eval=[120.0])
     assert res.velocity("wheel.theta")[-1] == pytest.approx(0.05 * 12 / (0.05**2 + 0.001 * 0.8), rel=1e-6)
+
+
+def test_elastic_elements_forces_are_their_potentials_gradients():
+    # Q = -dV/dq for the undamped bushing (its moment term included) and rotational spring, on
+    # two rigid bodies and a beam marker, at a state away from the rest one
+    s = Scene()
+    a = s.rigid_body("a", mass=1.0, inertia=0.1, angle=0.2)
+    b = s.rigid_body("b", mass=2.0, inertia=0.2, position=(0.5, 0.2), angle=-0.3)
+    s.bushing(a.point(0.2, 0.1, angle=0.1), b.point(-0.1, -0.05, angle=0.4), stiffness=(50.0, 80.0, 2.0))
+    s.rotational_spring_damper(a.frame(), b.frame(), stiffness=3.0)
+    system = s.build()
+    rng = np.random.default_rng(3)
+    q = system.q0 + 0.1 * rng.standard_normal(system.n_coords)
+    zero = np.zeros(system.n_coords)
+    Q = system.core.Q(0.0, q, zero)
+    h = 1e-6
+    grad = np.array([(system.core.potential_energy(q + h * e) - system.core.potential_energy(q - h * e)) / (2 * h)
+                     for e in np.eye(system.n_coords)])
+    assert np.max(np.abs(Q + grad)) < 1e-7 * np.max(np.abs(Q))
+    assert np.max(np.abs(Q)) > 1.0
