@@ -487,14 +487,32 @@ pub enum ForceDesc {
     },
 }
 
-/// A load's value: a number, an expression of `t` and state quantities, or a table.
-#[derive(Debug, Clone, Deserialize, Serialize)]
+/// A load's value: a number, an expression of `t` and state quantities, a table, or a
+/// callable's reference (read by its shape, with messages that say which was meant).
+#[derive(Debug, Clone, Serialize)]
 #[serde(untagged)]
 pub enum LoadValueDesc {
     Number(f64),
     Expression(String),
     Table(TableDesc),
     Callable(CallableDesc),
+}
+
+impl<'de> Deserialize<'de> for LoadValueDesc {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let v = Value::deserialize(d)?;
+        let msg = |e: serde_json::Error| e.to_string().replace('`', "'");
+        match v {
+            Value::Number(n) => n.as_f64().map(LoadValueDesc::Number).ok_or_else(|| D::Error::custom("expected a finite number")),
+            Value::String(s) => Ok(LoadValueDesc::Expression(s)),
+            Value::Object(ref m) if m.contains_key("callable") => {
+                serde_json::from_value(v).map(LoadValueDesc::Callable).map_err(|e| D::Error::custom(format!("callable: {}", msg(e))))
+            }
+            Value::Object(_) => serde_json::from_value(v).map(LoadValueDesc::Table).map_err(|e| D::Error::custom(format!("table {{of, x, y, period}}: {}", msg(e)))),
+            other => Err(D::Error::custom(format!("expected a number, an expression string, a table {{of, x, y, period}} or a callable, got {other}"))),
+        }
+    }
 }
 
 /// A Python callable `f(t, state)` given to `System` under the name `callable`; `state` is a

@@ -234,6 +234,10 @@ def test_bad_input_is_named():
         s.point_load(s["m"].point(), fx=LoadTable(of="t", x=[0, 2], y=[0, 1], period=1.0))
     with pytest.raises(ukflex.InvalidSceneError, match="increase"):
         s.point_load(s["m"].point(), fx=LoadTable(of="t", x=[0, 0], y=[0, 1]))
+    with pytest.raises(ukflex.InvalidSceneError, match="table .*missing field 'y'"):
+        s.point_load(s["m"].point(), fx={"of": "t", "x": [0, 1]})
+    with pytest.raises(ukflex.InvalidSceneError, match="expected a number, an expression string, a table"):
+        s.point_load(s["m"].point(), fx=[1.0, 2.0])
     w = s.rigid_body("w", mass=1.0, inertia=0.1)
     with pytest.raises(ukflex.InvalidSceneError, match="damping"):
         s.rotational_spring_damper(w.frame(), damping=-1.0)
