@@ -124,7 +124,7 @@ fn main() {
         let (q, qd) = bench_state(&model);
         let t = 0.01;
         uk::acceleration(&model, &mut data, t, &q, &qd).unwrap();
-        row(&format!("{name} 1 assembly M, Q"), time(|| dynamics::mass_and_forces(&model, &mut data, black_box(&q), black_box(&qd))));
+        row(&format!("{name} 1 assembly M, Q"), time(|| dynamics::mass_and_forces(&model, &mut data, 0.0, black_box(&q), black_box(&qd))));
         row(&format!("{name} 2 assembly A, b"), time(|| dynamics::constraints(&model, &mut data, black_box(t), black_box(&q), black_box(&qd), false)));
         row(&format!("{name} 3 factor M"), time(|| dynamics::factor_mass(&model, &mut data).unwrap()));
         row(&format!("{name} 4 free acceleration"), time(|| uk::free_acceleration(&model, &mut data)));

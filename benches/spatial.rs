@@ -49,7 +49,7 @@ fn stages(c: &mut Criterion) {
     let mut g = c.benchmark_group("spatial_slider_crank_stages");
     let (model, mut data, q, qd) = scene(SCENES[0].1);
     uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
-    g.bench_function("mass_and_forces", |b| b.iter(|| dynamics::mass_and_forces(&model, &mut data, black_box(&q), black_box(&qd))));
+    g.bench_function("mass_and_forces", |b| b.iter(|| dynamics::mass_and_forces(&model, &mut data, black_box(0.1), black_box(&q), black_box(&qd))));
     g.bench_function("constraints", |b| b.iter(|| dynamics::constraints(&model, &mut data, black_box(0.1), black_box(&q), black_box(&qd), false)));
     g.bench_function("factor_constraints", |b| b.iter(|| uk::factor_constraints(&model, &mut data).unwrap()));
     g.bench_function("correct", |b| b.iter(|| uk::correct(&model, &mut data)));

@@ -80,7 +80,7 @@ fn stages(c: &mut Criterion) {
         let t = 0.01;
         uk::acceleration(&model, &mut data, t, &q, &qd).unwrap();
         g.bench_function(format!("N{n_el}/1_assembly_M_Q"), |b| {
-            b.iter(|| dynamics::mass_and_forces(&model, &mut data, black_box(&q), black_box(&qd)))
+            b.iter(|| dynamics::mass_and_forces(&model, &mut data, 0.0, black_box(&q), black_box(&qd)))
         });
         g.bench_function(format!("N{n_el}/2_assembly_A_b"), |b| {
             b.iter(|| dynamics::constraints(&model, &mut data, black_box(t), black_box(&q), black_box(&qd), false))

@@ -59,6 +59,14 @@ pub struct Data {
     pub gamma: Vec<f64>,
     /// Where drivers' motion expressions evaluate (the longest tape of the model's drivers).
     pub motion_scratch: Vec<f64>,
+    /// Where loads' expressions evaluate (the longest need of the model's forces).
+    pub load_scratch: Vec<f64>,
+    /// Two n-long rows for the loads' analytic stiffness (`Force::add_stiffness`; empty when
+    /// no force has one).
+    pub load_rows: Vec<f64>,
+    /// The time of the last `dynamics::mass_and_forces` (the loads' stiffness is read at the
+    /// state that call left, as the bodies' blocks are).
+    pub t_forces: f64,
     /// `F^-1 Q` then `F^-1 Q + B^+ (b - A a)` (n).
     pub y: Vec<f64>,
     /// Unconstrained acceleration `a = M^-1 Q` (n).
@@ -137,6 +145,9 @@ impl Data {
             phi_t: vec![0.0; m],
             gamma: vec![0.0; m],
             motion_scratch: vec![0.0; model.constraints.iter().map(|c| c.scratch_len()).max().unwrap_or(0)],
+            load_scratch: vec![0.0; model.forces.iter().map(|f| f.scratch_len()).max().unwrap_or(0)],
+            load_rows: vec![0.0; if model.forces.iter().any(|f| f.has_stiffness()) { 2 * n } else { 0 }],
+            t_forces: 0.0,
             y: vec![0.0; n],
             qdd_free: vec![0.0; n],
             qdd: vec![0.0; n],

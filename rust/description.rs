@@ -443,6 +443,111 @@ pub enum ForceDesc {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         rest_length: Option<f64>,
     },
+    /// A force at a marker whose world components are functions (docs/loads.md).
+    PointLoad {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        point: MarkerDesc,
+        #[serde(default)]
+        fx: LoadValueDesc,
+        #[serde(default)]
+        fy: LoadValueDesc,
+    },
+    /// A torque on a marker frame that is a function.
+    TorqueLoad { #[serde(default, skip_serializing_if = "Option::is_none")] name: Option<String>, frame: MarkerDesc, torque: LoadValueDesc },
+    /// A torque `tau` between two marker frames (`+tau` on `a`, `-tau` on `b`, the ground
+    /// when absent), a function of their relative angle `angle` and rate `w`; the rotor's
+    /// inertia is added to `a`'s body.
+    Motor {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        a: MarkerDesc,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        b: Option<MarkerDesc>,
+        torque: LoadValueDesc,
+        #[serde(default)]
+        rotor_inertia: f64,
+    },
+    /// `tau = -k (angle - rest_angle) - c w` between two marker frames (`b`: the ground when
+    /// absent); with `k = 0` the viscous friction of a hinge.
+    RotationalSpringDamper {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        a: MarkerDesc,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        b: Option<MarkerDesc>,
+        stiffness: f64,
+        #[serde(default)]
+        damping: f64,
+        /// Default: the relative angle at the initial guess.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rest_angle: Option<f64>,
+    },
+    /// Linear stiffness and damping in x, y (in `b`'s frame) and the angle between two markers.
+    Bushing {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        a: MarkerDesc,
+        b: MarkerDesc,
+        stiffness: [f64; 3],
+        #[serde(default)]
+        damping: [f64; 3],
+    },
+}
+
+/// A load's value: a number, an expression of `t` and state quantities, a table, or a
+/// callable's reference (read by its shape, with messages that say which was meant).
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum LoadValueDesc {
+    Number(f64),
+    Expression(String),
+    Table(TableDesc),
+    Callable(CallableDesc),
+}
+
+impl<'de> Deserialize<'de> for LoadValueDesc {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let v = Value::deserialize(d)?;
+        let msg = |e: serde_json::Error| e.to_string().replace('`', "'");
+        match v {
+            Value::Number(n) => n.as_f64().map(LoadValueDesc::Number).ok_or_else(|| D::Error::custom("expected a finite number")),
+            Value::String(s) => Ok(LoadValueDesc::Expression(s)),
+            Value::Object(ref m) if m.contains_key("callable") => {
+                serde_json::from_value(v).map(LoadValueDesc::Callable).map_err(|e| D::Error::custom(format!("callable: {}", msg(e))))
+            }
+            Value::Object(_) => serde_json::from_value(v).map(LoadValueDesc::Table).map_err(|e| D::Error::custom(format!("table {{of, x, y, period}}: {}", msg(e)))),
+            other => Err(D::Error::custom(format!("expected a number, an expression string, a table {{of, x, y, period}} or a callable, got {other}"))),
+        }
+    }
+}
+
+/// A Python callable `f(t, state)` given to `System` under the name `callable`; `state` is a
+/// dict of the quantities `inputs` (docs/loads.md).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CallableDesc {
+    pub callable: String,
+    #[serde(default)]
+    pub inputs: Vec<String>,
+}
+
+impl Default for LoadValueDesc {
+    fn default() -> Self {
+        LoadValueDesc::Number(0.0)
+    }
+}
+
+/// A cubic spline of one state quantity `of` through `(x, y)`; `period` wraps `of`.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TableDesc {
+    pub of: String,
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
 }
 
 impl ForceDesc {
@@ -451,14 +556,24 @@ impl ForceDesc {
             ForceDesc::PointForce { .. } => "point_force",
             ForceDesc::Torque { .. } => "torque",
             ForceDesc::SpringDamper { .. } => "spring_damper",
+            ForceDesc::PointLoad { .. } => "point_load",
+            ForceDesc::TorqueLoad { .. } => "torque_load",
+            ForceDesc::Motor { .. } => "motor",
+            ForceDesc::RotationalSpringDamper { .. } => "rotational_spring_damper",
+            ForceDesc::Bushing { .. } => "bushing",
         }
     }
 
     pub fn name(&self) -> Option<&str> {
         match self {
-            ForceDesc::PointForce { name, .. } | ForceDesc::Torque { name, .. } | ForceDesc::SpringDamper { name, .. } => {
-                name.as_deref()
-            }
+            ForceDesc::PointForce { name, .. }
+            | ForceDesc::Torque { name, .. }
+            | ForceDesc::SpringDamper { name, .. }
+            | ForceDesc::PointLoad { name, .. }
+            | ForceDesc::TorqueLoad { name, .. }
+            | ForceDesc::Motor { name, .. }
+            | ForceDesc::RotationalSpringDamper { name, .. }
+            | ForceDesc::Bushing { name, .. } => name.as_deref(),
         }
     }
 }

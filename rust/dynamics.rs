@@ -13,13 +13,15 @@ use crate::body::BodyData;
 use crate::error::Result;
 use crate::model::Model;
 
-/// Per-body mass blocks and generalized forces at `(q, qd)` (forces do not depend on `t`).
-pub fn mass_and_forces(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
+/// Per-body mass blocks and generalized forces at `(t, q, qd)` (`t`: the loads that are
+/// functions of time; the mass blocks and body forces do not depend on it).
+pub fn mass_and_forces(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) {
+    data.t_forces = t;
     for (body, bd) in model.bodies.iter().zip(data.bodies.iter_mut()) {
         body.mass_and_forces(bd, q, qd, model.gravity, &mut data.force);
     }
     for (f, turn) in model.forces.iter().zip(data.turns.iter_mut()) {
-        f.add_to(&model.bodies, q, qd, turn, &mut data.force);
+        f.add_to(&model.bodies, t, q, qd, &mut data.load_scratch, turn, &mut data.force);
     }
 }
 
@@ -113,20 +115,35 @@ pub fn dense_mass_into(model: &Model, data: &Data, m: &mut [f64]) {
 }
 
 /// The stiffness part of `tangent_into` alone (n x n, overwritten).
-pub fn stiffness_into(model: &Model, data: &Data, q: &[f64], qd: &[f64], k: &mut [f64]) {
+pub fn stiffness_into(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], k: &mut [f64]) {
     let n = model.n;
     k.fill(0.0);
     for (body, bd) in model.bodies.iter().zip(&data.bodies) {
         let o = body.offset;
         body.tangent(bd, q, qd, &mut |i, j, v| k[(o + i) * n + o + j] += v, &mut |_, _, _| {});
     }
+    add_force_stiffness(model, data, q, qd, &mut |i, j, v| k[i * n + j] += v);
+}
+
+/// The analytic position stiffness of the force elements that have one (`Force::add_stiffness`:
+/// loads and motors whose values are expressions or tables), at `q`, `qd` and the time of the
+/// last `mass_and_forces`.
+pub fn add_force_stiffness(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], add: &mut dyn FnMut(usize, usize, f64)) {
+    if data.load_rows.is_empty() {
+        return;
+    }
+    let t = data.t_forces;
+    for f in model.forces.iter().filter(|f| f.has_stiffness()) {
+        f.add_stiffness(&model.bodies, t, q, qd, &mut data.load_scratch, &mut data.load_rows, add);
+    }
 }
 
 /// The stiffness `k = -dQ/dq` and damping `c = -dQ/dqd` that the bodies know analytically
 /// (elastic tangent stiffness and strain-rate damping; not the inertial velocity terms, the
-/// gravity or the force elements), n x n row-major, overwritten. For implicit methods'
-/// iteration matrices.
-pub fn tangent_into(model: &Model, data: &Data, q: &[f64], qd: &[f64], k: &mut [f64], c: &mut [f64]) {
+/// gravity or the force elements), plus the loads' analytic position stiffness
+/// (`add_force_stiffness`), n x n row-major, overwritten. For implicit methods' iteration
+/// matrices.
+pub fn tangent_into(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], k: &mut [f64], c: &mut [f64]) {
     let n = model.n;
     k.fill(0.0);
     c.fill(0.0);
@@ -134,11 +151,13 @@ pub fn tangent_into(model: &Model, data: &Data, q: &[f64], qd: &[f64], k: &mut [
         let o = body.offset;
         body.tangent(bd, q, qd, &mut |i, j, v| k[(o + i) * n + o + j] += v, &mut |i, j, v| c[(o + i) * n + o + j] += v);
     }
+    add_force_stiffness(model, data, q, qd, &mut |i, j, v| k[i * n + j] += v);
 }
 
 /// Kinetic energy `1/2 qd^T M qd` from the body blocks (calls `mass_and_forces` at `(q, qd)`).
 pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) -> f64 {
-    mass_and_forces(model, data, q, qd);
+    // the mass blocks alone are read: the loads' time does not matter
+    mass_and_forces(model, data, 0.0, q, qd);
     model.bodies.iter().zip(&data.bodies).map(|(b, bd)| b.kinetic_energy(bd, qd)).sum()
 }
 
@@ -167,7 +186,7 @@ pub fn velocity_jacobians_into(model: &Model, data: &mut Data, t: f64, q: &[f64]
     for j in 0..n {
         let s = 1e-3 * qd[j].abs().max(1.0);
         v[j] = qd[j] + s;
-        mass_and_forces(model, data, q, v);
+        mass_and_forces(model, data, t, q, v);
         constraints(model, data, t, q, v, false);
         for i in 0..n {
             c[i * n + j] = -data.force[i];
@@ -176,7 +195,7 @@ pub fn velocity_jacobians_into(model: &Model, data: &mut Data, t: f64, q: &[f64]
             bv[r * n + j] = data.gamma[r];
         }
         v[j] = qd[j] - s;
-        mass_and_forces(model, data, q, v);
+        mass_and_forces(model, data, t, q, v);
         constraints(model, data, t, q, v, false);
         for i in 0..n {
             c[i * n + j] = (c[i * n + j] + data.force[i]) / (2.0 * s);

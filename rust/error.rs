@@ -28,8 +28,8 @@ pub enum Error {
     /// A function argument (not the scene) is out of range: tolerances, times, options.
     #[error("{what}: {message}")]
     Argument { what: String, message: String },
-    /// A driver's motion expression does not parse (`position`: 0-based character index).
-    #[error("{item}: cannot parse the motion expression {} at position {position}: {message}", excerpt(text, *position))]
+    /// An expression (a driver's motion, a load) does not parse (`position`: 0-based character index).
+    #[error("{item}: cannot parse the expression {} at position {position}: {message}", excerpt(text, *position))]
     Expression { item: String, text: String, message: String, position: usize },
     /// A work budget of a run ran out (`what`: `max_steps`, `max_nfev`, `max_wall_time`,
     /// `min_step`).

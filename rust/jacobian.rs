@@ -155,7 +155,7 @@ pub fn assemble_first_order(n: usize, jq: &[f64], jv: &[f64], out: &mut [f64]) {
 
 /// The structured linearization of the UK acceleration, instead of differences of it: the
 /// acceleration solves `M qdd + A^T lambda = Q(q, qd)`, `A qdd = b(q, qd)`; with the stiffness
-/// `K = -dQ/dq` the bodies know analytically, `C = -dQ/dqd` and `db/dqd` (exact differences of
+/// `K = -dQ/dq` the bodies and the loads know analytically, `C = -dQ/dqd` and `db/dqd` (exact differences of
 /// functions quadratic in `qd`) and `M`, `A` held fixed,
 ///
 /// `[M, A^T; A, 0] [Jq e_j; .] = [-K e_j; 0]`, `[M, A^T; A, 0] [Jv e_j; .] = [-C e_j; db/dqd e_j]`,
@@ -217,7 +217,7 @@ impl StructuredJacobian {
         use crate::linalg::lu::{lu_cm, lu_cm_solve}; // the saddle-point matrix is symmetric: row- and column-major alike
         let (n, m) = (model.n, model.m);
         let nm = n + m;
-        dynamics::mass_and_forces(model, data, q, qd);
+        dynamics::mass_and_forces(model, data, t, q, qd);
         dynamics::dense_mass_into(model, data, &mut self.m_dense);
         dynamics::stiffness_into(model, data, q, qd, &mut self.k);
         data.ensure_dense_jac()?;

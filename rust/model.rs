@@ -111,6 +111,23 @@ impl Model {
             .collect()
     }
 
+    /// Attach the functions of the loads' callables (`force::value::Callable`): `resolve`
+    /// gives the function of a name and its inputs; a name it does not know is an error.
+    pub fn attach_callables(&mut self, resolve: &mut dyn FnMut(&str, &[String]) -> Option<std::sync::Arc<dyn crate::force::value::LoadCallback>>) -> Result<()> {
+        for f in &mut self.forces {
+            let name = f.name.clone();
+            for v in f.values_mut() {
+                if let crate::force::value::Value::Callable(c) = v {
+                    c.f = resolve(&c.name, &c.input_names);
+                    if c.f.is_none() {
+                        return Err(Error::invalid(format!("force '{name}'"), format!("the callable '{}' was not given to the System", c.name)));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Any body with stiffness-proportional damping (the scene is then truly stiff).
     pub fn has_damping(&self) -> bool {
         self.bodies.iter().any(|b| b.capabilities().damped)
@@ -395,7 +412,7 @@ impl ModelBuilder {
     }
 
     fn context(&self) -> BuildContext<'_> {
-        BuildContext { bodies: &self.bodies, index: &self.index, q0: &self.q0 }
+        BuildContext { bodies: &self.bodies, index: &self.index, q0: &self.q0, coordinate_names: &self.coordinate_names }
     }
 
     pub fn add_joint(&mut self, d: &JointDesc) -> Result<&Constraint> {
@@ -421,6 +438,15 @@ impl ModelBuilder {
         let item = item_name(Section::Force, d.kind(), d.name(), j);
         let f = Force::from_desc(&self.context(), &item, String::new(), d)?;
         let name = self.take_name(&item, d.name(), format!("{}{j}", d.kind()))?;
+        if let crate::force::ForceKind::Motor(m) = &f.kind {
+            if m.rotor_inertia > 0.0 {
+                let body = m.a.body.and_then(|b| self.bodies.get_mut(b));
+                match body {
+                    Some(b) => b.add_rotor_inertia(&item, m.rotor_inertia)?,
+                    None => return Err(Error::invalid(&item, "a rotor inertia needs the rotor marker 'a' on a body, not the ground")),
+                }
+            }
+        }
         self.forces.push(Force { name, ..f });
         Ok(self.forces.last().expect("just pushed"))
     }

@@ -201,7 +201,7 @@ pub fn check_conditioning(model: &Model, data: &mut Data, t: f64, q: &[f64], qd:
     if rank_a <= rank {
         return Ok(()); // the redundancy is the constraints' own
     }
-    dynamics::mass_and_forces(model, data, q, qd);
+    dynamics::mass_and_forces(model, data, t, q, qd);
     let mass = dynamics::dense_mass(model, data);
     let scale = model.length_scale;
     let names = &model.coordinate_names;

@@ -48,8 +48,8 @@ pub fn reactions_into(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
 /// (`3 * model.bodies.len()`), per force element its potential into `forces`
 /// (`model.forces.len()`: a spring's `k (l - l0)^2 / 2`, a constant load's `-F . r`,
 /// `-tau phi`).
-pub fn energies_into(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], bodies: &mut [f64], forces: &mut [f64]) {
-    dynamics::mass_and_forces(model, data, q, qd);
+pub fn energies_into(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], bodies: &mut [f64], forces: &mut [f64]) {
+    dynamics::mass_and_forces(model, data, t, q, qd);
     for (i, (b, bd)) in model.bodies.iter().zip(&data.bodies).enumerate() {
         bodies[3 * i] = b.kinetic_energy(bd, qd);
         bodies[3 * i + 1] = b.strain_energy(q);
@@ -86,12 +86,41 @@ pub fn unwrap_torque_potentials(model: &Model, fp: &mut [f64], nt: usize) {
 /// inertial velocity terms are quadratic in `qd` and the elastic, gravity and constant loads do
 /// not depend on it, so `Q_odd` is exactly the damping (spring-dampers, beam strain-rate
 /// damping) for every body kind. `v` and `f` are n-long scratch vectors.
-pub fn dissipation_power(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], v: &mut [f64], f: &mut [f64]) -> f64 {
-    dynamics::mass_and_forces(model, data, q, qd);
+///
+/// The loads that are functions of time and state (and motors) are not damping: their odd part
+/// is taken out here and their whole power is [`load_power`] (external work). `g` is a third
+/// n-long scratch.
+pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], v: &mut [f64], f: &mut [f64], g: &mut [f64]) -> f64 {
+    dynamics::mass_and_forces(model, data, t, q, qd);
     f.copy_from_slice(&data.force);
     for (vi, x) in v.iter_mut().zip(qd) {
         *vi = -x;
     }
-    dynamics::mass_and_forces(model, data, q, v);
-    -qd.iter().zip(f.iter().zip(&data.force)).map(|(x, (a, b))| x * 0.5 * (a - b)).sum::<f64>()
+    dynamics::mass_and_forces(model, data, t, q, v);
+    let p = -qd.iter().zip(f.iter().zip(&data.force)).map(|(x, (a, b))| x * 0.5 * (a - b)).sum::<f64>();
+    let plus = load_power(model, data, t, q, qd, qd, g);
+    let minus = load_power(model, data, t, q, v, qd, g);
+    p + 0.5 * (plus - minus)
+}
+
+/// Whether a force's work is counted as external work by its power (a load that is a
+/// function of time or state, a motor) rather than by a potential.
+pub fn works_by_power(f: &crate::force::Force) -> bool {
+    use crate::force::ForceKind;
+    match &f.kind {
+        ForceKind::Motor(_) => true,
+        ForceKind::Load(l) => !l.is_constant(),
+        _ => false,
+    }
+}
+
+/// `w . Q_L(t, q, qd)`: the power (for `w = qd`) of the loads that work by power
+/// ([`works_by_power`]). `g` is an n-long scratch.
+pub fn load_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], w: &[f64], g: &mut [f64]) -> f64 {
+    g.fill(0.0);
+    let mut no_turn = f64::NAN; // loads and motors count no turns
+    for f in model.forces.iter().filter(|f| works_by_power(f)) {
+        f.add_to(&model.bodies, t, q, qd, &mut data.load_scratch, &mut no_turn, g);
+    }
+    w.iter().zip(g.iter()).map(|(a, b)| a * b).sum()
 }

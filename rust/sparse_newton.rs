@@ -5,7 +5,8 @@
 //!
 //! `H = [M + g_c C + g_k K, A^T; A - g_c db/dqd, 0]`
 //!
-//! (`K = -dQ/dq` the bodies' analytic stiffness, `C = -dQ/dqd`). Every block is local:
+//! (`K = -dQ/dq` the bodies' analytic stiffness and the loads' (`Force::add_stiffness`),
+//! `C = -dQ/dqd`). Every block is local:
 //! `M`, `K`, `C` couple a body's own coordinates (dense for rigid, FFRF and modal bodies; an
 //! ANCF cable's within an element, `Body::coupling_halfwidth`) and the coordinates of a force
 //! element's markers; a constraint row depends on its markers' coordinates only
@@ -90,12 +91,22 @@ fn marker_coords<'a>(model: &Model, markers: impl IntoIterator<Item = Option<&'a
     out
 }
 
+/// The coordinates a force element's generalized force depends on: its markers' and those
+/// its values read (a load of another body's angle).
+fn force_coords(model: &Model, f: &crate::force::Force) -> Vec<usize> {
+    let mut c = marker_coords(model, f.markers().into_iter().chain(f.read_points().into_iter().map(Some)));
+    c.extend(f.read_coords());
+    c.sort_unstable();
+    c.dedup();
+    c
+}
+
 impl Pattern {
     /// Entries of the coordinate block (without building it): the memory check's estimate.
     pub fn estimate_nnz(model: &Model, hessian: bool) -> u64 {
         let mut nnz: u64 = model.bodies.iter().map(|b| (b.n_coords * (2 * b.coupling_halfwidth() + 1)) as u64).sum();
         for f in &model.forces {
-            nnz += (marker_coords(model, f.markers()).len() as u64).pow(2);
+            nnz += (force_coords(model, f).len() as u64).pow(2);
         }
         if hessian {
             for c in &model.constraints {
@@ -132,7 +143,7 @@ impl Pattern {
             }
         };
         for f in &model.forces {
-            clique(&marker_coords(model, f.markers()));
+            clique(&force_coords(model, f));
         }
         if hessian {
             for c in &model.constraints {
@@ -319,14 +330,16 @@ pub fn fill_mass(model: &Model, data: &Data, s: &mut Structure) {
     }
 }
 
-/// The bodies' analytic stiffness `K` (as `dynamics::stiffness_into`).
-pub fn fill_stiffness(model: &Model, data: &Data, q: &[f64], qd: &[f64], s: &mut Structure) {
+/// The bodies' and the loads' analytic stiffness `K` (as `dynamics::stiffness_into`).
+pub fn fill_stiffness(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], s: &mut Structure) {
     s.k.fill(0.0);
     let (p, out) = (&s.pattern, &mut s.k);
     for (body, bd) in model.bodies.iter().zip(&data.bodies) {
         let o = body.offset;
         body.tangent(bd, q, qd, &mut |i, j, v| out[p.find(o + i, o + j)] += v, &mut |_, _, _| {});
     }
+    // within the clique of the force's markers and what it reads (`force_coords`)
+    crate::dynamics::add_force_stiffness(model, data, q, qd, &mut |i, j, v| out[p.find(i, j)] += v);
 }
 
 /// `A`'s structural entries from the segment form of the last `dynamics::constraints`.
@@ -349,7 +362,7 @@ pub fn fill_velocity_terms(model: &Model, data: &mut Data, t: f64, q: &[f64], qd
             for &j in cols {
                 v[j] = qd[j] + sign * step(qd[j]);
             }
-            mass_and_forces(model, data, q, v);
+            mass_and_forces(model, data, t, q, v);
             constraints(model, data, t, q, v, false);
             for &j in cols {
                 let s2 = 2.0 * step(qd[j]);
@@ -371,7 +384,7 @@ pub fn fill_velocity_terms(model: &Model, data: &mut Data, t: f64, q: &[f64], qd
 
 /// Everything at `(t, q, qd)`: `M`, `K`, `A`, then `C`, `db/dqd` (as the dense `structure`).
 pub fn fill_structure(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], s: &mut Structure) {
-    mass_and_forces(model, data, q, qd);
+    mass_and_forces(model, data, t, q, qd);
     fill_mass(model, data, s);
     fill_stiffness(model, data, q, qd, s);
     constraints(model, data, t, q, qd, false);
@@ -399,7 +412,7 @@ pub fn fill_linearized_stiffness(model: &Model, data: &mut Data, t: f64, q: &[f6
             for &j in cols {
                 qv[j] = q[j] + sign * step(q[j]);
             }
-            mass_and_forces(model, data, qv, qd);
+            mass_and_forces(model, data, t, qv, qd);
             constraints(model, data, t, qv, qd, false);
             // f = M qdd + A^T lambda - Q  (= -F)
             mass_times(model, data, qdd, f);

@@ -145,7 +145,7 @@ fn constant_factor_reproduces_the_mass_matrix_and_gravity_is_consistent() {
     let c = cable(&model);
     let n = model.n;
     let zero = vec![0.0; n];
-    ukflex::dynamics::mass_and_forces(&model, &mut data, &model.q0, &zero);
+    ukflex::dynamics::mass_and_forces(&model, &mut data, 0.0, &model.q0, &zero);
     let m = ukflex::dynamics::dense_mass(&model, &data);
     // F^-1 M F^-T = I, column by column
     let mut x = DMatrix::from_row_slice(n, n, &m);

@@ -21,12 +21,12 @@ fn scenes() -> Vec<(String, String)> {
 
 fn mass(model: &Model, data: &mut Data, q: &[f64]) -> DMatrix<f64> {
     let zeros = vec![0.0; model.n];
-    dynamics::mass_and_forces(model, data, q, &zeros);
+    dynamics::mass_and_forces(model, data, 0.0, q, &zeros);
     DMatrix::from_row_slice(model.n, model.n, &dynamics::dense_mass(model, data))
 }
 
 fn forces(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) -> DVector<f64> {
-    dynamics::mass_and_forces(model, data, q, qd);
+    dynamics::mass_and_forces(model, data, 0.0, q, qd);
     DVector::from_column_slice(&data.force)
 }
 

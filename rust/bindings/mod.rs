@@ -3,6 +3,7 @@
 //! arrays, and never lets a panic cross into Python. `system.rs`: the compiled `System`;
 //! `scene.rs`: the item-by-item scene checker used by the Python `Scene` builder.
 
+mod callables;
 mod scene;
 mod sensors;
 mod system;
@@ -25,7 +26,7 @@ create_exception!(ukflex, InvalidSceneError, UkflexError, "Malformed or non-phys
 create_exception!(ukflex, SingularMassError, UkflexError, "The mass matrix is not positive definite.");
 create_exception!(ukflex, NonFiniteError, UkflexError, "An input array holds NaN or infinity.");
 create_exception!(ukflex, SolverError, UkflexError, "A solver kernel failed.");
-create_exception!(ukflex, ExpressionError, InvalidSceneError, "A driver's motion expression does not parse; `position` is the 0-based character index.");
+create_exception!(ukflex, ExpressionError, InvalidSceneError, "An expression (a driver's motion, a load) does not parse or names an unknown state quantity; `position` is the 0-based character index.");
 create_exception!(ukflex, MemoryLimitError, UkflexError, "An allocation would exceed the System's memory limit (refused before allocating).");
 create_exception!(ukflex, BudgetError, SolverError, "A work budget (max_wall_time, ...) ran out before the work was done (e.g. the initial-state correction of a build).");
 
@@ -113,6 +114,10 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Real {
 }
 
 pub(crate) fn to_py(e: Error) -> PyErr {
+    // a load's Python callable failed (its NaN stopped the computation): raise what it raised
+    if let Some(pending) = callables::take_pending() {
+        return pending;
+    }
     let msg = e.to_string();
     match e {
         Error::Description(_) | Error::InvalidProperty { .. } | Error::UnknownBody { .. } => InvalidSceneError::new_err(msg),

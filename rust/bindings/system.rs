@@ -128,8 +128,8 @@ impl PySystem {
     /// group of buffers may take (None: 2 GiB); above it a MemoryLimitError is raised before
     /// allocating.
     #[new]
-    #[pyo3(signature = (description_json, uk_solver="auto", memory_limit=None))]
-    fn new(description_json: &str, uk_solver: &str, memory_limit: Option<f64>) -> PyResult<Self> {
+    #[pyo3(signature = (description_json, uk_solver="auto", memory_limit=None, callables=None))]
+    fn new(description_json: &str, uk_solver: &str, memory_limit: Option<f64>, callables: Option<&Bound<'_, pyo3::types::PyDict>>) -> PyResult<Self> {
         let solver = UkSolver::parse(uk_solver).map_err(to_py)?;
         let memory_limit = match memory_limit {
             None => DEFAULT_MEMORY_LIMIT,
@@ -139,6 +139,8 @@ impl PySystem {
         let model = catch_unwind(|| Model::from_json(description_json))
             .map_err(|_| SolverError::new_err("internal error while building the model"))?
             .map_err(to_py)?;
+        let mut model = model;
+        super::callables::attach(&mut model, callables).map_err(to_py)?;
         let data = Data::build(&model, solver, memory_limit).map_err(to_py)?;
         let n = model.n;
         let ws = Workspace { data, q: vec![0.0; n], qd: vec![0.0; n], jws: JacobianWorkspace::new(&model), jq: Vec::new(), jv: Vec::new() };
@@ -244,7 +246,7 @@ impl PySystem {
         self.check_square("System.M (dense n x n)", n, 1, "M is n x n dense; use System.M_sparse (scipy.sparse), or raise memory_limit")?;
         let m = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
-            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            dynamics::mass_and_forces(model, &mut ws.data, 0.0, &ws.q, &ws.qd);
             let m = dynamics::dense_mass(model, &ws.data);
             finite_out("M(q)", &m)?;
             Ok(m)
@@ -259,7 +261,7 @@ impl PySystem {
     fn M_sparse<'py>(&self, py: Python<'py>, q: Vector<'py>) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>)> {
         let (r, c, v) = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
-            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            dynamics::mass_and_forces(model, &mut ws.data, 0.0, &ws.q, &ws.qd);
             let (mut r, mut c, mut v) = (Vec::new(), Vec::new(), Vec::new());
             for (body, bd) in model.bodies.iter().zip(&ws.data.bodies) {
                 let o = body.offset as i64;
@@ -352,7 +354,7 @@ impl PySystem {
         let v = self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
-            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            dynamics::mass_and_forces(model, &mut ws.data, t, &ws.q, &ws.qd);
             finite_out("Q(t, q, qd)", &ws.data.force)?;
             Ok(ws.data.force.clone())
         })?;

@@ -219,6 +219,19 @@ impl Body {
         &v[self.offset..self.offset + self.n_coords]
     }
 
+    /// Add a motor's rotor inertia `j` (it turns with this body: `j` adds to the body's
+    /// moment of inertia, exactly, whatever the motor's place). Rigid bodies only.
+    pub fn add_rotor_inertia(&mut self, item: &str, j: f64) -> Result<()> {
+        match &mut self.kind {
+            BodyKind::Rigid(r) => {
+                r.inertia += j;
+                r.j_ref += j;
+                Ok(())
+            }
+            _ => Err(crate::error::Error::invalid(item, format!("a rotor inertia needs a rigid rotor body; '{}' is not rigid (add the rotor as a rigid body welded to it)", self.name))),
+        }
+    }
+
     /// Mass blocks at `q` and generalized forces `Q_b(q, qd)` (inertial velocity terms,
     /// elastic forces, gravity) into `force` (the whole `Q`, this body's segment written).
     #[inline]

@@ -88,6 +88,8 @@ pub struct BuildContext<'a> {
     pub bodies: &'a [Body],
     pub index: &'a HashMap<String, usize>,
     pub q0: &'a [f64],
+    /// `body.coordinate` names, in `q`'s order (what loads' expressions may read).
+    pub coordinate_names: &'a [String],
 }
 
 impl BuildContext<'_> {

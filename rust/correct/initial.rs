@@ -221,7 +221,7 @@ pub fn correct_within(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
     while res > opts.position_tol && it < opts.max_iterations {
         over(it, res)?;
         it += 1;
-        mass_and_forces(model, data, &q, &zeros);
+        mass_and_forces(model, data, t, &q, &zeros);
         constraints(model, data, t, &q, &zeros, false);
         for i in 0..m {
             r[i] = -phi[i];
@@ -290,7 +290,7 @@ pub fn correct_within(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
         return Ok(out);
     }
     over(it, res)?;
-    mass_and_forces(model, data, &out.q, &zeros);
+    mass_and_forces(model, data, t, &out.q, &zeros);
     constraints(model, data, t, &out.q, &zeros, false);
     let mut vres = vec![0.0; m];
     velocity_residual(model, data, &out.qd, &mut vres);

@@ -265,7 +265,8 @@ pub fn project_in_place(model: &Model, data: &mut Data, ws: &mut ProjectWorkspac
 /// The minimum mass-norm `dx` with `A dx = gamma` (`gamma` already in `data.gamma`) into
 /// `data.qdd`: the UK solve at `q` with zero forces.
 fn min_mass_norm_step(model: &Model, data: &mut Data, q: &[f64], zeros: &[f64]) -> Result<()> {
-    mass_and_forces(model, data, q, zeros);
+    // the forces are discarded: only the mass blocks are read
+    mass_and_forces(model, data, 0.0, q, zeros);
     crate::dynamics::factor_mass(model, data)?;
     data.force.fill(0.0);
     solve(model, data)

@@ -85,6 +85,8 @@ impl TimeFunction {
 pub struct Function {
     vars: Vec<String>,
     tape: Tape,
+    /// `f` alone (the value without the gradient: [`Function::eval`]).
+    value: Tape,
 }
 
 impl Function {
@@ -97,7 +99,30 @@ impl Function {
         for k in 0..vars.len() {
             roots.push(g.derivative(f, k).map_err(|e| ParseError { message: e.to_string(), position: 0 })?);
         }
-        Ok(Function { vars: vars.iter().map(|v| v.to_string()).collect(), tape: Tape::new(&g, &roots) })
+        Ok(Function { vars: vars.iter().map(|v| v.to_string()).collect(), tape: Tape::new(&g, &roots), value: Tape::new(&g, &[f]) })
+    }
+
+    /// Parse `text` over those of `candidates` it uses (in the order of `candidates`): a load
+    /// may read any coordinate of the model, but its tape and gradient hold only what it reads.
+    pub fn parse_used(text: &str, candidates: &[&str]) -> std::result::Result<Function, ParseError> {
+        let mut g = Graph::new(candidates.len());
+        let f = parse(&mut g, text, candidates)?;
+        let reach = g.reachable(&[f]);
+        let mut used = vec![false; candidates.len()];
+        for (i, r) in reach.iter().enumerate() {
+            if let (true, Node::Var(k)) = (*r, g.node(i as NodeId)) {
+                used[k as usize] = true;
+            }
+        }
+        let vars: Vec<&str> = candidates.iter().zip(&used).filter(|(_, u)| **u).map(|(c, _)| *c).collect();
+        Function::parse(text, &vars)
+    }
+
+    /// `f(x)` alone; `buf` at least [`Function::scratch_len`] (overwritten).
+    #[inline]
+    pub fn eval(&self, x: &[f64], buf: &mut [f64]) -> f64 {
+        self.value.eval(x, buf);
+        self.value.output(0, buf)
     }
 
     /// The variables, in slot order.
@@ -105,9 +130,9 @@ impl Function {
         &self.vars
     }
 
-    /// Length of the buffer [`Function::eval_gradient`] needs.
+    /// Length of the buffer [`Function::eval_gradient`] and [`Function::eval`] need.
     pub fn scratch_len(&self) -> usize {
-        self.tape.len()
+        self.tape.len().max(self.value.len())
     }
 
     /// `f(x)`, with `grad[k] = df/dx_k`; `x` and `grad` hold one entry per variable, `buf` at

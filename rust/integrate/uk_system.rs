@@ -139,7 +139,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         self.ready = false;
         let (model, data) = (self.model, &mut self.data);
         let n = model.n;
-        dynamics::mass_and_forces(model, data, q, qd);
+        dynamics::mass_and_forces(model, data, t, q, qd);
         dynamics::constraints(model, data, t, q, qd, false);
         dynamics::mass_times(model, data, qdd, r1);
         for i in 0..n {
@@ -289,7 +289,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         // `uk::acceleration` / `augmented_residual` left the body blocks and A of (q, qd) in `data`
         self.ready = false;
         sparse_newton::fill_mass(self.model, &self.data, s);
-        sparse_newton::fill_stiffness(self.model, &self.data, q, qd, s);
+        sparse_newton::fill_stiffness(self.model, &mut self.data, q, qd, s);
         sparse_newton::fill_a(&self.data, s);
         Ok(true)
     }
@@ -303,7 +303,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         self.ready = false;
         let (model, data) = (self.model, &mut self.data);
         data.ensure_dense_jac()?;
-        dynamics::mass_and_forces(model, data, q, qd);
+        dynamics::mass_and_forces(model, data, t, q, qd);
         dynamics::dense_mass_into(model, data, m);
         dynamics::tangent_into(model, data, q, qd, k, c);
         dynamics::constraints(model, data, t, q, qd, false);

@@ -30,7 +30,7 @@ use dense::{correct_residual, factor_dense};
 /// Evaluate every model term at `(t, q, qd)`: mass blocks and factor, `Q`, `A`, `Phi_t`,
 /// `gamma` (and `Phi` when `with_phi`).
 pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], with_phi: bool) -> Result<()> {
-    mass_and_forces(model, data, q, qd);
+    mass_and_forces(model, data, t, q, qd);
     factor_mass(model, data)?;
     constraints(model, data, t, q, qd, with_phi);
     Ok(())
@@ -136,7 +136,7 @@ pub fn min_norm_correction(model: &Model, data: &mut Data, r: &[f64]) {
 /// and `B` depend on `q` only, so a change of `qd` changes just `Q` and `b`. Used for the
 /// velocity columns of the finite-difference Jacobian.
 pub fn acceleration_same_q(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) -> Result<()> {
-    dynamics::mass_and_forces(model, data, q, qd);
+    dynamics::mass_and_forces(model, data, t, q, qd);
     let with_phi = matches!(data.stabilization, Stabilization::Baumgarte { .. });
     constraints(model, data, t, q, qd, with_phi);
     stabilize_rhs(model, data, qd);

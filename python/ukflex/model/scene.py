@@ -177,6 +177,33 @@ class Spline:
         return d
 
 
+@dataclass(frozen=True)
+class LoadTable:
+    """A load's value tabulated against one state quantity ``of`` (``"t"``, a coordinate such
+    as ``"crank.theta"``, a rate ``"d:crank.theta"``, a motor's ``"w"``): the natural cubic
+    spline through ``(x, y)``, held at its end values outside ``[x_0, x_last]``; ``period``
+    wraps ``of`` into ``[x_0, x_0 + period)`` (a gas pressure against the crank angle over a
+    cycle). docs/loads.md."""
+
+    of: str
+    x: Sequence[float]
+    y: Sequence[float]
+    period: Optional[float] = None
+
+    def to_dict(self) -> Dict[str, Any]:
+        d: Dict[str, Any] = {"of": str(self.of), "x": reals("x", self.x, finite=False), "y": reals("y", self.y, finite=False)}
+        if self.period is not None:
+            d["period"] = self.period
+        return d
+
+
+def dc_motor_torque(k: float, resistance: float, voltage: Any) -> str:
+    """The torque of a DC motor (armature inductance neglected), ``k (V - k w) / R``, as a
+    motor's expression: ``k`` the torque (= back-EMF) constant [N m / A], ``resistance`` [Ohm],
+    ``voltage`` a number or an expression of ``t`` and state quantities [V]."""
+    return f"({float(k)!r}) * (({voltage}) - ({float(k)!r}) * w) / ({float(resistance)!r})"
+
+
 def _motion(motion: Any) -> Any:
     """A string motion is an :class:`Expression`."""
     return Expression(motion) if isinstance(motion, str) else motion
@@ -382,6 +409,29 @@ class Scene:
     def __init__(self, gravity: Optional[Sequence[float]] = None):
         self._checker = Checker(gravity)
         self.ground = GroundRef(self)
+        self._callables: Dict[str, Any] = {}
+
+    @property
+    def callables(self) -> Dict[str, Any]:
+        """The Python callables of the loads, by the name the description gives them
+        (``{"callable": name, "inputs": [...]}``); :meth:`build` hands them to the System.
+        They are not part of :meth:`to_dict` (a description is plain data)."""
+        return dict(getattr(self, "_callables", {}))
+
+    def _value(self, value: Any, inputs: Sequence[str]) -> Any:
+        """A load value as the description holds it: a Python callable becomes a reference."""
+        if callable(value) and not isinstance(value, (str, LoadTable)):
+            if not hasattr(self, "_callables"):
+                self._callables = {}
+            name = f"callable{len(self._callables)}"
+            self._callables[name] = value
+            return {"callable": name, "inputs": [str(i) for i in inputs]}
+        return value
+
+    @staticmethod
+    def _check_inputs(inputs: Sequence[str], *values: Any) -> None:
+        if inputs and not any(callable(v) and not isinstance(v, (str, LoadTable)) for v in values):
+            raise InvalidArgumentError("inputs", "name the state quantities of a Python callable only (an expression or a table names its own)")
 
     @property
     def gravity(self) -> Optional[List[float]]:
@@ -664,6 +714,75 @@ class Scene:
     def torque(self, frame: MarkerLike, torque: float, name: Optional[str] = None) -> str:
         """Constant torque [N m] on the angle of marker ``frame`` (on a beam: ``theta + psi(x)``)."""
         return self._add("forces", dict(kind="torque", frame=frame, torque=torque), name)
+
+    def point_load(
+        self, point: MarkerLike, fx: Any = 0.0, fy: Any = 0.0, name: Optional[str] = None, *, inputs: Sequence[str] = ()
+    ) -> str:
+        """Force at marker ``point`` whose world components are functions (docs/loads.md): each
+        of ``fx``, ``fy`` a number, an expression of ``t`` and state quantities (``"-2e4 *
+        sin(crank.theta) - 5 * d:slider.x"``), a :class:`LoadTable`, or a Python callable
+        ``f(t, state) -> float`` with ``state`` the dict of the quantities named by ``inputs``.
+        Expressions and tables are compiled in Rust; an unknown quantity is an
+        :class:`ukflex.ExpressionError` (a table's or a callable's input: an
+        :class:`ukflex.InvalidSceneError`)."""
+        self._check_inputs(inputs, fx, fy)
+        d = dict(kind="point_load", point=point, fx=self._value(fx, inputs), fy=self._value(fy, inputs))
+        return self._add("forces", d, name)
+
+    def torque_load(self, frame: MarkerLike, torque: Any, name: Optional[str] = None, *, inputs: Sequence[str] = ()) -> str:
+        """Torque [N m] on the angle of marker ``frame`` that is a function (a number, an
+        expression, a :class:`LoadTable` or a callable, as :meth:`point_load`)."""
+        self._check_inputs(inputs, torque)
+        return self._add("forces", dict(kind="torque_load", frame=frame, torque=self._value(torque, inputs)), name)
+
+    def motor(
+        self,
+        a: MarkerLike,
+        torque: Any,
+        b: Optional[MarkerLike] = None,
+        *,
+        rotor_inertia: float = 0.0,
+        name: Optional[str] = None,
+        inputs: Sequence[str] = (),
+    ) -> str:
+        """Motor torque ``tau`` on the frame of ``a`` (the rotor), ``-tau`` on ``b`` (the
+        stator; the ground when ``None``): ``torque`` a number, an expression or a
+        :class:`LoadTable` that may read ``angle = phi_a - phi_b`` and ``w = omega_a -
+        omega_b`` besides ``t`` and the state quantities (:func:`dc_motor_torque` writes a DC
+        motor's), or a callable of ``inputs`` (as :meth:`point_load`). ``rotor_inertia`` [kg m^2] is added to the inertia of ``a``'s body (rigid)."""
+        self._check_inputs(inputs, torque)
+        d = dict(kind="motor", a=a, torque=self._value(torque, inputs), rotor_inertia=rotor_inertia, **_given(b=b))
+        return self._add("forces", d, name)
+
+    def rotational_spring_damper(
+        self,
+        a: MarkerLike,
+        b: Optional[MarkerLike] = None,
+        *,
+        stiffness: float = 0.0,
+        damping: float = 0.0,
+        rest_angle: Optional[float] = None,
+        name: Optional[str] = None,
+    ) -> str:
+        """Torque ``-k (angle - rest_angle) - c w`` between the frames of ``a`` and ``b`` (the
+        ground when ``None``), ``angle = phi_a - phi_b``; ``rest_angle=None`` takes the angle at
+        the initial guess. With ``stiffness=0`` the viscous friction of a hinge."""
+        d = dict(kind="rotational_spring_damper", a=a, stiffness=stiffness, damping=damping, **_given(b=b, rest_angle=rest_angle))
+        return self._add("forces", d, name)
+
+    def bushing(
+        self,
+        a: MarkerLike,
+        b: MarkerLike,
+        *,
+        stiffness: Sequence[float],
+        damping: Sequence[float] = (0.0, 0.0, 0.0),
+        name: Optional[str] = None,
+    ) -> str:
+        """Linear stiffness and damping ``(x, y, angle)`` between two marker frames: the
+        offset of ``a`` from ``b`` in ``b``'s frame and the relative angle, unloaded at the
+        initial guess."""
+        return self._add("forces", dict(kind="bushing", a=a, b=b, stiffness=stiffness, damping=damping), name)
 
     def spring_damper(
         self,

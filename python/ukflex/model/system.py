@@ -195,7 +195,9 @@ class System:
         }
         self._settings: Dict[str, tuple] = {}
         self._core_options: Dict[str, Any] = {"uk_solver": uk_solver, "memory_limit": memory_limit}
-        self._bind(_core.System(json.dumps(self.description), **self._core_options))
+        # the loads' Python callables (docs/loads.md): not plain data, kept beside the description
+        self._callables: Dict[str, Any] = getattr(description, "callables", {}) if not isinstance(description, dict) else {}
+        self._bind(_core.System(json.dumps(self.description), callables=self._callables, **self._core_options))
         core = self.core
         self.t0 = float(t0)
         q_guess, qd_guess = core.initial_guess()
@@ -372,7 +374,9 @@ class System:
         self._build_options = dict(state["build_options"])
         self._settings = {}
         self._core_options = dict(state.get("core_options", {}))
-        self._bind(_core.System(json.dumps(self.description), **self._core_options))
+        # a copy keeps the callables; a pickle does not carry them (building then names them)
+        self._callables = getattr(self, "_callables", {})
+        self._bind(_core.System(json.dumps(self.description), callables=self._callables, **self._core_options))
         for name, args in state["settings"].items():
             getattr(self, name)(*args)
         for key in ("t0", "initial_correction", "q_guess", "qd_guess", "q0", "qd0"):
@@ -385,6 +389,7 @@ class System:
         need different settings at the same time each use their own copy (``simulate(..., stabilization=...)`` and
         ``stability.rank_history`` do this for you)."""
         new = System.__new__(System)
+        new._callables = self._callables
         new._restore(self.__getstate__())
         return new
 

@@ -90,6 +90,10 @@ def _states(res) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.asarray(res.t, dtype=float), q, qd
 
 
+#: Force kinds whose potential is stored elastic energy (``springs``), not a load's.
+_SPRING_KINDS = ("spring_damper", "rotational_spring_damper", "bushing")
+
+
 class Sensors:
     """Sensors of one :class:`ukflex.SimulationResult` (``res.sensors``), computed once on first
     use and cached."""
@@ -165,18 +169,25 @@ class Sensors:
         e = np.asarray(self._raw["body_energies"])
         fp = np.asarray(self._raw["force_potentials"])
         kinds = np.array(self._force_kinds, dtype=object)
-        springs = fp[:, kinds == "spring_damper"].sum(axis=1) if fp.size else np.zeros(e.shape[0])
-        loads = fp[:, kinds != "spring_damper"].sum(axis=1) if fp.size else np.zeros(e.shape[0])
+        spring = np.isin(kinds, _SPRING_KINDS)
+        springs = fp[:, spring].sum(axis=1) if fp.size else np.zeros(e.shape[0])
+        loads = fp[:, ~spring].sum(axis=1) if fp.size else np.zeros(e.shape[0])
         out = {"kinetic": e[:, :, 0].sum(axis=1), "strain": e[:, :, 1].sum(axis=1),
                "gravity": e[:, :, 2].sum(axis=1), "springs": springs, "loads": loads}
         out["total"] = out["kinetic"] + out["strain"] + out["gravity"] + out["springs"]
         return out
 
     def external_work(self) -> np.ndarray:
-        """Work of the constant external loads (point forces, torques) from ``t_0``: exactly
-        minus the change of their potential, shape (nt,)."""
+        """Work of the external loads from ``t_0``, shape (nt,): the constant ones (point
+        forces, torques) exactly minus the change of their potential; the loads that are
+        functions of time and state and the motors (docs/loads.md) by the integral of their
+        power (``System.sensors``' ``load_power``)."""
         loads = self.energies()["loads"]
-        return -(loads - loads[0])
+        w = -(loads - loads[0])
+        power = self._raw.get("load_power")
+        if power is not None and np.any(power):
+            w = w + cumulative_integral(self.t, np.asarray(power))
+        return w
 
     def dissipated(self) -> np.ndarray:
         """Energy dissipated by damping (spring-dampers, beam strain-rate damping) from ``t_0``,

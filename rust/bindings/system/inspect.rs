@@ -46,7 +46,7 @@ impl PySystem {
         }
         let v = self.with_ws(|model, ws| {
             Self::load(ws, &q, None)?;
-            dynamics::mass_and_forces(model, &mut ws.data, &ws.q, &ws.qd);
+            dynamics::mass_and_forces(model, &mut ws.data, 0.0, &ws.q, &ws.qd);
             let v = model.bodies[bi].axial_forces(&ws.data.bodies[bi])?;
             finite_out("axial_forces", &v)?;
             Ok(v)
@@ -155,7 +155,8 @@ impl PySystem {
     /// world frame on the first marker's body, fx_local, fy_local in the joint frame, power),
     /// `reaction_names`, `reaction_bodies` (body of the first marker, None = ground),
     /// `body_energies` (nt, n_bodies, 3: kinetic, strain, gravity), `body_names`,
-    /// `force_potentials` (nt, n_forces), `force_names`, `dissipation_power` (nt,).
+    /// `force_potentials` (nt, n_forces), `force_names`, `dissipation_power` (nt,),
+    /// `load_power` (nt,: the power of the loads that are functions and of motors).
     #[pyo3(signature = (t, q, qd, reactions=true))]
     fn sensors<'py>(&self, py: Python<'py>, t: Vector<'py>, q: &Bound<'py, PyAny>, qd: &Bound<'py, PyAny>, reactions: bool) -> PyResult<Bound<'py, PyDict>> {
         let n = self.model.n;
@@ -165,21 +166,24 @@ impl PySystem {
         let mut be = vec![0.0; nt * nb * 3];
         let mut fp = vec![0.0; nt * nf];
         let mut dp = vec![0.0; nt];
+        let mut lp = vec![0.0; nt];
         self.with_ws(|model, ws| {
-            let (mut v, mut f) = (vec![0.0; n], vec![0.0; n]);
+            let (mut v, mut f, mut g) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
             for k in 0..nt {
                 let (qk, qdk) = (&qs[k * n..(k + 1) * n], &qds[k * n..(k + 1) * n]);
                 if reactions {
                     sensors::reactions_into(model, &mut ws.data, ts[k], qk, qdk, &mut rx[k * nc * 6..(k + 1) * nc * 6])?;
                 }
-                sensors::energies_into(model, &mut ws.data, qk, qdk, &mut be[k * nb * 3..(k + 1) * nb * 3], &mut fp[k * nf..(k + 1) * nf]);
-                dp[k] = sensors::dissipation_power(model, &mut ws.data, qk, qdk, &mut v, &mut f);
+                sensors::energies_into(model, &mut ws.data, ts[k], qk, qdk, &mut be[k * nb * 3..(k + 1) * nb * 3], &mut fp[k * nf..(k + 1) * nf]);
+                dp[k] = sensors::dissipation_power(model, &mut ws.data, ts[k], qk, qdk, &mut v, &mut f, &mut g);
+                lp[k] = sensors::load_power(model, &mut ws.data, ts[k], qk, qdk, qdk, &mut g);
             }
             sensors::unwrap_torque_potentials(model, &mut fp, nt);
             finite_out("sensors reactions", &rx)?;
             finite_out("sensors body energies", &be)?;
             finite_out("sensors force potentials", &fp)?;
             finite_out("sensors dissipation power", &dp)?;
+            finite_out("sensors load power", &lp)?;
             Ok(())
         })?;
         let d = PyDict::new(py);
@@ -197,6 +201,7 @@ impl PySystem {
         d.set_item("force_potentials", mat(py, fp, nt, nf)?)?;
         d.set_item("force_names", names(&mut self.model.forces.iter().map(|f| f.name.clone())))?;
         d.set_item("dissipation_power", PyArray1::from_vec(py, dp))?;
+        d.set_item("load_power", PyArray1::from_vec(py, lp))?;
         Ok(d)
     }
 

@@ -183,6 +183,7 @@ impl PySystem {
         Error::check_memory("the implicit integrator's n x n matrices", implicit, limit, hint).map_err(to_py)?;
         // an exception of the progress callback (or a pending signal), raised after the run
         let mut raised: Option<PyErr> = None;
+        crate::bindings::callables::take_pending(); // nothing stale from an earlier call
         let result = py.detach(|| {
             catch_unwind(AssertUnwindSafe(|| {
                 let mut data = data;
@@ -211,6 +212,10 @@ impl PySystem {
             Ok(r) => r.map_err(to_py)?,
             Err(_) => return Err(SolverError::new_err("internal error in the ukflex core (a bug: please report it)")),
         };
+        // a load's callable failed and its NaN ended the run early: raise what it raised
+        if let Some(e) = crate::bindings::callables::take_pending() {
+            return Err(e);
+        }
         solution_dict(py, sol, jac_evals, wall)
     }
 

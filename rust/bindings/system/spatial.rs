@@ -47,7 +47,7 @@ impl PySystem {
         let mut gravity = vec![0.0; nb];
         let scratch_len = self.model.constraints.iter().map(|c| c.scratch_len()).max().unwrap_or(0);
         self.with_ws(|model, ws| {
-            let (mut scratch, mut v, mut f) = (vec![0.0; scratch_len], vec![0.0; n], vec![0.0; n]);
+            let (mut scratch, mut v, mut f, mut g) = (vec![0.0; scratch_len], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
             // the history's own turn count: from its first state (within half a turn of each
             // rotational spring's angle0), then state to state; the workspace's is kept for later calls
             let saved = std::mem::replace(&mut ws.data.turns, vec![f64::NAN; nf]);
@@ -60,17 +60,17 @@ impl PySystem {
                     }
                     mo[6 * k..6 * k + 6].copy_from_slice(&outputs::momentum(model, qk, qdk));
                     let bek = &mut be[k * nb * 3..(k + 1) * nb * 3];
-                    sensors::energies_into(model, &mut ws.data, qk, qdk, bek, &mut fp[k * nf..(k + 1) * nf]);
+                    sensors::energies_into(model, &mut ws.data, ts[k], qk, qdk, bek, &mut fp[k * nf..(k + 1) * nf]);
                     outputs::gravity_energies(model, qk, &mut gravity);
                     for (i, g) in gravity.iter().enumerate() {
                         bek[3 * i + 2] = *g;
                     }
                     outputs::count_turns(model, &ws.data.turns, &mut fp[k * nf..(k + 1) * nf]);
-                    outputs::force_powers(model, &ws.data.turns, qk, qdk, &mut v, &mut fw[k * nf..(k + 1) * nf]);
+                    outputs::force_powers(model, &ws.data.turns, ts[k], qk, qdk, &mut v, &mut fw[k * nf..(k + 1) * nf]);
                     ke[k] = dynamics::kinetic_energy(model, &mut ws.data, qk, qdk);
                     // spatial bodies carry no strain and no body gravity: the force elements' potentials
                     pe[k] = fp[k * nf..(k + 1) * nf].iter().sum();
-                    dp[k] = sensors::dissipation_power(model, &mut ws.data, qk, qdk, &mut v, &mut f);
+                    dp[k] = sensors::dissipation_power(model, &mut ws.data, ts[k], qk, qdk, &mut v, &mut f, &mut g);
                     dv[k * nc..(k + 1) * nc].copy_from_slice(&outputs::driver_values(model, ts[k], qk, &mut scratch));
                 }
                 Ok(())

@@ -1,0 +1,344 @@
+//! Applied forces other than gravity (which is a body-level term in `dynamics.rs`).
+//! Each adds its generalized force `J^T F` to `Q` (paper eqs. 34-37). The constant loads and
+//! the spring-damper are here; each further kind has its file (docs/loads.md): loads that are
+//! functions of time and state (`load.rs`, their values in `value.rs`), motors (`motor.rs`),
+//! rotational spring-dampers (`rotational_spring.rs`), bushings (`bushing.rs`).
+
+pub mod bushing;
+pub mod load;
+pub mod motor;
+pub mod rotational_spring;
+pub mod value;
+
+use crate::body::{Body, Marker};
+use crate::constraint::BuildContext;
+use crate::description::ForceDesc;
+use crate::error::{check_finite_item, non_negative, Result};
+
+#[derive(Debug, Clone)]
+pub enum ForceKind {
+    /// Constant world-frame force at a marker: `Q += r_q^T F`.
+    PointForce { point: Marker, force: [f64; 2] },
+    /// Constant torque on a marker frame: `Q += phi_q^T tau`.
+    Torque { frame: Marker, torque: f64 },
+    /// Linear spring-damper between two markers:
+    /// `Q -= (k (l - l0) + c l_dot) (r_a - r_b)_q^T e`, `e = (r_a - r_b) / l`.
+    SpringDamper { a: Marker, b: Marker, stiffness: f64, damping: f64, rest_length: f64 },
+    /// Spatial force elements, gravity included (`spatial/force.rs`).
+    Spatial(crate::spatial::force::SpatialForce),
+    /// A force or torque that is a function of time and state (`load.rs`).
+    Load(Box<load::Load>),
+    Motor(Box<motor::Motor>),
+    RotationalSpringDamper(Box<rotational_spring::RotationalSpringDamper>),
+    Bushing(Box<bushing::Bushing>),
+}
+
+#[derive(Debug, Clone)]
+pub struct Force {
+    pub name: String,
+    pub kind: ForceKind,
+}
+
+impl Force {
+    /// Write the defaults this force resolved into its description (a spring-damper's rest
+    /// length taken at the initial guess).
+    pub fn fill_defaults(&self, d: &mut ForceDesc) {
+        match (&self.kind, d) {
+            (ForceKind::SpringDamper { rest_length: r, .. }, ForceDesc::SpringDamper { rest_length, .. }) => *rest_length = Some(*r),
+            (ForceKind::RotationalSpringDamper(r), ForceDesc::RotationalSpringDamper { rest_angle, .. }) => *rest_angle = Some(r.rest_angle),
+            _ => {}
+        }
+    }
+
+    /// Build a force element; `item` names it in errors.
+    pub fn from_desc(ctx: &BuildContext, item: &str, name: String, d: &ForceDesc) -> Result<Force> {
+        let kind = match d {
+            ForceDesc::PointForce { point, force, .. } => {
+                check_finite_item(item, "force", force)?;
+                ForceKind::PointForce { point: ctx.marker(item, point)?, force: *force }
+            }
+            ForceDesc::Torque { frame, torque, .. } => {
+                check_finite_item(item, "torque", &[*torque])?;
+                ForceKind::Torque { frame: ctx.oriented_marker(item, frame)?, torque: *torque }
+            }
+            ForceDesc::SpringDamper { a, b, stiffness, damping, rest_length, .. } => {
+                let (a, b) = (ctx.marker(item, a)?, ctx.marker(item, b)?);
+                let rest_length = match rest_length {
+                    Some(l) => *l,
+                    None => {
+                        let (sa, sb) = (ctx.state0(&a), ctx.state0(&b));
+                        (sa.r[0] - sb.r[0]).hypot(sa.r[1] - sb.r[1])
+                    }
+                };
+                ForceKind::SpringDamper {
+                    a,
+                    b,
+                    stiffness: non_negative(item, "stiffness", *stiffness)?,
+                    damping: non_negative(item, "damping", *damping)?,
+                    rest_length: non_negative(item, "rest_length", rest_length)?,
+                }
+            }
+            ForceDesc::PointLoad { point, fx, fy, .. } => ForceKind::Load(Box::new(load::Load::force(ctx, item, point, fx, fy)?)),
+            ForceDesc::TorqueLoad { frame, torque, .. } => ForceKind::Load(Box::new(load::Load::torque(ctx, item, frame, torque)?)),
+            ForceDesc::Motor { a, b, torque, rotor_inertia, .. } => ForceKind::Motor(Box::new(motor::Motor::from_desc(ctx, item, a, b.as_ref(), torque, *rotor_inertia)?)),
+            ForceDesc::RotationalSpringDamper { a, b, stiffness, damping, rest_angle, .. } => {
+                ForceKind::RotationalSpringDamper(Box::new(rotational_spring::RotationalSpringDamper::from_desc(ctx, item, a, b.as_ref(), *stiffness, *damping, *rest_angle)?))
+            }
+            ForceDesc::Bushing { a, b, stiffness, damping, .. } => ForceKind::Bushing(Box::new(bushing::Bushing::from_desc(ctx, item, a, b, *stiffness, *damping)?)),
+        };
+        Ok(Force { name, kind })
+    }
+
+    /// The markers this force acts through (its generalized force depends on their states only).
+    pub fn markers(&self) -> [Option<&Marker>; 2] {
+        match &self.kind {
+            ForceKind::PointForce { point, .. } => [Some(point), None],
+            ForceKind::Torque { frame, .. } => [Some(frame), None],
+            ForceKind::SpringDamper { a, b, .. } => [Some(a), Some(b)],
+            ForceKind::Spatial(f) => f.markers(),
+            ForceKind::Load(l) => [Some(l.marker()), None],
+            ForceKind::Motor(m) => [Some(&m.a), Some(&m.b)],
+            ForceKind::RotationalSpringDamper(r) => [Some(&r.a), Some(&r.b)],
+            ForceKind::Bushing(b) => [Some(&b.a), Some(&b.b)],
+        }
+    }
+
+    /// The coordinates this force's values read besides its markers' (a load of another
+    /// body's angle; the points of `x(BODY, XI)` quantities are in `read_points`): they couple
+    /// in the sparse Newton matrices' pattern.
+    pub fn read_coords(&self) -> Vec<usize> {
+        self.values().into_iter().flat_map(|v| v.coords()).collect()
+    }
+
+    /// The markers of the point quantities this force's values read.
+    pub fn read_points(&self) -> Vec<&Marker> {
+        self.values().into_iter().flat_map(|v| v.points()).collect()
+    }
+
+    fn values(&self) -> Vec<&value::Value> {
+        match &self.kind {
+            ForceKind::Load(l) => match l.as_ref() {
+                load::Load::Force { f, .. } => f.iter().collect(),
+                load::Load::Torque { tau, .. } => vec![tau],
+            },
+            ForceKind::Motor(m) => vec![&m.torque],
+            _ => Vec::new(),
+        }
+    }
+
+    /// The values of this force (the loads' components, a motor's torque), mutable: where
+    /// callables are attached.
+    pub fn values_mut(&mut self) -> Vec<&mut value::Value> {
+        match &mut self.kind {
+            ForceKind::Load(l) => match l.as_mut() {
+                load::Load::Force { f, .. } => f.iter_mut().collect(),
+                load::Load::Torque { tau, .. } => vec![tau],
+            },
+            ForceKind::Motor(m) => vec![&mut m.torque],
+            _ => Vec::new(),
+        }
+    }
+
+    /// Whether [`Force::add_stiffness`] adds anything (a load or motor whose value is an
+    /// expression or a table).
+    pub fn has_stiffness(&self) -> bool {
+        self.values().iter().any(|v| v.has_gradient())
+    }
+
+    /// `add(i, j, K_ij)` of this force's analytic position stiffness `K = -dQ/dq`: for the loads
+    /// and motors whose value is an expression or a table, `-J^T dF/dq` from the symbolic
+    /// gradient (the change of the application point's Jacobian with `q`, `(dJ^T/dq) F`, is
+    /// left out, as for the constant loads). `rows` is a `2 n` scratch, `scratch` the force's
+    /// evaluation scratch. Nothing for the other kinds.
+    pub fn add_stiffness(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], scratch: &mut [f64], rows: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        let n = q.len();
+        let (p, r) = rows[..2 * n].split_at_mut(n);
+        match &self.kind {
+            ForceKind::Load(l) => {
+                let env = value::Env { bodies, t, q, qd, local: [0.0; 2] };
+                match l.as_ref() {
+                    load::Load::Force { point, f } => {
+                        for (c, v) in f.iter().enumerate().filter(|(_, v)| v.has_gradient()) {
+                            r.fill(0.0);
+                            v.add_position_gradient(&env, scratch, r);
+                            p.fill(0.0);
+                            let mut w = [0.0; 2];
+                            w[c] = 1.0;
+                            point.add_point_jacobian(bodies, &point.state(bodies, q, qd), w, p);
+                            outer(p, r, add);
+                        }
+                    }
+                    load::Load::Torque { frame, tau } if tau.has_gradient() => {
+                        r.fill(0.0);
+                        tau.add_position_gradient(&env, scratch, r);
+                        p.fill(0.0);
+                        frame.add_angle_jacobian(bodies, &frame.state(bodies, q, qd), 1.0, p);
+                        outer(p, r, add);
+                    }
+                    load::Load::Torque { .. } => {}
+                }
+            }
+            ForceKind::Motor(m) if m.torque.has_gradient() => {
+                let (sa, sb, local) = motor::relative(bodies, &m.a, &m.b, q, qd);
+                r.fill(0.0);
+                let [d_angle, _] = m.torque.add_position_gradient(&value::Env { bodies, t, q, qd, local }, scratch, r);
+                m.a.add_angle_jacobian(bodies, &sa, d_angle, r);
+                m.b.add_angle_jacobian(bodies, &sb, -d_angle, r);
+                p.fill(0.0);
+                m.a.add_angle_jacobian(bodies, &sa, 1.0, p);
+                m.b.add_angle_jacobian(bodies, &sb, -1.0, p);
+                outer(p, r, add);
+            }
+            _ => {}
+        }
+    }
+
+    /// Evaluation scratch this force needs (`Data::load_scratch`).
+    pub fn scratch_len(&self) -> usize {
+        match &self.kind {
+            ForceKind::Load(l) => l.scratch_len(),
+            ForceKind::Motor(m) => m.torque.scratch_len(),
+            _ => 0,
+        }
+    }
+
+    /// Add this force's generalized force to `qvec` (length n).
+    #[inline]
+    pub fn add_to(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], scratch: &mut [f64], turn: &mut f64, qvec: &mut [f64]) {
+        match &self.kind {
+            ForceKind::PointForce { point, force } => {
+                let s = point.state(bodies, q, qd);
+                point.add_point_jacobian(bodies, &s, *force, qvec);
+            }
+            ForceKind::Torque { frame, torque } => {
+                let s = frame.state(bodies, q, qd);
+                frame.add_angle_jacobian(bodies, &s, *torque, qvec);
+            }
+            ForceKind::SpringDamper { a, b, stiffness, damping, rest_length } => {
+                let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
+                let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];
+                let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                if l == 0.0 {
+                    // direction undefined at zero length: no force (documented limitation)
+                    return;
+                }
+                let e = [d[0] / l, d[1] / l];
+                let ldot = e[0] * (sa.v[0] - sb.v[0]) + e[1] * (sa.v[1] - sb.v[1]);
+                let f = stiffness * (l - rest_length) + damping * ldot;
+                a.add_point_jacobian(bodies, &sa, [-f * e[0], -f * e[1]], qvec);
+                b.add_point_jacobian(bodies, &sb, [f * e[0], f * e[1]], qvec);
+            }
+            ForceKind::Spatial(f) => f.add_to(bodies, q, qd, turn, qvec),
+            ForceKind::Load(l) => l.add_to(bodies, t, q, qd, scratch, qvec),
+            ForceKind::Motor(m) => m.add_to(bodies, t, q, qd, scratch, qvec),
+            ForceKind::RotationalSpringDamper(r) => r.add_to(bodies, q, qd, qvec),
+            ForceKind::Bushing(b) => b.add_to(bodies, q, qd, qvec),
+        }
+    }
+
+    /// `1/2 k ldot^2` of a spring-damper for the motion `v` at `q` (its length's first-order
+    /// change squared: the spring's share of a mode's stiffness; 0 for the loads).
+    pub fn material_energy(&self, bodies: &[Body], q: &[f64], v: &[f64]) -> f64 {
+        match &self.kind {
+            ForceKind::SpringDamper { a, b, stiffness, .. } => {
+                let (sa, sb) = (a.state(bodies, q, v), b.state(bodies, q, v));
+                let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];
+                let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                if l == 0.0 {
+                    return 0.0;
+                }
+                let ldot = (d[0] * (sa.v[0] - sb.v[0]) + d[1] * (sa.v[1] - sb.v[1])) / l;
+                0.5 * stiffness * ldot * ldot
+            }
+            ForceKind::PointForce { .. } | ForceKind::Torque { .. } | ForceKind::Load(_) | ForceKind::Motor(_) => 0.0,
+            ForceKind::Spatial(f) => f.material_energy(bodies, q, v),
+            ForceKind::RotationalSpringDamper(r) => r.material_energy(bodies, q, v),
+            ForceKind::Bushing(b) => b.material_energy(bodies, q, v),
+        }
+    }
+
+    /// Potential energy stored in this force element (springs only).
+    pub fn potential(&self, bodies: &[Body], q: &[f64]) -> f64 {
+        match &self.kind {
+            ForceKind::SpringDamper { a, b, stiffness, rest_length, .. } => {
+                let zeros = vec![0.0; q.len()];
+                let (sa, sb) = (a.state(bodies, q, &zeros), b.state(bodies, q, &zeros));
+                let l = ((sa.r[0] - sb.r[0]).powi(2) + (sa.r[1] - sb.r[1]).powi(2)).sqrt();
+                0.5 * stiffness * (l - rest_length).powi(2)
+            }
+            // constant forces are not potential-free in general (follower frames); they are
+            // world-fixed here, so their potential is -F . r
+            ForceKind::PointForce { point, force } => {
+                let zeros = vec![0.0; q.len()];
+                let s = point.state(bodies, q, &zeros);
+                -(force[0] * s.r[0] + force[1] * s.r[1])
+            }
+            ForceKind::Torque { frame, torque } => {
+                let zeros = vec![0.0; q.len()];
+                -torque * frame.state(bodies, q, &zeros).phi
+            }
+            ForceKind::Spatial(f) => f.potential(bodies, q),
+            ForceKind::RotationalSpringDamper(r) => r.potential(bodies, q),
+            ForceKind::Bushing(b) => b.potential(bodies, q),
+            // a load that is a function has no potential unless it is constant; a motor's work
+            // is input, not stored (sensors: `external_work`)
+            ForceKind::Load(l) => l.potential(bodies, q).unwrap_or(0.0),
+            ForceKind::Motor(_) => 0.0,
+        }
+    }
+}
+
+/// `add(i, j, -p_i r_j)` over the non-zeros of `p` and `r`: `K = -dQ/dq` of `Q = p F`,
+/// `dF/dq = r`.
+fn outer(p: &[f64], r: &[f64], add: &mut dyn FnMut(usize, usize, f64)) {
+    for (i, &pi) in p.iter().enumerate().filter(|(_, x)| **x != 0.0) {
+        for (j, &rj) in r.iter().enumerate().filter(|(_, x)| **x != 0.0) {
+            add(i, j, -pi * rj);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::data::Data;
+    use crate::dynamics;
+    use crate::model::Model;
+
+    #[test]
+    fn analytic_load_stiffness_matches_differences() {
+        // point-mass and rigid-frame Jacobians are constant: -dQ/dq is exactly -J^T dF/dq
+        let text = r#"{"bodies": [
+            {"kind": "point_mass", "name": "m", "mass": 1.0, "position": [1.0, 0.5]},
+            {"kind": "rigid", "name": "w", "mass": 2.0, "inertia": 0.1, "angle": 0.3, "position": [0.2, -0.4]}],
+          "forces": [
+            {"kind": "point_load", "point": {"body": "m"},
+             "fx": "-200 * (m.x - 1) - 3 * m.y^2 + sin(t) * w.theta + d:m.x",
+             "fy": {"of": "m.x", "x": [0, 0.5, 1.5, 2], "y": [0, 1, -1, 3]}},
+            {"kind": "motor", "a": {"body": "w"}, "torque": "-5 * angle^2 + 0.3 * w + y(w, 0) * x(w, 0)"},
+            {"kind": "torque_load", "frame": {"body": "w"}, "torque": "m.x * w.theta"}]}"#;
+        let model = Model::from_json(text).unwrap();
+        let mut data = Data::new(&model);
+        let n = model.n;
+        let q: Vec<f64> = model.q0.iter().enumerate().map(|(i, x)| x + 0.01 * (i as f64 + 1.0)).collect();
+        let qd: Vec<f64> = (0..n).map(|i| 0.3 - 0.1 * i as f64).collect();
+        let t = 0.7;
+        let mut k = vec![0.0; n * n];
+        dynamics::mass_and_forces(&model, &mut data, t, &q, &qd);
+        dynamics::stiffness_into(&model, &mut data, &q, &qd, &mut k);
+        let mut qv = q.clone();
+        let h = 1e-6;
+        for j in 0..n {
+            qv[j] = q[j] + h;
+            dynamics::mass_and_forces(&model, &mut data, t, &qv, &qd);
+            let fp = data.force.clone();
+            qv[j] = q[j] - h;
+            dynamics::mass_and_forces(&model, &mut data, t, &qv, &qd);
+            qv[j] = q[j];
+            for i in 0..n {
+                let fd = -(fp[i] - data.force[i]) / (2.0 * h);
+                assert!((k[i * n + j] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "K[{i}][{j}] = {} vs {fd}", k[i * n + j]);
+            }
+        }
+        assert!(k[0] == 200.0 && k[4 * n + 4] != 0.0 && k[4 * n] != 0.0, "{k:?}");
+    }
+}
