@@ -96,7 +96,7 @@ pub struct Data {
     pub spatial_drift: Option<f64>,
     /// Per force element: the angle `theta - angle0` a spatial rotational spring-damper read at
     /// the last evaluation, continuous over any number of turns (NaN until its first reading;
-    /// `spatial::force`); unused by the other elements.
+    /// `force::spatial`); unused by the other elements.
     pub turns: Vec<f64>,
     pub stabilization: Stabilization,
     pub rank_info: RankInfo,
@@ -130,7 +130,7 @@ impl Data {
             }
         };
         let hint = if sparse.is_some() { "raise memory_limit" } else { "use uk_solver='sparse' for a long chain or rope, or raise memory_limit" };
-        let base = SegJac::bytes(model) + 8 * (6 * n as u64 + 8 * m as u64);
+        let base = SegJac::bytes(&model.constraints, &model.bodies, m) + 8 * (6 * n as u64 + 8 * m as u64);
         let dense = if sparse.is_none() { dense_uk_bytes(model) } else { 0 };
         let sparse_bytes = if sparse.is_some() { SparseUk::bytes(model) } else { 0 };
         Error::check_memory("the UK workspace (constraint Jacobian and factorization buffers)", base + dense + sparse_bytes, memory_limit, hint)?;
@@ -139,7 +139,7 @@ impl Data {
             bodies,
             force: vec![0.0; n],
             phi: vec![0.0; m],
-            ajac: SegJac::new(model),
+            ajac: SegJac::new(&model.constraints, &model.bodies, n, m),
             jac: Vec::new(),
             dense_jac: false,
             phi_t: vec![0.0; m],
@@ -163,7 +163,7 @@ impl Data {
             svd_backend: SvdBackend::default(),
             factored_with: Factored::None,
             tolerance: RankTolerance::default(),
-            spatial_drift: crate::spatial::is_spatial(model).then_some(0.0),
+            spatial_drift: model.is_spatial().then_some(0.0),
             turns: vec![f64::NAN; model.forces.len()],
             stabilization: Stabilization::None,
             rank_info: RankInfo::default(),
@@ -201,7 +201,7 @@ impl Data {
         self.svd_v = Mat::zeros(m, k);
         self.coeff = vec![0.0; k];
         self.mem = MemBuffer::new(req);
-        self.qrj = if m > 0 && m <= n { Some(QrJacobi::with_unit_columns(n, m, &crate::uk::dense::unit_columns(model))) } else { None };
+        self.qrj = if m > 0 && m <= n { Some(QrJacobi::with_unit_columns(n, m, &model.unit_columns())) } else { None };
         self.dense_ready = true;
         Ok(())
     }

@@ -26,10 +26,8 @@ pub mod integrate;
 pub mod jacobian;
 pub mod linalg;
 pub mod model;
-pub mod scale;
 pub mod sensors;
 pub mod sparse_newton;
-pub mod spatial;
 pub mod uk;
 
 #[cfg(feature = "python")]

@@ -42,7 +42,7 @@ PROJECTION_PER_ATOL: float
 #: many tolerance units is retried shorter.
 PROJECTION_MOVE_LIMIT: float
 #: positions are resolved to this fraction of the scene's length scale, angles to this many
-#: radians (rust/scale.rs)
+#: radians (rust/model/scale.rs)
 RESOLUTION: float
 def normal_weight(kappa: float, kappa_ref: float) -> float:
     """Weight of the part of an error estimate across the constraints: min(1, kappa / kappa_ref)^2."""

@@ -312,7 +312,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MemoryLimitError", py.get_type::<MemoryLimitError>())?;
     m.add("PROJECTION_PER_ATOL", crate::integrate::PROJECTION_PER_ATOL)?;
     m.add("PROJECTION_MOVE_LIMIT", crate::integrate::PROJECTION_MOVE_LIMIT)?;
-    m.add("RESOLUTION", crate::scale::RESOLUTION)?;
+    m.add("RESOLUTION", crate::model::scale::RESOLUTION)?;
     m.add_function(wrap_pyfunction!(normal_weight, m)?)?;
     m.add("BudgetError", py.get_type::<BudgetError>())?;
     Ok(())

@@ -194,20 +194,20 @@ impl PySystem {
         Ok(d)
     }
 
-    /// The scene's length scale [m] (`rust/scale.rs`): the largest body dimension.
+    /// The scene's length scale [m] (`rust/model/scale.rs`, `rust/correct/conditioning.rs`): the largest body dimension.
     #[getter]
     fn length_scale(&self) -> f64 {
         self.model.length_scale
     }
 
-    /// Refuse a state double precision cannot resolve (`rust/scale.rs`): positions or angles too
+    /// Refuse a state double precision cannot resolve (`rust/model/scale.rs`, `rust/correct/conditioning.rs`): positions or angles too
     /// far from the origin, masses too disparate for the rank decision (InvalidSceneError).
     fn check_state(&self, t: Real, q: Vector<'_>, qd: Vector<'_>) -> PyResult<()> {
         let t = t.0;
         self.with_ws(|model, ws| {
             check_time(t)?;
             Self::load(ws, &q, Some(&qd))?;
-            crate::scale::check_state(model, &mut ws.data, t, &ws.q, &ws.qd)
+            crate::correct::check_state(model, &mut ws.data, t, &ws.q, &ws.qd)
         })
     }
 

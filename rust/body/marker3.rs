@@ -11,8 +11,8 @@
 
 use super::{Body, BodyKind, Marker, MarkerShape};
 use crate::error::{check_finite_item, Error, Result};
-use crate::spatial::desc::Marker3Desc;
-use crate::spatial::rot::{add, col, frame_from_z, m34_t_vec, m34_vec, mat_vec, norm, quad_term, rot_a, rot_b, scale, sub, M3, M34, V3};
+use crate::description::spatial::Marker3Desc;
+use crate::linalg::rot3::{add, col, frame_from_z, m34_t_vec, m34_vec, mat_vec, norm, quad_term, rot_a, rot_b, scale, sub, M3, M34, V3};
 
 /// Every axis (`Marker3::state_axes`).
 pub const ALL_AXES: u8 = 0b111;

@@ -95,7 +95,7 @@ pub enum BodyKind {
     PointMass(PointMass),
     Cable(AncfCable),
     Flexible(Flexible),
-    /// Spatial rigid body (`rigid3.rs`, built by `spatial::build`).
+    /// Spatial rigid body (`rigid3.rs`, built by `model::spatial`).
     Rigid3(Rigid3),
     /// Spatial point mass (`point3.rs`).
     Point3(Point3),
@@ -435,7 +435,7 @@ fn rigid3_motions(q: &[f64], qd: &[f64], o: usize, col0: usize, put: &mut impl F
     if q.len() < 7 {
         return 3;
     }
-    use crate::spatial::rot::rot_e;
+    use crate::linalg::rot3::rot_e;
     let e = rot_e(&q[3..7]);
     for k in 0..3 {
         for l in 0..4 {

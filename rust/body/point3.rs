@@ -1,9 +1,9 @@
 //! Spatial point mass: coordinates `r` (3), mass block `m I`, no orientation (its markers carry
-//! the world axes). Gravity is a force element in spatial scenes (`spatial::force`).
+//! the world axes). Gravity is a force element in spatial scenes (`force::spatial`).
 
 use super::InitialState;
 use crate::error::{check_finite_item, positive, Result};
-use crate::spatial::desc::Point3Desc;
+use crate::description::spatial::Point3Desc;
 
 #[derive(Debug, Clone)]
 pub struct Point3 {

@@ -10,12 +10,12 @@
 //! no factorization per call. Velocity term `8 Gd^T J Gd p` plus the right-hand-side shift
 //! `-4 k (pd.pd) p` of the regularization (no effect on the accelerations; it makes the
 //! multipliers those of the true mass matrix).
-//! Gravity is a force element in spatial scenes (`spatial::force`), so `gravity` is unused here.
+//! Gravity is a force element in spatial scenes (`force::spatial`), so `gravity` is unused here.
 
 use super::InitialState;
 use crate::error::{check_finite_item, positive, Error, Result};
-use crate::spatial::desc::{OrientationDesc, Rigid3Desc};
-use crate::spatial::rot::{cross, dot, mat_vec, p_from_matrix, rot_a, rot_e, rot_g, M3, V3};
+use crate::description::spatial::{OrientationDesc, Rigid3Desc};
+use crate::linalg::rot3::{cross, dot, mat_vec, p_from_matrix, rot_a, rot_e, rot_g, M3, V3};
 
 /// The body coordinate onto which `F^-1` maps the normalization row: `F^-1 [0, 2 p]^T =
 /// e_6 / sqrt k` (`finv`: `G p = 0`, `p . 2 p / (2 |p|^2) = 1`), the unit row of

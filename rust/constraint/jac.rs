@@ -12,7 +12,8 @@
 //! the implicit integrators' Newton matrices, `System.A`): `dynamics::constraints` scatters into
 //! it after filling this form.
 
-use crate::model::Model;
+use super::Constraint;
+use crate::body::Body;
 
 /// One body piece of one row: columns `col..col + len` of `A` are `vals[val..val + len]`.
 #[derive(Debug, Clone, Copy)]
@@ -40,31 +41,31 @@ pub struct SegJac {
 }
 
 impl SegJac {
-    /// The pattern of `model`'s constraint rows.
-    pub fn new(model: &Model) -> SegJac {
-        let (n, m) = (model.n, model.m);
-        let mut layouts = Vec::with_capacity(model.constraints.len());
-        let mut widths = Vec::with_capacity(model.constraints.len());
+    /// The pattern of the constraint rows (`m` rows on `n` coordinates; a model's
+    /// `constraints` and `bodies`).
+    pub fn new(constraints: &[Constraint], bodies: &[Body], n: usize, m: usize) -> SegJac {
+        let mut layouts = Vec::with_capacity(constraints.len());
+        let mut widths = Vec::with_capacity(constraints.len());
         let mut row_ptr = Vec::with_capacity(m + 1);
         let mut seg_ptr = Vec::with_capacity(m + 1);
         let mut segs = Vec::new();
         row_ptr.push(0);
         seg_ptr.push(0);
         let mut val = 0;
-        for c in &model.constraints {
+        for c in constraints {
             debug_assert_eq!(row_ptr.len() - 1, c.row, "constraint rows are consecutive");
-            let mut bodies: Vec<usize> = c.bodies().into_iter().flatten().collect();
-            bodies.sort_unstable();
-            bodies.dedup();
-            let mut layout = Vec::with_capacity(bodies.len());
+            let mut mine: Vec<usize> = c.bodies().into_iter().flatten().collect();
+            mine.sort_unstable();
+            mine.dedup();
+            let mut layout = Vec::with_capacity(mine.len());
             let mut width = 0;
-            for &b in &bodies {
+            for &b in &mine {
                 layout.push((b, width));
-                width += model.bodies[b].n_coords;
+                width += bodies[b].n_coords;
             }
             for _ in 0..c.rows() {
                 for &(b, start) in &layout {
-                    let body = &model.bodies[b];
+                    let body = &bodies[b];
                     segs.push(Seg { body: b, col: body.offset, len: body.n_coords, val: val + start });
                 }
                 val += width;
@@ -77,14 +78,13 @@ impl SegJac {
         SegJac { m, n, layouts, widths, row_ptr, seg_ptr, segs, vals: vec![0.0; val] }
     }
 
-    /// Heap bytes of the pattern and values of `model` (without building it).
-    pub fn bytes(model: &Model) -> u64 {
-        let nnz: u64 = model
-            .constraints
+    /// Heap bytes of the pattern and values of `m` rows (without building it).
+    pub fn bytes(constraints: &[Constraint], bodies: &[Body], m: usize) -> u64 {
+        let nnz: u64 = constraints
             .iter()
-            .map(|c| c.rows() as u64 * c.bodies().into_iter().flatten().map(|b| model.bodies[b].n_coords as u64).sum::<u64>())
+            .map(|c| c.rows() as u64 * c.bodies().into_iter().flatten().map(|b| bodies[b].n_coords as u64).sum::<u64>())
             .sum();
-        8 * nnz + 48 * nnz.min(8 * model.m as u64) + 16 * model.m as u64
+        8 * nnz + 48 * nnz.min(8 * m as u64) + 16 * m as u64
     }
 
     /// Stored values (the nonzero pattern of `A`).

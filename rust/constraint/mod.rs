@@ -56,7 +56,7 @@ pub struct Constraint {
 /// What a joint or driver exerts on the body of its first marker (`a`, `point`), at that
 /// marker, from its multipliers (`M qdd + A^T lambda = Q`: the constraint force on the
 /// coordinates is `-A^T lambda`): a force in the world frame, a torque, and the angle of the
-/// joint frame in which `force` is also reported (`rust/sensors.rs`). The second marker's body
+/// joint frame in which `force` is also reported (`rust/sensors/mod.rs`). The second marker's body
 /// receives the opposite force at the same point.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Reaction {
@@ -252,7 +252,7 @@ impl Constraint {
             ConstraintKind::Distance(c) => c.reaction(bodies, q, qd, lam),
             ConstraintKind::AngleDriver(c) => c.reaction(bodies, q, qd, lam),
             ConstraintKind::CoordinateDriver(c) => c.reaction(bodies, q, qd, lam),
-            // spatial reactions are 3D wrenches: spatial::outputs::reactions
+            // spatial reactions are 3D wrenches: sensors::spatial::reactions
             ConstraintKind::Spatial(_) => Reaction::default(),
         }
     }

@@ -3,14 +3,12 @@
 //! the free coordinates (`metric_step`) or of the bodies' rigid motions (`rigid.rs`), then one
 //! velocity projection, and a report of what changed.
 
-use faer::Mat;
-
 use super::rigid::{rigid_step, RigidBasis};
-use super::{max_abs, velocity_residual};
+use super::{max_abs, reduced_gauss_step, velocity_residual};
 use crate::data::Data;
 use crate::dynamics::{constraints, mass_and_forces};
 use crate::error::{Error, Result};
-use crate::linalg::dense::{cholesky, pinv_solve, solve_lower, solve_upper};
+use crate::linalg::dense::{cholesky, solve_lower, solve_upper};
 use crate::model::Model;
 use crate::uk::solve;
 
@@ -157,29 +155,6 @@ fn metric_step(model: &Model, data: &mut Data, free: &[bool], r: &[f64]) -> Resu
         dx[g] = y[p];
     }
     Ok(dx)
-}
-
-/// The Gauss projection in a reduced basis `C` of `k` columns (the free coordinates, or the
-/// bodies' rigid motions): `y = F^-T (A C F^-T)^+ r` with `C^T M C = F F^T` block diagonal by
-/// body, the pseudoinverse with the rank cut of `scipy.linalg.pinv` (`linalg::dense::pinv_solve`).
-/// `row_into(i, col)` adds row `i` of `A C` into the zeroed `col` (k); `finv` and `finvt`
-/// apply `F^-1` and `F^-T` in place.
-pub(super) fn reduced_gauss_step(k: usize, r: &[f64], row_into: impl Fn(usize, &mut [f64]), finv: impl Fn(&mut [f64]), finvt: impl Fn(&mut [f64])) -> Result<Vec<f64>> {
-    let m = r.len();
-    // B^T = F^-1 (A C)^T (k x m)
-    let mut bt = Mat::<f64>::zeros(k, m);
-    let mut col = vec![0.0; k];
-    for i in 0..m {
-        col.fill(0.0);
-        row_into(i, &mut col);
-        finv(&mut col);
-        for p in 0..k {
-            bt[(p, i)] = col[p];
-        }
-    }
-    let mut y = pinv_solve(&bt, r).map_err(|e| Error::Solver(format!("SVD in the state correction did not converge: {e:?}")))?;
-    finvt(&mut y);
-    Ok(y)
 }
 
 /// Correct `(q, qd)` onto the constraints at time `t`, holding the coordinates marked in

@@ -2,7 +2,7 @@
 //! rigidly (an ANCF cable's nodal field turns and translates as a whole), and the Newton step
 //! is the Gauss projection restricted to those motions.
 
-use super::initial::reduced_gauss_step;
+use super::reduced_gauss_step;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::linalg::dense::{cholesky, solve_lower, solve_upper};

@@ -10,6 +10,7 @@ pub mod motor;
 pub mod rotational_spring;
 pub mod value;
 
+pub mod spatial;
 use crate::body::{Body, Marker};
 use crate::constraint::BuildContext;
 use crate::description::ForceDesc;
@@ -24,8 +25,8 @@ pub enum ForceKind {
     /// Linear spring-damper between two markers:
     /// `Q -= (k (l - l0) + c l_dot) (r_a - r_b)_q^T e`, `e = (r_a - r_b) / l`.
     SpringDamper { a: Marker, b: Marker, stiffness: f64, damping: f64, rest_length: f64 },
-    /// Spatial force elements, gravity included (`spatial/force.rs`).
-    Spatial(crate::spatial::force::SpatialForce),
+    /// Spatial force elements, gravity included (`force/spatial.rs`).
+    Spatial(spatial::SpatialForce),
     /// A force or torque that is a function of time and state (`load.rs`).
     Load(Box<load::Load>),
     Motor(Box<motor::Motor>),

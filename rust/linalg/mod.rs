@@ -19,6 +19,7 @@ pub mod dense;
 pub mod lu;
 pub mod quadrature;
 pub mod rcm;
+pub mod rot3;
 pub mod small_svd;
 
 pub use banded::{Banded, BandedCholesky};

@@ -9,8 +9,6 @@ use faer::linalg::svd::svd;
 use faer::Par;
 
 use super::settings::{Factored, RankInfo, SvdBackend};
-use crate::constraint::spatial::SpatialConstraint;
-use crate::constraint::ConstraintKind;
 use crate::data::Data;
 use crate::dynamics::{apply_finv_sparse, apply_finvt};
 use crate::error::{Error, Result};
@@ -59,21 +57,6 @@ pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
     }
     data.rank_info = rank_from_singular_values(data, n, m, rcond, atol)?;
     Ok(())
-}
-
-/// The columns of `B^T = F^-1 A^T` that are multiples of unit vectors, as `(row of A, coordinate)`:
-/// the spatial rigid bodies' normalization rows (`Normalization::unit_coordinate`). The QR of
-/// `B^T` skips them (`QrJacobi::with_unit_columns`): the normalization rows are eliminated in
-/// closed form (docs/spatial-design.md, section 3).
-pub fn unit_columns(model: &Model) -> Vec<(usize, usize)> {
-    model
-        .constraints
-        .iter()
-        .filter_map(|c| match &c.kind {
-            ConstraintKind::Spatial(SpatialConstraint::Normalization(nr)) => Some((c.row, nr.unit_coordinate(&model.bodies))),
-            _ => None,
-        })
-        .collect()
 }
 
 /// Above this many constraint rows `exact_rank_info` keeps the sparse path's certified bounds
@@ -257,7 +240,7 @@ mod tests {
     use crate::linalg::small_svd::QrJacobi;
     use crate::uk;
 
-    /// The normalization rows eliminated in the QR (`unit_columns`) give the accelerations,
+    /// The normalization rows eliminated in the QR (`Model::unit_columns`) give the accelerations,
     /// multipliers and rank of the plain QR of `B^T` on the spatial slider-crank (certified
     /// full-rank path) and on Bricard's mechanism (rank 34 of 35: the Jacobi SVD of the permuted
     /// `R`, and the default path), at a consistent state and off it.
@@ -271,7 +254,7 @@ mod tests {
         for (json, rank, backend) in scenes {
             let model = Model::from_json(json).unwrap();
             let (n, m) = (model.n, model.m);
-            assert_eq!(unit_columns(&model).len(), model.bodies.len(), "one normalization row per rigid3 body");
+            assert_eq!(model.unit_columns().len(), model.bodies.len(), "one normalization row per rigid3 body");
             let fresh = || {
                 let mut d = Data::new(&model);
                 d.ensure_dense(&model).unwrap();

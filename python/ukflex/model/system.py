@@ -559,20 +559,20 @@ class System:
         return ", ".join(f"{self.constraint_names[i]} = {residual[i]:.3e}" for i in order)
 
     #: positions must be resolved by double precision to this fraction of the scene's length scale
-    #: (the core's rule, ``rust/scale.rs``; the initial correction's tolerance is never coarser)
+    #: (the core's rule, ``rust/model/scale.rs``, ``rust/correct/conditioning.rs``; the initial correction's tolerance is never coarser)
     RESOLUTION = _core.RESOLUTION
 
     def _check_state(self) -> None:
         """Refuse a corrected start double precision cannot resolve (positions or angles far from
         the origin, masses too disparate for the rank decision): the core's rules,
-        ``rust/scale.rs``."""
+        ``rust/model/scale.rs``, ``rust/correct/conditioning.rs``."""
         self.core.check_state(self.t0, self.q0, self.qd0)
 
     @property
     def length_scale(self) -> float:
         """The scene's length scale [m]: the largest body dimension (beam lengths, centre-of-mass
         and marker offsets on bodies, distance lengths; 1 m for a scene without any), from the
-        core (``rust/scale.rs``); tolerances in metres are read against it."""
+        core (``rust/model/scale.rs``, ``rust/correct/conditioning.rs``); tolerances in metres are read against it."""
         return self.core.length_scale
 
     #: A driven coordinate moved by the initial correction by more than this (rad for angle and

@@ -6,7 +6,7 @@ reaction force and torque; momenta and energies. :class:`SpatialSensors` is ``re
 a spatial result: the same numbers by name, energies by kind and the energy balance (the
 planar :class:`ukflex.results.sensors.Sensors` API, with 3D reactions). Everything per state is
 computed in Rust by the System's own model (``System.core.spatial_outputs``,
-``rust/spatial/outputs.rs``, ``rust/sensors.rs``): one call for the whole history.
+``rust/sensors/spatial.rs``, ``rust/sensors/mod.rs``): one call for the whole history.
 """
 
 from __future__ import annotations

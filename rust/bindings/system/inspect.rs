@@ -151,7 +151,7 @@ impl PySystem {
     }
 
     /// Sensors at the states `(t[k], q[k], qd[k])` (`t` (nt,), `q`, `qd` (nt, n)), computed in
-    /// Rust (`rust/sensors.rs`): a dict with `reactions` (nt, n_items, 6: fx, fy, torque in the
+    /// Rust (`rust/sensors/mod.rs`): a dict with `reactions` (nt, n_items, 6: fx, fy, torque in the
     /// world frame on the first marker's body, fx_local, fy_local in the joint frame, power),
     /// `reaction_names`, `reaction_bodies` (body of the first marker, None = ground),
     /// `body_energies` (nt, n_bodies, 3: kinetic, strain, gravity), `body_names`,

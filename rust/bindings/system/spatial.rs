@@ -1,4 +1,4 @@
-//! `System.spatial_outputs`: the spatial sensors (`spatial::outputs`, `sensors`) over stored
+//! `System.spatial_outputs`: the spatial sensors (`sensors::spatial`, `sensors`) over stored
 //! states, on the System's own model and workspace (no rebuild, no Python per state), for
 //! `ukflex.spatial_outputs` and the sensors of a spatial result (`ukflex.results.spatial`).
 
@@ -14,7 +14,7 @@ use crate::dynamics;
 use crate::error::Error;
 use crate::force::ForceKind;
 use crate::sensors;
-use crate::spatial::{self, outputs};
+use crate::sensors::spatial as outputs;
 
 #[pymethods]
 impl PySystem {
@@ -30,7 +30,7 @@ impl PySystem {
     /// `dissipation_power` (nt,); `driver_values` (nt, n_constraints; NaN for non-drivers).
     #[pyo3(signature = (t, q, qd, reactions=true))]
     fn spatial_outputs<'py>(&self, py: Python<'py>, t: Vector<'py>, q: &Bound<'py, PyAny>, qd: &Bound<'py, PyAny>, reactions: bool) -> PyResult<Bound<'py, PyDict>> {
-        if !spatial::is_spatial(&self.model) {
+        if !self.model.is_spatial() {
             return Err(arg_err("System.spatial_outputs", "a planar model has no spatial outputs (use System.sensors); build a scene with \"dim\": 3"));
         }
         let n = self.model.n;

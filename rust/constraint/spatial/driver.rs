@@ -50,8 +50,8 @@ impl RotationDriver {
         let (si, sj) = self.pair.states(bodies, q, &zero);
         let f = self.motion.eval(t, scratch).0;
         let (sf, cf) = f.sin_cos();
-        let s = crate::spatial::rot::dot(&si.axes[1].v, &sj.axes[0].v);
-        let c = crate::spatial::rot::dot(&si.axes[0].v, &sj.axes[0].v);
+        let s = crate::linalg::rot3::dot(&si.axes[1].v, &sj.axes[0].v);
+        let c = crate::linalg::rot3::dot(&si.axes[0].v, &sj.axes[0].v);
         f + (s * cf - c * sf).atan2(s * sf + c * cf)
     }
 }

@@ -15,7 +15,7 @@ pub struct Normalization {
 impl Normalization {
     /// The coordinate `c` with `F^-1 A_n^T = e_c / sqrt k`: the rigid body's factor maps its
     /// normalization row onto one unit vector (`Rigid3::NORMALIZATION_COORD`), so the UK
-    /// kernel eliminates the row in closed form (`uk::dense::unit_columns`).
+    /// kernel eliminates the row in closed form (`Model::unit_columns`).
     pub fn unit_coordinate(&self, bodies: &[Body]) -> usize {
         bodies[self.body].offset + crate::body::rigid3::NORMALIZATION_COORD
     }

@@ -7,7 +7,7 @@
 use crate::body::marker3::{add_jacobian, Kin3, Marker3State};
 use crate::body::Body;
 use crate::constraint::ConstraintOut;
-use crate::spatial::rot::{dot, scale, sub, V3};
+use crate::linalg::rot3::{dot, scale, sub, V3};
 
 /// Value, rate and quadratic term of `u . w` (`u` of marker `i`, `w` of marker `j`).
 #[inline]

@@ -8,6 +8,9 @@
 //! used both for a whole description (`Model::from_json`) and item by item by the Python scene
 //! builder (so Python never re-derives a rule).
 
+pub mod scale;
+pub mod spatial;
+
 use std::collections::HashMap;
 
 use serde::de::DeserializeOwned;
@@ -45,13 +48,13 @@ impl Model {
     pub fn from_json(text: &str) -> Result<Model> {
         let mut model = Self::build_json(text)?;
         let desc: Value = serde_json::from_str(text).map_err(|e| Error::Description(e.to_string()))?;
-        model.length_scale = crate::scale::length_scale(&desc);
-        crate::scale::check_lengths(&desc, model.length_scale)?;
+        model.length_scale = scale::length_scale(&desc);
+        scale::check_lengths(&desc, model.length_scale)?;
         Ok(model)
     }
 
     fn build_json(text: &str) -> Result<Model> {
-        if let Some(model) = crate::spatial::build::model_if_spatial(text)? {
+        if let Some(model) = spatial::model_if_spatial(text)? {
             return Ok(model);
         }
         let raw: RawDescription = parse_json("scene", text)?;
@@ -88,8 +91,8 @@ impl Model {
         }
         let mut model = b.finish()?;
         let desc = item_to_json(d)?;
-        model.length_scale = crate::scale::length_scale(&desc);
-        crate::scale::check_lengths(&desc, model.length_scale)?;
+        model.length_scale = scale::length_scale(&desc);
+        scale::check_lengths(&desc, model.length_scale)?;
         Ok(model)
     }
 
@@ -128,6 +131,28 @@ impl Model {
         Ok(())
     }
 
+    /// The columns of `B^T = F^-1 A^T` that are multiples of unit vectors, as `(row of A,
+    /// coordinate)`: the spatial rigid bodies' normalization rows
+    /// (`Normalization::unit_coordinate`). The QR of `B^T` skips them
+    /// (`QrJacobi::with_unit_columns`): the normalization rows are eliminated in closed form
+    /// (docs/spatial-design.md, section 3).
+    pub fn unit_columns(&self) -> Vec<(usize, usize)> {
+        use crate::constraint::spatial::SpatialConstraint;
+        use crate::constraint::ConstraintKind;
+        self.constraints
+            .iter()
+            .filter_map(|c| match &c.kind {
+                ConstraintKind::Spatial(SpatialConstraint::Normalization(nr)) => Some((c.row, nr.unit_coordinate(&self.bodies))),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// A model built from a `"dim": 3` description (its bodies are spatial kinds).
+    pub fn is_spatial(&self) -> bool {
+        self.bodies.iter().any(|b| matches!(b.kind, crate::body::BodyKind::Rigid3(_) | crate::body::BodyKind::Point3(_)))
+    }
+
     /// Any body with stiffness-proportional damping (the scene is then truly stiff).
     pub fn has_damping(&self) -> bool {
         self.bodies.iter().any(|b| b.capabilities().damped)
@@ -138,7 +163,7 @@ impl Model {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawDescription {
-    /// 2 (planar; also when absent); 3 is built by `spatial::build`.
+    /// 2 (planar; also when absent); 3 is built by `model::spatial`.
     #[serde(default)]
     #[allow(dead_code)]
     dim: Option<u32>,

@@ -3,6 +3,7 @@
 //! constraint forces (the drivers' power) and the dissipated power. `bindings` loops these over
 //! the output times so that no Python runs per state; `python/ukflex/sensors.py` names them.
 
+pub mod spatial;
 use crate::data::Data;
 use crate::dynamics;
 use crate::error::Result;

@@ -18,9 +18,9 @@
 use crate::body::marker3::{add_jacobian, Marker3};
 use crate::body::{Body, BodyKind, Marker, MarkerShape};
 use crate::constraint::spatial::prim;
-use crate::spatial::desc::FrameDesc;
+use crate::description::spatial::FrameDesc;
 use crate::constraint::rows::wrap_angle;
-use crate::spatial::rot::{dot, mat_t_vec, mat_vec, norm, rot_a, rot_g, scale, V3};
+use crate::linalg::rot3::{dot, mat_t_vec, mat_vec, norm, rot_a, rot_g, scale, V3};
 
 #[derive(Debug, Clone)]
 pub enum SpatialForce {

@@ -8,6 +8,8 @@
 //! that keeps the path of every field in error messages (serde loses it inside internally
 //! tagged enums). `to_internal` turns it back.
 
+pub mod spatial;
+
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 

@@ -3,6 +3,13 @@
 //! in the planar builder (`model::item_name`). The constraint rows are the joints', then the
 //! drivers', then one normalization row per rigid3 body; the force elements are gravity (one
 //! element, `gravity`, when the scene's gravity is nonzero) and the listed ones.
+//!
+//! Spatial (3D) rigid multibody systems (issue 30; docs/spatial.md, docs/spatial-design.md) live
+//! in the layers of the planar ones: the description `description/spatial.rs`, the
+//! Euler-parameter algebra `linalg/rot3.rs`, the bodies `body/rigid3.rs` and `body/point3.rs`,
+//! the joints `constraint/spatial/`, the force elements `force/spatial.rs`, this builder (the
+//! same `Model` as the planar scenes) and the sensors `sensors/spatial.rs`. The kernels
+//! (`dynamics`, `uk`, `correct`, `integrate`) run them unchanged.
 
 use std::collections::HashMap;
 
@@ -16,9 +23,9 @@ use crate::constraint::{Constraint, ConstraintKind, Motion};
 use crate::error::{check_finite_item, non_negative, positive, Error, Result};
 use crate::force::{Force, ForceKind};
 use crate::model::{assign_rows, item_name, parse_item, parse_json, take_name, Model, Section};
-use crate::spatial::desc::{Body3Desc, Driver3Desc, Force3Desc, Joint3Desc, Marker3Desc};
-use crate::spatial::force::{marker_point, SpatialForce};
-use crate::spatial::rot::{norm, sub};
+use crate::description::spatial::{Body3Desc, Driver3Desc, Force3Desc, Joint3Desc, Marker3Desc};
+use crate::force::spatial::{marker_point, SpatialForce};
+use crate::linalg::rot3::{norm, sub};
 
 /// Planar body kinds (refused in a spatial scene) and spatial ones (refused in a planar one).
 const PLANAR_KINDS: [&str; 4] = ["rigid", "point_mass", "beam", "flexible"];

@@ -1,6 +1,6 @@
 //! The description of a spatial scene (`"dim": 3`, docs/spatial.md): plain data parsed from the
-//! JSON dict, as `description.rs` is for planar scenes. Validation happens when the model is
-//! built (`spatial::build`, each kind's `from_desc`), not here.
+//! JSON dict, as `description/mod.rs` is for planar scenes. Validation happens when the model is
+//! built (`model::spatial`, each kind's `from_desc`), not here.
 
 use serde::{Deserialize, Serialize};
 

@@ -16,8 +16,8 @@ use crate::data::Data;
 use crate::error::Result;
 use crate::force::ForceKind;
 use crate::model::Model;
-use crate::spatial::force::{gravity_energy, SpatialForce};
-use crate::spatial::rot::{cross, dot, mat_t_vec, mat_vec, rot_a, rot_g, scale, sub};
+use crate::force::spatial::{gravity_energy, SpatialForce};
+use crate::linalg::rot3::{cross, dot, mat_t_vec, mat_vec, rot_a, rot_g, scale, sub};
 use crate::uk;
 
 /// Columns of one body's row (see [`body_outputs`]).
