@@ -18,4 +18,16 @@ with the library: :mod:`ukflex.benchmarks`. The stability diagnostics users call
 are the library's :mod:`ukflex.stability`.
 """
 
-__all__ = ["extreme", "stability", "crosscheck", "geometric", "flexible_coupler", "simeon_crank", "sweeps"]
+import sys
+import time
+
+__all__ = ["progress", "extreme", "stability", "crosscheck", "geometric", "flexible_coupler", "simeon_crank", "sweeps"]
+
+
+_START = time.perf_counter()
+
+
+def progress(study: str, what: str) -> None:
+    """One line on stderr as a long study starts a case (``python -m studies NAME``): the study,
+    the case and the seconds since the studies were imported (stdout keeps the study's tables)."""
+    print(f"[{study} {time.perf_counter() - _START:7.1f} s] {what}", file=sys.stderr, flush=True)

@@ -1,7 +1,10 @@
 """``python -m studies NAME [options]``: the studies of the repository, on the public ukflex API.
 
 They are not part of the wheel (the library is ``python/ukflex``); run them from the
-repository's root with the development build (``bash scripts/dev-build.sh``):
+repository's root with the development build (``bash scripts/dev-build.sh``). The long ones
+report each case on stderr as they start it (``[crosscheck   12.3 s] sweep timoshenko, ...``;
+stability and geometric their own log lines, sweeps a progress bar); their tables go to stdout
+or their output folder:
 
   python -m studies stability --out results/stability --quick
   python -m studies crosscheck errata

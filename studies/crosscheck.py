@@ -23,6 +23,8 @@ from ukflex.reference import ReferenceModel, correct_initial_state, simulate_cp,
 from ukflex.reference.paper_closed_form import ALL_FIXES, PaperSliderCrank
 from ukflex.reference.uk import fd_jacobian
 
+from . import progress
+
 __all__ = ["STUDIES", "paper_description", "errata_effects", "rtol_sweep", "timing", "bdf_study", "run"]
 
 #: The studies of :func:`run` (``python -m studies crosscheck STUDY``).
@@ -88,6 +90,7 @@ def errata_effects(theory="timoshenko", t_end=0.07, rtol=1e-8, atol=1e-11, npts=
                                                   rotary="full")
     out = {}
     for name, kw in variants.items():
+        progress("crosscheck", f"errata {theory}: {name}")
         out[name] = (t, _closed_form_deflection(PaperSliderCrank(theory, **kw), t_end, t, rtol, atol))
     # the general element-by-element model through coordinate partitioning, for the record
     m = ReferenceModel(paper_description(theory))
@@ -133,6 +136,7 @@ def rtol_sweep(theory="timoshenko", gravity=True, t_end=0.07, rtols=(1e-6, 1e-8,
     S, _ = m.beam_shape("coupler", 0.5)
     rows = []
     for rtol in rtols:
+        progress("crosscheck", f"sweep {theory}, gravity={gravity}: rtol {rtol:g}")
         atol = 1e-3 * rtol
         tic = time.perf_counter()
         sr = solve_ivp(r.rhs, (0, t_end), np.r_[q0, qd0], method=method, rtol=rtol, atol=atol,
@@ -162,6 +166,7 @@ def timing(theory="timoshenko", t_end=0.02, rtol=1e-6, method="DOP853"):
                                                          atol=1e-3 * rtol, q0=q0, qd0=qd0,
                                                          partition="every_call")),
     ]:
+        progress("crosscheck", f"timing {theory}: {name}")
         best = None
         for _ in range(3):
             res = f()
@@ -178,6 +183,7 @@ def bdf_study(t_end=0.07, stream=None):
     t = np.linspace(0.0, t_end, 701)
     ref = {}
     for beam in ("euler-bernoulli", "timoshenko"):
+        progress("crosscheck", f"bdf {beam}")
         d = paper_description(beam)
         r, m = _rust(d), ReferenceModel(d)
         q0, qd0 = correct_initial_state(m)

@@ -31,6 +31,8 @@ import numpy as np
 from ukflex import ConstantSpeed, FlexibleData, InterfacePoint, Scene, fe, scenes, simulate
 from ukflex.reference import fe_invariants as fi
 
+from . import progress
+
 __all__ = ["coupler_data", "mesh_coupler_data", "scene", "peak", "study", "mesh_study", "beam_frequencies", "figure"]
 
 P = scenes.PAPER
@@ -153,6 +155,7 @@ def study(elements: int = 8, ks=(2, 4, 8), strain: str = "linear", rtol: float =
                  f_max=None)]
     full = coupler_data(elements, None, strain)
     for k in ks:
+        progress("flexible-coupler", f"{k} modes of the {elements}-element coupler")
         data = fe.reduce(full, k, modal_derivatives=modal_derivatives)
         r = run_flexible(data, strain, rtol)
         rows.append(dict(model=f"flexible k={k}", k=k, n_f=data.n_f, peak=r["peak"],
@@ -187,6 +190,7 @@ def mesh_study(meshes=MESHES, ks=(2, 4, 8), order: int = 2, cells: str = "quad",
         beam_k = {k: run_flexible(fe.reduce(beam32, k), "linear", rtol)["peak"] for k in ks}
     rows = []
     for nx, ny in meshes:
+        progress("flexible-coupler", f"mesh {nx}x{ny}: build and reduce")
         t0 = time.perf_counter()
         data = mesh_coupler_data(nx, ny, order, max(ks), cells)
         build = time.perf_counter() - t0
@@ -197,6 +201,7 @@ def mesh_study(meshes=MESHES, ks=(2, 4, 8), order: int = 2, cells: str = "quad",
                 dk = fe.reduce(data, k)
             else:
                 dk = mesh_coupler_data(nx, ny, order, k, cells, "nonlinear", modal_derivatives)
+            progress("flexible-coupler", f"mesh {nx}x{ny}: {k} modes")
             r = run_flexible(dk, strain, rtol)
             row["runs"].append(dict(k=k, n_f=dk.n_f, peak=r["peak"], error=abs(r["peak"] - ref["peak"]) / ref["peak"],
                                     error_k=abs(r["peak"] - beam_k[k]) / beam_k[k] if beam_k else None, wall=r["wall"]))

@@ -279,6 +279,11 @@ def test_stability_and_crosscheck_commands(tmp_path):
     r = studies_cli("crosscheck", "timing", "--t-end", "0.001", "--theory", "euler-bernoulli")
     assert r.returncode == 0, r.stderr
     assert "### euler-bernoulli" in r.stdout and "| CP, partition every call |" in r.stdout
+    # a long study reports each case on stderr as it starts it (its tables stay on stdout)
+    started = [line for line in r.stderr.splitlines() if line.startswith("[crosscheck ")]
+    assert [line.split("] ")[1] for line in started] == [
+        "timing euler-bernoulli: UK (NumPy, eigh + pinv)", "timing euler-bernoulli: CP, partition once",
+        "timing euler-bernoulli: CP, partition every call"], r.stderr
     bad = studies_cli("crosscheck", "nope")
     assert bad.returncode == 2 and "invalid choice" in bad.stderr
 
