@@ -840,22 +840,22 @@ _FE_SPECIAL = {
     "cells": ["out_of_range", "negative", "float", "repeat", "shape", "empty", "strings", "nan"],
     "points": ["nan", "shape", "collinear", "strings", "huge"],
     "interfaces": ["float", "out_of_range", "empty", "callable_bad", "not_dict", "bool_mask"],
-    "fixed": ["short", "junk", "names"],
+    "frame": ["short", "junk", "names", "word"],
     "reduce": ["none", "int", "modes", "damping", "tol"],
 }
 
 
 @st.composite
 def _fe_case(draw):
-    field = draw(st.sampled_from(sorted(_FE_FIELDS) + ["cells", "points", "interfaces", "fixed", "reduce", "none"]))
-    if field in ("cells", "points", "interfaces", "fixed", "reduce"):
+    field = draw(st.sampled_from(sorted(_FE_FIELDS) + ["cells", "points", "interfaces", "frame", "reduce", "none"]))
+    if field in ("cells", "points", "interfaces", "frame", "reduce"):
         value = draw(st.sampled_from(_FE_SPECIAL[field]))
     elif field == "none":
         value = None
     else:
         value = draw(st.one_of(st.sampled_from(_FE_SPECIAL.get(field, [])) if field in _FE_SPECIAL else hostile(),
                                hostile()))
-    return dict(field=field, value=value, quads=draw(st.booleans()), frame=draw(st.sampled_from(["mean-axis", "fixed"])))
+    return dict(field=field, value=value, quads=draw(st.booleans()), frame=draw(st.sampled_from(["mean-axis", "pinned-pinned"])))
 
 
 def _fe_mesh(quads: bool) -> Tuple[np.ndarray, np.ndarray]:
@@ -898,8 +898,6 @@ def _check_fe(case: Dict[str, Any]) -> List[Finding]:
     uk = _ukflex()
     pts, cells = _fe_mesh(case["quads"])
     kw: Dict[str, Any] = dict(_FE_FIELDS, cells=cells, interfaces={"A": [0, 4, 8], "B": [3, 7, 11]}, frame=case["frame"])
-    if case["frame"] == "fixed":
-        kw["fixed"] = [("A", "x"), ("A", "y"), ("B", "y")]
     field, value = case["field"], case["value"]
     hostile_in = field != "none"
     if field in _FE_FIELDS:
@@ -919,9 +917,8 @@ def _check_fe(case: Dict[str, Any]) -> List[Finding]:
         kw["interfaces"] = {"float": {"A": [0.5, 4]}, "out_of_range": {"A": [0, 400]}, "empty": {"A": []},
                             "callable_bad": {"A": lambda p: "x"}, "not_dict": [0, 1],
                             "bool_mask": {"A": lambda p: np.array([True, False])}}[value]
-    elif field == "fixed":
-        kw["frame"] = "fixed"
-        kw["fixed"] = {"short": [("A", "x")], "junk": 5, "names": [("Z", "x"), ("A", "q"), ("B", "y")]}[value]
+    elif field == "frame":
+        kw["frame"] = {"short": [("A", "x")], "junk": 5, "names": [("Z", "x"), ("A", "q"), ("B", "y")], "word": "fixed"}[value]
     with _quiet():
         try:
             data = fe.from_mesh(pts, **kw)
@@ -933,7 +930,7 @@ def _check_fe(case: Dict[str, Any]) -> List[Finding]:
                     rkw["tol"] = -1.0
                 data = fe.reduce(target, **rkw)
         except BaseException as exc:  # noqa: BLE001
-            names = ["mesh", "cells", "points", "interfaces", "fixed", "frame", "data", "modes", "damping_ratio", "tol",
+            names = ["mesh", "cells", "points", "interfaces", "frame", "reduction", "data", "modes", "damping_ratio", "tol",
                      "order", "thickness", "density", "youngs_modulus", "poisson_ratio", "stiffness_matrix", "mass_matrix"]
             return _classify(exc, names, f"fe ({field}): ")
     if hostile_in:

@@ -85,8 +85,8 @@ def mesh_coupler_data(nx: int, ny: int, order: int = 2, modes: int = 4, cells: s
     tol = 1e-9 * lb
     ifs = {name: (lambda p, x0=x0: np.abs(p[:, 0] - x0) < tol) for name, x0 in (("A", 0.0), ("M", lb / 2), ("B", lb))}
     return fe.from_mesh(pts, cells=cellarr, thickness=t, density=P["density"], youngs_modulus=P["youngs_modulus"],
-                        poisson_ratio=P["poisson_ratio"], interfaces=ifs, modes=modes, frame="fixed",
-                        fixed=[("A", "x"), ("A", "y"), ("B", "y")], order=order, strain=strain,
+                        poisson_ratio=P["poisson_ratio"], interfaces=ifs, modes=modes,
+                        frame=[("A", "x"), ("A", "y"), ("B", "y")], order=order, strain=strain,
                         modal_derivatives=modal_derivatives)
 
 

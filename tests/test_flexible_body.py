@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import ukflex
-from ukflex import FlexibleData, InterfacePoint, Scene
+from ukflex import FlexibleData, InterfacePoint, Rectangular, Scene
 from ukflex.reference import fe_invariants as fi
 
 L, N, RHO, E, B, H, NU = 0.3048, 3, 2770.0, 7.1e10, 0.0127, 0.0127 / 4, 0.33
@@ -159,16 +159,17 @@ def _plate_mesh(nx=12, ny=3, length=0.3, height=0.02):
     return pts, np.array(tris)
 
 
-@pytest.mark.parametrize("frame", ["mean-axis", "fixed", "craig-bampton"])
-def test_mesh_invariants_match_an_independent_quadrature(frame):
+@pytest.mark.parametrize("frame,reduction", [("mean-axis", "modes"), ("pinned-pinned", "modes"),
+                                             ([("A", "x"), ("A", "y"), ("B", "y")], "modes"),
+                                             ("pinned-pinned", "craig-bampton")])
+def test_mesh_invariants_match_an_independent_quadrature(frame, reduction):
     fe = pytest.importorskip("ukflex.model.fe")
     pytest.importorskip("skfem")
     pts, tris = _plate_mesh()
     left = [i for i, p in enumerate(pts) if p[0] == 0.0]
     right = [i for i, p in enumerate(pts) if abs(p[0] - 0.3) < 1e-12]
-    fixed = [("A", "x"), ("A", "y"), ("B", "y")]
     data = fe.from_mesh(pts, cells=tris, thickness=0.01, density=7800.0, youngs_modulus=2e11, poisson_ratio=0.3,
-                        interfaces={"A": left, "B": right}, modes=4, frame=frame, fixed=None if frame == "mean-axis" else fixed)
+                        interfaces={"A": left, "B": right}, modes=4, frame=frame, reduction=reduction)
     ref = fi.triangle_invariants(pts, tris, 0.01, 7800.0, data.info["modes"])
     for key in ("mass", "inertia", "s_bar", "s_u0", "s_ju0", "s_tilde", "m_ff"):
         a, b = np.asarray(getattr(data, key), dtype=float), np.asarray(ref[key], dtype=float)
@@ -312,7 +313,7 @@ def test_quadratic_mesh_invariants_of_a_rectangle():
     length, height, t, rho = 0.3, 0.02, 0.01, 7800.0
     ifs = {"A": lambda p: np.isclose(p[:, 0], 0.0), "B": lambda p: np.isclose(p[:, 0], length)}
     data = fe.from_mesh(pts, cells=tris, thickness=t, density=rho, youngs_modulus=2e11, poisson_ratio=0.3,
-                        interfaces=ifs, modes=3, frame="fixed", fixed=[("A", "x"), ("A", "y"), ("B", "y")], order=2)
+                        interfaces=ifs, modes=3, frame="pinned-pinned", order=2)
     m = rho * t * length * height
     assert abs(data.mass - m) <= 1e-12 * m
     assert np.allclose(data.com, (length / 2, 0.0), atol=1e-15)
@@ -342,6 +343,44 @@ def _nodal_plate():
     return fe, nodes, mm, kk, {"A": left, "B": right}
 
 
+def test_one_frame_vocabulary_for_beams_and_fe_bodies():
+    """``frame`` has one vocabulary (the core's): a pinned-pinned FE body takes the chord of its
+    first two interfaces, also when the chord is not the body's x axis; clamped fixes the first
+    interface's rotation; a beam refuses 'mean-axis' by name."""
+    fe, nodes, mm, kk, ifs = _nodal_plate()
+    assert fe.FRAMES == ("pinned-pinned", "clamped", "mean-axis")
+    # the chord frame of the ends equals the explicit conditions when AB is the x axis
+    a = fe.from_nodal(nodes, mm, kk, interfaces=ifs, modes=3, frame="pinned-pinned")
+    b = fe.from_nodal(nodes, mm, kk, interfaces=ifs, modes=3, frame=[("A", "x"), ("A", "y"), ("B", "y")])
+    assert np.allclose(a.info["frequencies"], b.info["frequencies"], rtol=1e-12)
+    # a slanted chord (A = the left edge, B = the upper right corner, named): B moves along AB only
+    corner = [i for i, p in enumerate(nodes) if abs(p[0] - 0.3) < 1e-12 and p[1] == nodes[:, 1].max()]
+    c = fe.from_nodal(nodes, mm, kk, interfaces={"M": [2], "B": corner, "A": ifs["A"]}, modes=3,
+                      frame=("pinned-pinned", "A", "B"))
+    chord = np.subtract(c.markers["B"].point, c.markers["A"].point)
+    across = np.array([-chord[1], chord[0]]) / np.hypot(*chord)
+    assert np.max(np.abs(c.markers["A"].displacement)) < 1e-12
+    assert np.max(np.abs(across @ np.asarray(c.markers["B"].displacement))) < 1e-12
+    assert np.max(np.abs(np.asarray(c.markers["B"].displacement))) > 1e-3
+    # clamped: the first interface neither moves nor turns
+    d = fe.from_nodal(nodes, mm, kk, interfaces=ifs, modes=3, frame="clamped")
+    assert np.max(np.abs(d.markers["A"].displacement)) < 1e-12
+    assert np.max(np.abs(d.markers["A"].rotation)) < 1e-12
+    assert d.info["frequencies"][0] < a.info["frequencies"][0]  # cantilever below pinned-pinned
+    for frame, match in (("fixed", "unknown frame"), ([("A", "x")], "three"), (("pinned-pinned", "A"), "2 interface"), ([("A", "q"), ("A", "y"), ("B", "y")], "rotation")):
+        with pytest.raises(ukflex.InvalidArgumentError, match=match):
+            fe.from_nodal(nodes, mm, kk, interfaces=ifs, modes=3, frame=frame)
+    with pytest.raises(ukflex.InvalidArgumentError, match="single node"):
+        fe.from_nodal(nodes, mm, kk, interfaces={"A": [0], "B": ifs["B"]}, modes=3, frame="clamped")
+    with pytest.raises(ukflex.InvalidArgumentError, match="reduction"):
+        fe.from_nodal(nodes, mm, kk, interfaces=ifs, modes=3, frame="mean-axis", reduction="craig-bampton")
+    with pytest.raises(ukflex.InvalidSceneError, match="modal bodies from FE data"):
+        s = Scene()
+        s.beam("b", length=1.0, elements=2, density=7800.0, youngs_modulus=2e11, theory="euler-bernoulli",
+               section=Rectangular(0.01, 0.02), frame="mean-axis")
+        s.build()
+
+
 @pytest.mark.parametrize("case, match", [
     ("mass unsymmetric", "mass_matrix: must be symmetric"),
     ("mass indefinite", "mass_matrix: is not positive definite"),
@@ -368,13 +407,12 @@ def test_bad_fe_input_raises_named_errors(case, match):
     elif case == "stiffness supported":
         kk = kk + np.diag(np.r_[1e-3 * kk[0, 0], 1e-3 * kk[0, 0], np.zeros(n - 2)])
     elif case == "fixed frame leaves a rigid motion":
-        kw.update(frame="fixed", fixed=[("A", "x"), ("A", "x"), ("B", "y")])
+        kw.update(frame=[("A", "x"), ("A", "x"), ("B", "y")])
     elif case == "fixed frame on a disconnected stiffness":
         kk = kk.copy()
         kk[:, :2] = kk[:2, :] = 0.0  # node 0 connected to nothing
         kk = kk + np.diag(np.r_[0.0, 0.0, np.zeros(n - 2)])
-        kw.update(frame="fixed", fixed=[("B", "x"), ("B", "y"), ("M", "y")],
-                  interfaces={"B": ifs["B"], "M": [2]})
+        kw.update(frame=[("B", "x"), ("B", "y"), ("M", "y")], interfaces={"B": ifs["B"], "M": [2]})
     elif case == "marker outside the mesh":
         kw.update(interfaces={"A": [0], "B": [len(nodes) + 3]})
     elif case == "too many modes":

@@ -17,6 +17,7 @@ __all__ = [
     "SceneChecker",
     "item_name",
     "beam_elastic_dofs",
+    "frame_options",
     "motion_values",
     "dense_eval",
     "run_options",
@@ -265,6 +266,9 @@ def motion_values(motion_json: str, t: _F64) -> _F64:
     ...
 def beam_elastic_dofs(elements: int, frame: str) -> int:
     """Number of elastic coordinates of a beam."""
+
+def frame_options() -> List[str]:
+    """The words of the floating-frame option, in order."""
 
 def dense_eval(method: str, meta: _F64, data: _F64, part_len: List[int], t: _F64) -> _F64:
     """Evaluate the dense output recorded by ``System.integrate(..., dense=True)`` at t (k,): (dim, k)."""

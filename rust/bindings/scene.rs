@@ -106,9 +106,18 @@ pub fn item_name(section: &str, kind: &str, name: Option<&str>, index: usize) ->
 /// Number of elastic coordinates of a beam with `elements` elements and reference `frame`.
 #[pyfunction]
 pub fn beam_elastic_dofs(elements: usize, frame: &str) -> PyResult<usize> {
-    let f: crate::description::ReferenceConditions = serde_json::from_value(serde_json::Value::String(frame.to_string()))
-        .map_err(|_| InvalidSceneError::new_err(format!("unknown frame '{frame}'; expected 'pinned-pinned' or 'clamped'")))?;
-    Ok(crate::body::ffrf_beam::elastic_dofs(elements, f))
+    use crate::description::ReferenceConditions;
+    let f: ReferenceConditions = serde_json::from_value(serde_json::Value::String(frame.to_string())).map_err(|_| {
+        let words: Vec<String> = ReferenceConditions::ALL.iter().map(|w| format!("'{}'", w.word())).collect();
+        InvalidSceneError::new_err(format!("unknown frame '{frame}'; expected one of {}", words.join(", ")))
+    })?;
+    crate::body::ffrf_beam::elastic_dofs(elements, f, "beam").map_err(super::to_py)
+}
+
+/// The words of the floating-frame option (`ReferenceConditions`), in order.
+#[pyfunction]
+pub fn frame_options() -> Vec<String> {
+    crate::description::ReferenceConditions::ALL.iter().map(|f| f.word()).collect()
 }
 
 fn constraint_info<'py>(py: Python<'py>, c: &crate::constraint::Constraint) -> PyResult<Bound<'py, PyDict>> {

@@ -187,20 +187,24 @@ pub fn section_properties(item: &str, section: &SectionDesc) -> Result<(f64, f64
     Ok((area, second_moment))
 }
 
-/// Nodal dofs `(u, v, psi)` per node removed by the reference conditions of the floating frame.
-fn removed_dofs(elements: usize, frame: ReferenceConditions) -> [usize; 3] {
+/// Nodal dofs `(u, v, psi)` per node removed by the reference conditions of the floating frame
+/// (a beam's frame is defined on its end nodes: `mean-axis` is refused).
+fn removed_dofs(elements: usize, frame: ReferenceConditions, item: &str) -> Result<[usize; 3]> {
     match frame {
         // u_1 = v_1 = 0, v_{N+1} = 0
-        ReferenceConditions::PinnedPinned => [0, 1, 3 * elements + 1],
+        ReferenceConditions::PinnedPinned => Ok([0, 1, 3 * elements + 1]),
         // u_1 = v_1 = psi_1 = 0
-        ReferenceConditions::Clamped => [0, 1, 2],
+        ReferenceConditions::Clamped => Ok([0, 1, 2]),
+        ReferenceConditions::MeanAxis => Err(Error::invalid(item, format!(
+            "an FFRF beam's frame is '{}' or '{}' (reference conditions on its end nodes); '{}' is the frame of modal bodies from FE data (ukflex.fe)",
+            ReferenceConditions::PinnedPinned.word(), ReferenceConditions::Clamped.word(), ReferenceConditions::MeanAxis.word()))),
     }
 }
 
 /// Number of elastic coordinates: the `3 (N + 1)` nodal dofs less the three removed by the
 /// reference conditions.
-pub fn elastic_dofs(elements: usize, frame: ReferenceConditions) -> usize {
-    3 * (elements + 1) - removed_dofs(elements, frame).len()
+pub fn elastic_dofs(elements: usize, frame: ReferenceConditions, item: &str) -> Result<usize> {
+    Ok(3 * (elements + 1) - removed_dofs(elements, frame, item)?.len())
 }
 
 /// Largest number of elements of one beam.
@@ -293,7 +297,7 @@ impl Beam {
         let n_el = d.elements;
         let l = length / n_el as f64;
         let n_nodal = 3 * (n_el + 1);
-        let removed = removed_dofs(n_el, d.frame);
+        let removed = removed_dofs(n_el, d.frame, item)?;
         let mut dof_map = vec![None; n_nodal];
         let mut dof_of_qf = Vec::new();
         for (k, slot) in dof_map.iter_mut().enumerate() {

@@ -244,16 +244,34 @@ pub enum Strain {
     Nonlinear,
 }
 
-/// Reference conditions of an FFRF beam's floating frame (which nodal coordinates the frame takes
-/// out; not a boundary condition). Default: pinned-pinned (the chord frame).
+/// The floating frame of an FFRF body: which elastic motions the frame takes out (reference
+/// conditions, not a boundary condition). One vocabulary for every FFRF kind: a beam takes
+/// `pinned-pinned` (default) or `clamped`; a modal body from FE data (`ukflex.fe`) takes these
+/// two on its first interfaces, `mean-axis`, or three explicit reference conditions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReferenceConditions {
-    /// u_1 = v_1 = 0, v_{N+1} = 0 (the paper's choice).
+    /// The chord frame: the first point fixed in x and y, the second's displacement across the
+    /// chord zero (a beam: u_1 = v_1 = 0, v_{N+1} = 0; the paper's choice).
     #[default]
     PinnedPinned,
-    /// u_1 = v_1 = psi_1 = 0 (cantilever frame).
+    /// The first point fixed in x, y and rotation (a beam: u_1 = v_1 = psi_1 = 0).
     Clamped,
+    /// Free-free modes without the rigid-body modes (Buckens' mean axes, linearized).
+    MeanAxis,
+}
+
+impl ReferenceConditions {
+    /// Every option, in the order the documentation lists them.
+    pub const ALL: [ReferenceConditions; 3] = [Self::PinnedPinned, Self::Clamped, Self::MeanAxis];
+
+    /// The option's word in scene descriptions (its serde name).
+    pub fn word(self) -> String {
+        match serde_json::to_value(self) {
+            Ok(serde_json::Value::String(s)) => s,
+            _ => String::new(),
+        }
+    }
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize)]

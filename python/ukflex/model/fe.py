@@ -10,16 +10,24 @@ computed from a planar FE model reduced to a few modes (docs/flexible-bodies.md)
 
 Interfaces (where joints attach) are nodes or rigid averages of several nodes (RBE3-like: the
 point is their centroid, its displacement their mean displacement, its rotation their mean
-rotation about it).  Reduction (``frame``):
+rotation about it).  The floating frame (``frame``) uses the vocabulary of every FFRF body
+(:data:`FRAMES`, the core's; the beams of :meth:`ukflex.Scene.beam` take the first two):
 
-* ``"mean-axis"`` -- free-free eigenmodes without the three rigid-body modes (the floating
-  frame then satisfies the mean-axis conditions ``S_bar q = 0``, ``s_ju0 . q = 0``);
-* ``"fixed"`` -- reference conditions ``fixed = [(interface, "x"|"y"), ...]`` (three of them,
-  e.g. pinned-pinned: ``[("A", "x"), ("A", "y"), ("B", "y")]``, the chord frame of the beams),
-  then the eigenmodes of the constrained model;
-* ``"craig-bampton"`` -- the same reference conditions, plus the remaining dofs of the
-  interfaces as boundary: static constraint modes for each of them and fixed-interface normal
-  modes.
+* ``"pinned-pinned"`` -- the chord frame of two interfaces ``A``, ``B``
+  (``("pinned-pinned", "A", "B")``; the word alone: the first two, in the order given): ``A``
+  fixed in x and y, ``B``'s displacement across the line ``AB`` zero (a beam's
+  ``u_1 = v_1 = v_N+1 = 0``);
+* ``"clamped"`` -- an interface (``("clamped", "A")``; the word alone: the first) fixed in x, y
+  and rotation (a beam's ``u_1 = v_1 = psi_1 = 0``; the interface needs several nodes to have a
+  rotation);
+* ``"mean-axis"`` (default) -- free-free eigenmodes without the three rigid-body modes (the
+  floating frame then satisfies the mean-axis conditions ``S_bar q = 0``, ``s_ju0 . q = 0``);
+* three explicit reference conditions ``[(interface, "x"|"y"|"rotation"), ...]``.
+
+Reduction (``reduction``): ``"modes"`` (default) keeps the eigenmodes of the model with the
+frame's reference conditions; ``"craig-bampton"`` (a frame with reference conditions) takes the
+remaining dofs of the interfaces as boundary: static constraint modes for each of them and
+fixed-interface normal modes.
 
 ``modes`` is the number of normal modes kept; ``damping_ratio`` gives modal damping.
 """
@@ -34,12 +42,19 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..arguments import count, non_negative, positive, real, real_array
-from ..errors import InvalidArgumentError, require
+from ..errors import InvalidArgumentError, core, require
 from .flexible import FlexibleData, InterfacePoint
 
-__all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices", "reduce"]
+__all__ = ["from_nodal", "from_mesh", "plane_stress_mesh_matrices", "reduce", "FRAMES", "REDUCTIONS"]
+
+#: The floating-frame options (the core's vocabulary, shared with :meth:`ukflex.Scene.beam`).
+FRAMES: Tuple[str, ...] = tuple(core.frame_options())
+#: The reductions of :func:`from_nodal` / :func:`from_mesh`.
+REDUCTIONS: Tuple[str, ...] = ("modes", "craig-bampton")
+_AXES = ("x", "y", "rotation")
 
 Interface = Union[int, Sequence[int]]
+Frame = Union[str, Sequence[Tuple[str, str]]]
 
 
 def _indices(name: str, value: Any, n: int, what: str) -> np.ndarray:
@@ -113,6 +128,68 @@ def _scalar_mass(mm: np.ndarray) -> np.ndarray:
     return m
 
 
+def _reference_rows(frame: Any, iface: Dict[str, Any]) -> Optional[np.ndarray]:
+    """The rows ``c`` (3, 2N) of the frame's reference conditions ``c u = 0`` (``None``: the mean
+    axes), checked independent."""
+    names = list(iface)
+    word, on = frame, None
+    if not isinstance(frame, str) and isinstance(frame, (tuple, list)) and frame and isinstance(frame[0], str):
+        word, on = frame[0], list(frame[1:])  # ("pinned-pinned", "A", "B"), ("clamped", "A")
+    if isinstance(word, str):
+        if word not in FRAMES:
+            raise InvalidArgumentError("frame", f"unknown frame {word!r}; expected one of {list(FRAMES)} or three "
+                                       "(interface, 'x'|'y'|'rotation') reference conditions")
+        if word == "mean-axis":
+            if on:
+                raise InvalidArgumentError("frame", "the mean axes are not defined on interfaces")
+            return None
+        need = 2 if word == "pinned-pinned" else 1
+        if on is not None:
+            if len(on) != need or any(nm not in iface for nm in on):
+                raise InvalidArgumentError("frame", f"frame {word!r} is defined on {need} interface(s) of {names}, got {on}")
+            names = on
+        elif len(names) < need:
+            raise InvalidArgumentError("frame", f"frame {word!r} is defined on the first {need} interface(s); the body "
+                                       f"has {len(names)}")
+        frame = word
+        (pa, da, ra) = iface[names[0]]
+        if frame == "clamped":
+            if ra is None:
+                raise InvalidArgumentError("frame", f"frame 'clamped' fixes the rotation of interface {names[0]!r}, which is a "
+                                           "single node (no rotation): give it several nodes")
+            return np.vstack([da, ra])
+        pb, db, _ = iface[names[1]]
+        chord = np.subtract(pb, pa)
+        length = float(np.hypot(*chord))
+        if length <= 0.0:
+            raise InvalidArgumentError("frame", f"frame 'pinned-pinned': interfaces {names[0]!r} and {names[1]!r} are at the "
+                                       "same point (no chord)")
+        cx, cy = chord / length
+        return np.vstack([da, -cy * db[0] + cx * db[1]])
+    try:
+        entries = [tuple(e) for e in frame]
+    except TypeError:
+        entries = []
+    if len(entries) != 3 or any(len(e) != 2 for e in entries):
+        raise InvalidArgumentError("frame", f"expected one of {list(FRAMES)} or three (interface, 'x'|'y'|'rotation') "
+                                   f"reference conditions, got {reprlib.repr(frame)}")
+    rows = []
+    for name, ax in entries:
+        if name not in iface or ax not in _AXES:
+            raise InvalidArgumentError("frame", f"reference condition ({name!r}, {ax!r}): expected an interface name "
+                                       f"{names} and one of {list(_AXES)}")
+        _, d, rot = iface[name]
+        if ax == "rotation" and rot is None:
+            raise InvalidArgumentError("frame", f"reference condition ({name!r}, 'rotation'): the interface is a single node "
+                                       "(no rotation)")
+        rows.append(rot if ax == "rotation" else d[_AXES.index(ax)])
+    c = np.array(rows)
+    if np.linalg.matrix_rank(c) < 3:
+        raise InvalidArgumentError("frame", f"the reference conditions {entries} are not independent (they do "
+                                   "not fix the three rigid-body motions of the frame)")
+    return c
+
+
 def from_nodal(
     nodes: np.ndarray,
     mass_matrix: np.ndarray,
@@ -120,12 +197,12 @@ def from_nodal(
     *,
     interfaces: Mapping[str, Interface],
     modes: int = 4,
-    frame: str = "mean-axis",
-    fixed: Optional[Sequence[Tuple[str, str]]] = None,
+    frame: Frame = "mean-axis",
+    reduction: str = "modes",
     damping_ratio: float = 0.0,
 ) -> FlexibleData:
     """A :class:`FlexibleData` from nodal coordinates (N, 2) and the assembled mass and stiffness
-    matrices (2N, 2N) of a planar FE model (see the module docs for ``frame`` and ``fixed``).
+    matrices (2N, 2N) of a planar FE model (see the module docs for ``frame`` and ``reduction``).
 
     The returned data carries ``info["frequencies"]`` (rad/s, the kept normal modes; for
     Craig-Bampton those of the reduced model) and ``info["modes"]`` (2N, n_f), the nodal shapes.
@@ -153,7 +230,13 @@ def from_nodal(
                                    "without mass)") from None
     m_scalar = _scalar_mass(mm)
     iface = {name: _interface_rows(x, spec) for name, spec in interfaces.items()}
-    if frame == "mean-axis":
+    if reduction not in REDUCTIONS:
+        raise InvalidArgumentError("reduction", f"unknown reduction {reduction!r}; expected one of {list(REDUCTIONS)}")
+    c = _reference_rows(frame, iface)
+    if c is None:
+        if reduction != "modes":
+            raise InvalidArgumentError("reduction", f"the {reduction} reduction needs a frame with reference conditions "
+                                       f"({[f for f in FRAMES if f != 'mean-axis']} or three (interface, axis)), not 'mean-axis'")
         lam, vec = _eigh(kk, mm)
         if modes + 3 > n:
             raise InvalidArgumentError("modes", f"{modes} modes do not fit a model with {n} dofs")
@@ -163,25 +246,8 @@ def from_nodal(
                              f"(lowest eigenvalues {lam[:4]}): is the part supported or disconnected?")
         phi = vec[:, 3:3 + modes]
         freq = np.sqrt(np.maximum(lam[3:3 + modes], 0.0))
-    elif frame in ("fixed", "craig-bampton"):
-        try:
-            fixed = [tuple(e) for e in fixed]  # type: ignore[union-attr]
-        except TypeError:
-            fixed = None
-        if fixed is None or len(fixed) != 3 or any(len(e) != 2 for e in fixed):
-            raise InvalidArgumentError("fixed",
-                                       "frame 'fixed' and 'craig-bampton' need fixed = three (interface, 'x'|'y') reference conditions")
-        ref = []
-        for name, ax in fixed:
-            if name not in iface or ax not in ("x", "y"):
-                raise InvalidArgumentError("fixed",
-                                           f"fixed entry ({name!r}, {ax!r}): expected an interface name {list(iface)} and 'x' or 'y'")
-            ref.append(iface[name][1][0 if ax == "x" else 1])
-        c = np.array(ref)  # (3, n) constraint rows c u = 0
-        if np.linalg.matrix_rank(c) < 3:
-            raise InvalidArgumentError("fixed", f"the reference conditions {list(fixed)} are not independent (they do "
-                                       "not fix the three rigid-body motions of the frame)")
-        if frame == "craig-bampton":
+    else:
+        if reduction == "craig-bampton":
             rows = [iface[nm][1][k] for nm in iface for k in range(2)]
             rows = [r for r in rows if np.linalg.matrix_rank(np.vstack([c, r])) > np.linalg.matrix_rank(c)]
             b = np.array(rows) if rows else np.zeros((0, n))
@@ -191,13 +257,10 @@ def from_nodal(
         kr, mr = phi.T @ kk @ phi, phi.T @ mm @ phi
         lam = _eigh(kr, mr, eigvals_only=True)
         if lam[0] <= 1e-9 * abs(lam[-1]):
-            raise InvalidArgumentError("stiffness_matrix", f"the stiffness with the reference conditions {list(fixed)} is "
+            raise InvalidArgumentError("stiffness_matrix", f"the stiffness with the reference conditions of frame {frame!r} is "
                                        f"not positive definite (lowest eigenvalue {lam[0]:.3e}): rigid-body motions left "
                                        "free, a mechanism or a disconnected part, or an indefinite stiffness")
         freq = np.sqrt(np.maximum(lam, 0.0))
-    else:
-        raise InvalidArgumentError("frame",
-                                   f"unknown frame {frame!r}; expected 'mean-axis', 'fixed' or 'craig-bampton'")
     data = _data_from_basis(x, mm, kk, m_scalar, iface, phi, damping_ratio)
     data.info["frequencies"] = freq
     return data
@@ -447,8 +510,8 @@ def _mesh_input(mesh: Any, cells: Any) -> Tuple[Any, Any]:
 
 
 def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: float, poisson_ratio: float,
-              interfaces: Mapping[str, Interface], modes: int = 4, frame: str = "mean-axis",
-              fixed: Optional[Sequence[Tuple[str, str]]] = None, damping_ratio: float = 0.0,
+              interfaces: Mapping[str, Interface], modes: int = 4, frame: Frame = "mean-axis",
+              reduction: str = "modes", damping_ratio: float = 0.0,
               cells: Optional[np.ndarray] = None, order: int = 1, strain: str = "linear",
               modal_derivatives: Union[bool, int] = False,
               progress: Optional[Callable[[float], None]] = None) -> FlexibleData:
@@ -486,9 +549,9 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
         raise InvalidArgumentError("strain", f"expected 'linear' or 'nonlinear', got {strain!r}")
     if modal_derivatives is not False and strain != "nonlinear":
         raise InvalidArgumentError("modal_derivatives", "modal derivatives need strain='nonlinear'")
-    if modal_derivatives is not False and frame == "mean-axis":
+    if modal_derivatives is not False and isinstance(frame, str) and frame == "mean-axis":
         raise InvalidArgumentError("modal_derivatives", "modal derivatives need a frame fixed by reference conditions "
-                                   "(frame='fixed' or 'craig-bampton'): the free-free static problem is singular")
+                                   "(not frame='mean-axis'): the free-free static problem is singular")
     points, cells = _mesh_input(mesh, cells)
     if not isinstance(interfaces, Mapping):
         raise InvalidArgumentError("interfaces", f"expected a dict name -> node index, indices or selector, got {type(interfaces).__name__}")
@@ -513,7 +576,7 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             resolved[name] = idx
         else:
             resolved[name] = spec
-    data = from_nodal(nodes, mm, kk, interfaces=resolved, modes=modes, frame=frame, fixed=fixed,
+    data = from_nodal(nodes, mm, kk, interfaces=resolved, modes=modes, frame=frame, reduction=reduction,
                       damping_ratio=damping_ratio)
     done(FE_STAGES["reduced"])
     if strain == "nonlinear":
@@ -530,7 +593,7 @@ def from_mesh(mesh: Any, *, thickness: float, density: float, youngs_modulus: fl
             low = phi @ v[:, :nd]
             loads = _green_lagrange_md_loads(basis, perm, low, thickness, lam_ps, mu)
             iface = {name: _interface_rows(nodes, spec) for name, spec in resolved.items()}
-            c = np.array([iface[name][1][0 if ax == "x" else 1] for name, ax in fixed])  # type: ignore[union-attr]
+            c = _reference_rows(frame, iface)
             kkt = np.block([[kk, c.T], [c, np.zeros((3, 3))]])
             theta = np.linalg.solve(kkt, np.vstack([loads, np.zeros((3, loads.shape[1]))]))[:kk.shape[0]]
             p = _enrich(np.zeros((kk.shape[0], 0)), np.hstack([phi, theta]), mm, 1e-9)

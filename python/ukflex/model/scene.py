@@ -558,7 +558,9 @@ class Scene:
         frame : {"pinned-pinned", "clamped"}, optional
             Reference conditions of the floating frame: which nodal coordinates the frame
             takes out (it is not a boundary condition; clamp a beam with a weld).  Default (the
-            core's): ``"pinned-pinned"``.
+            core's): ``"pinned-pinned"``.  The words are those of every FFRF body
+            (``ukflex.fe.FRAMES``); a beam's frame is on its end nodes, so ``"mean-axis"`` is
+            refused.
         rotary_inertia : bool, optional
             Default: true for Timoshenko, false for Euler-Bernoulli (decided by the core).
         damping : float
