@@ -62,6 +62,34 @@ impl Bushing {
         self.b.add_angle_jacobian(bodies, &sb, f[2], qvec);
     }
 
+    /// `K = sum_i k_i p_i p_i^T` with `p_i = (d_i)_q`, the rows whose products with `qd` are
+    /// the rates of `kinematics` (`p`: an `n` scratch; see `Force::add_stiffness`).
+    pub fn add_stiffness(&self, bodies: &[Body], q: &[f64], qd: &[f64], p: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        let (sa, sb) = (self.a.state(bodies, q, qd), self.b.state(bodies, q, qd));
+        let (d, _) = kinematics(&sa, &sb);
+        let (c, s) = (sb.phi.cos(), sb.phi.sin());
+        for (i, &k) in self.stiffness.iter().enumerate().filter(|(_, k)| **k > 0.0) {
+            p.fill(0.0);
+            match i {
+                0 => {
+                    self.a.add_point_jacobian(bodies, &sa, [c, s], p);
+                    self.b.add_point_jacobian(bodies, &sb, [-c, -s], p);
+                    self.b.add_angle_jacobian(bodies, &sb, d[1], p);
+                }
+                1 => {
+                    self.a.add_point_jacobian(bodies, &sa, [-s, c], p);
+                    self.b.add_point_jacobian(bodies, &sb, [s, -c], p);
+                    self.b.add_angle_jacobian(bodies, &sb, -d[0], p);
+                }
+                _ => {
+                    self.a.add_angle_jacobian(bodies, &sa, 1.0, p);
+                    self.b.add_angle_jacobian(bodies, &sb, -1.0, p);
+                }
+            }
+            super::outer(p, p, k, add);
+        }
+    }
+
     pub fn potential(&self, bodies: &[Body], q: &[f64]) -> f64 {
         let zeros = vec![0.0; q.len()];
         let (d, _) = kinematics(&self.a.state(bodies, q, &zeros), &self.b.state(bodies, q, &zeros));

@@ -140,17 +140,26 @@ impl Force {
         }
     }
 
-    /// Whether [`Force::add_stiffness`] adds anything (a load or motor whose value is an
-    /// expression or a table).
+    /// Whether [`Force::add_stiffness`] adds anything: a load or motor whose value is an
+    /// expression or a table, a spring (translational, rotational, bushing) with stiffness or
+    /// damping.
     pub fn has_stiffness(&self) -> bool {
-        self.values().iter().any(|v| v.has_gradient())
+        match &self.kind {
+            ForceKind::SpringDamper { stiffness, damping, .. } => *stiffness > 0.0 || *damping > 0.0,
+            ForceKind::RotationalSpringDamper(r) => r.stiffness > 0.0,
+            ForceKind::Bushing(b) => b.stiffness.iter().any(|k| *k > 0.0),
+            ForceKind::Spatial(f) => f.has_stiffness(),
+            _ => self.values().iter().any(|v| v.has_gradient()),
+        }
     }
 
     /// `add(i, j, K_ij)` of this force's analytic position stiffness `K = -dQ/dq`: for the loads
     /// and motors whose value is an expression or a table, `-J^T dF/dq` from the symbolic
-    /// gradient (the change of the application point's Jacobian with `q`, `(dJ^T/dq) F`, is
-    /// left out, as for the constant loads). `rows` is a `2 n` scratch, `scratch` the force's
-    /// evaluation scratch. Nothing for the other kinds.
+    /// gradient; for the springs, their stiffness through the markers' Jacobians (the
+    /// spring-damper's also the turning of its line under load). The change of the markers'
+    /// Jacobians with `q`, `(dJ^T/dq) F`, is left out, as for the constant loads: it is what
+    /// the implicit methods' Newton iteration needs, not an exact Jacobian. `rows` is a `2 n`
+    /// scratch, `scratch` the force's evaluation scratch. Nothing for the other kinds.
     pub fn add_stiffness(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], scratch: &mut [f64], rows: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
         let n = q.len();
         let (p, r) = rows[..2 * n].split_at_mut(n);
@@ -166,7 +175,7 @@ impl Force {
                             let mut w = [0.0; 2];
                             w[c] = 1.0;
                             point.add_point_jacobian(bodies, &point.state(bodies, q, qd), w, p);
-                            outer(p, r, add);
+                            outer(p, r, -1.0, add);
                         }
                     }
                     load::Load::Torque { frame, tau } if tau.has_gradient() => {
@@ -174,11 +183,35 @@ impl Force {
                         tau.add_position_gradient(&env, scratch, r);
                         p.fill(0.0);
                         frame.add_angle_jacobian(bodies, &frame.state(bodies, q, qd), 1.0, p);
-                        outer(p, r, add);
+                        outer(p, r, -1.0, add);
                     }
                     load::Load::Torque { .. } => {}
                 }
             }
+            ForceKind::SpringDamper { a, b, stiffness, damping, rest_length } => {
+                let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
+                let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];
+                let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                if l == 0.0 {
+                    return;
+                }
+                let (e, nrm) = ([d[0] / l, d[1] / l], [-d[1] / l, d[0] / l]);
+                let vrel = [sa.v[0] - sb.v[0], sa.v[1] - sb.v[1]];
+                let f = stiffness * (l - rest_length) + damping * (e[0] * vrel[0] + e[1] * vrel[1]);
+                // p = G^T e (dl/dq), r = G^T n, G = (r_a - r_b)_q: K = k p p^T + c (v . n)/l p r^T + f/l r r^T
+                p.fill(0.0);
+                a.add_point_jacobian(bodies, &sa, e, p);
+                b.add_point_jacobian(bodies, &sb, [-e[0], -e[1]], p);
+                r.fill(0.0);
+                a.add_point_jacobian(bodies, &sa, nrm, r);
+                b.add_point_jacobian(bodies, &sb, [-nrm[0], -nrm[1]], r);
+                outer(p, p, *stiffness, add);
+                outer(p, r, damping * (vrel[0] * nrm[0] + vrel[1] * nrm[1]) / l, add);
+                outer(r, r, f / l, add);
+            }
+            ForceKind::RotationalSpringDamper(rs) => rs.add_stiffness(bodies, q, qd, p, add),
+            ForceKind::Bushing(bu) => bu.add_stiffness(bodies, q, qd, p, add),
+            ForceKind::Spatial(f) => f.add_stiffness(bodies, q, qd, p, r, add),
             ForceKind::Motor(m) if m.torque.has_gradient() => {
                 let (sa, sb, local) = motor::relative(bodies, &m.a, &m.b, q, qd);
                 r.fill(0.0);
@@ -188,7 +221,7 @@ impl Force {
                 p.fill(0.0);
                 m.a.add_angle_jacobian(bodies, &sa, 1.0, p);
                 m.b.add_angle_jacobian(bodies, &sb, -1.0, p);
-                outer(p, r, add);
+                outer(p, r, -1.0, add);
             }
             _ => {}
         }
@@ -289,12 +322,15 @@ impl Force {
     }
 }
 
-/// `add(i, j, -p_i r_j)` over the non-zeros of `p` and `r`: `K = -dQ/dq` of `Q = p F`,
-/// `dF/dq = r`.
-fn outer(p: &[f64], r: &[f64], add: &mut dyn FnMut(usize, usize, f64)) {
+/// `add(i, j, s p_i r_j)` over the non-zeros of `p` and `r` (`s = -1`: `K = -dQ/dq` of
+/// `Q = p F`, `dF/dq = r`).
+fn outer(p: &[f64], r: &[f64], s: f64, add: &mut dyn FnMut(usize, usize, f64)) {
+    if s == 0.0 {
+        return;
+    }
     for (i, &pi) in p.iter().enumerate().filter(|(_, x)| **x != 0.0) {
         for (j, &rj) in r.iter().enumerate().filter(|(_, x)| **x != 0.0) {
-            add(i, j, -pi * rj);
+            add(i, j, s * pi * rj);
         }
     }
 }
@@ -341,5 +377,59 @@ mod tests {
             }
         }
         assert!(k[0] == 200.0 && k[4 * n + 4] != 0.0 && k[4 * n] != 0.0, "{k:?}");
+    }
+
+    /// `K` of `stiffness_into` against central differences of the forces.
+    fn stiffness_against_differences(text: &str, dq: f64, qd0: f64) -> Vec<f64> {
+        let model = Model::from_json(text).unwrap();
+        let mut data = Data::new(&model);
+        let n = model.n;
+        let q: Vec<f64> = model.q0.iter().enumerate().map(|(i, x)| x + dq * (i as f64 + 1.0)).collect();
+        let qd: Vec<f64> = (0..n).map(|i| qd0 * (1.0 - 0.4 * i as f64)).collect();
+        let mut k = vec![0.0; n * n];
+        dynamics::mass_and_forces(&model, &mut data, 0.0, &q, &qd);
+        dynamics::stiffness_into(&model, &mut data, &q, &qd, &mut k);
+        let (mut qv, h) = (q.clone(), 1e-6);
+        for j in 0..n {
+            qv[j] = q[j] + h;
+            dynamics::mass_and_forces(&model, &mut data, 0.0, &qv, &qd);
+            let fp = data.force.clone();
+            qv[j] = q[j] - h;
+            dynamics::mass_and_forces(&model, &mut data, 0.0, &qv, &qd);
+            qv[j] = q[j];
+            for i in 0..n {
+                let fd = -(fp[i] - data.force[i]) / (2.0 * h);
+                assert!((k[i * n + j] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "K[{i}][{j}] = {} vs {fd}", k[i * n + j]);
+            }
+        }
+        k
+    }
+
+    #[test]
+    fn spring_stiffness_matches_differences() {
+        // a loaded, moving spring-damper between point masses (its line turns: the f / l and
+        // c (v . n) / l terms) and a rotational spring-damper between frames: exact
+        let k = stiffness_against_differences(r#"{"bodies": [
+            {"kind": "point_mass", "name": "m", "mass": 1.0, "position": [1.0, 0.5]},
+            {"kind": "point_mass", "name": "p", "mass": 1.0, "position": [0.2, -0.3]},
+            {"kind": "rigid", "name": "w", "mass": 2.0, "inertia": 0.1, "angle": 0.3}],
+          "forces": [
+            {"kind": "spring_damper", "a": {"body": "m"}, "b": {"body": "p"}, "stiffness": 1e4, "damping": 30.0, "rest_length": 0.5},
+            {"kind": "rotational_spring_damper", "a": {"body": "w"}, "stiffness": 70.0, "damping": 2.0}]}"#, 0.02, 0.5);
+        assert!(k[0] > 1e3 && k[1] != 0.0 && k[6 * 7 + 6] > 0.0, "{k:?}");
+        // a bushing at rest (no load: its K is the exact sum k_i p_i p_i^T), b's frame turned
+        let k = stiffness_against_differences(r#"{"bodies": [
+            {"kind": "rigid", "name": "u", "mass": 1.0, "inertia": 0.1, "angle": 0.2, "position": [0.3, 0.1]},
+            {"kind": "rigid", "name": "w", "mass": 2.0, "inertia": 0.1, "angle": 0.7, "position": [-0.2, 0.4]}],
+          "forces": [
+            {"kind": "bushing", "a": {"body": "u", "point": [0.1, 0.05]}, "b": {"body": "w", "point": [-0.1, 0.2]},
+             "stiffness": [1e5, 3e4, 50.0], "damping": [0.0, 0.0, 0.0]}]}"#, 0.0, 0.0);
+        assert!(k[0] > 1e4 && k[2 * 6 + 5] != 0.0, "{k:?}");
+        // the spatial spring-damper between point masses: exact, its line turning in 3D
+        let k = stiffness_against_differences(r#"{"dim": 3, "bodies": [
+            {"kind": "point3", "name": "a", "mass": 1.0, "position": [1.0, 0.5, 0.2]},
+            {"kind": "point3", "name": "b", "mass": 2.0, "position": [0.1, -0.3, 0.4]}],
+          "forces": [{"kind": "spring_damper", "a": {"body": "a"}, "b": {"body": "b"}, "stiffness": 1e4, "damping": 30.0, "rest_length": 0.5}]}"#, 0.02, 0.5);
+        assert!(k[0] > 1e3 && k[1] != 0.0 && k[2] != 0.0, "{k:?}");
     }
 }

@@ -38,6 +38,15 @@ impl RotationalSpringDamper {
         self.b.add_angle_jacobian(bodies, &sb, -tau, qvec);
     }
 
+    /// `K = k p p^T`, `p = (phi_a - phi_b)_q` (`p`: an `n` scratch; see `Force::add_stiffness`).
+    pub fn add_stiffness(&self, bodies: &[Body], q: &[f64], qd: &[f64], p: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        let (sa, sb, _) = relative(bodies, &self.a, &self.b, q, qd);
+        p.fill(0.0);
+        self.a.add_angle_jacobian(bodies, &sa, 1.0, p);
+        self.b.add_angle_jacobian(bodies, &sb, -1.0, p);
+        super::outer(p, p, self.stiffness, add);
+    }
+
     pub fn potential(&self, bodies: &[Body], q: &[f64]) -> f64 {
         let zeros = vec![0.0; q.len()];
         let (_, _, [angle, _]) = relative(bodies, &self.a, &self.b, q, &zeros);

@@ -20,7 +20,7 @@ use crate::body::{Body, BodyKind, Marker, MarkerShape};
 use crate::constraint::spatial::prim;
 use crate::description::spatial::FrameDesc;
 use crate::constraint::rows::wrap_angle;
-use crate::linalg::rot3::{dot, mat_t_vec, mat_vec, norm, rot_a, rot_g, scale, V3};
+use crate::linalg::rot3::{dot, mat_t_vec, mat_vec, norm, rot_a, rot_g, scale, sub, V3};
 
 #[derive(Debug, Clone)]
 pub enum SpatialForce {
@@ -149,6 +149,43 @@ impl SpatialForce {
                 prim::dot_jacobian(bodies, &sa, &sa.axes[1], &sb, &sb.axes[0], tau * c / r2, qv, None);
                 prim::dot_jacobian(bodies, &sa, &sa.axes[0], &sb, &sb.axes[0], -tau * s / r2, qv, None);
             }
+        }
+    }
+
+    /// Whether `add_stiffness` adds anything (a spring-damper with stiffness or damping).
+    pub fn has_stiffness(&self) -> bool {
+        matches!(self, SpatialForce::SpringDamper { stiffness, damping, .. } if *stiffness > 0.0 || *damping > 0.0)
+    }
+
+    /// The spring-damper's position stiffness, as the planar one's (`Force::add_stiffness`):
+    /// with `G = d_q` (`d = P_b - P_a`, `u = d / l`), `p = G^T u` and `r_i = G^T n_i` for two
+    /// unit vectors across `u`, `K = k p p^T + sum_i (c (v . n_i)/l p r_i^T + f/l r_i r_i^T)`.
+    /// The rotational spring-damper adds nothing (left to the differences of the velocity terms
+    /// and to Newton).
+    pub fn add_stiffness(&self, bodies: &[Body], q: &[f64], qd: &[f64], p: &mut [f64], r: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        let SpatialForce::SpringDamper { a, b, stiffness, damping, rest_length } = self else { return };
+        let (l, ld, u, [sa, sb]) = Self::spring(a, b, bodies, q, qd);
+        let Some(u) = u else { return };
+        let (_, v, _) = prim::separation(&sa, &sb);
+        let f = stiffness * (l - rest_length) + damping * ld;
+        let row = |w: &V3, out: &mut [f64]| {
+            out.fill(0.0);
+            add_jacobian(bodies, &sb, &sb.point, w, out, None);
+            add_jacobian(bodies, &sa, &sa.point, &scale(-1.0, w), out, None);
+        };
+        row(&u, p);
+        super::outer(p, p, *stiffness, add);
+        // two unit vectors across u: the axis least aligned with u, orthogonalized, and u x n1
+        let k = (0..3).min_by(|&i, &j| u[i].abs().total_cmp(&u[j].abs())).unwrap_or(0);
+        let mut n1 = [0.0; 3];
+        n1[k] = 1.0;
+        let n1 = sub(&n1, &scale(u[k], &u));
+        let n1 = scale(1.0 / norm(&n1), &n1);
+        let n2 = [u[1] * n1[2] - u[2] * n1[1], u[2] * n1[0] - u[0] * n1[2], u[0] * n1[1] - u[1] * n1[0]];
+        for nv in [n1, n2] {
+            row(&nv, r);
+            super::outer(p, r, damping * dot(&v, &nv) / l, add);
+            super::outer(r, r, f / l, add);
         }
     }
 
