@@ -189,14 +189,8 @@ impl Force {
                 }
             }
             ForceKind::SpringDamper { a, b, stiffness, damping, rest_length } => {
-                let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
-                let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];
-                let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
-                if l == 0.0 {
-                    return;
-                }
-                let (e, nrm) = ([d[0] / l, d[1] / l], [-d[1] / l, d[0] / l]);
-                let vrel = [sa.v[0] - sb.v[0], sa.v[1] - sb.v[1]];
+                let Some(Line { sa, sb, l, e, vrel }) = Line::of(a, b, bodies, q, qd) else { return };
+                let nrm = [-e[1], e[0]];
                 let f = stiffness * (l - rest_length) + damping * (e[0] * vrel[0] + e[1] * vrel[1]);
                 // p = G^T e (dl/dq), r = G^T n, G = (r_a - r_b)_q: K = k p p^T + c (v . n)/l p r^T + f/l r r^T
                 p.fill(0.0);
@@ -249,16 +243,9 @@ impl Force {
                 frame.add_angle_jacobian(bodies, &s, *torque, qvec);
             }
             ForceKind::SpringDamper { a, b, stiffness, damping, rest_length } => {
-                let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
-                let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];
-                let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
-                if l == 0.0 {
-                    // direction undefined at zero length: no force (documented limitation)
-                    return;
-                }
-                let e = [d[0] / l, d[1] / l];
-                let ldot = e[0] * (sa.v[0] - sb.v[0]) + e[1] * (sa.v[1] - sb.v[1]);
-                let f = stiffness * (l - rest_length) + damping * ldot;
+                // direction undefined at zero length: no force (documented limitation)
+                let Some(Line { sa, sb, l, e, vrel }) = Line::of(a, b, bodies, q, qd) else { return };
+                let f = stiffness * (l - rest_length) + damping * (e[0] * vrel[0] + e[1] * vrel[1]);
                 a.add_point_jacobian(bodies, &sa, [-f * e[0], -f * e[1]], qvec);
                 b.add_point_jacobian(bodies, &sb, [f * e[0], f * e[1]], qvec);
             }
@@ -319,6 +306,30 @@ impl Force {
             ForceKind::Load(l) => l.potential(bodies, q).unwrap_or(0.0),
             ForceKind::Motor(_) => 0.0,
         }
+    }
+}
+
+/// The line of a spring-damper: marker states, length, unit vector `e` from `b` to `a`, relative
+/// velocity (`None` at zero length, where the direction is undefined).
+struct Line {
+    sa: crate::body::MarkerState,
+    sb: crate::body::MarkerState,
+    l: f64,
+    e: [f64; 2],
+    vrel: [f64; 2],
+}
+
+impl Line {
+    #[inline]
+    fn of(a: &Marker, b: &Marker, bodies: &[Body], q: &[f64], qd: &[f64]) -> Option<Line> {
+        let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
+        let d = [sa.r[0] - sb.r[0], sa.r[1] - sb.r[1]];
+        let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+        if l == 0.0 {
+            return None;
+        }
+        let vrel = [sa.v[0] - sb.v[0], sa.v[1] - sb.v[1]];
+        Some(Line { sa, sb, l, e: [d[0] / l, d[1] / l], vrel })
     }
 }
 
