@@ -45,7 +45,7 @@ lowest modes of the sparse analysis (:mod:`ukflex.analysis.modes`).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any, Dict, Optional
 
 import numpy as np
@@ -96,7 +96,10 @@ class MethodChoice:
     floor_modes: list = field(default_factory=list)
 
     def as_dict(self) -> Dict[str, Any]:
-        return asdict(self)
+        """The fields as a plain dict (the options dict and the floor's list copied)."""
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        d["options"], d["floor_modes"] = dict(self.options), list(self.floor_modes)
+        return d
 
 
 def elastic_shares(system, omega: np.ndarray, shapes: np.ndarray, q: np.ndarray) -> np.ndarray:
