@@ -272,3 +272,29 @@ pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &
     }
     Ok(c)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_step_follows_rtol_up_to_its_caps() {
+        let (w, span) = (100.0, 1.0);
+        let phase = |rtol: f64| PHASE_CAP.min(PHASE_PER_RTOL * rtol);
+        // loose: one radian of omega_c per step; never more than span / MIN_STEPS
+        assert_eq!(resolving_step(w, phase(1e-3), span), RADAU_MAX_STEP_OMEGA / w);
+        assert_eq!(resolving_step(1e-3, phase(1e-3), span), span / MIN_STEPS);
+        // tight: y = (phi / (RADAU_DECAY omega_c T))^(1/5)
+        let y = (phase(1e-8) / (RADAU_DECAY * w * span)).powf(0.2);
+        assert!((resolving_step(w, phase(1e-8), span) - y / w).abs() < 1e-15);
+        assert!(local_newton_ok(LOCAL_NEWTON_MIN_STEP_OMEGA / w, w) && !local_newton_ok(0.5 / w, w));
+    }
+
+    #[test]
+    fn the_prelude_needs_no_spectrum_for_prescribed_or_rigid_scenes() {
+        let rigid = SceneTraits { damped: false, elastic_potential: false };
+        assert_eq!(prelude(rigid, 0).unwrap().verdict, Verdict::NoDof);
+        assert_eq!(prelude(rigid, 3).unwrap().verdict, Verdict::NoElasticPotential);
+        assert!(prelude(SceneTraits { damped: false, elastic_potential: true }, 3).is_none());
+    }
+}
