@@ -115,7 +115,24 @@ pub fn uk_jacobian(model: &Model, data: &mut Data, ws: &mut JacobianWorkspace, t
         }
         ws.qd[j] = qd[j];
     }
-    // position columns: full evaluations
+    position_columns(model, data, ws, t, q, qd, c, jq)
+}
+
+/// `jq = d qdd / d q` at `(t, q, qd)` by central differences alone (the velocity columns left
+/// out): the linearization of the modal analysis (`method="auto"`, `System.frequencies`).
+/// Allocates its workspace (once per analysis, not per step).
+pub fn position_jacobian(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], jq: &mut [f64]) -> Result<()> {
+    let mut ws = JacobianWorkspace::new(model);
+    ws.q.copy_from_slice(q);
+    uk::acceleration(model, data, t, q, qd)?;
+    ws.f0.copy_from_slice(&data.qdd);
+    position_columns(model, data, &mut ws, t, q, qd, f64::EPSILON.cbrt(), jq)
+}
+
+/// The position columns of [`uk_jacobian`] (full UK evaluations), `ws.q = q` and `ws.f0` the
+/// base point's `qdd` on entry.
+fn position_columns(model: &Model, data: &mut Data, ws: &mut JacobianWorkspace, t: f64, q: &[f64], qd: &[f64], c: f64, jq: &mut [f64]) -> Result<()> {
+    let n = model.n;
     for j in 0..n {
         let h = step(q[j], c, ws.typ);
         ws.q[j] = q[j] + h;

@@ -185,3 +185,60 @@ def test_a_spinning_cable_does_not_reject_most_of_its_steps():
     res = simulate(scenes.spin_up(formulation="ancf"), 30.0)
     assert res.success and res.method == "RADAU5M"
     assert res.extra["nreject"] < 0.03 * res.extra["naccept"], res.extra
+
+
+def _scenes_for_the_core_check():
+    """Built-in scenes, ANCF and FFRF, spinning and falling beams, damped and overdamped ones:
+    (label, system, t_end)."""
+    from ukflex import spatial_scenes
+
+    s = ukflex.Scene(gravity=None)  # a lone spring mode (DOPRI5)
+    slider = s.rigid_body("slider", mass=1.0, inertia=0.01, position=(1.0, 0.0))
+    s.prismatic(slider.frame(), s.ground.line((0, 0), angle=0.0), name="slide")
+    s.spring_damper(slider.point(0, 0), s.ground.point(0.0, 0.0), stiffness=100.0, rest_length=0.9, name="spring")
+    out = [("spring", s, 1.0), ("pendulum", scenes.pendulum(), 1.0), ("four_bar", scenes.four_bar(), 0.5),
+           ("paper", scenes.slider_crank(), 0.1), ("paper NL N=4", scenes.slider_crank(strain="nonlinear", elements=4), 0.1),
+           ("paper ANCF N=4", scenes.slider_crank(formulation="ancf", elements=4), 0.1),
+           ("every_joint", scenes.every_joint(), 0.3),
+           ("damped cantilever", scenes.cantilever(damping=1e-3), 0.8),
+           ("flyball governor", spatial_scenes.flyball_governor(), 0.2)]
+    for f in ("ffrf", "ancf"):
+        out += [(f"cantilever {f}", scenes.cantilever(formulation=f), 0.8),
+                (f"spin_up {f}", scenes.spin_up(formulation=f), 2.0),
+                (f"falling {f}", scenes.flexible_pendulum(formulation=f), 1.5),
+                (f"pinned {f}", scenes.pinned_beam(formulation=f, elements=4, gravity=True), 0.1)]
+    return [(label, sc.build() if isinstance(sc, ukflex.Scene) else ukflex.System(sc), t) for label, sc, t in out]
+
+
+def test_the_cores_decision_is_the_former_python_ones():
+    """auto's analysis moved into the core (rust/integrate/choice/): on every kind of scene its
+    decision (method, step, Newton tolerance, frequencies, floor and its modes, reason) is the
+    one the former Python analysis (tests/_auto_reference.py, kept only here) gave, to the
+    round-off of two eigensolvers."""
+    import re
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import _auto_reference as former
+
+    numbers = re.compile(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?")
+    methods = set()
+    for label, system, t_end in _scenes_for_the_core_check():
+        for rtol in (1e-3, 1e-6, 1e-9):
+            new, old = choose_method(system, 0.0, t_end, rtol), former.choose_method(system, 0.0, t_end, rtol)
+            methods.add((new.method, new.step is not None))
+            where = (label, rtol, new, old)
+            assert new.method == old.method and new.options.keys() == old.options.keys(), where
+            assert numbers.sub("#", new.reason) == numbers.sub("#", old.reason), where
+            for key in ("step", "omega_elastic", "omega_max", "rtol"):
+                a, b = getattr(new, key), getattr(old, key)
+                assert (a is None) == (b is None) and (a is None or a == pytest.approx(b, rel=1e-6)), (key, where)
+            assert (new.floor is None) == (old.floor is None), where
+            if old.floor is not None:
+                assert new.floor == pytest.approx(old.floor, rel=1e-3, abs=1e-15), where
+                assert len(new.floor_modes) == len(old.floor_modes), where
+                for a, b in zip(new.floor_modes, old.floor_modes):
+                    assert a == pytest.approx(b, rel=1e-3), where
+    # every branch of the rule was taken: DOPRI5, fixed-step and adaptive RADAU5M
+    assert methods >= {("DOPRI5", False), ("RADAU5M", True), ("RADAU5M", False)}, methods

@@ -31,6 +31,7 @@ __all__ = [
     "MemoryLimitError",
     "PROJECTION_PER_ATOL",
     "RESOLUTION",
+    "AUTO",
     "PROJECTION_MOVE_LIMIT",
     "normal_weight",
     "BudgetError",
@@ -45,6 +46,9 @@ PROJECTION_MOVE_LIMIT: float
 #: positions are resolved to this fraction of the scene's length scale, angles to this many
 #: radians (rust/model/scale.rs)
 RESOLUTION: float
+#: method="auto"'s constants by name (rust/integrate/choice/mod.rs): PHASE_PER_RTOL, ...,
+#: FLOOR_POINTS (a list)
+AUTO: Dict[str, Any]
 def normal_weight(kappa: float, kappa_ref: float) -> float:
     """Weight of the part of an error estimate across the constraints: min(1, kappa / kappa_ref)^2."""
 
@@ -180,6 +184,11 @@ class System:
     def tangent_project(self, t: float, q: _F64, v: _F64) -> Tuple[_F64, float]:
         """The columns of v (n, k) projected onto the constraints' tangent space at (t, q) in the mass metric,
         and sigma_min / sigma_max of A M^-1/2 there."""
+    def auto_choice(self, t0: float, q: _F64, qd: _F64, t_end: float, rtol: float, n_dof: Optional[int] = None,
+                    omega: Optional[_F64] = None, shapes: Optional[_F64] = None,
+                    omega_max: Optional[float] = None) -> Dict[str, Any]:
+        """method="auto"'s decision (rust/integrate/choice/): verdict, method, omega_elastic, omega_max, step,
+        newton_rtol, phase, floor, floor_modes, overdamped; a large system gives n_dof and its lowest modes."""
     def material_energies(self, q: _F64, shapes: _F64) -> _F64:
         """1/2 v^T K_m v per column v of shapes (n, k): the bodies' material stiffness and the springs."""
     def rigid_motions(self, q: _F64, qd: _F64) -> Tuple[_F64, _F64]:

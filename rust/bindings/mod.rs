@@ -314,6 +314,12 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("PROJECTION_PER_ATOL", crate::integrate::PROJECTION_PER_ATOL)?;
     m.add("PROJECTION_MOVE_LIMIT", crate::integrate::PROJECTION_MOVE_LIMIT)?;
     m.add("RESOLUTION", crate::model::scale::RESOLUTION)?;
+    let auto = pyo3::types::PyDict::new(py);
+    for (name, value) in crate::integrate::choice::constants() {
+        auto.set_item(name, value)?;
+    }
+    auto.set_item("FLOOR_POINTS", crate::integrate::choice::FLOOR_POINTS.to_vec())?;
+    m.add("AUTO", auto)?;
     m.add_function(wrap_pyfunction!(normal_weight, m)?)?;
     m.add("BudgetError", py.get_type::<BudgetError>())?;
     Ok(())

@@ -1,5 +1,6 @@
 //! `ukflex._core.System`: a compiled model with its workspace behind a lock.
 
+mod choice;
 mod inspect;
 mod run;
 mod spatial;
@@ -73,6 +74,8 @@ pub(super) fn passages_list<'py>(py: Python<'py>, passages: &[Passage]) -> PyRes
 #[pyclass(name = "System", module = "ukflex._core", frozen)]
 pub struct PySystem {
     model: Model,
+    /// What `method="auto"` reads from the description (dampers, springs).
+    traits: crate::integrate::choice::SceneTraits,
     ws: Mutex<Workspace>,
 }
 
@@ -144,7 +147,9 @@ impl PySystem {
         let data = Data::build(&model, solver, memory_limit).map_err(to_py)?;
         let n = model.n;
         let ws = Workspace { data, q: vec![0.0; n], qd: vec![0.0; n], jws: JacobianWorkspace::new(&model), jq: Vec::new(), jv: Vec::new() };
-        Ok(PySystem { model, ws: Mutex::new(ws) })
+        let desc: serde_json::Value = serde_json::from_str(description_json).map_err(|e| to_py(Error::Description(e.to_string())))?;
+        let traits = crate::integrate::choice::SceneTraits::of(&model, &desc);
+        Ok(PySystem { model, traits, ws: Mutex::new(ws) })
     }
 
     /// The UK path asked for at build ("auto", "dense", "sparse") and the one the last

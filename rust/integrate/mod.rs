@@ -32,6 +32,7 @@ mod radau_m;
 pub mod singular;
 mod dense;
 mod options;
+pub mod choice;
 mod uk_system;
 
 pub use dopri5::{Dopri5, PROJECTION_MOVE_LIMIT};

@@ -1,0 +1,300 @@
+//! `method="auto"`: the integrator picked from the constrained system's natural frequencies
+//! (docs/integrators.md; `python/ukflex/run/choice.py` is the glue that states the reason).
+//!
+//! A scene is *stiff* for a run when the step that resolves the motions the user asked about
+//! is too long for its fastest mode. The motions of interest are every flexible body's lowest
+//! elastic mode (a mode whose potential energy is mostly material strain or spring energy,
+//! [`ELASTIC_SHARE`]) and everything slower; `omega_c` is the highest of those. RADAU5M at
+//! the fixed step `h = y / omega_c`, `y = min(1, (phi / (RADAU_DECAY omega_c T))^(1/5))`,
+//! `phi = min(1, 20 rtol)` (at most `T / 20`), when `h omega_max` exceeds what an explicit
+//! step may take at equal cost; otherwise DOPRI5, unless overdamped modes make it stiff
+//! ([`overdamped`]). The fast modes the start sets off and the step damps give the run an
+//! error floor ([`floor`]).
+//!
+//! The whole analysis of a small system (below `System.SPARSE_MODES_MIN` coordinates) runs
+//! here in one call ([`spectrum::dense_spectrum`], [`choose`]); a large system's lowest modes
+//! come from the sparse Lanczos of `ukflex.analysis.modes` and are handed to [`choose`].
+
+mod floor;
+mod overdamped;
+pub mod spectrum;
+
+use serde_json::Value;
+
+use crate::data::Data;
+use crate::error::Result;
+use crate::model::Model;
+pub use spectrum::Spectrum;
+
+/// Amplitude budget per rtol over the run, and its cap.
+pub const PHASE_PER_RTOL: f64 = 20.0;
+pub const PHASE_CAP: f64 = 1.0;
+/// Fewest steps per run.
+pub const MIN_STEPS: f64 = 20.0;
+/// RADAU5M on a resolved mode: amplitude loss per step `RADAU_DECAY (omega h)^6` (|R(i y)| of
+/// Radau IIA: 1.3e-10 at y = 0.1, 1.3e-4 at y = 1; the phase lag is 2.3e-5 y^6).
+pub const RADAU_DECAY: f64 = 1.3e-4;
+/// ... its largest step in radians of omega_c (reached at loose rtol: ~1e-3). Newton's failures
+/// at such steps on ANCF couplers (109 of 337 attempts at 0.5) cost little since a fixed step
+/// that Newton could not take stays short for a few steps.
+pub const RADAU_MAX_STEP_OMEGA: f64 = 1.0;
+/// RADAU5M's Newton tolerance (its `rtol` with a fixed step) per rtol: 1e-4 at the default rtol
+/// (measured on five built-in scenes at auto's step: Newton at 1e-4 instead of 1e-6 keeps every
+/// error within 10 %, 20-30 % less time) ...
+pub const NEWTON_PER_RTOL: f64 = 100.0;
+/// ... and at most this.
+pub const NEWTON_MAX_RTOL: f64 = 1e-3;
+/// DOPRI5's average `h omega_max` on stiff flexible scenes, and a RADAU5M step's cost in DOPRI5
+/// steps (nonlinear FFRF coupler N = 4: 17 us against 6 UK calls of ~1.7 us).
+pub const EXPLICIT_STEP_OMEGA: f64 = 0.5;
+pub const RADAU_COST_RATIO: f64 = 1.6;
+/// DOPRI5's stability interval on the negative real axis, `h |lambda| <= 3.3` (its step control
+/// settles at 3.15 on A05's fastest overdamped decay, 8.1e3 1/s: 5 103 steps over 2 s).
+pub const DOPRI5_REAL_STABILITY: f64 = 3.3;
+/// GENALPHA by hand (`newton_local_error`): the fraction of the local error estimate at which
+/// Newton may stop (2.3 instead of 3.2-4.4 iterations per step on the paper scene) ...
+pub const NEWTON_LOCAL_ERROR: f64 = 0.3;
+/// ... safe only on steps this coarse against the fastest mode, `h omega_max`: on the ANCF
+/// coupler (N = 4 and 8) the looser test keeps the answer at `h omega_max` >= 3.5 with
+/// `rho_inf` 0.9 and >= 8.7 with 1.0, and lets it drift off at 2.2-2.6 (0.9) and 4.4 (1.0).
+pub const LOCAL_NEWTON_MIN_STEP_OMEGA: f64 = 8.0;
+/// A mode is elastic when more than this share of `omega^2` is the material stiffness of its
+/// strains (elastic bodies, springs) rather than gravity, constraint forces or stress.
+pub const ELASTIC_SHARE: f64 = 0.5;
+/// A mode belongs to a flexible body when it carries at least this share of its kinetic energy.
+pub const BODY_SHARE: f64 = 0.2;
+/// Large systems: the sparse modal analysis starts from this many lowest modes and takes four
+/// times more until every flexible body's lowest elastic mode is among them.
+pub const FIRST_MODES: usize = 8;
+/// The body points at which the floor's displacements are read (fractions of a beam's length).
+pub const FLOOR_POINTS: [f64; 4] = [0.25, 0.5, 0.75, 1.0];
+
+/// The constants above by name (`ukflex._core.AUTO`).
+pub fn constants() -> Vec<(&'static str, f64)> {
+    vec![
+        ("PHASE_PER_RTOL", PHASE_PER_RTOL),
+        ("PHASE_CAP", PHASE_CAP),
+        ("MIN_STEPS", MIN_STEPS),
+        ("RADAU_DECAY", RADAU_DECAY),
+        ("RADAU_MAX_STEP_OMEGA", RADAU_MAX_STEP_OMEGA),
+        ("NEWTON_PER_RTOL", NEWTON_PER_RTOL),
+        ("NEWTON_MAX_RTOL", NEWTON_MAX_RTOL),
+        ("EXPLICIT_STEP_OMEGA", EXPLICIT_STEP_OMEGA),
+        ("RADAU_COST_RATIO", RADAU_COST_RATIO),
+        ("DOPRI5_REAL_STABILITY", DOPRI5_REAL_STABILITY),
+        ("NEWTON_LOCAL_ERROR", NEWTON_LOCAL_ERROR),
+        ("LOCAL_NEWTON_MIN_STEP_OMEGA", LOCAL_NEWTON_MIN_STEP_OMEGA),
+        ("ELASTIC_SHARE", ELASTIC_SHARE),
+        ("BODY_SHARE", BODY_SHARE),
+        ("FIRST_MODES", FIRST_MODES as f64),
+    ]
+}
+
+/// What the description says that the chooser needs before any analysis.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SceneTraits {
+    /// A body or force dissipates (a nonzero `damping`, a modal body's `d_ff`).
+    pub damped: bool,
+    /// A mode can store strain or spring energy: a flexible body or a spring-damper with stiffness.
+    pub elastic_potential: bool,
+}
+
+impl SceneTraits {
+    /// Read from the model (flexible bodies) and its description (dampers, springs).
+    pub fn of(model: &Model, desc: &Value) -> SceneTraits {
+        let items = |key: &str| desc.get(key).and_then(Value::as_array).cloned().unwrap_or_default();
+        let (bodies, forces) = (items("bodies"), items("forces"));
+        fn nonzero(v: &Value) -> bool {
+            match v {
+                Value::Number(x) => x.as_f64().is_some_and(|x| x != 0.0),
+                Value::Array(a) => a.iter().any(nonzero),
+                _ => false,
+            }
+        }
+        let damped = bodies.iter().chain(&forces).any(|it| ["damping", "d_ff"].iter().any(|k| it.get(*k).is_some_and(nonzero)));
+        let spring = forces.iter().any(|f| {
+            f.get("kind").and_then(Value::as_str) == Some("spring_damper") && f.get("stiffness").and_then(Value::as_f64).unwrap_or(0.0) > 0.0
+        });
+        let flexible = model.bodies.iter().any(|b| b.capabilities().elastic);
+        SceneTraits { damped, elastic_potential: flexible || spring }
+    }
+}
+
+/// Why the chooser picked what it picked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// No degree of freedom: the motion is prescribed (DOPRI5).
+    NoDof,
+    /// No flexible body and no spring: no frequency analysis needed (DOPRI5).
+    NoElasticPotential,
+    /// No mode is elastic (DOPRI5).
+    NoElasticMode,
+    /// RADAU5M at a fixed step.
+    Stiff,
+    /// Overdamped modes: adaptive RADAU5M.
+    Overdamped,
+    /// DOPRI5 resolves the fastest mode at the step the elastic modes need.
+    NotStiff,
+    /// A large system's sparse analysis has not yet found every flexible body's lowest
+    /// elastic mode: ask for more modes.
+    NeedMoreModes,
+}
+
+impl Verdict {
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::NoDof => "no_dof",
+            Verdict::NoElasticPotential => "no_elastic_potential",
+            Verdict::NoElasticMode => "no_elastic_mode",
+            Verdict::Stiff => "stiff",
+            Verdict::Overdamped => "overdamped",
+            Verdict::NotStiff => "not_stiff",
+            Verdict::NeedMoreModes => "need_more_modes",
+        }
+    }
+}
+
+/// The overdamped mode that decided an adaptive RADAU5M run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OverdampedMode {
+    pub omega: f64,
+    pub zeta: f64,
+    /// Its fast decay rate `omega (zeta + sqrt(zeta^2 - 1))` [1/s].
+    pub fast: f64,
+    /// The explicit step that decay allows.
+    pub h_explicit: f64,
+}
+
+/// The chooser's decision and the numbers its reason states.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AutoChoice {
+    pub verdict: Verdict,
+    /// "DOPRI5" or "RADAU5M" (empty for `NeedMoreModes`).
+    pub method: &'static str,
+    pub omega_elastic: Option<f64>,
+    pub omega_max: f64,
+    /// The step the elastic modes need (RADAU5M's fixed step when `Stiff`).
+    pub step: Option<f64>,
+    /// RADAU5M's Newton tolerance with a fixed step.
+    pub newton_rtol: Option<f64>,
+    /// The amplitude budget over the run.
+    pub phase: f64,
+    /// The error floor [m] of a fixed-step RADAU5M run (every mode known), and its largest
+    /// contributions `(omega, amplitude at a body point, error)`.
+    pub floor: Option<f64>,
+    pub floor_modes: Vec<[f64; 3]>,
+    pub overdamped: Option<OverdampedMode>,
+}
+
+impl AutoChoice {
+    /// The answer to a large system's first question: a spectrum is needed.
+    pub fn needs_spectrum() -> AutoChoice {
+        AutoChoice::plain(Verdict::NeedMoreModes, "", 0.0)
+    }
+
+    fn plain(verdict: Verdict, method: &'static str, omega_max: f64) -> AutoChoice {
+        AutoChoice { verdict, method, omega_elastic: None, omega_max, step: None, newton_rtol: None, phase: 0.0, floor: None, floor_modes: Vec::new(), overdamped: None }
+    }
+}
+
+/// The decisions that need no spectrum: `Some` when the scene has no degree of freedom or no
+/// elastic potential.
+pub fn prelude(traits: SceneTraits, n_dof: usize) -> Option<AutoChoice> {
+    if n_dof == 0 {
+        return Some(AutoChoice::plain(Verdict::NoDof, "DOPRI5", 0.0));
+    }
+    if !traits.elastic_potential {
+        return Some(AutoChoice::plain(Verdict::NoElasticPotential, "DOPRI5", 0.0));
+    }
+    None
+}
+
+/// The step that resolves `omega_c` to the amplitude budget `phase` over `span`: `(y, h)`.
+pub fn resolving_step(omega_c: f64, phase: f64, span: f64) -> f64 {
+    let y = RADAU_MAX_STEP_OMEGA.min((phase / (RADAU_DECAY * omega_c * span)).powf(0.2));
+    (y / omega_c).min(span / MIN_STEPS)
+}
+
+/// Whether GENALPHA's Newton may stop at the local error level with step `h` on a system whose
+/// fastest mode is `omega_max`: only on coarse steps.
+pub fn local_newton_ok(h: f64, omega_max: f64) -> bool {
+    h * omega_max >= LOCAL_NEWTON_MIN_STEP_OMEGA
+}
+
+/// The whole choice for a small system: the dense spectrum at `(t0, q, qd)` and the rule.
+pub fn choose_dense(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &[f64], qd: &[f64], span: f64, rtol: f64) -> Result<AutoChoice> {
+    let rank = spectrum::constraint_rank(model, data, q)?;
+    if let Some(c) = prelude(traits, model.n - rank.0) {
+        return Ok(c);
+    }
+    let sp = spectrum::dense_spectrum(model, data, t0, q, qd, rank)?;
+    choose(model, data, traits, t0, q, qd, span, rtol, &sp)
+}
+
+/// The rule on a spectrum (every mode of a small system, or a large one's lowest modes).
+pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &[f64], qd: &[f64], span: f64, rtol: f64, sp: &Spectrum) -> Result<AutoChoice> {
+    if let Some(c) = prelude(traits, sp.n_dof) {
+        return Ok(c);
+    }
+    let shares = spectrum::elastic_shares(model, q, sp);
+    let per_body = spectrum::lowest_per_body(model, data, q, sp, &shares);
+    if !sp.complete() {
+        let elastic_any = (0..sp.len()).any(|k| sp.omega[k] > 0.0 && shares[k] > ELASTIC_SHARE);
+        let found = if per_body.is_empty() { elastic_any } else { per_body.iter().all(Option::is_some) };
+        if !found {
+            return Ok(AutoChoice::plain(Verdict::NeedMoreModes, "", sp.omega_max));
+        }
+    }
+    let Some(omega_c) = spectrum::lowest_elastic_frequency(sp, &shares, &per_body) else {
+        return Ok(AutoChoice::plain(Verdict::NoElasticMode, "DOPRI5", sp.omega_max));
+    };
+    let phase = PHASE_CAP.min(PHASE_PER_RTOL * rtol);
+    let h = resolving_step(omega_c, phase, span);
+    let mut c = AutoChoice::plain(Verdict::NotStiff, "DOPRI5", sp.omega_max);
+    c.omega_elastic = Some(omega_c);
+    c.step = Some(h);
+    c.phase = phase;
+    if h * sp.omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO {
+        c.verdict = Verdict::Stiff;
+        c.method = "RADAU5M";
+        c.newton_rtol = Some((NEWTON_PER_RTOL * rtol).min(NEWTON_MAX_RTOL));
+        if sp.complete() {
+            let (total, top) = floor::transient_floor(model, data, traits, t0, q, qd, sp, omega_c, h, span)?;
+            c.floor = Some(total);
+            c.floor_modes = top;
+        }
+        return Ok(c);
+    }
+    if sp.complete() && traits.damped {
+        if let Some(d) = overdamped::choice(model, data, t0, q, qd, sp, &shares, phase, span)? {
+            return Ok(d);
+        }
+    }
+    Ok(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_step_follows_rtol_up_to_its_caps() {
+        let (w, span) = (100.0, 1.0);
+        let phase = |rtol: f64| PHASE_CAP.min(PHASE_PER_RTOL * rtol);
+        // loose: one radian of omega_c per step; never more than span / MIN_STEPS
+        assert_eq!(resolving_step(w, phase(1e-3), span), RADAU_MAX_STEP_OMEGA / w);
+        assert_eq!(resolving_step(1e-3, phase(1e-3), span), span / MIN_STEPS);
+        // tight: y = (phi / (RADAU_DECAY omega_c T))^(1/5)
+        let y = (phase(1e-8) / (RADAU_DECAY * w * span)).powf(0.2);
+        assert!((resolving_step(w, phase(1e-8), span) - y / w).abs() < 1e-15);
+        assert!(local_newton_ok(LOCAL_NEWTON_MIN_STEP_OMEGA / w, w) && !local_newton_ok(0.5 / w, w));
+    }
+
+    #[test]
+    fn the_prelude_needs_no_spectrum_for_prescribed_or_rigid_scenes() {
+        let rigid = SceneTraits { damped: false, elastic_potential: false };
+        assert_eq!(prelude(rigid, 0).unwrap().verdict, Verdict::NoDof);
+        assert_eq!(prelude(rigid, 3).unwrap().verdict, Verdict::NoElasticPotential);
+        assert!(prelude(SceneTraits { damped: false, elastic_potential: true }, 3).is_none());
+    }
+}
