@@ -160,3 +160,24 @@ def test_a05_radau5m_steps_follow_rtol():
         assert extra["nreject"] < 0.25 * extra["naccept"], (rtol, extra)
         assert np.abs(s - ref).max() < 300 * rtol, (rtol, np.abs(s - ref).max())
     assert steps[1e-3] < 0.85 * steps[1e-5], steps
+
+
+def test_bricard_cod_backend_matches_the_svd_on_the_manifold():
+    """``set_pseudoinverse("cod")``: A04's rank-deficient B by the certified complete orthogonal
+    decomposition (rust/linalg/small_svd/cod.rs) gives the SVD's rank and, on the manifold, its
+    accelerations and multipliers; off it by 1e-8 they differ by about the drift (the two
+    truncations), which is why it is not the default (docs/spatial.md)."""
+    cod, svd = (ukflex.System(spatial_scenes.bricard()) for _ in range(2))
+    cod.set_pseudoinverse("cod")
+    svd.set_pseudoinverse("faer")
+    res = ukflex.simulate(svd, 1.0, method="DOPRI5", rtol=1e-10)
+    for k in (0, res.t.size // 2, -1):
+        q, qd = res.y[:35, k], res.y[35:, k]
+        a, b = cod.qdd(0.0, q, qd), svd.qdd(0.0, q, qd)
+        assert np.abs(a - b).max() < 1e-10 * np.abs(b).max()
+        la, lb = cod.multipliers(0.0, q, qd), svd.multipliers(0.0, q, qd)
+        assert np.abs(la - lb).max() < 1e-8 * np.abs(lb).max()
+        assert cod.rank_info(0.0, q, qd, False)["rank"] == 34
+        assert not cod.rank_info(0.0, q, qd, False)["exact"]       # the decomposition's bounds
+    with pytest.raises(ukflex.InvalidArgumentError):
+        cod.set_pseudoinverse("svd?")

@@ -32,11 +32,12 @@ pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
     let redundant = redundant_rule(data);
     let backend = if data.qrj.is_some() { data.svd_backend } else { SvdBackend::Faer };
     match backend {
-        SvdBackend::Auto | SvdBackend::QrJacobi => {
+        SvdBackend::Auto | SvdBackend::QrJacobi | SvdBackend::Cod => {
             let qrj = data.qrj.as_mut().expect("checked");
             let bt = &data.bt;
             qrj.qr_cols(|j| bt.col_as_slice(j));
-            if backend == SvdBackend::Auto && data.redundant == 0 {
+            let auto = backend != SvdBackend::QrJacobi;
+            if auto && data.redundant == 0 {
                 let (upper, lower) = qrj.full_rank_bounds();
                 let tol_bound = atol.max(rcond * upper);
                 if upper.is_finite() && lower > tol_bound && lower > 0.0 {
@@ -46,12 +47,12 @@ pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
                     return Ok(());
                 }
             }
-            if backend == SvdBackend::Auto && m > AUTO_JACOBI_MAX_ROWS {
-                // rank-deficient: the certified complete orthogonal decomposition of R, the SVD
-                // only when its bounds cannot decide the rank
+            if auto && m > AUTO_JACOBI_MAX_ROWS {
+                // rank-deficient: with `Cod`, the certified complete orthogonal decomposition of
+                // R, the SVD only when its bounds cannot decide the rank
                 let (red, rcond_red) = redundant.unwrap_or((0, rcond));
                 let rule = RankRule { rcond, atol, redundant: red, rcond_redundant: rcond_red };
-                if let Some(c) = qrj.cod_factor(&rule) {
+                if let Some(c) = if backend == SvdBackend::Cod { qrj.cod_factor(&rule) } else { None } {
                     data.factored_with = Factored::Cod;
                     data.rank_info = RankInfo { rank: c.rank, sigma_max: c.sigma_max, sigma_min_kept: c.sigma_min_kept, sigma_max_dropped: c.sigma_max_dropped, tolerance: c.tolerance, exact: false };
                     record_redundancy(data, n, m);

@@ -47,6 +47,11 @@ pub enum SvdBackend {
     QrJacobi,
     /// faer's bidiagonal SVD through its scratch (`MemBuffer`) API, every call.
     Faer,
+    /// As `Auto`, but a rank-deficient `B` (m above `AUTO_JACOBI_MAX_ROWS`) goes through the
+    /// certified complete orthogonal decomposition of `R` (`QrJacobi::cod_factor`) instead of
+    /// faer's SVD: ~2x cheaper per call on A04, but off the manifold its truncation differs from
+    /// the SVD's by about the drift (docs/spatial.md), so not the default.
+    Cod,
 }
 
 /// Which factorization of `B^T` is currently held in `Data` (set by `uk::factor_constraints`).
