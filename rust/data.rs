@@ -94,6 +94,10 @@ pub struct Data {
     /// Spatial models: `max |Phi_i|` at the last `dynamics::constraints` (the state's drift,
     /// which sets the default rank tolerance, `uk::dense`); `None` for planar models.
     pub spatial_drift: Option<f64>,
+    /// Spatial models: how many singular values of `B` the last rank decision at a nearly
+    /// consistent state dropped (`RankTolerance::decides_redundancy`); far off the manifold
+    /// they are dropped up to the drift (`RankTolerance::redundant_rcond`, `uk::dense`).
+    pub redundant: usize,
     /// Per force element: the angle `theta - angle0` a spatial rotational spring-damper read at
     /// the last evaluation, continuous over any number of turns (NaN until its first reading;
     /// `force::spatial`); unused by the other elements.
@@ -164,6 +168,7 @@ impl Data {
             factored_with: Factored::None,
             tolerance: RankTolerance::default(),
             spatial_drift: model.is_spatial().then_some(0.0),
+            redundant: 0,
             turns: vec![f64::NAN; model.forces.len()],
             stabilization: Stabilization::None,
             rank_info: RankInfo::default(),

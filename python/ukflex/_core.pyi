@@ -133,7 +133,7 @@ class System:
     def set_rank_tolerance(self, rcond: Optional[float] = None, atol: float = 0.0) -> None:
         """Drop singular values of A F^-T at or below max(atol, rcond sigma_max)."""
     def set_pseudoinverse(self, kind: str = "auto") -> None:
-        """Pseudoinverse backend: "auto", "qr-jacobi" or "faer"."""
+        """Pseudoinverse backend: "auto", "qr-jacobi", "faer" or "cod" (rank-deficient B by a complete orthogonal decomposition)."""
     def set_stabilization(self, kind: str = "none", alpha: float = 0.0, beta: float = 0.0) -> None:
         """Constraint stabilization: kind "none" or "baumgarte" (Phi_dd + 2 alpha Phi_d + beta^2 Phi = 0)."""
     def jac(self, t: float, y: _F64, scheme: str = "central") -> _F64:

@@ -628,15 +628,18 @@ impl PySystem {
     }
 
     /// How the UK pseudoinverse is computed: "auto" (default: certified full-rank QR, Jacobi
-    /// SVD otherwise), "qr-jacobi" (QR + Jacobi SVD every call) or "faer" (faer's SVD).
-    /// Same results to rounding; see docs/performance.md.
+    /// SVD otherwise), "qr-jacobi" (QR + Jacobi SVD every call), "faer" (faer's SVD) or "cod"
+    /// ("auto" with the certified complete orthogonal decomposition instead of the SVD for a
+    /// rank-deficient B: same rank, the correction differs off the manifold by about the
+    /// drift; docs/spatial.md). Same results to rounding otherwise; see docs/performance.md.
     #[pyo3(signature = (kind="auto"))]
     fn set_pseudoinverse(&self, kind: &str) -> PyResult<()> {
         let b = match kind {
             "auto" => SvdBackend::Auto,
             "qr-jacobi" => SvdBackend::QrJacobi,
             "faer" => SvdBackend::Faer,
-            other => return Err(arg_err("kind", format!("unknown pseudoinverse kind '{other}' (use 'auto', 'qr-jacobi' or 'faer')"))),
+            "cod" => SvdBackend::Cod,
+            other => return Err(arg_err("kind", format!("unknown pseudoinverse kind '{other}' (use 'auto', 'qr-jacobi', 'faer' or 'cod')"))),
         };
         self.with_ws(|_, ws| {
             ws.data.svd_backend = b;

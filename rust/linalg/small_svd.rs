@@ -24,6 +24,9 @@
 //! number: singular values below `sqrt(eps) sigma_max` come out as noise, which would break the
 //! pseudoinverse's rank decision at its default tolerance `max(m, n) eps sigma_max`. Rejected.
 
+mod cod;
+pub use cod::{CodRank, RankRule};
+
 /// Column-major workspace for the QR + Jacobi SVD of an n x m matrix with m <= n.
 #[derive(Debug, Clone)]
 pub struct QrJacobi {
@@ -54,6 +57,8 @@ pub struct QrJacobi {
     tp: Vec<f64>,
     /// Jacobi sweeps used by the last factorization (including the final clean sweep).
     pub sweeps: usize,
+    /// The complete orthogonal decomposition of `R` (rank-deficient `G` without an SVD: `cod`).
+    cod: cod::Cod,
 }
 
 /// Maximum number of Jacobi sweeps before giving up (quadratic convergence: ~5 usually).
@@ -79,6 +84,7 @@ impl QrJacobi {
             permuted: false,
             tp: vec![0.0; m],
             sweeps: 0,
+            cod: cod::Cod::new(m),
         }
     }
 

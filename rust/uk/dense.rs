@@ -12,7 +12,7 @@ use super::settings::{Factored, RankInfo, SvdBackend};
 use crate::data::Data;
 use crate::dynamics::{apply_finv_sparse, apply_finvt};
 use crate::error::{Error, Result};
-use crate::linalg::small_svd::MAX_SWEEPS;
+use crate::linalg::small_svd::{RankRule, MAX_SWEEPS};
 use crate::model::Model;
 
 /// The dense path of `factor_constraints`: `B^T` (n x m) and its certified QR / SVD.
@@ -26,22 +26,38 @@ pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
     }
     let rcond = data.tolerance.rcond_at(n, m, data.spatial_drift);
     let atol = data.tolerance.atol;
+    // rows found redundant at the last nearly consistent state, far off the manifold: their
+    // singular values may pass the capped tolerance (and a full-rank certificate) but are the
+    // drift's, so the rank-revealing path decides with the drift's tolerance for them
+    let redundant = redundant_rule(data);
     let backend = if data.qrj.is_some() { data.svd_backend } else { SvdBackend::Faer };
     match backend {
-        SvdBackend::Auto | SvdBackend::QrJacobi => {
+        SvdBackend::Auto | SvdBackend::QrJacobi | SvdBackend::Cod => {
             let qrj = data.qrj.as_mut().expect("checked");
             let bt = &data.bt;
             qrj.qr_cols(|j| bt.col_as_slice(j));
-            if backend == SvdBackend::Auto {
+            let auto = backend != SvdBackend::QrJacobi;
+            if auto && data.redundant == 0 {
                 let (upper, lower) = qrj.full_rank_bounds();
                 let tol_bound = atol.max(rcond * upper);
                 if upper.is_finite() && lower > tol_bound && lower > 0.0 {
                     data.factored_with = Factored::FullRankQr;
                     data.rank_info = RankInfo { rank: m, sigma_max: upper, sigma_min_kept: lower, sigma_max_dropped: 0.0, tolerance: tol_bound, exact: false };
+                    record_redundancy(data, n, m);
                     return Ok(());
                 }
             }
-            if backend == SvdBackend::Auto && m > AUTO_JACOBI_MAX_ROWS {
+            if auto && m > AUTO_JACOBI_MAX_ROWS {
+                // rank-deficient: with `Cod`, the certified complete orthogonal decomposition of
+                // R, the SVD only when its bounds cannot decide the rank
+                let (red, rcond_red) = redundant.unwrap_or((0, rcond));
+                let rule = RankRule { rcond, atol, redundant: red, rcond_redundant: rcond_red };
+                if let Some(c) = if backend == SvdBackend::Cod { qrj.cod_factor(&rule) } else { None } {
+                    data.factored_with = Factored::Cod;
+                    data.rank_info = RankInfo { rank: c.rank, sigma_max: c.sigma_max, sigma_min_kept: c.sigma_min_kept, sigma_max_dropped: c.sigma_max_dropped, tolerance: c.tolerance, exact: false };
+                    record_redundancy(data, n, m);
+                    return Ok(());
+                }
                 faer_svd(data)?;
             } else if jacobi_of_r(model, data).is_err() {
                 if backend == SvdBackend::QrJacobi {
@@ -55,8 +71,27 @@ pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
         }
         SvdBackend::Faer => faer_svd(data)?,
     }
-    data.rank_info = rank_from_singular_values(data, n, m, rcond, atol)?;
+    data.rank_info = rank_from_singular_values(data, n, m, rcond, atol, redundant)?;
+    record_redundancy(data, n, m);
     Ok(())
+}
+
+/// `(count, relative tolerance)` for the smallest singular values found redundant at the last
+/// nearly consistent state, when the state is far enough off the manifold that the capped
+/// tolerance may keep them (`RankTolerance::redundant_rcond`); `None` otherwise.
+pub(super) fn redundant_rule(data: &Data) -> Option<(usize, f64)> {
+    if data.redundant == 0 {
+        return None;
+    }
+    data.tolerance.redundant_rcond(data.spatial_drift).map(|r| (data.redundant, r))
+}
+
+/// After a rank decision at a nearly consistent state (`RankTolerance::decides_redundancy`):
+/// keep how many singular values it dropped.
+pub(super) fn record_redundancy(data: &mut Data, n: usize, m: usize) {
+    if data.tolerance.decides_redundancy(data.spatial_drift) {
+        data.redundant = n.min(m) - data.rank_info.rank.min(n.min(m));
+    }
 }
 
 /// Above this many constraint rows `exact_rank_info` keeps the sparse path's certified bounds
@@ -102,25 +137,29 @@ fn jacobi_of_r(model: &Model, data: &mut Data) -> Result<()> {
     Ok(())
 }
 
-fn rank_from_singular_values(data: &Data, n: usize, m: usize, rcond: f64, atol: f64) -> Result<RankInfo> {
+fn rank_from_singular_values(data: &Data, n: usize, m: usize, rcond: f64, atol: f64, redundant: Option<(usize, f64)>) -> Result<RankInfo> {
     let k = n.min(m);
     let s = data.svd_s.column_vector();
     let sigma_max = if k > 0 { s[0] } else { 0.0 };
     if !sigma_max.is_finite() {
         return Err(Error::Solver("SVD of A F^-T: non-finite singular values".into()));
     }
-    Ok(rank_decision(k, |j| s[j], rcond, atol))
+    Ok(rank_decision(k, |j| s[j], rcond, atol, redundant))
 }
 
 /// The rank decision on the `k` singular values `sigma(0) >= sigma(1) >= ...`: those above
-/// `max(atol, rcond sigma_max)` (and above zero) are kept.
-fn rank_decision(k: usize, sigma: impl Fn(usize) -> f64, rcond: f64, atol: f64) -> RankInfo {
+/// `max(atol, rcond sigma_max)` (and above zero) are kept; with `redundant = (r, rc)` the `r`
+/// smallest are kept only above `max(atol, rc sigma_max)` (`redundant_rule`).
+fn rank_decision(k: usize, sigma: impl Fn(usize) -> f64, rcond: f64, atol: f64, redundant: Option<(usize, f64)>) -> RankInfo {
     let sigma_max = if k > 0 { sigma(0) } else { 0.0 };
     let tol = atol.max(rcond * sigma_max);
+    let (r, rc) = redundant.unwrap_or((0, rcond));
+    let tol_redundant = tol.max(rc * sigma_max);
     let mut info = RankInfo { sigma_max, tolerance: tol, exact: true, ..Default::default() };
     for j in 0..k {
         let sj = sigma(j);
-        if sj > tol && sj > 0.0 {
+        let tj = if j + r >= k { tol_redundant } else { tol };
+        if sj > tj && sj > 0.0 {
             info.rank += 1;
             info.sigma_min_kept = sj;
         } else if sj > info.sigma_max_dropped {
@@ -150,6 +189,15 @@ pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
         data.ensure_dense(model)?;
         factor_dense(model, data)?;
     }
+    if data.factored_with == Factored::Cod && !data.rank_info.exact {
+        // the bounds of the decomposition: the exact values by the SVD of the same B^T (the
+        // correction then uses it: same q, same rank)
+        let (n, m) = (model.n, model.m);
+        let rcond = data.tolerance.rcond_at(n, m, data.spatial_drift);
+        let redundant = redundant_rule(data);
+        faer_svd(data)?;
+        data.rank_info = rank_from_singular_values(data, n, m, rcond, data.tolerance.atol, redundant)?;
+    }
     if data.factored_with == Factored::FullRankQr && !data.rank_info.exact {
         let (n, m) = (model.n, model.m);
         let qrj = data.qrj.as_mut().expect("QR workspace");
@@ -159,7 +207,7 @@ pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
             return Err(Error::Solver("Jacobi SVD of A F^-T did not converge".into()));
         }
         let rcond = data.tolerance.rcond_at(n, m, data.spatial_drift);
-        data.rank_info = rank_decision(n.min(m), |j| tmp.sigma(j), rcond, data.tolerance.atol);
+        data.rank_info = rank_decision(n.min(m), |j| tmp.sigma(j), rcond, data.tolerance.atol, None);
     }
     Ok(data.rank_info)
 }
@@ -188,9 +236,13 @@ pub(super) fn correct_residual(model: &Model, data: &mut Data) {
     let (n, m) = (model.n, model.m);
     let k = n.min(m);
     let rank = data.rank_info.rank;
-    if data.factored_with == Factored::FullRankQr {
+    if matches!(data.factored_with, Factored::FullRankQr | Factored::Cod) {
         let qrj = data.qrj.as_mut().expect("factored with QR");
-        qrj.full_rank_solve(&data.residual, &mut data.y, &mut data.lambda);
+        if data.factored_with == Factored::Cod {
+            qrj.cod_solve(&data.residual, &mut data.y, &mut data.lambda);
+        } else {
+            qrj.full_rank_solve(&data.residual, &mut data.y, &mut data.lambda);
+        }
         data.qdd.copy_from_slice(&data.y);
         apply_finvt(model, &data.bodies, &mut data.qdd);
         return;

@@ -63,16 +63,19 @@ pub fn free_acceleration(model: &Model, data: &mut Data) {
 /// `B^T = F^-1 A^T` and its thin SVD with the rank decision (into `data.rank_info`).
 /// Needs `m > 0` and the mass factor of `dynamics::factor_mass`.
 pub fn factor_constraints(model: &Model, data: &mut Data) -> Result<()> {
-    if let Some(sp) = data.sparse.as_mut() {
+    // rows found redundant before, far off the manifold: the rank-revealing path decides
+    let sparse = if dense::redundant_rule(data).is_none() { data.sparse.as_mut() } else { None };
+    if let Some(sp) = sparse {
         let tol = data.tolerance.resolved(model.n, model.m, data.spatial_drift);
         if let Some(info) = sp.factor(model, &data.bodies, &data.ajac, &tol) {
             data.factored_with = Factored::SparseGram;
             data.rank_info = info;
+            dense::record_redundancy(data, model.n, model.m);
             return Ok(());
         }
-        // no full-rank certificate: the dense rank-revealing path decides (and reports) the rank
-        data.ensure_dense(model)?;
     }
+    // no full-rank certificate: the dense rank-revealing path decides (and reports) the rank
+    data.ensure_dense(model)?;
     factor_dense(model, data)
 }
 

@@ -47,6 +47,11 @@ pub enum SvdBackend {
     QrJacobi,
     /// faer's bidiagonal SVD through its scratch (`MemBuffer`) API, every call.
     Faer,
+    /// As `Auto`, but a rank-deficient `B` (m above `AUTO_JACOBI_MAX_ROWS`) goes through the
+    /// certified complete orthogonal decomposition of `R` (`QrJacobi::cod_factor`) instead of
+    /// faer's SVD: ~2x cheaper per call on A04, but off the manifold its truncation differs from
+    /// the SVD's by about the drift (docs/spatial.md), so not the default.
+    Cod,
 }
 
 /// Which factorization of `B^T` is currently held in `Data` (set by `uk::factor_constraints`).
@@ -60,6 +65,9 @@ pub enum Factored {
     Jacobi,
     /// faer SVD in `svd_u`, `svd_s`, `svd_v`.
     Faer,
+    /// Certified rank-revealing complete orthogonal decomposition of the QR's `R` in `qrj`
+    /// (`QrJacobi::cod_factor`: rank-deficient `B` without an SVD).
+    Cod,
     /// Certified full-rank band Cholesky of `A M^-1 A^T` in `sparse` (`uk::sparse`).
     SparseGram,
 }
@@ -95,6 +103,28 @@ impl RankTolerance {
             (Some(r), _) => r,
             (None, Some(d)) if d.is_finite() => floor.max((DRIFT_RANK_FACTOR * d).min(DRIFT_RANK_CAP)),
             _ => floor,
+        }
+    }
+
+    /// Whether the default drift-tied tolerance decides the rank reliably at this drift (no
+    /// explicit `rcond`, a spatial model, `DRIFT_RANK_FACTOR drift <= DRIFT_RANK_CAP`): a
+    /// redundant row's singular value (at most 6e-3 `drift` relative on A04) is then surely
+    /// dropped and a well-posed row's surely kept. The rank deficiency found at such a state is
+    /// kept (`Data::redundant`) for the states where the cap binds (`redundant_rcond`).
+    pub fn decides_redundancy(&self, drift: Option<f64>) -> bool {
+        self.rcond.is_none() && matches!(drift, Some(d) if d.is_finite() && DRIFT_RANK_FACTOR * d <= DRIFT_RANK_CAP)
+    }
+
+    /// Where the cap binds (no explicit `rcond`, `DRIFT_RANK_FACTOR drift > DRIFT_RANK_CAP`,
+    /// e.g. the stages of a long explicit step): the relative tolerance
+    /// `min(DRIFT_RANK_FACTOR drift, 1)` for the smallest singular values that were redundant at
+    /// the last state where the rank was decided reliably (`decides_redundancy`). They are
+    /// dropped while the drift explains them; a row that stopped being redundant (a singular
+    /// configuration left) grows past it and is kept. `None` where the ordinary tolerance rules.
+    pub fn redundant_rcond(&self, drift: Option<f64>) -> Option<f64> {
+        match (self.rcond, drift) {
+            (None, Some(d)) if d.is_finite() && DRIFT_RANK_FACTOR * d > DRIFT_RANK_CAP => Some((DRIFT_RANK_FACTOR * d).min(1.0)),
+            _ => None,
         }
     }
 
