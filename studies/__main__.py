@@ -12,6 +12,7 @@ or their output folder:
   python -m studies flexible-coupler [--nonlinear] [--mesh] [--modal-derivatives[=K]] [--figure PNG]
   python -m studies simeon-crank [--nonlinear]
   python -m studies sweeps --out results/sweeps [--small]
+  python -m studies clearance [flores]
 """
 
 from __future__ import annotations
@@ -179,6 +180,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _passthrough(sub, "flexible-coupler", "flexible_coupler", "the FE-reduced coupler against the beam (docs/flexible-bodies.md)")
     _passthrough(sub, "simeon-crank", "simeon_crank", "Simeon's flexible slider-crank test set (docs/flexible-bodies.md)")
     _passthrough(sub, "sweeps", "sweeps", "the sweep study: serial, processes, Dask (docs/sweeps.md)")
+    _passthrough(sub, "clearance", "clearance", "revolute joints with clearance: Flores's slider-crank, the flexible coupler (docs/loads.md)")
     return parser
 
 

@@ -2,9 +2,11 @@
 //! Each adds its generalized force `J^T F` to `Q` (paper eqs. 34-37). The constant loads and
 //! the spring-damper are here; each further kind has its file (docs/loads.md): loads that are
 //! functions of time and state (`load.rs`, their values in `value.rs`), motors (`motor.rs`),
-//! rotational spring-dampers (`rotational_spring.rs`), bushings (`bushing.rs`).
+//! rotational spring-dampers (`rotational_spring.rs`), bushings (`bushing.rs`), revolute joints
+//! with clearance (`clearance.rs`).
 
 pub mod bushing;
+pub mod clearance;
 pub mod load;
 pub mod motor;
 pub mod rotational_spring;
@@ -32,6 +34,7 @@ pub enum ForceKind {
     Motor(Box<motor::Motor>),
     RotationalSpringDamper(Box<rotational_spring::RotationalSpringDamper>),
     Bushing(Box<bushing::Bushing>),
+    RevoluteClearance(Box<clearance::Clearance>),
 }
 
 #[derive(Debug, Clone)]
@@ -86,6 +89,20 @@ impl Force {
                 ForceKind::RotationalSpringDamper(Box::new(rotational_spring::RotationalSpringDamper::from_desc(ctx, item, a, b.as_ref(), *stiffness, *damping, *rest_angle)?))
             }
             ForceDesc::Bushing { a, b, stiffness, damping, .. } => ForceKind::Bushing(Box::new(bushing::Bushing::from_desc(ctx, item, a, b, *stiffness, *damping)?)),
+            ForceDesc::RevoluteClearance { journal, bearing, clearance, journal_radius, stiffness, exponent, restitution, impact_velocity, law, friction, friction_velocities, .. } => {
+                let p = clearance::ClearanceParams {
+                    clearance: *clearance,
+                    journal_radius: *journal_radius,
+                    stiffness: *stiffness,
+                    exponent: *exponent,
+                    restitution: *restitution,
+                    impact_velocity: *impact_velocity,
+                    law: *law,
+                    friction: *friction,
+                    friction_velocities: *friction_velocities,
+                };
+                ForceKind::RevoluteClearance(Box::new(clearance::Clearance::from_desc(ctx, item, journal, bearing, p)?))
+            }
         };
         Ok(Force { name, kind })
     }
@@ -101,6 +118,7 @@ impl Force {
             ForceKind::Motor(m) => [Some(&m.a), Some(&m.b)],
             ForceKind::RotationalSpringDamper(r) => [Some(&r.a), Some(&r.b)],
             ForceKind::Bushing(b) => [Some(&b.a), Some(&b.b)],
+            ForceKind::RevoluteClearance(c) => [Some(&c.journal), Some(&c.bearing)],
         }
     }
 
@@ -234,6 +252,7 @@ impl Force {
             ForceKind::Motor(m) => m.add_to(bodies, t, q, qd, scratch, qvec),
             ForceKind::RotationalSpringDamper(r) => r.add_to(bodies, q, qd, qvec),
             ForceKind::Bushing(b) => b.add_to(bodies, q, qd, qvec),
+            ForceKind::RevoluteClearance(c) => c.add_to(bodies, q, qd, qvec),
         }
     }
 
@@ -255,6 +274,7 @@ impl Force {
             ForceKind::Spatial(f) => f.material_energy(bodies, q, v),
             ForceKind::RotationalSpringDamper(r) => r.material_energy(bodies, q, v),
             ForceKind::Bushing(b) => b.material_energy(bodies, q, v),
+            ForceKind::RevoluteClearance(c) => c.material_energy(bodies, q, v),
         }
     }
 
@@ -281,6 +301,7 @@ impl Force {
             ForceKind::Spatial(f) => f.potential(bodies, q),
             ForceKind::RotationalSpringDamper(r) => r.potential(bodies, q),
             ForceKind::Bushing(b) => b.potential(bodies, q),
+            ForceKind::RevoluteClearance(c) => c.potential(bodies, q),
             // a load that is a function has no potential unless it is constant; a motor's work
             // is input, not stored (sensors: `external_work`)
             ForceKind::Load(l) => l.potential(bodies, q).unwrap_or(0.0),
