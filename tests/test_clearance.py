@@ -156,3 +156,17 @@ def test_contact_is_an_output_expression():
     assert force.max() > 0
     with pytest.raises(ValueError, match="unknown revolute joint with clearance"):
         outputs.validate(res.system, "clearance(nope).force")
+
+
+def test_auto_takes_an_error_controlled_step_with_contacts():
+    # the flexible coupler is stiff (a fixed RADAU5M step on its lowest mode without a
+    # contact); an a-priori step would step over the impacts, so auto keeps step control
+    from studies.clearance import coupler_scene
+    from ukflex.run.choice import choose_method
+
+    fixed = choose_method(coupler_scene(None).build(), 0.0, 0.08, 1e-7)
+    contact = choose_method(coupler_scene(5e-4).build(), 0.0, 0.08, 1e-7)
+    assert fixed.method == "RADAU5M" and "step" in fixed.options
+    assert contact.method == "RADAU5M" and "step" not in contact.options and contact.rtol is None
+    # a rigid scene with a contact: DOPRI5 at the user's tolerances
+    assert choose_method(flores_scene(5e-4).build(), 0.0, 0.01, 1e-7).method == "DOPRI5"

@@ -57,6 +57,8 @@ pub struct Contact {
     pub tangential_force: f64,
     /// `n` (world), the journal's direction from the bearing's centre.
     pub normal: [f64; 2],
+    /// `delta' = n . (v_J - v_B)`.
+    pub rate: f64,
 }
 
 impl Clearance {
@@ -118,6 +120,7 @@ impl Clearance {
         let vt = -n[1] * dv[0] + n[0] * dv[1] + self.p.journal_radius * sa.omega - rb * sb.omega;
         let ft = if self.p.friction > 0.0 && vt != 0.0 { -self.p.friction * self.slip_factor(vt) * fn_ * vt.signum() } else { 0.0 };
         c.normal = n;
+        c.rate = rate;
         c.normal_force = fn_;
         c.tangential_force = ft;
         c
@@ -142,6 +145,42 @@ impl Clearance {
             if self.bearing.has_orientation() {
                 let rb = self.p.journal_radius + self.p.clearance;
                 self.bearing.add_angle_jacobian(bodies, &sb, -rb * c.tangential_force, qvec);
+            }
+        }
+    }
+
+    /// `add(i, j, K_ij)` of the normal force's position stiffness `K = -dQ/dq = J^T S J`, `J`
+    /// the rows of `(r_J - r_B)_q`, `S = k_n n n^T + (F_n / eps) (I - n n^T)`, `k_n = p K
+    /// delta^(p-1) (1 + D delta')` (for the implicit methods' Newton matrices). Left out, as for
+    /// the loads: the friction's and `delta'`'s change with `q` and `(dJ^T/dq) F`. `px`, `py`:
+    /// n-long scratch rows.
+    pub fn add_stiffness(&self, bodies: &[Body], q: &[f64], qd: &[f64], px: &mut [f64], py: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        let (sa, sb) = (self.journal.state(bodies, q, qd), self.bearing.state(bodies, q, qd));
+        let c = self.contact(&sa, &sb);
+        if c.normal_force == 0.0 {
+            return;
+        }
+        let p = self.p.exponent;
+        let kn = p * self.p.stiffness * c.penetration.powf(p - 1.0) * (1.0 + self.hysteresis * c.rate);
+        let (n, g) = (c.normal, c.normal_force / c.eccentricity);
+        let s = [[kn * n[0] * n[0] + g * (1.0 - n[0] * n[0]), (kn - g) * n[0] * n[1]], [(kn - g) * n[0] * n[1], kn * n[1] * n[1] + g * (1.0 - n[1] * n[1])]];
+        for (row, w) in [(&mut *px, [1.0, 0.0]), (&mut *py, [0.0, 1.0])] {
+            row.fill(0.0);
+            self.journal.add_point_jacobian(bodies, &sa, w, row);
+            self.bearing.add_point_jacobian(bodies, &sb, [-w[0], -w[1]], row);
+        }
+        let rows = [&*px, &*py];
+        for i in 0..q.len() {
+            let (ai, bi) = (rows[0][i], rows[1][i]);
+            if ai == 0.0 && bi == 0.0 {
+                continue;
+            }
+            for j in 0..q.len() {
+                let (aj, bj) = (rows[0][j], rows[1][j]);
+                if aj == 0.0 && bj == 0.0 {
+                    continue;
+                }
+                add(i, j, ai * (s[0][0] * aj + s[0][1] * bj) + bi * (s[1][0] * aj + s[1][1] * bj));
             }
         }
     }
@@ -171,5 +210,50 @@ impl Clearance {
         let rate = (e[0] * (sa.v[0] - sb.v[0]) + e[1] * (sa.v[1] - sb.v[1])) / eps;
         let p = self.p.exponent;
         0.5 * p * self.p.stiffness * delta.powf(p - 1.0) * rate * rate
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::data::Data;
+    use crate::dynamics;
+    use crate::model::Model;
+
+    #[test]
+    fn contact_stiffness_matches_differences() {
+        // a journal at a rigid body's reference point (constant Jacobian) in a bearing on a
+        // second body's: -dQ/dq at rest is exactly J^T S J
+        let text = r#"{"bodies": [
+            {"kind": "rigid", "name": "j", "mass": 1.0, "inertia": 0.01, "position": [0.0011, 0.0004], "angle": 0.3},
+            {"kind": "rigid", "name": "b", "mass": 2.0, "inertia": 0.02, "position": [0.0, 0.0001], "angle": -0.2}],
+          "forces": [{"kind": "revolute_clearance", "journal": {"body": "j"}, "bearing": {"body": "b"},
+            "clearance": 0.001, "journal_radius": 0.01, "stiffness": 1e9, "restitution": 0.8,
+            "impact_velocity": 1.0, "friction": 0.1}]}"#;
+        let model = Model::from_json(text).unwrap();
+        let mut data = Data::new(&model);
+        let n = model.n;
+        let q = model.q0.clone();
+        let qd = vec![0.0; n];
+        let mut k = vec![0.0; n * n];
+        let mut c = vec![0.0; n * n];
+        dynamics::mass_and_forces(&model, &mut data, 0.0, &q, &qd);
+        dynamics::tangent_into(&model, &mut data, &q, &qd, &mut k, &mut c);
+        let mut qv = q.clone();
+        let h = 1e-9;
+        let mut largest = 0.0_f64;
+        for j in 0..n {
+            qv[j] = q[j] + h;
+            dynamics::mass_and_forces(&model, &mut data, 0.0, &qv, &qd);
+            let fp = data.force.clone();
+            qv[j] = q[j] - h;
+            dynamics::mass_and_forces(&model, &mut data, 0.0, &qv, &qd);
+            qv[j] = q[j];
+            for i in 0..n {
+                let fd = -(fp[i] - data.force[i]) / (2.0 * h);
+                largest = largest.max(fd.abs());
+                assert!((k[i * n + j] - fd).abs() < 1e-5 * (1.0 + fd.abs()), "K[{i}][{j}] = {} vs {fd}", k[i * n + j]);
+            }
+        }
+        assert!(largest > 1e6, "the contact is closed: {largest}");
     }
 }

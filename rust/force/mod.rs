@@ -159,16 +159,17 @@ impl Force {
     }
 
     /// Whether [`Force::add_stiffness`] adds anything (a load or motor whose value is an
-    /// expression or a table).
+    /// expression or a table, a revolute joint with clearance).
     pub fn has_stiffness(&self) -> bool {
-        self.values().iter().any(|v| v.has_gradient())
+        matches!(self.kind, ForceKind::RevoluteClearance(_)) || self.values().iter().any(|v| v.has_gradient())
     }
 
     /// `add(i, j, K_ij)` of this force's analytic position stiffness `K = -dQ/dq`: for the loads
     /// and motors whose value is an expression or a table, `-J^T dF/dq` from the symbolic
     /// gradient (the change of the application point's Jacobian with `q`, `(dJ^T/dq) F`, is
     /// left out, as for the constant loads). `rows` is a `2 n` scratch, `scratch` the force's
-    /// evaluation scratch. Nothing for the other kinds.
+    /// evaluation scratch. A revolute joint with clearance adds its contact stiffness
+    /// (`clearance.rs`); nothing for the other kinds.
     pub fn add_stiffness(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], scratch: &mut [f64], rows: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
         let n = q.len();
         let (p, r) = rows[..2 * n].split_at_mut(n);
@@ -197,6 +198,7 @@ impl Force {
                     load::Load::Torque { .. } => {}
                 }
             }
+            ForceKind::RevoluteClearance(c) => c.add_stiffness(bodies, q, qd, p, r, add),
             ForceKind::Motor(m) if m.torque.has_gradient() => {
                 let (sa, sb, local) = motor::relative(bodies, &m.a, &m.b, q, qd);
                 r.fill(0.0);

@@ -293,6 +293,12 @@ def _has_elastic_potential(system) -> bool:
                for f in system.description.get("forces", []))
 
 
+def _has_contact(system) -> bool:
+    """Whether the scene has contacts (revolute joints with clearance): forces that switch on
+    and off during the run, which the spectrum at the start does not see."""
+    return any(f.get("kind") == "revolute_clearance" for f in system.description.get("forces", []))
+
+
 def _spectrum(system, t0, q, qd, deadline):
     """``(omega, shapes, omega_max)`` for the chooser.  Small systems: every mode.  Large ones
     (sparse, ``System.SPARSE_MODES_MIN``): ``omega_max`` from ``System.max_frequency`` and the
@@ -386,6 +392,12 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
     phase = min(PHASE_CAP, PHASE_PER_RTOL * rtol)
     y = min(RADAU_MAX_STEP_OMEGA, (phase / (RADAU_DECAY * omega_c * span)) ** 0.2)
     h = min(y / omega_c, span / MIN_STEPS)
+    if h * omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO and _has_contact(system):
+        return MethodChoice(
+            "RADAU5M", omega_elastic=omega_c, omega_max=omega_max,
+            reason=(f"stiff (the fastest mode, {omega_max:.4g} rad/s, is beyond an explicit step that resolves the "
+                    f"lowest elastic one, {omega_c:.4g} rad/s) and with contacts, whose impacts a step chosen before "
+                    "the run cannot see: Radau IIA (L-stable) with its own step control at the user's tolerances"))
     if h * omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:
         floor: Dict[str, Any] = {}
         if omega.size >= system.n_dof:  # every mode known (small systems): the floor
