@@ -15,6 +15,7 @@ Commands (docs/loads.md has the tables and times)::
 
     python -m studies clearance            # the flexible coupler against the clearance
     python -m studies clearance flores     # the rigid slider-crank of Flores et al.
+    python -m studies clearance flores --figure docs/results/clearance/flores.png
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from ukflex import Circular, ConstantSpeed, Scene, scenes, simulate
 
 from . import progress
 
-__all__ = ["hertz_stiffness", "flores_scene", "flores", "coupler_scene", "study", "main"]
+__all__ = ["hertz_stiffness", "flores_scene", "flores", "figure", "coupler_scene", "study", "main"]
 
 #: Flores et al.'s slider-crank: lengths [m], masses [kg], inertias [kg m^2], crank speed [rad/s].
 FLORES = dict(crank=0.05, coupler=0.12, masses=(0.30, 0.21, 0.14), inertias=(0.0001, 0.00025, 0.0001),
@@ -177,6 +178,48 @@ def study(clearances: Sequence[Optional[float]] = (None, 0.01e-3, 0.05e-3, 0.1e-
     return _runs(coupler_scene, 2 * math.pi / p["omega"], clearances, revolutions, samples, method, rtol, measure)
 
 
+def figure(path: str, clearances: Sequence[Optional[float]] = (None, 0.5e-3, 0.1e-3), revolutions: int = 2,
+           samples: int = 4000) -> Dict[str, Any]:
+    """Plot the slider acceleration and the contact force of :func:`flores_scene` against the
+    crank angle over the last of ``revolutions`` turns (DOPRI5, rtol 1e-8) into ``path``; returns
+    per clearance the crank angles [deg] of the impacts over that turn."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    period = 2 * math.pi / FLORES["omega"]
+    t_end = revolutions * period
+    te = np.linspace(0.0, t_end, revolutions * samples + 1)
+    last = te >= t_end - period * (1 + 1e-9)
+    angle = np.degrees(FLORES["omega"] * (te[last] - (t_end - period)))
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.5, 6.5), sharex=True)
+    impacts: Dict[str, Any] = {}
+    for c in clearances:
+        system = flores_scene(c).build()
+        res = simulate(system, t_end, method="DOPRI5", rtol=1e-8, t_eval=te)
+        label = _mm(c) + ("" if c is None else " mm")
+        ax1.plot(angle, _slider_acceleration(res)[last] / 1e3, lw=0.8 if c else 1.6, label=label)
+        if c is None:
+            r = res.sensors.reaction("piston_pin")
+            ax2.plot(angle, np.hypot(r["fx"], r["fy"])[last] / 1e3, lw=1.6, label="ideal (reaction)")
+        else:
+            k = res.sensors.clearance("piston_pin")
+            ax2.plot(angle, k["force"][last] / 1e3, lw=0.8, label=label)
+            pen = k["penetration"][last]
+            impacts[label] = [round(float(a), 1) for a in angle[1:][(pen[1:] > 0) & (pen[:-1] <= 0)]]
+    ax1.set_ylabel("slider acceleration [km/s^2]")
+    ax2.set_ylabel("piston pin force [kN]")
+    ax2.set_xlabel("crank angle [deg] (turn %d)" % revolutions)
+    ax1.legend(fontsize=8)
+    ax2.legend(fontsize=8)
+    fig.suptitle("Slider-crank of Flores et al., 5000 rpm, clearance at the piston pin")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return impacts
+
+
 def _mm(c: Optional[float]) -> str:
     return "ideal" if c is None else f"{c * 1e3:g}"
 
@@ -185,6 +228,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m studies clearance", description=__doc__.split("\n\n")[0])
     parser.add_argument("case", nargs="?", choices=("coupler", "flores"), default="coupler",
                         help="coupler (default): the flexible coupler; flores: the rigid slider-crank of Flores et al.")
+    parser.add_argument("--figure", metavar="PNG", default=None, help="flores: also plot the second turn into PNG")
     args = parser.parse_args(argv)
     t0 = time.perf_counter()
     if args.case == "flores":
@@ -193,6 +237,10 @@ def main(argv: Optional[List[str]] = None) -> int:
         for r in flores():
             print(f"| {_mm(r['clearance'])} | {r['method']} | {r['a_min']:.4g} / {r['a_max']:.4g} | {r['force']:.4g} | "
                   f"{r.get('impacts', '-')} | {r.get('contact', 1.0):.0%} | {r.get('balance', float('nan')):.1e} | {r['run']:.2f} |")
+        if args.figure:
+            for label, angles in figure(args.figure).items():
+                print(f"impacts over turn 2, {label}: crank angles {angles} deg")
+            print(f"wrote {args.figure}")
     else:
         print("| clearance [mm] | peak v(0.5)/Lb | peak strain | change | peak pin force [N] | run [s] | auto: method | peak strain | run [s] |")
         print("|---|---:|---:|---:|---:|---:|---|---:|---:|")
