@@ -116,6 +116,13 @@ def test_scene_file_round_trip_and_defaults():
     f = d["forces"][0]
     assert f["kind"] == "revolute_clearance" and f["exponent"] == 1.5 and f["friction_velocities"] == [1e-4, 1e-3]
     assert loads(dumps(s)).scene.to_dict() == d
+    # the core fills what is not given
+    bare = Scene()
+    j = bare.rigid_body("j", mass=1.0, inertia=1e-3)
+    bare.revolute_clearance(j.point(0, 0), bare.ground.point(0, 0), clearance=C, journal_radius=R, stiffness=1e9,
+                            restitution=0.9, impact_velocity=1.0)
+    f = bare.to_dict()["forces"][0]
+    assert (f["law"], f["exponent"], f["friction"], f["friction_velocities"]) == ("lankarani_nikravesh", 1.5, 0.0, [1e-4, 1e-3])
     assert Scene.from_dict(d).to_dict() == d
 
 
@@ -184,3 +191,16 @@ def test_native_integrators_agree_on_an_oblique_impact_with_friction(method, opt
     for name in ("j.x", "j.theta"):
         assert res.velocity(name)[-1] == pytest.approx(ref.velocity(name)[-1], rel=1e-5)
     assert res.sensors.energy_balance()["relative_error"] < 1e-5
+
+
+def test_study_command_takes_its_options(capsys):
+    # python -m studies clearance [coupler|flores] [--figure PNG]: the options reach the study
+    # (an argparse.REMAINDER refused arguments that start with "-")
+    from studies.__main__ import main
+
+    with pytest.raises(SystemExit) as e:
+        main(["clearance", "--help"])
+    assert e.value.code == 0 and "--figure PNG" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as e:
+        main(["clearance", "nope"])
+    assert e.value.code == 2

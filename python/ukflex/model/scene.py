@@ -794,10 +794,10 @@ class Scene:
         stiffness: float,
         restitution: float,
         impact_velocity: float,
-        exponent: float = 1.5,
-        law: str = "lankarani_nikravesh",
-        friction: float = 0.0,
-        friction_velocities: Sequence[float] = (1e-4, 1e-3),
+        exponent: Optional[float] = None,
+        law: Optional[str] = None,
+        friction: Optional[float] = None,
+        friction_velocities: Optional[Sequence[float]] = None,
         name: Optional[str] = None,
     ) -> str:
         """A revolute joint with clearance: the journal (marker ``journal``, radius
@@ -807,11 +807,13 @@ class Scene:
         c_e^2) / (4 v_0)``, or ``"flores"``, ``D = 8 (1 - c_e) / (5 c_e v_0)``, ``c_e =
         restitution`` at the impact velocity ``v_0 = impact_velocity``) and the friction
         Ambrosio's modified Coulomb law with coefficient ``friction`` (none below
-        ``friction_velocities[0]``, full above ``[1]``). Its contact is in ``res.sensors.clearance(name)``
-        (docs/loads.md)."""
+        ``friction_velocities[0]``, full above ``[1]``). ``None``: the core's defaults
+        (``exponent`` 1.5, Lankarani-Nikravesh, no friction, ``(1e-4, 1e-3)`` m/s). Its contact
+        is in ``res.sensors.clearance(name)`` (docs/loads.md)."""
         d = dict(kind="revolute_clearance", journal=journal, bearing=bearing, clearance=clearance,
-                 journal_radius=journal_radius, stiffness=stiffness, exponent=exponent, restitution=restitution,
-                 impact_velocity=impact_velocity, law=law, friction=friction, friction_velocities=friction_velocities)
+                 journal_radius=journal_radius, stiffness=stiffness, restitution=restitution,
+                 impact_velocity=impact_velocity,
+                 **_given(exponent=exponent, law=law, friction=friction, friction_velocities=friction_velocities))
         return self._add("forces", d, name)
 
     def spring_damper(
