@@ -89,8 +89,9 @@ pub fn unwrap_torque_potentials(model: &Model, fp: &mut [f64], nt: usize) {
 /// damping) for every body kind. `v` and `f` are n-long scratch vectors.
 ///
 /// The loads that are functions of time and state (and motors) are not damping: their odd part
-/// is taken out here and their whole power is [`load_power`] (external work). `g` is a third
-/// n-long scratch.
+/// is taken out here and their whole power is [`load_power`] (external work). A contact (a
+/// revolute joint with clearance) dissipates `-qd . (Q_c(q, qd) - Q_c(q, 0))`, which is not odd
+/// in `qd`: its odd part is replaced by that. `g` is a third n-long scratch.
 pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], v: &mut [f64], f: &mut [f64], g: &mut [f64]) -> f64 {
     dynamics::mass_and_forces(model, data, t, q, qd);
     f.copy_from_slice(&data.force);
