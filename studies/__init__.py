@@ -11,7 +11,9 @@ repository's root.
 * :mod:`.flexible_coupler` -- the paper's coupler as an FE-reduced flexible body
   (``python -m studies flexible-coupler``);
 * :mod:`.simeon_crank` -- Simeon's flexible slider-crank test set (``python -m studies simeon-crank``);
-* :mod:`.sweeps` -- the sweep study (``python -m studies sweeps``).
+* :mod:`.sweeps` -- the sweep study (``python -m studies sweeps``);
+* :mod:`.clearance` -- revolute joints with clearance at the piston pin: Flores's slider-crank,
+  the flexible coupler's peak strain against the clearance (``python -m studies clearance``).
 
 The paper's reproduction and the work-precision bench (``ukflex paper``, ``ukflex bench``) ship
 with the library: :mod:`ukflex.benchmarks`. The stability diagnostics users call on their own runs
@@ -21,7 +23,7 @@ are the library's :mod:`ukflex.stability`.
 import sys
 import time
 
-__all__ = ["progress", "extreme", "stability", "crosscheck", "geometric", "flexible_coupler", "simeon_crank", "sweeps"]
+__all__ = ["progress", "extreme", "stability", "crosscheck", "geometric", "flexible_coupler", "simeon_crank", "sweeps", "clearance"]
 
 
 _START = time.perf_counter()

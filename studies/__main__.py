@@ -12,6 +12,7 @@ or their output folder:
   python -m studies flexible-coupler [--nonlinear] [--mesh] [--modal-derivatives[=K]] [--figure PNG]
   python -m studies simeon-crank [--nonlinear]
   python -m studies sweeps --out results/sweeps [--small]
+  python -m studies clearance [flores]
 """
 
 from __future__ import annotations
@@ -95,8 +96,15 @@ def _cmd_geometric(args: argparse.Namespace) -> int:
     return 0
 
 
+#: The studies with their own argument handling (``module.main(argv)``), by command name:
+#: ``main`` hands them their arguments before parsing (an ``argparse.REMAINDER`` does not take
+#: arguments that start with ``-``, so ``flexible-coupler --nonlinear`` was refused).
+_PASSTHROUGH = {"flexible-coupler": "flexible_coupler", "simeon-crank": "simeon_crank", "sweeps": "sweeps",
+                "clearance": "clearance"}
+
+
 def _passthrough(sub, name: str, module: str, help: str) -> None:
-    """A study with its own argument handling (``module.main(argv)``)."""
+    """A study with its own argument handling (``module.main(argv)``), listed in the help."""
     p = sub.add_parser(name, help=help, add_help=False)
     p.add_argument("rest", nargs=argparse.REMAINDER)
     p.set_defaults(func=lambda args: __import__(f"studies.{module}", fromlist=["main"]).main(args.rest))
@@ -179,11 +187,15 @@ def _build_parser() -> argparse.ArgumentParser:
     _passthrough(sub, "flexible-coupler", "flexible_coupler", "the FE-reduced coupler against the beam (docs/flexible-bodies.md)")
     _passthrough(sub, "simeon-crank", "simeon_crank", "Simeon's flexible slider-crank test set (docs/flexible-bodies.md)")
     _passthrough(sub, "sweeps", "sweeps", "the sweep study: serial, processes, Dask (docs/sweeps.md)")
+    _passthrough(sub, "clearance", "clearance", "revolute joints with clearance: Flores's slider-crank, the flexible coupler (docs/loads.md)")
     return parser
 
 
 def main(argv: Optional[List[str]] = None) -> int:
-    args = _build_parser().parse_args(sys.argv[1:] if argv is None else argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] in _PASSTHROUGH:
+        return int(__import__(f"studies.{_PASSTHROUGH[argv[0]]}", fromlist=["main"]).main(argv[1:]) or 0)
+    args = _build_parser().parse_args(argv)
     return int(args.func(args) or 0)
 
 

@@ -513,6 +513,51 @@ pub enum ForceDesc {
         #[serde(default)]
         damping: [f64; 3],
     },
+    /// A revolute joint with clearance: a journal inside a bearing, contact by a dissipative
+    /// Hertz law with Coulomb friction, no constraint rows (docs/loads.md).
+    RevoluteClearance {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        journal: MarkerDesc,
+        bearing: MarkerDesc,
+        /// Radial clearance `R_B - R_J` [m].
+        clearance: f64,
+        journal_radius: f64,
+        /// `K` of `K delta^exponent` [N/m^exponent].
+        stiffness: f64,
+        #[serde(default = "hertz_exponent")]
+        exponent: f64,
+        restitution: f64,
+        /// The impact velocity at which the law's restitution is `restitution` [m/s].
+        impact_velocity: f64,
+        #[serde(default)]
+        law: ClearanceLaw,
+        #[serde(default)]
+        friction: f64,
+        /// `[v1, v2]` of the modified Coulomb law: no friction below `v1`, full above `v2`.
+        #[serde(default = "clearance_friction_velocities")]
+        friction_velocities: [f64; 2],
+    },
+}
+
+/// The hysteresis factor of a clearance joint's normal law (docs/loads.md).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClearanceLaw {
+    /// `D = 3 (1 - c_e^2) / (4 v_0)`.
+    #[default]
+    LankaraniNikravesh,
+    /// `D = 8 (1 - c_e) / (5 c_e v_0)`.
+    Flores,
+}
+
+fn hertz_exponent() -> f64 {
+    1.5
+}
+
+/// Ambrosio's transition velocities of the modified Coulomb law (as used by Flores et al.).
+fn clearance_friction_velocities() -> [f64; 2] {
+    [1e-4, 1e-3]
 }
 
 /// A load's value: a number, an expression of `t` and state quantities, a table, or a
@@ -581,6 +626,7 @@ impl ForceDesc {
             ForceDesc::Motor { .. } => "motor",
             ForceDesc::RotationalSpringDamper { .. } => "rotational_spring_damper",
             ForceDesc::Bushing { .. } => "bushing",
+            ForceDesc::RevoluteClearance { .. } => "revolute_clearance",
         }
     }
 
@@ -593,7 +639,8 @@ impl ForceDesc {
             | ForceDesc::TorqueLoad { name, .. }
             | ForceDesc::Motor { name, .. }
             | ForceDesc::RotationalSpringDamper { name, .. }
-            | ForceDesc::Bushing { name, .. } => name.as_deref(),
+            | ForceDesc::Bushing { name, .. }
+            | ForceDesc::RevoluteClearance { name, .. } => name.as_deref(),
         }
     }
 }

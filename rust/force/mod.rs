@@ -2,9 +2,11 @@
 //! Each adds its generalized force `J^T F` to `Q` (paper eqs. 34-37). The constant loads and
 //! the spring-damper are here; each further kind has its file (docs/loads.md): loads that are
 //! functions of time and state (`load.rs`, their values in `value.rs`), motors (`motor.rs`),
-//! rotational spring-dampers (`rotational_spring.rs`), bushings (`bushing.rs`).
+//! rotational spring-dampers (`rotational_spring.rs`), bushings (`bushing.rs`), revolute joints
+//! with clearance (`clearance.rs`).
 
 pub mod bushing;
+pub mod clearance;
 pub mod load;
 pub mod motor;
 pub mod rotational_spring;
@@ -32,6 +34,7 @@ pub enum ForceKind {
     Motor(Box<motor::Motor>),
     RotationalSpringDamper(Box<rotational_spring::RotationalSpringDamper>),
     Bushing(Box<bushing::Bushing>),
+    RevoluteClearance(Box<clearance::Clearance>),
 }
 
 #[derive(Debug, Clone)]
@@ -86,6 +89,20 @@ impl Force {
                 ForceKind::RotationalSpringDamper(Box::new(rotational_spring::RotationalSpringDamper::from_desc(ctx, item, a, b.as_ref(), *stiffness, *damping, *rest_angle)?))
             }
             ForceDesc::Bushing { a, b, stiffness, damping, .. } => ForceKind::Bushing(Box::new(bushing::Bushing::from_desc(ctx, item, a, b, *stiffness, *damping)?)),
+            ForceDesc::RevoluteClearance { journal, bearing, clearance, journal_radius, stiffness, exponent, restitution, impact_velocity, law, friction, friction_velocities, .. } => {
+                let p = clearance::ClearanceParams {
+                    clearance: *clearance,
+                    journal_radius: *journal_radius,
+                    stiffness: *stiffness,
+                    exponent: *exponent,
+                    restitution: *restitution,
+                    impact_velocity: *impact_velocity,
+                    law: *law,
+                    friction: *friction,
+                    friction_velocities: *friction_velocities,
+                };
+                ForceKind::RevoluteClearance(Box::new(clearance::Clearance::from_desc(ctx, item, journal, bearing, p)?))
+            }
         };
         Ok(Force { name, kind })
     }
@@ -101,6 +118,7 @@ impl Force {
             ForceKind::Motor(m) => [Some(&m.a), Some(&m.b)],
             ForceKind::RotationalSpringDamper(r) => [Some(&r.a), Some(&r.b)],
             ForceKind::Bushing(b) => [Some(&b.a), Some(&b.b)],
+            ForceKind::RevoluteClearance(c) => [Some(&c.journal), Some(&c.bearing)],
         }
     }
 
@@ -142,13 +160,14 @@ impl Force {
 
     /// Whether [`Force::add_stiffness`] adds anything: a load or motor whose value is an
     /// expression or a table, a spring (translational, rotational, bushing) with stiffness or
-    /// damping.
+    /// damping, a revolute joint with clearance.
     pub fn has_stiffness(&self) -> bool {
         match &self.kind {
             ForceKind::SpringDamper { stiffness, damping, .. } => *stiffness > 0.0 || *damping > 0.0,
             ForceKind::RotationalSpringDamper(r) => r.stiffness > 0.0,
             ForceKind::Bushing(b) => b.stiffness.iter().any(|k| *k > 0.0),
             ForceKind::Spatial(f) => f.has_stiffness(),
+            ForceKind::RevoluteClearance(_) => true,
             _ => self.values().iter().any(|v| v.has_gradient()),
         }
     }
@@ -159,7 +178,8 @@ impl Force {
     /// spring-damper's also the turning of its line under load). The change of the markers'
     /// Jacobians with `q`, `(dJ^T/dq) F`, is left out, as for the constant loads: it is what
     /// the implicit methods' Newton iteration needs, not an exact Jacobian. `rows` is a `2 n`
-    /// scratch, `scratch` the force's evaluation scratch. Nothing for the other kinds.
+    /// scratch, `scratch` the force's evaluation scratch. A revolute joint with clearance adds its
+    /// contact stiffness (`clearance.rs`); nothing for the other kinds.
     pub fn add_stiffness(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], scratch: &mut [f64], rows: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
         let n = q.len();
         let (p, r) = rows[..2 * n].split_at_mut(n);
@@ -206,6 +226,7 @@ impl Force {
             ForceKind::RotationalSpringDamper(rs) => rs.add_stiffness(bodies, q, qd, p, add),
             ForceKind::Bushing(bu) => bu.add_stiffness(bodies, q, qd, p, add),
             ForceKind::Spatial(f) => f.add_stiffness(bodies, q, qd, p, r, add),
+            ForceKind::RevoluteClearance(c) => c.add_stiffness(bodies, q, qd, p, r, add),
             ForceKind::Motor(m) if m.torque.has_gradient() => {
                 let (sa, sb, local) = motor::relative(bodies, &m.a, &m.b, q, qd);
                 r.fill(0.0);
@@ -254,6 +275,7 @@ impl Force {
             ForceKind::Motor(m) => m.add_to(bodies, t, q, qd, scratch, qvec),
             ForceKind::RotationalSpringDamper(r) => r.add_to(bodies, q, qd, qvec),
             ForceKind::Bushing(b) => b.add_to(bodies, q, qd, qvec),
+            ForceKind::RevoluteClearance(c) => c.add_to(bodies, q, qd, qvec),
         }
     }
 
@@ -275,6 +297,7 @@ impl Force {
             ForceKind::Spatial(f) => f.material_energy(bodies, q, v),
             ForceKind::RotationalSpringDamper(r) => r.material_energy(bodies, q, v),
             ForceKind::Bushing(b) => b.material_energy(bodies, q, v),
+            ForceKind::RevoluteClearance(c) => c.material_energy(bodies, q, v),
         }
     }
 
@@ -301,6 +324,7 @@ impl Force {
             ForceKind::Spatial(f) => f.potential(bodies, q),
             ForceKind::RotationalSpringDamper(r) => r.potential(bodies, q),
             ForceKind::Bushing(b) => b.potential(bodies, q),
+            ForceKind::RevoluteClearance(c) => c.potential(bodies, q),
             // a load that is a function has no potential unless it is constant; a motor's work
             // is input, not stored (sensors: `external_work`)
             ForceKind::Load(l) => l.potential(bodies, q).unwrap_or(0.0),

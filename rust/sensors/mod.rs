@@ -89,8 +89,9 @@ pub fn unwrap_torque_potentials(model: &Model, fp: &mut [f64], nt: usize) {
 /// damping) for every body kind. `v` and `f` are n-long scratch vectors.
 ///
 /// The loads that are functions of time and state (and motors) are not damping: their odd part
-/// is taken out here and their whole power is [`load_power`] (external work). `g` is a third
-/// n-long scratch.
+/// is taken out here and their whole power is [`load_power`] (external work). A contact (a
+/// revolute joint with clearance) dissipates `-qd . (Q_c(q, qd) - Q_c(q, 0))`, which is not odd
+/// in `qd`: its odd part is replaced by that. `g` is a third n-long scratch.
 pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], v: &mut [f64], f: &mut [f64], g: &mut [f64]) -> f64 {
     dynamics::mass_and_forces(model, data, t, q, qd);
     f.copy_from_slice(&data.force);
@@ -101,7 +102,40 @@ pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: 
     let p = -qd.iter().zip(f.iter().zip(&data.force)).map(|(x, (a, b))| x * 0.5 * (a - b)).sum::<f64>();
     let plus = load_power(model, data, t, q, qd, qd, g);
     let minus = load_power(model, data, t, q, v, qd, g);
-    p + 0.5 * (plus - minus)
+    let mut p = p + 0.5 * (plus - minus);
+    if model.forces.iter().any(is_contact) {
+        // a contact's dissipation is not odd in qd (its friction grows with the normal force's
+        // damping part): take its odd part out and count `-qd . (Q_c(q, qd) - Q_c(q, 0))`
+        let plus = forces_power(model, data, t, q, qd, qd, g, is_contact);
+        let minus = forces_power(model, data, t, q, v, qd, g, is_contact);
+        f.fill(0.0);
+        let rest = forces_power(model, data, t, q, f, qd, g, is_contact);
+        p += 0.5 * (plus - minus) - (plus - rest);
+    }
+    p
+}
+
+/// Whether a force is a contact (a revolute joint with clearance), whose dissipated power
+/// [`dissipation_power`] counts apart.
+pub fn is_contact(f: &crate::force::Force) -> bool {
+    matches!(f.kind, crate::force::ForceKind::RevoluteClearance(_))
+}
+
+/// Columns of one clearance joint's row (see [`clearance_into`]).
+pub const CLEARANCE_COLUMNS: [&str; 5] = ["eccentricity", "penetration", "normal_force", "tangential_force", "force"];
+
+/// For each revolute joint with clearance (in `model.forces` order), 5 numbers into `out`: the
+/// eccentricity, the penetration (negative in free flight), the normal and tangential contact
+/// forces and the contact force's magnitude.
+pub fn clearance_into(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64]) {
+    let contacts = model.forces.iter().filter_map(|f| match &f.kind {
+        crate::force::ForceKind::RevoluteClearance(c) => Some(c),
+        _ => None,
+    });
+    for (c, o) in contacts.zip(out.chunks_exact_mut(CLEARANCE_COLUMNS.len())) {
+        let k = c.contact(&c.journal.state(&model.bodies, q, qd), &c.bearing.state(&model.bodies, q, qd));
+        o.copy_from_slice(&[k.eccentricity, k.penetration, k.normal_force, k.tangential_force, k.normal_force.hypot(k.tangential_force)]);
+    }
 }
 
 /// Whether a force's work is counted as external work by its power (a load that is a
@@ -118,9 +152,15 @@ pub fn works_by_power(f: &crate::force::Force) -> bool {
 /// `w . Q_L(t, q, qd)`: the power (for `w = qd`) of the loads that work by power
 /// ([`works_by_power`]). `g` is an n-long scratch.
 pub fn load_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], w: &[f64], g: &mut [f64]) -> f64 {
+    forces_power(model, data, t, q, qd, w, g, works_by_power)
+}
+
+/// `w . Q_F(t, q, qd)` of the forces `pick` selects. `g` is an n-long scratch.
+#[allow(clippy::too_many_arguments)]
+fn forces_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], w: &[f64], g: &mut [f64], pick: fn(&crate::force::Force) -> bool) -> f64 {
     g.fill(0.0);
-    let mut no_turn = f64::NAN; // loads and motors count no turns
-    for f in model.forces.iter().filter(|f| works_by_power(f)) {
+    let mut no_turn = f64::NAN; // loads, motors and contacts count no turns
+    for f in model.forces.iter().filter(|f| pick(f)) {
         f.add_to(&model.bodies, t, q, qd, &mut data.load_scratch, &mut no_turn, g);
     }
     w.iter().zip(g.iter()).map(|(a, b)| a * b).sum()

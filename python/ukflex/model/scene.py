@@ -786,6 +786,38 @@ class Scene:
         initial guess."""
         return self._add("forces", dict(kind="bushing", a=a, b=b, stiffness=stiffness, damping=damping), name)
 
+    def revolute_clearance(
+        self,
+        journal: MarkerLike,
+        bearing: MarkerLike,
+        *,
+        clearance: float,
+        journal_radius: float,
+        stiffness: float,
+        restitution: float,
+        impact_velocity: float,
+        exponent: Optional[float] = None,
+        law: Optional[str] = None,
+        friction: Optional[float] = None,
+        friction_velocities: Optional[Sequence[float]] = None,
+        name: Optional[str] = None,
+    ) -> str:
+        """A revolute joint with clearance: the journal (marker ``journal``, radius
+        ``journal_radius``) moves inside the bearing (marker ``bearing``, radius
+        ``journal_radius + clearance``) with no constraint rows; in contact the normal force is
+        ``K delta^exponent (1 + D delta')`` (``law``: ``"lankarani_nikravesh"``, ``D = 3 (1 -
+        c_e^2) / (4 v_0)``, or ``"flores"``, ``D = 8 (1 - c_e) / (5 c_e v_0)``, ``c_e =
+        restitution`` at the impact velocity ``v_0 = impact_velocity``) and the friction
+        Ambrosio's modified Coulomb law with coefficient ``friction`` (none below
+        ``friction_velocities[0]``, full above ``[1]``). ``None``: the core's defaults
+        (``exponent`` 1.5, Lankarani-Nikravesh, no friction, ``(1e-4, 1e-3)`` m/s). Its contact
+        is in ``res.sensors.clearance(name)`` (docs/loads.md)."""
+        d = dict(kind="revolute_clearance", journal=journal, bearing=bearing, clearance=clearance,
+                 journal_radius=journal_radius, stiffness=stiffness, restitution=restitution,
+                 impact_velocity=impact_velocity,
+                 **_given(exponent=exponent, law=law, friction=friction, friction_velocities=friction_velocities))
+        return self._add("forces", d, name)
+
     def spring_damper(
         self,
         a: MarkerLike,

@@ -18,7 +18,8 @@ An *output expression* is one of
   ``fx_local``, ``fy_local``, ``power``), ``work(DRIVER)``, ``energy.kinetic`` (``strain``,
   ``gravity``, ``springs``, ``loads``, ``total``), ``energy(BODY).kinetic``, ``work.drivers``,
   ``work.external``, ``dissipated``, ``balance``, ``N(BEAM, XI)`` (``V``, ``M``, ``eps``,
-  ``kappa``).
+  ``kappa``), ``clearance(JOINT).force`` (``eccentricity``, ``penetration``, ``normal_force``,
+  ``tangential_force``: a revolute joint with clearance, docs/loads.md).
 """
 
 from __future__ import annotations

@@ -55,6 +55,7 @@ INTERNAL_COLUMNS = ("N", "V", "M", "eps", "kappa")
 SENSOR_HELP = (
     "reaction(JOINT).fx|fy|torque|fx_local|fy_local|power, work(DRIVER), "
     "energy.kinetic|strain|gravity|springs|loads|total, energy(BODY).kinetic|strain|gravity, "
+    "clearance(JOINT).eccentricity|penetration|normal_force|tangential_force|force, "
     "work.drivers|external, dissipated, balance, N|V|M|eps|kappa(BEAM, XI)"
 )
 
@@ -91,7 +92,7 @@ def _states(res) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 #: Force kinds whose potential is stored elastic energy (``springs``), not a load's.
-_SPRING_KINDS = ("spring_damper", "rotational_spring_damper", "bushing")
+_SPRING_KINDS = ("spring_damper", "rotational_spring_damper", "bushing", "revolute_clearance")
 
 
 class Sensors:
@@ -176,6 +177,16 @@ class Sensors:
                "gravity": e[:, :, 2].sum(axis=1), "springs": springs, "loads": loads}
         out["total"] = out["kinetic"] + out["strain"] + out["gravity"] + out["springs"]
         return out
+
+    def clearance(self, name: str) -> Dict[str, np.ndarray]:
+        """The contact of the revolute joint with clearance ``name``, each (nt,):
+        ``eccentricity``, ``penetration`` (negative in free flight), ``normal_force``,
+        ``tangential_force`` and ``force`` (the contact force's magnitude)."""
+        names = list(self._raw["clearance_names"])
+        if name not in names:
+            raise UnknownNameError.of("revolute joint with clearance", name, names)
+        c = np.asarray(self._raw["clearance"])[:, names.index(name), :]
+        return {col: c[:, i].copy() for i, col in enumerate(self._raw["clearance_columns"])}
 
     def external_work(self) -> np.ndarray:
         """Work of the external loads from ``t_0``, shape (nt,): the constant ones (point
@@ -279,6 +290,9 @@ class Sensors:
                 out[f"energy({b}).{k}"] = v
         for k, v in self.energies().items():
             out[f"energy.{k}"] = v
+        for j in self._raw["clearance_names"]:
+            for k, v in self.clearance(j).items():
+                out[f"clearance({j}).{k}"] = v
         bal = self.energy_balance()
         out["work.drivers"] = bal["driver_work"]
         out["work.external"] = bal["external_work"]
@@ -295,6 +309,7 @@ class Sensors:
     _REACTION = re.compile(r"^reaction\(\s*([^()\s]+)\s*\)\.(\w+)$")
     _WORK = re.compile(r"^work\(\s*([^()\s]+)\s*\)$")
     _BODY_ENERGY = re.compile(r"^energy\(\s*([^()\s]+)\s*\)\.(\w+)$")
+    _CLEARANCE = re.compile(r"^clearance\(\s*([^()\s]+)\s*\)\.(\w+)$")
 
     @classmethod
     def parse(cls, system, expr: str) -> Optional[Tuple[Any, ...]]:
@@ -309,6 +324,15 @@ class Sensors:
             if m.group(1) not in items:
                 raise ValueError(f"output {expr!r}: unknown joint or driver {m.group(1)!r}; joints and drivers are {items}")
             return ("reaction", m.group(1), m.group(2))
+        m = cls._CLEARANCE.match(e)
+        if m:
+            raw = system.core.sensors(np.array([system.t0]), system.q0[None, :], system.qd0[None, :], reactions=False)
+            names, columns = list(raw["clearance_names"]), list(raw["clearance_columns"])
+            if m.group(1) not in names:
+                raise ValueError(f"output {expr!r}: unknown revolute joint with clearance {m.group(1)!r}; they are {names}")
+            if m.group(2) not in columns:
+                raise ValueError(f"output {expr!r}: clearance columns are {tuple(columns)}")
+            return ("clearance", m.group(1), m.group(2))
         m = cls._INTERNAL.match(e)
         if m:
             what, body, xi_text = m.groups()
@@ -356,6 +380,9 @@ class Sensors:
             if p[1] not in self.driver_names:
                 raise ValueError(f"work({p[1]}): not a driver; drivers are {self.driver_names}")
             return f"work({p[1]}) [J]", self.driver_work(p[1])
+        if kind == "clearance":
+            unit = {"eccentricity": "m", "penetration": "m"}.get(p[2], "N")
+            return f"clearance({p[1]}).{p[2]} [{unit}]", self.clearance(p[1])[p[2]]
         if kind == "body_energy":
             return f"energy({p[1]}).{p[2]} [J]", self.body_energies(p[1])[p[2]]
         _, what, body, xi = p

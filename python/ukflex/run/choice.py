@@ -172,6 +172,12 @@ def _stated(d: Dict[str, Any], span: float) -> MethodChoice:
                     f"{h * w_max:.3g}/omega_max ({w_max:.4g} rad/s), beyond what an explicit method may take "
                     f"(~{EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:g}/omega_max at equal cost): Radau IIA (order 5, "
                     "L-stable) damps the fast modes instead of resolving them" + said))
+    if verdict == "stiff_contact":
+        return MethodChoice(
+            "RADAU5M", omega_elastic=w_c, omega_max=w_max,
+            reason=(f"stiff (the fastest mode, {w_max:.4g} rad/s, is beyond an explicit step that resolves the "
+                    f"lowest elastic one, {w_c:.4g} rad/s) and with contacts, whose impacts a step chosen before "
+                    "the run cannot see: Radau IIA (L-stable) with its own step control at the user's tolerances"))
     if verdict == "overdamped":
         o = d["overdamped"]
         return MethodChoice(

@@ -156,7 +156,9 @@ impl PySystem {
     /// `reaction_names`, `reaction_bodies` (body of the first marker, None = ground),
     /// `body_energies` (nt, n_bodies, 3: kinetic, strain, gravity), `body_names`,
     /// `force_potentials` (nt, n_forces), `force_names`, `dissipation_power` (nt,),
-    /// `load_power` (nt,: the power of the loads that are functions and of motors).
+    /// `load_power` (nt,: the power of the loads that are functions and of motors),
+    /// `clearance` (nt, n_clearance, 5: eccentricity, penetration, normal force, tangential
+    /// force, contact force of each revolute joint with clearance), `clearance_names`.
     #[pyo3(signature = (t, q, qd, reactions=true))]
     fn sensors<'py>(&self, py: Python<'py>, t: Vector<'py>, q: &Bound<'py, PyAny>, qd: &Bound<'py, PyAny>, reactions: bool) -> PyResult<Bound<'py, PyDict>> {
         let n = self.model.n;
@@ -167,6 +169,9 @@ impl PySystem {
         let mut fp = vec![0.0; nt * nf];
         let mut dp = vec![0.0; nt];
         let mut lp = vec![0.0; nt];
+        let ncl = self.model.forces.iter().filter(|f| sensors::is_contact(f)).count();
+        let nccol = sensors::CLEARANCE_COLUMNS.len();
+        let mut cl = vec![0.0; nt * ncl * nccol];
         self.with_ws(|model, ws| {
             let (mut v, mut f, mut g) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
             for k in 0..nt {
@@ -177,6 +182,7 @@ impl PySystem {
                 sensors::energies_into(model, &mut ws.data, ts[k], qk, qdk, &mut be[k * nb * 3..(k + 1) * nb * 3], &mut fp[k * nf..(k + 1) * nf]);
                 dp[k] = sensors::dissipation_power(model, &mut ws.data, ts[k], qk, qdk, &mut v, &mut f, &mut g);
                 lp[k] = sensors::load_power(model, &mut ws.data, ts[k], qk, qdk, qdk, &mut g);
+                sensors::clearance_into(model, qk, qdk, &mut cl[k * ncl * nccol..(k + 1) * ncl * nccol]);
             }
             sensors::unwrap_torque_potentials(model, &mut fp, nt);
             finite_out("sensors reactions", &rx)?;
@@ -202,6 +208,9 @@ impl PySystem {
         d.set_item("force_names", names(&mut self.model.forces.iter().map(|f| f.name.clone())))?;
         d.set_item("dissipation_power", PyArray1::from_vec(py, dp))?;
         d.set_item("load_power", PyArray1::from_vec(py, lp))?;
+        d.set_item("clearance", PyArray1::from_vec(py, cl).reshape([nt, ncl, nccol])?)?;
+        d.set_item("clearance_names", names(&mut self.model.forces.iter().filter(|f| sensors::is_contact(f)).map(|f| f.name.clone())))?;
+        d.set_item("clearance_columns", sensors::CLEARANCE_COLUMNS.to_vec())?;
         Ok(d)
     }
 

@@ -97,6 +97,9 @@ pub struct SceneTraits {
     pub damped: bool,
     /// A mode can store strain or spring energy: a flexible body or a spring-damper with stiffness.
     pub elastic_potential: bool,
+    /// Contacts (revolute joints with clearance): forces that switch on and off during the run,
+    /// which the spectrum at the start does not see.
+    pub contact: bool,
 }
 
 impl SceneTraits {
@@ -116,7 +119,8 @@ impl SceneTraits {
             f.get("kind").and_then(Value::as_str) == Some("spring_damper") && f.get("stiffness").and_then(Value::as_f64).unwrap_or(0.0) > 0.0
         });
         let flexible = model.bodies.iter().any(|b| b.capabilities().elastic);
-        SceneTraits { damped, elastic_potential: flexible || spring }
+        let contact = forces.iter().any(|f| f.get("kind").and_then(Value::as_str) == Some("revolute_clearance"));
+        SceneTraits { damped, elastic_potential: flexible || spring, contact }
     }
 }
 
@@ -131,6 +135,9 @@ pub enum Verdict {
     NoElasticMode,
     /// RADAU5M at a fixed step.
     Stiff,
+    /// Stiff with contacts: RADAU5M with its own step control (a step chosen before the run
+    /// cannot see the impacts).
+    StiffContact,
     /// Overdamped modes: adaptive RADAU5M.
     Overdamped,
     /// DOPRI5 resolves the fastest mode at the step the elastic modes need.
@@ -147,6 +154,7 @@ impl Verdict {
             Verdict::NoElasticPotential => "no_elastic_potential",
             Verdict::NoElasticMode => "no_elastic_mode",
             Verdict::Stiff => "stiff",
+            Verdict::StiffContact => "stiff_contact",
             Verdict::Overdamped => "overdamped",
             Verdict::NotStiff => "not_stiff",
             Verdict::NeedMoreModes => "need_more_modes",
@@ -254,6 +262,11 @@ pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &
     c.omega_elastic = Some(omega_c);
     c.step = Some(h);
     c.phase = phase;
+    if h * sp.omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO && traits.contact {
+        c.verdict = Verdict::StiffContact;
+        c.method = "RADAU5M";
+        return Ok(c);
+    }
     if h * sp.omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO {
         c.verdict = Verdict::Stiff;
         c.method = "RADAU5M";
@@ -292,9 +305,9 @@ mod tests {
 
     #[test]
     fn the_prelude_needs_no_spectrum_for_prescribed_or_rigid_scenes() {
-        let rigid = SceneTraits { damped: false, elastic_potential: false };
+        let rigid = SceneTraits { damped: false, elastic_potential: false, contact: false };
         assert_eq!(prelude(rigid, 0).unwrap().verdict, Verdict::NoDof);
         assert_eq!(prelude(rigid, 3).unwrap().verdict, Verdict::NoElasticPotential);
-        assert!(prelude(SceneTraits { damped: false, elastic_potential: true }, 3).is_none());
+        assert!(prelude(SceneTraits { damped: false, elastic_potential: true, contact: false }, 3).is_none());
     }
 }
