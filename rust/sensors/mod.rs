@@ -91,7 +91,17 @@ pub fn unwrap_torque_potentials(model: &Model, fp: &mut [f64], nt: usize) {
 /// The loads that are functions of time and state (and motors) are not damping: their odd part
 /// is taken out here and their whole power is [`load_power`] (external work). `g` is a third
 /// n-long scratch.
-pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], v: &mut [f64], f: &mut [f64], g: &mut [f64]) -> f64 {
+///
+/// Joint friction (`force::friction`, not in `Q`: it reads the multipliers) adds `-sum F_i v_i`,
+/// its forces closed with the reactions by a UK solve at the state.
+pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], v: &mut [f64], f: &mut [f64], g: &mut [f64]) -> Result<f64> {
+    let friction = match data.friction.is_some() {
+        true => {
+            uk::acceleration(model, data, t, q, qd)?;
+            -data.friction.as_ref().map_or(0.0, |w| w.power())
+        }
+        false => 0.0,
+    };
     dynamics::mass_and_forces(model, data, t, q, qd);
     f.copy_from_slice(&data.force);
     for (vi, x) in v.iter_mut().zip(qd) {
@@ -101,7 +111,7 @@ pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: 
     let p = -qd.iter().zip(f.iter().zip(&data.force)).map(|(x, (a, b))| x * 0.5 * (a - b)).sum::<f64>();
     let plus = load_power(model, data, t, q, qd, qd, g);
     let minus = load_power(model, data, t, q, v, qd, g);
-    p + 0.5 * (plus - minus)
+    Ok(p + 0.5 * (plus - minus) + friction)
 }
 
 /// Whether a force's work is counted as external work by its power (a load that is a

@@ -14,6 +14,7 @@
 //! algorithm: evaluate the terms, the free acceleration, factor, correct.
 
 pub mod dense;
+pub mod friction;
 pub mod settings;
 pub mod sparse;
 
@@ -37,7 +38,8 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], w
 }
 
 /// UK acceleration into `data.qdd` and multipliers into `data.lambda`, from the terms already
-/// in `data` (see `evaluate`). The three stages below can also be called separately: the
+/// in `data` (see `evaluate`); with joint friction, the friction forces closed with the
+/// multipliers (`friction::close`, added to `data.force`). The three stages below can also be called separately: the
 /// factorization of `B^T` depends on `q` only (through `M` and `A`), so a caller that changes
 /// only `Q` and `b` (velocity columns of a Jacobian) may reuse it.
 pub fn solve(model: &Model, data: &mut Data) -> Result<()> {
@@ -49,6 +51,9 @@ pub fn solve(model: &Model, data: &mut Data) -> Result<()> {
     }
     factor_constraints(model, data)?;
     correct(model, data);
+    if data.friction.is_some() {
+        friction::close(model, data, false)?;
+    }
     Ok(())
 }
 
@@ -145,6 +150,10 @@ pub fn acceleration_same_q(model: &Model, data: &mut Data, t: f64, q: &[f64], qd
         data.qdd.copy_from_slice(&data.qdd_free);
     } else {
         correct(model, data);
+        if data.friction.is_some() {
+            // the responses to the friction forces depend on q only: those of the full call
+            friction::close(model, data, true)?;
+        }
     }
     Ok(())
 }
