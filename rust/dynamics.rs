@@ -23,8 +23,17 @@ pub fn mass_and_forces(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[
     for (f, turn) in model.forces.iter().zip(data.turns.iter_mut()) {
         f.add_to(&model.bodies, t, q, qd, &mut data.load_scratch, turn, &mut data.force);
     }
+    if data.friction.is_some() {
+        prepare_friction(model, data, q, qd);
+    }
+}
+
+/// Joint friction reads the multipliers: its slip rates here, its forces in `uk::solve`. Out of
+/// line: the scenes without friction keep their hot path as it was.
+#[cold]
+#[inline(never)]
+fn prepare_friction(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
     if let Some(w) = data.friction.as_mut() {
-        // joint friction reads the multipliers: its slip rates here, its forces in `uk::solve`
         w.prepare(&model.forces, &model.bodies, q, qd);
     }
 }

@@ -38,7 +38,9 @@ pub const CLOSURE_MAX_ITER: usize = 50;
 /// `data.lambda`, the friction forces added to `data.force` and in `FrictionWork::f`.
 /// `reuse`: the responses `(u_j, l_j)` of the last closure are still valid (same `q`, same
 /// factorization: the velocity columns of a finite-difference Jacobian). Nothing without
-/// friction elements.
+/// friction elements. Out of line (`cold`): the scenes without friction keep their hot path.
+#[cold]
+#[inline(never)]
 pub fn close(model: &Model, data: &mut Data, reuse: bool) -> Result<()> {
     let Some(mut w) = data.friction.take() else { return Ok(()) };
     let t = data.t_forces;
@@ -169,4 +171,78 @@ fn gauss_solve(a: &mut [f64], x: &mut [f64], k: usize) -> bool {
         x[c] = (x[c] - s) / a[c * k + c];
     }
     true
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::data::{Data, UkSolver};
+    use crate::model::Model;
+    use crate::uk;
+
+    /// A rigid slider-crank with friction in the main bearing, the crank pin and the guide
+    /// (with a slider length): three coupled friction forces.
+    const SCENE: &str = r#"{"gravity": [0, -9.81], "bodies": [
+        {"kind": "rigid", "name": "crank", "mass": 1.0, "inertia": 0.01, "com": [0.075, 0.0], "angle": 0.5, "angular_velocity": 20.0},
+        {"kind": "rigid", "name": "coupler", "mass": 1.0, "inertia": 0.0075, "com": [0.15, 0.0], "position": [0.1316, 0.0719], "angle": -0.2411},
+        {"kind": "rigid", "name": "slider", "mass": 0.5, "inertia": 0.001, "position": [0.4229, 0.0]}],
+      "joints": [
+        {"kind": "revolute", "name": "main", "a": {"body": "crank", "point": [0, 0]}, "b": {"body": "ground", "point": [0, 0]}},
+        {"kind": "revolute", "name": "crankpin", "a": {"body": "crank", "point": [0.15, 0]}, "b": {"body": "coupler", "point": [0, 0]}},
+        {"kind": "revolute", "name": "pistonpin", "a": {"body": "coupler", "point": [0.3, 0]}, "b": {"body": "slider", "point": [0, 0]}},
+        {"kind": "prismatic", "name": "guide", "a": {"body": "slider"}, "b": {"body": "ground"}}],
+      "forces": [
+        {"kind": "point_force", "point": {"body": "slider"}, "force": [-300.0, 40.0]},
+        {"kind": "joint_friction", "joint": "main", "mu": 0.3, "radius": 0.02},
+        {"kind": "joint_friction", "joint": "crankpin", "mu": 0.3, "radius": 0.015, "damping": 0.001},
+        {"kind": "joint_friction", "joint": "guide", "mu": 0.4, "length": 0.03}]}"#;
+
+    fn check(solver: UkSolver) {
+        let model = Model::from_json(SCENE).unwrap();
+        let mut data = Data::build(&model, solver, u64::MAX).unwrap();
+        let (q, qd) = (model.q0.clone(), vec![0.1, -0.2, 20.0, 0.3, 1.2, -3.0, -1.1, 0.05, 0.0]);
+        uk::acceleration(&model, &mut data, 0.0, &q, &qd).unwrap();
+        let w = data.friction.as_ref().unwrap();
+        // each friction force is its law at the closed multipliers
+        for i in 0..3 {
+            let (law, _, _) = w.force_at(&model.forces, i, &data.lambda);
+            assert!((w.f[i] - law).abs() <= 1e-12 * law.abs().max(1e-3), "element {i}: {} vs {law}", w.f[i]);
+            assert!(w.f[i] != 0.0);
+        }
+        assert!(w.iterations <= 4, "{} Newton iterations", w.iterations);
+        // an independent UK solve with the friction forces as given loads gives the same motion
+        let (f, g, n) = (w.f.clone(), w.g.clone(), model.n);
+        let mut plain = Data::build(&model, solver, u64::MAX).unwrap();
+        let saved = plain.friction.take();
+        uk::evaluate(&model, &mut plain, 0.0, &q, &qd, false).unwrap();
+        for (i, fi) in f.iter().enumerate() {
+            for (x, gi) in plain.force.iter_mut().zip(&g[i * n..(i + 1) * n]) {
+                *x += fi * gi;
+            }
+        }
+        uk::solve(&model, &mut plain).unwrap();
+        for (a, b) in data.qdd.iter().zip(&plain.qdd) {
+            assert!((a - b).abs() <= 1e-10 * (1.0 + b.abs()), "qdd {a} vs {b}");
+        }
+        for (a, b) in data.lambda.iter().zip(&plain.lambda) {
+            assert!((a - b).abs() <= 1e-10 * (1.0 + b.abs()), "lambda {a} vs {b}");
+        }
+        // a single pass (the friction of the reactions without friction) is measurably different
+        plain.friction = saved;
+        uk::evaluate(&model, &mut plain, 0.0, &q, &qd, false).unwrap();
+        uk::free_acceleration(&model, &mut plain);
+        uk::factor_constraints(&model, &mut plain).unwrap();
+        uk::correct(&model, &mut plain);
+        let single: Vec<f64> = (0..3).map(|i| plain.friction.as_ref().unwrap().force_at(&model.forces, i, &plain.lambda).0).collect();
+        assert!(single.iter().zip(&f).any(|(s, c)| (s - c).abs() > 1e-3 * c.abs()), "{single:?} vs {f:?}");
+    }
+
+    #[test]
+    fn closure_is_the_fixed_point_dense() {
+        check(UkSolver::Dense);
+    }
+
+    #[test]
+    fn closure_is_the_fixed_point_sparse() {
+        check(UkSolver::Sparse);
+    }
 }
