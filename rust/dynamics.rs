@@ -28,7 +28,7 @@ pub fn mass_and_forces(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[
     }
 }
 
-/// Joint friction reads the multipliers: its slip rates here, its forces in `uk::solve`. Out of
+/// Joint friction reads the multipliers: its slip rates here, its forces in `uk::acceleration`. Out of
 /// line: the scenes without friction keep their hot path as it was.
 #[cold]
 #[inline(never)]

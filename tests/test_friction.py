@@ -132,11 +132,13 @@ def _pendulum_reference(t):
     return sol.y[0]
 
 
-@pytest.mark.parametrize("method", ["DOPRI5", "RADAU5", "RADAU5M", "Radau", "LSODA"])
-def test_pendulum_with_pin_friction_follows_the_coupled_equations_with_every_method(method):
-    # released horizontal: swings down to the bottom and up the other side with friction
+@pytest.mark.parametrize("method,opts", [("DOPRI5", {}), ("DOPRI5", {"projection_tol": 1e-13}), ("RADAU5", {}),
+                                         ("RADAU5M", {}), ("Radau", {}), ("LSODA", {})])
+def test_pendulum_with_pin_friction_follows_the_coupled_equations_with_every_method(method, opts):
+    # released horizontal: swings down to the bottom and up the other side with friction; the
+    # projections after steps (minimum-norm steps with no forces) must not see the friction
     t = np.linspace(0.0, 0.6, 13)
-    res = ukflex.simulate(_pendulum().build(), t[-1], method=method, t_eval=t, rtol=1e-9, atol=1e-11)
+    res = ukflex.simulate(_pendulum().build(), t[-1], method=method, t_eval=t, rtol=1e-9, atol=1e-11, **opts)
     np.testing.assert_allclose(res.coordinate("rod.theta"), _pendulum_reference(t), atol=1e-6)
 
 

@@ -33,7 +33,8 @@ pub const CLOSURE_RTOL: f64 = 1e-12;
 /// Newton iterations before the closure reports failure.
 pub const CLOSURE_MAX_ITER: usize = 50;
 
-/// After a UK solve of the terms without friction (`data.qdd`, `data.lambda`, the factorization
+/// After a UK solve of the terms without friction (`uk::solve`; called by the acceleration
+/// functions, never by the projections' minimum-norm steps) (`data.qdd`, `data.lambda`, the factorization
 /// of `B^T`): close the friction loop, leaving the solution with friction in `data.qdd`,
 /// `data.lambda`, the friction forces added to `data.force` and in `FrictionWork::f`.
 /// `reuse`: the responses `(u_j, l_j)` of the last closure are still valid (same `q`, same
