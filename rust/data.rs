@@ -12,6 +12,7 @@ use crate::model::Model;
 use crate::error::{Error, Result};
 use crate::linalg::small_svd::QrJacobi;
 use crate::uk::sparse::SparseUk;
+use crate::force::friction::FrictionWork;
 /// The UK settings and rank types live in `uk::settings`; the workspace holds them (and
 /// `data::RankInfo`, ... stay valid paths).
 pub use crate::uk::settings::{Factored, RankInfo, RankTolerance, Stabilization, SvdBackend, UkSolver};
@@ -112,6 +113,8 @@ pub struct Data {
     pub dense_ready: bool,
     /// Largest allocation (bytes) a lazily sized buffer may take (`Error::Memory` above).
     pub memory_limit: u64,
+    /// The joint friction elements' buffers (`None` without any: `uk::friction`).
+    pub friction: Option<Box<FrictionWork>>,
 }
 
 impl Data {
@@ -176,6 +179,7 @@ impl Data {
             dense_ready: false,
             sparse,
             memory_limit,
+            friction: FrictionWork::new(&model.forces, &model.constraints, n, m),
         };
         if data.sparse.is_none() {
             data.ensure_dense(model)?;

@@ -23,6 +23,29 @@ pub fn mass_and_forces(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[
     for (f, turn) in model.forces.iter().zip(data.turns.iter_mut()) {
         f.add_to(&model.bodies, t, q, qd, &mut data.load_scratch, turn, &mut data.force);
     }
+    if data.friction.is_some() {
+        prepare_friction(model, data, q, qd);
+    }
+}
+
+/// Joint friction reads the multipliers: its slip rates here, its forces in `uk::acceleration`. Out of
+/// line: the scenes without friction keep their hot path as it was.
+#[cold]
+#[inline(never)]
+fn prepare_friction(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
+    if let Some(w) = data.friction.as_mut() {
+        w.prepare(&model.forces, &model.bodies, q, qd);
+    }
+}
+
+/// `data.force += ` the joint friction forces at the multipliers in `data.lambda` (those of
+/// the last UK solve) and the state of the last `mass_and_forces`: the velocity Jacobian `C` of
+/// the implicit methods' Newton matrices sees the friction's dependence on the rates at fixed
+/// reactions (`velocity_jacobians_into`, `sparse_newton::fill_velocity_terms`).
+pub fn add_friction_at_last_multipliers(model: &Model, data: &mut Data) {
+    if let Some(w) = &data.friction {
+        w.add_forces(&model.forces, &data.lambda, &mut data.force);
+    }
 }
 
 /// Factor each body block `M_b = F_b F_b^T` (after `mass_and_forces`).
@@ -187,6 +210,7 @@ pub fn velocity_jacobians_into(model: &Model, data: &mut Data, t: f64, q: &[f64]
         let s = 1e-3 * qd[j].abs().max(1.0);
         v[j] = qd[j] + s;
         mass_and_forces(model, data, t, q, v);
+        add_friction_at_last_multipliers(model, data);
         constraints(model, data, t, q, v, false);
         for i in 0..n {
             c[i * n + j] = -data.force[i];
@@ -196,6 +220,7 @@ pub fn velocity_jacobians_into(model: &Model, data: &mut Data, t: f64, q: &[f64]
         }
         v[j] = qd[j] - s;
         mass_and_forces(model, data, t, q, v);
+        add_friction_at_last_multipliers(model, data);
         constraints(model, data, t, q, v, false);
         for i in 0..n {
             c[i * n + j] = (c[i * n + j] + data.force[i]) / (2.0 * s);

@@ -363,6 +363,7 @@ pub fn fill_velocity_terms(model: &Model, data: &mut Data, t: f64, q: &[f64], qd
                 v[j] = qd[j] + sign * step(qd[j]);
             }
             mass_and_forces(model, data, t, q, v);
+            crate::dynamics::add_friction_at_last_multipliers(model, data);
             constraints(model, data, t, q, v, false);
             for &j in cols {
                 let s2 = 2.0 * step(qd[j]);

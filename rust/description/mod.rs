@@ -503,6 +503,29 @@ pub enum ForceDesc {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         rest_angle: Option<f64>,
     },
+    /// Regularized Coulomb and viscous friction in a planar revolute or prismatic joint,
+    /// from the joint's reaction (`force/friction.rs`, docs/loads.md).
+    JointFriction {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        /// The name of the revolute or prismatic joint.
+        joint: String,
+        /// Coulomb friction coefficient.
+        mu: f64,
+        /// Pin radius of a revolute joint (the friction torque's lever).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        radius: Option<f64>,
+        /// Slider length of a prismatic joint (its reaction moment adds normal force); absent:
+        /// the moment is left out.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        length: Option<f64>,
+        /// Viscous coefficient (N s/m or N m s/rad).
+        #[serde(default)]
+        damping: f64,
+        /// Regularization speed (m/s or rad/s); default `force::friction::DEFAULT_V_EPS`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        v_eps: Option<f64>,
+    },
     /// Linear stiffness and damping in x, y (in `b`'s frame) and the angle between two markers.
     Bushing {
         #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -627,6 +650,7 @@ impl ForceDesc {
             ForceDesc::RotationalSpringDamper { .. } => "rotational_spring_damper",
             ForceDesc::Bushing { .. } => "bushing",
             ForceDesc::RevoluteClearance { .. } => "revolute_clearance",
+            ForceDesc::JointFriction { .. } => "joint_friction",
         }
     }
 
@@ -640,7 +664,8 @@ impl ForceDesc {
             | ForceDesc::Motor { name, .. }
             | ForceDesc::RotationalSpringDamper { name, .. }
             | ForceDesc::Bushing { name, .. }
-            | ForceDesc::RevoluteClearance { name, .. } => name.as_deref(),
+            | ForceDesc::RevoluteClearance { name, .. }
+            | ForceDesc::JointFriction { name, .. } => name.as_deref(),
         }
     }
 }

@@ -3,10 +3,12 @@
 //! the spring-damper are here; each further kind has its file (docs/loads.md): loads that are
 //! functions of time and state (`load.rs`, their values in `value.rs`), motors (`motor.rs`),
 //! rotational spring-dampers (`rotational_spring.rs`), bushings (`bushing.rs`), revolute joints
-//! with clearance (`clearance.rs`).
+//! with clearance (`clearance.rs`), joint friction (`friction.rs`: not added by `add_to`, it
+//! reads the joint's multipliers: `uk::friction`).
 
 pub mod bushing;
 pub mod clearance;
+pub mod friction;
 pub mod load;
 pub mod motor;
 pub mod rotational_spring;
@@ -14,7 +16,7 @@ pub mod value;
 
 pub mod spatial;
 use crate::body::{Body, Marker};
-use crate::constraint::BuildContext;
+use crate::constraint::{BuildContext, Constraint};
 use crate::description::ForceDesc;
 use crate::error::{check_finite_item, non_negative, Result};
 
@@ -35,6 +37,8 @@ pub enum ForceKind {
     RotationalSpringDamper(Box<rotational_spring::RotationalSpringDamper>),
     Bushing(Box<bushing::Bushing>),
     RevoluteClearance(Box<clearance::Clearance>),
+    /// Coulomb and viscous friction in a joint, a function of its reaction (`friction.rs`).
+    JointFriction(Box<friction::JointFriction>),
 }
 
 #[derive(Debug, Clone)]
@@ -50,12 +54,14 @@ impl Force {
         match (&self.kind, d) {
             (ForceKind::SpringDamper { rest_length: r, .. }, ForceDesc::SpringDamper { rest_length, .. }) => *rest_length = Some(*r),
             (ForceKind::RotationalSpringDamper(r), ForceDesc::RotationalSpringDamper { rest_angle, .. }) => *rest_angle = Some(r.rest_angle),
+            (ForceKind::JointFriction(f), ForceDesc::JointFriction { v_eps, .. }) => *v_eps = Some(f.v_eps),
             _ => {}
         }
     }
 
-    /// Build a force element; `item` names it in errors.
-    pub fn from_desc(ctx: &BuildContext, item: &str, name: String, d: &ForceDesc) -> Result<Force> {
+    /// Build a force element; `item` names it in errors; `joints`: the joints so far (joint
+    /// friction names one).
+    pub fn from_desc(ctx: &BuildContext, joints: &[Constraint], item: &str, name: String, d: &ForceDesc) -> Result<Force> {
         let kind = match d {
             ForceDesc::PointForce { point, force, .. } => {
                 check_finite_item(item, "force", force)?;
@@ -103,6 +109,9 @@ impl Force {
                 };
                 ForceKind::RevoluteClearance(Box::new(clearance::Clearance::from_desc(ctx, item, journal, bearing, p)?))
             }
+            ForceDesc::JointFriction { joint, mu, radius, length, damping, v_eps, .. } => {
+                ForceKind::JointFriction(Box::new(friction::JointFriction::from_desc(item, joints, joint, *mu, *radius, *length, *damping, *v_eps)?))
+            }
         };
         Ok(Force { name, kind })
     }
@@ -119,6 +128,7 @@ impl Force {
             ForceKind::RotationalSpringDamper(r) => [Some(&r.a), Some(&r.b)],
             ForceKind::Bushing(b) => [Some(&b.a), Some(&b.b)],
             ForceKind::RevoluteClearance(c) => [Some(&c.journal), Some(&c.bearing)],
+            ForceKind::JointFriction(f) => [Some(&f.a), Some(&f.b)],
         }
     }
 
@@ -276,6 +286,8 @@ impl Force {
             ForceKind::RotationalSpringDamper(r) => r.add_to(bodies, q, qd, qvec),
             ForceKind::Bushing(b) => b.add_to(bodies, q, qd, qvec),
             ForceKind::RevoluteClearance(c) => c.add_to(bodies, q, qd, qvec),
+            // a function of the joint's multipliers: added by the UK kernel (`uk::friction`)
+            ForceKind::JointFriction(_) => {}
         }
     }
 
@@ -293,7 +305,7 @@ impl Force {
                 let ldot = (d[0] * (sa.v[0] - sb.v[0]) + d[1] * (sa.v[1] - sb.v[1])) / l;
                 0.5 * stiffness * ldot * ldot
             }
-            ForceKind::PointForce { .. } | ForceKind::Torque { .. } | ForceKind::Load(_) | ForceKind::Motor(_) => 0.0,
+            ForceKind::PointForce { .. } | ForceKind::Torque { .. } | ForceKind::Load(_) | ForceKind::Motor(_) | ForceKind::JointFriction(_) => 0.0,
             ForceKind::Spatial(f) => f.material_energy(bodies, q, v),
             ForceKind::RotationalSpringDamper(r) => r.material_energy(bodies, q, v),
             ForceKind::Bushing(b) => b.material_energy(bodies, q, v),
@@ -328,7 +340,7 @@ impl Force {
             // a load that is a function has no potential unless it is constant; a motor's work
             // is input, not stored (sensors: `external_work`)
             ForceKind::Load(l) => l.potential(bodies, q).unwrap_or(0.0),
-            ForceKind::Motor(_) => 0.0,
+            ForceKind::Motor(_) | ForceKind::JointFriction(_) => 0.0,
         }
     }
 }

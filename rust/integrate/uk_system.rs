@@ -140,6 +140,10 @@ impl SecondOrderSystem for UkSystem<'_> {
         let (model, data) = (self.model, &mut self.data);
         let n = model.n;
         dynamics::mass_and_forces(model, data, t, q, qd);
+        if let Some(w) = &data.friction {
+            // joint friction at the iterate's multipliers: the loop closes in the Newton iteration
+            w.add_forces(&model.forces, lambda, &mut data.force);
+        }
         dynamics::constraints(model, data, t, q, qd, false);
         dynamics::mass_times(model, data, qdd, r1);
         for i in 0..n {

@@ -461,7 +461,7 @@ impl ModelBuilder {
     pub fn add_force(&mut self, d: &ForceDesc) -> Result<&Force> {
         let j = self.forces.len();
         let item = item_name(Section::Force, d.kind(), d.name(), j);
-        let f = Force::from_desc(&self.context(), &item, String::new(), d)?;
+        let f = Force::from_desc(&self.context(), &self.joints, &item, String::new(), d)?;
         let name = self.take_name(&item, d.name(), format!("{}{j}", d.kind()))?;
         if let crate::force::ForceKind::Motor(m) = &f.kind {
             if m.rotor_inertia > 0.0 {

@@ -92,7 +92,17 @@ pub fn unwrap_torque_potentials(model: &Model, fp: &mut [f64], nt: usize) {
 /// is taken out here and their whole power is [`load_power`] (external work). A contact (a
 /// revolute joint with clearance) dissipates `-qd . (Q_c(q, qd) - Q_c(q, 0))`, which is not odd
 /// in `qd`: its odd part is replaced by that. `g` is a third n-long scratch.
-pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], v: &mut [f64], f: &mut [f64], g: &mut [f64]) -> f64 {
+///
+/// Joint friction (`force::friction`, not in `Q`: it reads the multipliers) adds `-sum F_i v_i`,
+/// its forces closed with the reactions by a UK solve at the state.
+pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], v: &mut [f64], f: &mut [f64], g: &mut [f64]) -> Result<f64> {
+    let friction = match data.friction.is_some() {
+        true => {
+            uk::acceleration(model, data, t, q, qd)?;
+            -data.friction.as_ref().map_or(0.0, |w| w.power())
+        }
+        false => 0.0,
+    };
     dynamics::mass_and_forces(model, data, t, q, qd);
     f.copy_from_slice(&data.force);
     for (vi, x) in v.iter_mut().zip(qd) {
@@ -112,7 +122,7 @@ pub fn dissipation_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: 
         let rest = forces_power(model, data, t, q, f, qd, g, is_contact);
         p += 0.5 * (plus - minus) - (plus - rest);
     }
-    p
+    Ok(p + friction)
 }
 
 /// Whether a force is a contact (a revolute joint with clearance), whose dissipated power

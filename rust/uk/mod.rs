@@ -14,6 +14,7 @@
 //! algorithm: evaluate the terms, the free acceleration, factor, correct.
 
 pub mod dense;
+pub mod friction;
 pub mod settings;
 pub mod sparse;
 
@@ -37,9 +38,10 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], w
 }
 
 /// UK acceleration into `data.qdd` and multipliers into `data.lambda`, from the terms already
-/// in `data` (see `evaluate`). The three stages below can also be called separately: the
-/// factorization of `B^T` depends on `q` only (through `M` and `A`), so a caller that changes
-/// only `Q` and `b` (velocity columns of a Jacobian) may reuse it.
+/// in `data` (see `evaluate`), joint friction left out (`solve_closed` adds it). The three
+/// stages below can also be called separately: the factorization of `B^T` depends on `q`
+/// only (through `M` and `A`), so a caller that changes only `Q` and `b` (velocity columns of
+/// a Jacobian) may reuse it.
 pub fn solve(model: &Model, data: &mut Data) -> Result<()> {
     free_acceleration(model, data);
     if model.m == 0 {
@@ -49,6 +51,19 @@ pub fn solve(model: &Model, data: &mut Data) -> Result<()> {
     }
     factor_constraints(model, data)?;
     correct(model, data);
+    Ok(())
+}
+
+/// `solve`, then the joint friction closed with the multipliers (`friction::close`; nothing
+/// without friction elements). The acceleration calls use this; `solve` alone is the linear
+/// UK solve of the terms in `data` (the projections' minimum-norm steps, with `Q = 0`, must
+/// not see friction).
+#[inline]
+fn solve_closed(model: &Model, data: &mut Data) -> Result<()> {
+    solve(model, data)?;
+    if data.friction.is_some() && model.m > 0 {
+        friction::close(model, data, false)?;
+    }
     Ok(())
 }
 
@@ -102,7 +117,7 @@ pub fn acceleration(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64
     let with_phi = matches!(data.stabilization, Stabilization::Baumgarte { .. });
     evaluate(model, data, t, q, qd, with_phi)?;
     stabilize_rhs(model, data, qd);
-    solve(model, data)
+    solve_closed(model, data)
 }
 
 /// `acceleration` that also leaves `Phi` in `data.phi` (for a projection that reuses the
@@ -110,7 +125,7 @@ pub fn acceleration(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64
 pub fn acceleration_with_phi(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]) -> Result<()> {
     evaluate(model, data, t, q, qd, true)?;
     stabilize_rhs(model, data, qd);
-    solve(model, data)
+    solve_closed(model, data)
 }
 
 /// `data.qdd = F^-T B^+ r`: the minimum-mass-norm `dx` with `A dx = r`, from the
@@ -148,6 +163,10 @@ pub fn acceleration_same_q(model: &Model, data: &mut Data, t: f64, q: &[f64], qd
         data.qdd.copy_from_slice(&data.qdd_free);
     } else {
         correct(model, data);
+        if data.friction.is_some() {
+            // the responses to the friction forces depend on q only: those of the full call
+            friction::close(model, data, true)?;
+        }
     }
     Ok(())
 }
@@ -166,7 +185,7 @@ fn stabilize_rhs(model: &Model, data: &mut Data, qd: &[f64]) {
 /// `A qd + Phi_t`, acceleration `A qdd - b`, written into the three slices (length m).
 pub fn residuals(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], pos: &mut [f64], vel: &mut [f64], acc: &mut [f64]) -> Result<()> {
     evaluate(model, data, t, q, qd, true)?;
-    solve(model, data)?;
+    solve_closed(model, data)?;
     for i in 0..model.m {
         pos[i] = data.phi[i];
         vel[i] = data.ajac.row_dot(i, qd) + data.phi_t[i];

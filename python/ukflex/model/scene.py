@@ -772,6 +772,28 @@ class Scene:
         d = dict(kind="rotational_spring_damper", a=a, stiffness=stiffness, damping=damping, **_given(b=b, rest_angle=rest_angle))
         return self._add("forces", d, name)
 
+    def joint_friction(
+        self,
+        joint: str,
+        *,
+        mu: float,
+        radius: Optional[float] = None,
+        length: Optional[float] = None,
+        damping: float = 0.0,
+        v_eps: Optional[float] = None,
+        name: Optional[str] = None,
+    ) -> str:
+        """Regularized Coulomb and viscous friction in the revolute or prismatic joint named
+        ``joint`` (added before), from its reaction: a revolute's torque
+        ``-mu radius |F| sat(w / v_eps) - damping w`` (``radius``: the pin radius), a
+        prismatic's force ``-mu N_eff sat(v / v_eps) - damping v`` along the slide axis
+        (``N_eff = |N|``, or ``max(|N|, 2 |M| / length)`` with a slider ``length`` that
+        carries the reaction moment ``M``). ``sat(x) = clamp(x, -1, 1)``; ``v_eps=None`` takes
+        the core's default (docs/loads.md, "Joint friction"). The friction is closed with the
+        reactions in every acceleration call."""
+        d = dict(kind="joint_friction", joint=joint, mu=mu, damping=damping, **_given(radius=radius, length=length, v_eps=v_eps))
+        return self._add("forces", d, name)
+
     def bushing(
         self,
         a: MarkerLike,

@@ -180,7 +180,7 @@ impl PySystem {
                     sensors::reactions_into(model, &mut ws.data, ts[k], qk, qdk, &mut rx[k * nc * 6..(k + 1) * nc * 6])?;
                 }
                 sensors::energies_into(model, &mut ws.data, ts[k], qk, qdk, &mut be[k * nb * 3..(k + 1) * nb * 3], &mut fp[k * nf..(k + 1) * nf]);
-                dp[k] = sensors::dissipation_power(model, &mut ws.data, ts[k], qk, qdk, &mut v, &mut f, &mut g);
+                dp[k] = sensors::dissipation_power(model, &mut ws.data, ts[k], qk, qdk, &mut v, &mut f, &mut g)?;
                 lp[k] = sensors::load_power(model, &mut ws.data, ts[k], qk, qdk, qdk, &mut g);
                 sensors::clearance_into(model, qk, qdk, &mut cl[k * ncl * nccol..(k + 1) * ncl * nccol]);
             }

@@ -70,7 +70,7 @@ impl PySystem {
                     ke[k] = dynamics::kinetic_energy(model, &mut ws.data, qk, qdk);
                     // spatial bodies carry no strain and no body gravity: the force elements' potentials
                     pe[k] = fp[k * nf..(k + 1) * nf].iter().sum();
-                    dp[k] = sensors::dissipation_power(model, &mut ws.data, ts[k], qk, qdk, &mut v, &mut f, &mut g);
+                    dp[k] = sensors::dissipation_power(model, &mut ws.data, ts[k], qk, qdk, &mut v, &mut f, &mut g)?;
                     dv[k * nc..(k + 1) * nc].copy_from_slice(&outputs::driver_values(model, ts[k], qk, &mut scratch));
                 }
                 Ok(())
