@@ -11,6 +11,7 @@ or their output folder:
   python -m studies geometric --out results/geometric --quick
   python -m studies flexible-coupler [--nonlinear] [--mesh] [--modal-derivatives[=K]] [--figure PNG]
   python -m studies simeon-crank [--nonlinear]
+  python -m studies spatial-fe-bar
   python -m studies sweeps --out results/sweeps [--small]
 """
 
@@ -178,6 +179,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_geometric_parser(sub)
     _passthrough(sub, "flexible-coupler", "flexible_coupler", "the FE-reduced coupler against the beam (docs/flexible-bodies.md)")
     _passthrough(sub, "simeon-crank", "simeon_crank", "Simeon's flexible slider-crank test set (docs/flexible-bodies.md)")
+    _passthrough(sub, "spatial-fe-bar", "spatial_fe_bar", "the modes of a 3D FE bar against closed forms (docs/spatial-flexible.md)")
     _passthrough(sub, "sweeps", "sweeps", "the sweep study: serial, processes, Dask (docs/sweeps.md)")
     return parser
 
