@@ -426,7 +426,7 @@ impl Flexible3 {
 
     /// `out += M x` with `M = T^T Mv T + 4 k p p^T`.
     pub fn mass_times(&self, bd: &Flexible3Data, x: &[f64], out: &mut [f64]) {
-        let (n, m) = (self.n, 6 + self.n);
+        let m = 6 + self.n;
         let g = rot_g(&bd.p);
         let xr = mat_t_vec(&bd.r, &[x[0], x[1], x[2]]);
         let mut xw = [0.0; 3];
@@ -453,7 +453,6 @@ impl Flexible3 {
         for c in 0..4 {
             out[3 + c] += 2.0 * (g[0][c] * zw[0] + g[1][c] * zw[1] + g[2][c] * zw[2]) + 4.0 * self.k * bd.p[c] * px;
         }
-        let _ = n;
     }
 
     /// The entries of `M` (inspection, correction; allocates).
@@ -524,7 +523,7 @@ impl Flexible3 {
     pub fn add_gravity(&self, q: &[f64], g: &V3, f: &mut [f64]) {
         let n = self.n;
         let p = &q[3..7];
-        let (r, _, p2) = Self::frame(p, &[0.0; 4]);
+        let (r, _, _) = Self::frame(p, &[0.0; 4]);
         let gb = mat_t_vec(&r, g);
         let st = self.first_moment(&q[7..7 + n]);
         for c in 0..3 {
@@ -538,7 +537,6 @@ impl Flexible3 {
         for j in 0..n {
             f[7 + j] += dot(&self.first[j + 1], &gb);
         }
-        let _ = p2;
     }
 
     /// `-g . int rho r_P dV = -g . (m r + R S_t)`.
