@@ -143,6 +143,9 @@ def test_bad_input_named_errors():
         fe3.from_mesh(mesh, interfaces={"A": _face(0.0)}, modes=10 ** 6, **ok)
     with pytest.raises(InvalidArgumentError, match="selects no node"):
         fe3.from_mesh(mesh, interfaces={"A": _face(7.0)}, **ok)
+    axis = lambda x: (np.abs(x[:, 1]) < 1e-9) & (np.abs(x[:, 2]) < 1e-9)  # noqa: E731 - nodes on a line
+    with pytest.raises(InvalidArgumentError, match="on a line"):
+        fe3.from_mesh(mesh, interfaces={"A": axis}, **ok)
     # a degenerate (flat) tetrahedron
     flat = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], dtype=float)
     with pytest.raises(InvalidArgumentError, match="degenerate"):
