@@ -11,6 +11,8 @@ or their output folder:
   python -m studies geometric --out results/geometric --quick
   python -m studies flexible-coupler [--nonlinear] [--mesh] [--modal-derivatives[=K]] [--figure PNG]
   python -m studies simeon-crank [--nonlinear]
+  python -m studies spatial-fe-bar
+  python -m studies spatial-flexible-exudyn
   python -m studies sweeps --out results/sweeps [--small]
   python -m studies clearance [flores]
 """
@@ -186,6 +188,8 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_geometric_parser(sub)
     _passthrough(sub, "flexible-coupler", "flexible_coupler", "the FE-reduced coupler against the beam (docs/flexible-bodies.md)")
     _passthrough(sub, "simeon-crank", "simeon_crank", "Simeon's flexible slider-crank test set (docs/flexible-bodies.md)")
+    _passthrough(sub, "spatial-fe-bar", "spatial_fe_bar", "the modes of a 3D FE bar against closed forms (docs/spatial-flexible.md)")
+    _passthrough(sub, "spatial-flexible-exudyn", "spatial_flexible_exudyn", "the 3D flexible pendulum against Exudyn's ObjectFFRFreducedOrder (docs/spatial-flexible.md)")
     _passthrough(sub, "sweeps", "sweeps", "the sweep study: serial, processes, Dask (docs/sweeps.md)")
     _passthrough(sub, "clearance", "clearance", "revolute joints with clearance: Flores's slider-crank, the flexible coupler (docs/loads.md)")
     return parser

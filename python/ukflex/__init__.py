@@ -62,9 +62,10 @@ from .results.spatial import outputs as spatial_outputs
 from .results.vtk import export_vtk
 
 #: Public modules of the rooms, loaded on first use: ``ukflex.fe`` (flexible bodies from FE
-#: data, :mod:`ukflex.model.fe`) and ``ukflex.stability`` (diagnostics of runs,
+#: data, :mod:`ukflex.model.fe`), ``ukflex.fe3`` (spatial flexible bodies from 3D FE data,
+#: :mod:`ukflex.model.fe3`) and ``ukflex.stability`` (diagnostics of runs,
 #: :mod:`ukflex.analysis.stability`).
-_LAZY = {"fe": "ukflex.model.fe", "stability": "ukflex.analysis.stability"}
+_LAZY = {"fe": "ukflex.model.fe", "fe3": "ukflex.model.fe3", "stability": "ukflex.analysis.stability"}
 
 
 def __getattr__(name: str):

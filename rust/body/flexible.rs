@@ -44,7 +44,7 @@ pub struct Flexible {
 }
 
 /// A matrix given as rows, checked `n x n` and finite, with its largest |entry|.
-fn square(item: &str, what: &str, rows: &[Vec<f64>], n: usize) -> Result<(Vec<f64>, f64)> {
+pub(crate) fn square(item: &str, what: &str, rows: &[Vec<f64>], n: usize) -> Result<(Vec<f64>, f64)> {
     if rows.len() != n || rows.iter().any(|r| r.len() != n) {
         let got: Vec<usize> = rows.iter().map(|r| r.len()).collect();
         return Err(Error::invalid(item, format!("{what} must be {n} x {n} (n_f = {n}, the size of k_ff), got {} rows of lengths {got:?}", rows.len())));
@@ -56,7 +56,7 @@ fn square(item: &str, what: &str, rows: &[Vec<f64>], n: usize) -> Result<(Vec<f6
 }
 
 /// `a[i][j] = sign * a[j][i]` within `SYM_TOL` of the largest entry.
-fn check_symmetry(item: &str, what: &str, a: &[f64], n: usize, big: f64, sign: f64) -> Result<()> {
+pub(crate) fn check_symmetry(item: &str, what: &str, a: &[f64], n: usize, big: f64, sign: f64) -> Result<()> {
     for i in 0..n {
         for j in 0..i {
             let (x, y) = (a[i * n + j], sign * a[j * n + i]);

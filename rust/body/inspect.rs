@@ -58,6 +58,7 @@ impl Body {
         match &self.kind {
             BodyKind::Rigid(_) | BodyKind::Rigid3(_) => Capabilities { oriented: true, ..Default::default() },
             BodyKind::PointMass(_) | BodyKind::Point3(_) => Capabilities::default(),
+            BodyKind::Flexible3(f) => Capabilities { elastic: true, elastic_coordinates: true, oriented: true, damped: f.d_ff.is_some(), ..Default::default() },
             BodyKind::Beam(b) => Capabilities { beam: true, elastic: true, elastic_coordinates: true, axial_forces: true, oriented: true, damped: b.damping > 0.0, ..Default::default() },
             BodyKind::Cable(c) => Capabilities { beam: true, elastic: true, oriented: true, nodal_deformation: true, damped: c.damping > 0.0, ..Default::default() },
             BodyKind::Flexible(f) => Capabilities { elastic: true, elastic_coordinates: true, named_markers: true, oriented: true, damped: f.d_ff.is_some(), ..Default::default() },
@@ -78,6 +79,7 @@ impl Body {
             BodyKind::Cable(k) => k.info(&mut m),
             BodyKind::Flexible(k) => k.info(&mut m),
             BodyKind::Rigid3(k) => k.info(&mut m),
+            BodyKind::Flexible3(k) => k.info(&mut m),
             BodyKind::PointMass(_) | BodyKind::Point3(_) => {}
         }
         m

@@ -6,13 +6,18 @@
 //! `a = A c`, `J_a = [0, B(p, c)]`, `ad = B(p, c) pd`, `h_a = 2 A(pd) c`.
 //!
 //! Ground markers are constants; a point mass's marker is the particle with the world axes.
+//! On a `flexible3` body a marker sits on an interface node and moves with the deformation:
+//! `s' = u0 + Phi q_f` and axes `c' = c + (Psi q_f) x c` (the node's small rotation, linear in
+//! `q_f` as the modal field is), so `J_P = [I, B(p, s'), A Phi]`,
+//! `h_P = 2 A(pd) s' + 2 B(p, Phi qd_f) pd`, `J_a = [0, B(p, c'), -A ~c Psi]`,
+//! `h_a = 2 A(pd) c' + 2 B(p, (Psi qd_f) x c) pd`.
 //! `base` is the marker as the planar machinery sees it (its body, `MarkerShape::Spatial`),
 //! which gives the structural pattern (`Marker::coords`) to `sparse_newton`.
 
-use super::{Body, BodyKind, Marker, MarkerShape};
+use super::{Body, BodyKind, Flexible3, Marker, MarkerShape};
 use crate::error::{check_finite_item, Error, Result};
 use crate::description::spatial::Marker3Desc;
-use crate::linalg::rot3::{add, col, frame_from_z, m34_t_vec, m34_vec, mat_vec, norm, quad_term, rot_a, rot_b, scale, sub, M3, M34, V3};
+use crate::linalg::rot3::{add, col, cross, frame_from_z, m34_t_vec, m34_vec, mat_vec, norm, quad_term, rot_a, rot_b, scale, sub, M3, M34, V3};
 
 /// Every axis (`Marker3::state_axes`).
 pub const ALL_AXES: u8 = 0b111;
@@ -28,6 +33,8 @@ pub struct Marker3 {
     pub s: V3,
     /// Axes (columns `x, y, z`) in body axes (world axes for the ground and point masses).
     pub c: M3,
+    /// The interface node of a `flexible3` body the marker sits on.
+    pub iface: Option<usize>,
 }
 
 /// A vector quantity of one marker with its Jacobian (`jr`: the identity `r` block of a point,
@@ -39,6 +46,11 @@ pub struct Kin3 {
     pub h: V3,
     pub jr: f64,
     pub jp: M34,
+    /// On a `flexible3` body: 1 the point, `2 + k` the axis `k` (its elastic Jacobian columns,
+    /// `Flexible3::add_marker_jacobian`); 0 otherwise.
+    pub flex: u8,
+    /// The axis in body axes (undeformed) of an axis quantity on a `flexible3` body.
+    pub c: V3,
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -47,6 +59,9 @@ pub struct Marker3State {
     pub rigid: bool,
     pub point: Kin3,
     pub axes: [Kin3; 3],
+    /// `flexible3`: the interface node and `A(p)` (the elastic Jacobian's rotation).
+    pub iface: Option<usize>,
+    pub rot: M3,
 }
 
 /// A frame's axes from a description: `z` (default `(0, 0, 1)`, normalized; zero or non-finite
@@ -75,7 +90,7 @@ impl Marker3 {
         let point = md.point.unwrap_or([0.0; 3]);
         check_finite_item(item, "marker point", &point)?;
         if md.body == "ground" {
-            return Ok(Marker3 { base: Marker { body: None, angle: 0.0, shape: MarkerShape::Spatial }, body: None, rigid: false, s: point, c });
+            return Ok(Marker3 { base: Marker { body: None, angle: 0.0, shape: MarkerShape::Spatial }, body: None, rigid: false, s: point, c, iface: None });
         }
         let Some(&bi) = index.get(&md.body) else {
             let mut known: Vec<&str> = vec!["ground"];
@@ -84,14 +99,25 @@ impl Marker3 {
         };
         let base = Marker { body: Some(bi), angle: 0.0, shape: MarkerShape::Spatial };
         match &bodies[bi].kind {
-            BodyKind::Rigid3(k) => Ok(Marker3 { base, body: Some(bi), rigid: true, s: sub(&point, &k.com), c }),
+            BodyKind::Rigid3(k) => Ok(Marker3 { base, body: Some(bi), rigid: true, s: sub(&point, &k.com), c, iface: None }),
+            BodyKind::Flexible3(k) => {
+                let Some(f) = k.interface_at(&point) else {
+                    let pts: Vec<String> = k.interfaces.iter().map(|f| format!("{:?}", f.point)).collect();
+                    return Err(Error::invalid(item, format!(
+                        "a marker on flexible body '{}' must sit on one of its interface nodes (markers move with the node's deformation); no interface node at {point:?}; interface nodes: [{}]",
+                        md.body,
+                        pts.join(", ")
+                    )));
+                };
+                Ok(Marker3 { base, body: Some(bi), rigid: true, s: point, c, iface: Some(f) })
+            }
             BodyKind::Point3(_) => {
                 if point != [0.0; 3] {
                     return Err(Error::invalid(item, format!("a marker on point mass '{}' is the particle itself: point must be [0, 0, 0], got {point:?}", md.body)));
                 }
-                Ok(Marker3 { base, body: Some(bi), rigid: false, s: point, c })
+                Ok(Marker3 { base, body: Some(bi), rigid: false, s: point, c, iface: None })
             }
-            _ => Err(Error::invalid(item, format!("body '{}' is planar: a spatial scene holds only rigid3 and point3 bodies", md.body))),
+            _ => Err(Error::invalid(item, format!("body '{}' is planar: a spatial scene holds only rigid3, point3 and flexible3 bodies", md.body))),
         }
     }
 
@@ -114,7 +140,7 @@ impl Marker3 {
     /// spherical joint computes no axis at all.
     #[inline]
     pub fn state_axes(&self, bodies: &[Body], q: &[f64], qd: &[f64], axes: u8) -> Marker3State {
-        let mut st = Marker3State { body: self.body, rigid: self.rigid, ..Default::default() };
+        let mut st = Marker3State { body: self.body, rigid: self.rigid, iface: self.iface, ..Default::default() };
         for k in 0..3 {
             if axes & (1 << k) != 0 {
                 st.axes[k].v = col(&self.c, k);
@@ -134,17 +160,48 @@ impl Marker3 {
             return st;
         }
         let (p, pd) = (&q[o + 3..o + 7], &qd[o + 3..o + 7]);
+        if let (Some(f), BodyKind::Flexible3(k)) = (self.iface, &bodies[bi].kind) {
+            return self.flexible_state(st, k, f, r, rd, q, qd, o, axes);
+        }
         let a = rot_a(p);
         let ad = rot_a(pd);
         let jp = rot_b(p, &self.s);
-        st.point = Kin3 { v: add(&r, &mat_vec(&a, &self.s)), vd: add(&rd, &m34_vec(&jp, pd)), h: scale(2.0, &mat_vec(&ad, &self.s)), jr: 1.0, jp };
+        st.point = Kin3 { v: add(&r, &mat_vec(&a, &self.s)), vd: add(&rd, &m34_vec(&jp, pd)), h: scale(2.0, &mat_vec(&ad, &self.s)), jr: 1.0, jp, ..Default::default() };
         for k in 0..3 {
             if axes & (1 << k) == 0 {
                 continue;
             }
             let ck = col(&self.c, k);
             let jp = rot_b(p, &ck);
-            st.axes[k] = Kin3 { v: mat_vec(&a, &ck), vd: m34_vec(&jp, pd), h: quad_term(pd, &ck), jr: 0.0, jp };
+            st.axes[k] = Kin3 { v: mat_vec(&a, &ck), vd: m34_vec(&jp, pd), h: quad_term(pd, &ck), jr: 0.0, jp, ..Default::default() };
+        }
+        st
+    }
+
+    /// `state_axes` of a marker on an interface node of a `flexible3` body (module docs).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn flexible_state(&self, mut st: Marker3State, k: &Flexible3, f: usize, r: V3, rd: V3, q: &[f64], qd: &[f64], o: usize, axes: u8) -> Marker3State {
+        let n = k.n;
+        let (p, pd) = (&q[o + 3..o + 7], &qd[o + 3..o + 7]);
+        let [s, sd, th, thd] = k.interface_state(f, &q[o + 7..o + 7 + n], &qd[o + 7..o + 7 + n]);
+        let a = rot_a(p);
+        st.rot = a;
+        let jp = rot_b(p, &s);
+        let vd = add(&add(&rd, &m34_vec(&jp, pd)), &mat_vec(&a, &sd));
+        let h = add(&quad_term(pd, &s), &scale(2.0, &m34_vec(&rot_b(p, &sd), pd)));
+        st.point = Kin3 { v: add(&r, &mat_vec(&a, &s)), vd, h, jr: 1.0, jp, flex: 1, c: [0.0; 3] };
+        for kx in 0..3 {
+            if axes & (1 << kx) == 0 {
+                continue;
+            }
+            let ck = col(&self.c, kx);
+            let cd = cross(&thd, &ck);
+            let cc = add(&ck, &cross(&th, &ck));
+            let jp = rot_b(p, &cc);
+            let vd = add(&m34_vec(&jp, pd), &mat_vec(&a, &cd));
+            let h = add(&quad_term(pd, &cc), &scale(2.0, &m34_vec(&rot_b(p, &cd), pd)));
+            st.axes[kx] = Kin3 { v: mat_vec(&a, &cc), vd, h, jr: 0.0, jp, flex: 2 + kx as u8, c: ck };
         }
         st
     }
@@ -168,6 +225,11 @@ pub fn add_jacobian(bodies: &[Body], ms: &Marker3State, k: &Kin3, w: &V3, row: &
         let g = m34_t_vec(&k.jp, w);
         for l in 0..4 {
             row[start + 3 + l] += g[l];
+        }
+    }
+    if k.flex != 0 {
+        if let (Some(f), BodyKind::Flexible3(b)) = (ms.iface, &bodies[bi].kind) {
+            b.add_marker_jacobian(f, k.flex, &k.c, &ms.rot, w, &mut row[start + 7..start + 7 + b.n]);
         }
     }
 }

@@ -18,6 +18,9 @@ pub mod ffrf_beam;
 pub mod frame;
 pub mod marker;
 pub mod flexible;
+pub mod flexible3;
+#[cfg(test)]
+mod flexible3_tests;
 pub mod inspect;
 pub mod marker3;
 pub mod outline;
@@ -32,6 +35,7 @@ pub use ffrf_beam::{Beam, BeamData};
 pub use inspect::{Array, Capabilities};
 pub use marker::{Marker, MarkerShape, MarkerState};
 pub use flexible::Flexible;
+pub use flexible3::{Flexible3, Flexible3Data};
 pub use point_mass::{PointMass, PointMassData};
 pub use rigid::{Rigid, RigidData};
 pub use point3::{Point3, Point3Data};
@@ -52,6 +56,7 @@ macro_rules! with_kind {
             BodyKind::Flexible($k) => $e,
             BodyKind::Rigid3($k) => $e,
             BodyKind::Point3($k) => $e,
+            BodyKind::Flexible3($k) => $e,
         }
     };
 }
@@ -64,6 +69,7 @@ macro_rules! with_elastic_kind {
             BodyKind::Beam($k) => $e,
             BodyKind::Cable($k) => $e,
             BodyKind::Flexible($k) => $e,
+            BodyKind::Flexible3($k) => $e,
             BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Rigid3(_) | BodyKind::Point3(_) => $rigid,
         }
     };
@@ -80,6 +86,7 @@ macro_rules! with_kind_data {
             (BodyKind::Flexible($k), BodyData::Flexible($d)) => $e,
             (BodyKind::Rigid3($k), BodyData::Rigid3($d)) => $e,
             (BodyKind::Point3($k), BodyData::Point3($d)) => $e,
+            (BodyKind::Flexible3($k), BodyData::Flexible3($d)) => $e,
             _ => unreachable!("body data of another kind"),
         }
     };
@@ -99,6 +106,8 @@ pub enum BodyKind {
     Rigid3(Rigid3),
     /// Spatial point mass (`point3.rs`).
     Point3(Point3),
+    /// Spatial floating-frame modal body (`flexible3.rs`).
+    Flexible3(Flexible3),
 }
 
 /// Per-body workspace, one variant per kind (sized once in `Data::new`).
@@ -112,6 +121,7 @@ pub enum BodyData {
     Flexible(FfrfData),
     Rigid3(Rigid3Data),
     Point3(Point3Data),
+    Flexible3(Flexible3Data),
 }
 
 #[derive(Debug, Clone)]
@@ -170,6 +180,7 @@ impl Body {
             BodyKind::Flexible(_) => "flexible",
             BodyKind::Rigid3(_) => "rigid3",
             BodyKind::Point3(_) => "point3",
+            BodyKind::Flexible3(_) => "flexible3",
         }
     }
 
@@ -178,6 +189,7 @@ impl Body {
     pub fn elastic_range(&self) -> std::ops::Range<usize> {
         match &self.kind {
             BodyKind::Beam(_) | BodyKind::Flexible(_) => self.offset + 3..self.offset + self.n_coords,
+            BodyKind::Flexible3(_) => self.offset + 7..self.offset + self.n_coords,
             BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Cable(_) | BodyKind::Rigid3(_) | BodyKind::Point3(_) => self.offset..self.offset,
         }
     }
@@ -211,6 +223,7 @@ impl Body {
             BodyKind::Flexible(k) => BodyData::Flexible(k.new_data()),
             BodyKind::Rigid3(k) => BodyData::Rigid3(k.new_data()),
             BodyKind::Point3(k) => BodyData::Point3(k.new_data()),
+            BodyKind::Flexible3(k) => BodyData::Flexible3(k.new_data()),
         }
     }
 
@@ -319,8 +332,8 @@ impl Body {
                 put(o + 1, col0 + 1, 1.0);
                 2
             }
-            BodyKind::Rigid3(_) | BodyKind::Point3(_) => {
-                let (qb, vb) = (self.seg(q), self.seg(qd));
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) | BodyKind::Flexible3(_) => {
+                let (qb, vb) = (&self.seg(q)[..self.n_coords.min(7)], &self.seg(qd)[..self.n_coords.min(7)]);
                 rigid3_motions(qb, vb, o, col0, put, &mut cen[o..o + self.n_coords])
             }
             BodyKind::Rigid(_) | BodyKind::Beam(_) | BodyKind::Flexible(_) => {
@@ -344,8 +357,8 @@ impl Body {
                 q[o] += x[0];
                 q[o + 1] += x[1];
             }
-            BodyKind::Rigid3(_) | BodyKind::Point3(_) => {
-                let n = self.n_coords;
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) | BodyKind::Flexible3(_) => {
+                let n = self.n_coords.min(7);
                 rigid3_move(&mut q[o..o + n], x)
             }
             BodyKind::Rigid(_) | BodyKind::Beam(_) | BodyKind::Flexible(_) => {
@@ -373,7 +386,7 @@ impl Body {
                 point_mass::check_marker(md, &self.name, item)?;
                 MarkerShape::Particle
             }
-            BodyKind::Rigid3(_) | BodyKind::Point3(_) => {
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) | BodyKind::Flexible3(_) => {
                 return Err(Error::invalid(item, format!("body '{}' is spatial: a planar item cannot attach to it (a scene does not mix dimensions)", self.name)));
             }
         };

@@ -22,7 +22,7 @@ impl Body {
             BodyKind::Beam(k) => k.outline_points(per_element),
             BodyKind::Cable(k) => k.outline_points(per_element),
             BodyKind::Flexible(k) => k.outline_points(),
-            BodyKind::Rigid3(_) | BodyKind::Point3(_) => return Err(self.not_a("a planar body (its outline is drawn by the 3D animation)")),
+            BodyKind::Rigid3(_) | BodyKind::Point3(_) | BodyKind::Flexible3(_) => return Err(self.not_a("a planar body (its outline is drawn by the 3D animation)")),
         };
         Ok(shapes.iter().map(|sh| self.drawn_point(sh, q, s)).collect())
     }

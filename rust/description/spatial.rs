@@ -22,6 +22,7 @@ pub enum OrientationDesc {
 pub enum Body3Desc {
     Rigid3(Rigid3Desc),
     Point3(Point3Desc),
+    Flexible3(Flexible3Desc),
 }
 
 impl Body3Desc {
@@ -29,6 +30,7 @@ impl Body3Desc {
         match self {
             Body3Desc::Rigid3(r) => &r.name,
             Body3Desc::Point3(p) => &p.name,
+            Body3Desc::Flexible3(f) => &f.name,
         }
     }
 }
@@ -73,6 +75,52 @@ fn inertia_matrix<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[[f64; 3]; 3
         Ok(Inertia::Principal([a, b, c])) => Ok([[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]]),
         Err(_) => Err(serde::de::Error::custom("inertia must be a 3x3 matrix (rows) or its 3 principal moments [Ixx, Iyy, Izz]")),
     }
+}
+
+/// A 3D floating-frame modal body (`body/flexible3.rs`, docs/spatial-flexible.md): coordinates
+/// `[r (3), p (4), q_f (n)]`, `r` the origin of the floating frame (world), `p` its Euler
+/// parameters, `q_f` the elastic (modal) coordinates; the displacement field
+/// `u(P) = u0(P) + sum_j S_j(P) q_f,j` in the frame. With the extended shapes `S_0 = u0` and
+/// `xi = [1, q_f]` the body is given by its inertia invariants: `first_moment[a] = int rho S_a dV`
+/// (n + 1 vectors) and `second_moment[a (n + 1) + b] = int rho S_a S_b^T dV` (3x3 each).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Flexible3Desc {
+    pub name: String,
+    pub mass: f64,
+    pub first_moment: Vec<Vec3>,
+    pub second_moment: Vec<[[f64; 3]; 3]>,
+    pub k_ff: Vec<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d_ff: Option<Vec<Vec<f64>>>,
+    /// Interface nodes (the only places markers may sit): undeformed point, per-mode nodal
+    /// displacement `phi` (n x 3) and rotation `psi` (n x 3, default zero).
+    #[serde(default)]
+    pub interfaces: Vec<Interface3Desc>,
+    /// Origin of the floating frame (world).
+    #[serde(default)]
+    pub position: Vec3,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<OrientationDesc>,
+    #[serde(default)]
+    pub velocity: Vec3,
+    /// Angular velocity of the frame (world components).
+    #[serde(default)]
+    pub angular_velocity: Vec3,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elastic: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elastic_rates: Option<Vec<f64>>,
+}
+
+/// One interface node of a `flexible3` body.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Interface3Desc {
+    pub point: Vec3,
+    pub phi: Vec<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub psi: Option<Vec<Vec3>>,
 }
 
 /// A particle: coordinates `r` (3), no orientation.

@@ -1,7 +1,8 @@
 //! Spatial force elements (docs/spatial-design.md, section 4), each adding its generalized force
 //! to `Q` through the markers' Jacobians:
 //!
-//! * gravity `m g` at every body's centre of mass (one element per scene, named `gravity`);
+//! * gravity `m g` at every body's centre of mass (one element per scene, named `gravity`; a
+//!   `flexible3` body's distributed gravity is its own, `Flexible3::add_gravity`);
 //! * a point force `F` at a marker (world components, or components in the marker's axes that
 //!   turn with the body: `F = A C F'`): `Q = J_P^T F`;
 //! * a torque (world `n`, or body axes `n'`): `Q_p = 2 G^T n'`, `n' = A^T n`;
@@ -105,7 +106,9 @@ impl SpatialForce {
         match self {
             SpatialForce::Gravity { g } => {
                 for b in bodies {
-                    if let Some(m) = spatial_mass(b) {
+                    if let BodyKind::Flexible3(k) = &b.kind {
+                        k.add_gravity(&q[b.offset..b.offset + b.n_coords], g, &mut qv[b.offset..b.offset + b.n_coords]);
+                    } else if let Some(m) = spatial_mass(b) {
                         for c in 0..3 {
                             qv[b.offset + c] += m * g[c];
                         }
@@ -236,6 +239,9 @@ impl SpatialForce {
 
 /// Gravity potential `-m g . r` of one body (0 for planar kinds).
 pub fn gravity_energy(g: &V3, b: &Body, q: &[f64]) -> f64 {
+    if let BodyKind::Flexible3(k) = &b.kind {
+        return k.gravity_potential(&q[b.offset..b.offset + b.n_coords], g);
+    }
     spatial_mass(b).map_or(0.0, |m| -m * (g[0] * q[b.offset] + g[1] * q[b.offset + 1] + g[2] * q[b.offset + 2]))
 }
 

@@ -150,7 +150,7 @@ impl Model {
 
     /// A model built from a `"dim": 3` description (its bodies are spatial kinds).
     pub fn is_spatial(&self) -> bool {
-        self.bodies.iter().any(|b| matches!(b.kind, crate::body::BodyKind::Rigid3(_) | crate::body::BodyKind::Point3(_)))
+        self.bodies.iter().any(|b| matches!(b.kind, crate::body::BodyKind::Rigid3(_) | crate::body::BodyKind::Point3(_) | crate::body::BodyKind::Flexible3(_)))
     }
 
     /// Any body with stiffness-proportional damping (the scene is then truly stiff).

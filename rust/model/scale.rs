@@ -17,8 +17,8 @@ pub const RESOLUTION: f64 = 1e-9;
 pub const MAX_LENGTH_SCALE: f64 = 1e150;
 
 /// The scene's length scale [m]: the largest body dimension -- beam lengths, centre-of-mass and
-/// marker offsets on bodies (not on the ground: those place the mechanism) and distance
-/// lengths; 1 m for a scene without any. A spring's rest length is a force parameter, not a
+/// marker offsets on bodies (not on the ground: those place the mechanism), a flexible3 body's
+/// radius of gyration about its frame origin, and distance lengths; 1 m for a scene without any. A spring's rest length is a force parameter, not a
 /// size (0 is usual), so it does not count. `desc` is the description in its documented form
 /// (`{"kind": .., ..}` items).
 pub fn length_scale(desc: &Value) -> f64 {
@@ -30,6 +30,11 @@ pub fn length_scale(desc: &Value) -> f64 {
         }
         if let Some(com) = b.get("com").and_then(Value::as_array) {
             sizes.extend(com.iter().filter_map(Value::as_f64).map(f64::abs));
+        }
+        // a flexible3 body: its radius of gyration about the frame origin, sqrt(tr P_00 / m)
+        if let (Some(p00), Some(m)) = (b.get("second_moment").and_then(|v| v.get(0)), b.get("mass").and_then(Value::as_f64)) {
+            let tr: f64 = (0..3).filter_map(|i| p00.get(i).and_then(|r| r.get(i)).and_then(Value::as_f64)).sum();
+            sizes.push((tr / m).sqrt());
         }
     }
     for section in ["joints", "drivers", "forces"] {

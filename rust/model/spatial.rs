@@ -17,7 +17,7 @@ use serde::Deserialize;
 use serde_json::Value;
 
 use crate::body::marker3::Marker3;
-use crate::body::{Body, BodyKind, InitialState, Point3, Rigid3};
+use crate::body::{Body, BodyKind, Flexible3, InitialState, Point3, Rigid3};
 use crate::constraint::spatial::{self as sc, Normalization, Pair, RotationDriver, SpatialConstraint, TranslationDriver};
 use crate::constraint::{Constraint, ConstraintKind, Motion};
 use crate::error::{check_finite_item, non_negative, positive, Error, Result};
@@ -29,7 +29,7 @@ use crate::linalg::rot3::{norm, sub};
 
 /// Planar body kinds (refused in a spatial scene) and spatial ones (refused in a planar one).
 const PLANAR_KINDS: [&str; 4] = ["rigid", "point_mass", "beam", "flexible"];
-const SPATIAL_KINDS: [&str; 2] = ["rigid3", "point3"];
+const SPATIAL_KINDS: [&str; 3] = ["rigid3", "point3", "flexible3"];
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -117,6 +117,11 @@ impl Builder {
                 let k = Point3::from_desc(p, item)?;
                 let init = k.initial_state(p, item)?;
                 (BodyKind::Point3(k), init)
+            }
+            Body3Desc::Flexible3(f) => {
+                let k = Flexible3::from_desc(f, item)?;
+                let init = k.initial_state(f, item)?;
+                (BodyKind::Flexible3(k), init)
             }
         };
         let offset = self.q0.len();
@@ -237,7 +242,7 @@ pub fn build(text: &str) -> Result<Model> {
         let name = v.get("name").and_then(Value::as_str).map(str::to_string);
         let item = item_name(Section::Body, &kind, name.as_deref(), i);
         if PLANAR_KINDS.contains(&kind.as_str()) {
-            return Err(Error::invalid(item, format!("body kind '{kind}' is planar: a scene with \"dim\": 3 holds rigid3 and point3 bodies (a scene does not mix dimensions)")));
+            return Err(Error::invalid(item, format!("body kind '{kind}' is planar: a scene with \"dim\": 3 holds rigid3, point3 and flexible3 bodies (a scene does not mix dimensions)")));
         }
         let d: Body3Desc = parse_item(Section::Body, i, v)?;
         b.add_body(&item, &d)?;
@@ -261,7 +266,7 @@ pub fn build(text: &str) -> Result<Model> {
         constraints.push(Constraint { name, row: 0, kind: ConstraintKind::Spatial(kind) });
     }
     for (bi, body) in b.bodies.iter().enumerate() {
-        if matches!(body.kind, BodyKind::Rigid3(_)) {
+        if matches!(body.kind, BodyKind::Rigid3(_) | BodyKind::Flexible3(_)) {
             let kind = SpatialConstraint::Normalization(Normalization { body: bi, base: SpatialForce::torque_marker(bi) });
             constraints.push(Constraint { name: format!("{}.normalization", body.name), row: 0, kind: ConstraintKind::Spatial(kind) });
         }

@@ -45,7 +45,7 @@ pub fn body_outputs(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64]) {
         w[0..3].copy_from_slice(&q[o..o + 3]);
         w[3..6].copy_from_slice(&qd[o..o + 3]);
         match &b.kind {
-            BodyKind::Rigid3(_) => {
+            BodyKind::Rigid3(_) | BodyKind::Flexible3(_) => {
                 let (p, pd) = (&q[o + 3..o + 7], &qd[o + 3..o + 7]);
                 let p2 = dot(&[p[0], p[1], p[2]], &[p[0], p[1], p[2]]) + p[3] * p[3];
                 let n = p2.sqrt();
@@ -89,6 +89,14 @@ pub fn momentum(model: &Model, q: &[f64], qd: &[f64]) -> [f64; 6] {
                 (k.mass, mat_vec(&r_mat, &mat_vec(&k.inertia, &wb)))
             }
             BodyKind::Point3(k) => (k.mass, [0.0; 3]),
+            BodyKind::Flexible3(k) => {
+                let (lin, ang) = k.momentum(&q[o..o + b.n_coords], &qd[o..o + b.n_coords]);
+                for c in 0..3 {
+                    out[c] += lin[c];
+                    out[3 + c] += ang[c];
+                }
+                continue;
+            }
             _ => continue,
         };
         let l = cross(&r, &rd);
@@ -119,11 +127,13 @@ pub fn reactions(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], 
         let body = &model.bodies[target];
         let nb = body.n_coords;
         // generalized constraint force on the target body: -sum lam_r A_r
+        // the reference coordinates `[r, p]` (a flexible3 body's modal coordinates carry no
+        // part of the wrench on its frame)
         let mut qc = [0.0; 7];
         for r in c.row..c.row + c.rows() {
             for sg in data.ajac.row_segs(r) {
                 if sg.body == target {
-                    for l in 0..nb {
+                    for l in 0..nb.min(7) {
                         qc[l] -= data.lambda[r] * data.ajac.vals[sg.val + l];
                     }
                 }
@@ -134,7 +144,7 @@ pub fn reactions(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], 
         let x = si.point.v;
         let ob = body.offset;
         let rc = [q[ob], q[ob + 1], q[ob + 2]];
-        let n_c = if matches!(body.kind, BodyKind::Rigid3(_)) {
+        let n_c = if matches!(body.kind, BodyKind::Rigid3(_) | BodyKind::Flexible3(_)) {
             let p = &q[ob + 3..ob + 7];
             let p2: f64 = p.iter().map(|v| v * v).sum();
             let g = rot_g(p);

@@ -39,7 +39,7 @@ import numpy as np
 from .. import _core
 from ..errors import InvalidSceneError
 
-__all__ = ["SpatialScene", "SpatialMarker", "SpatialBodyRef", "outputs", "normalize_spatial", "NATIVE_METHODS_3D"]
+__all__ = ["SpatialScene", "SpatialMarker", "SpatialBodyRef", "SpatialFlexibleRef", "outputs", "normalize_spatial", "NATIVE_METHODS_3D"]
 
 #: Native methods that run a spatial scene (the others are refused by name, see docs/spatial.md).
 NATIVE_METHODS_3D = ("DOPRI5", "RADAU5", "RADAU5M", "GENALPHA")
@@ -88,6 +88,19 @@ class SpatialBodyRef:
         return SpatialMarker(self.name, tuple(point), None if z is None else tuple(z), None if x is None else tuple(x))
 
 
+@dataclass(frozen=True)
+class SpatialFlexibleRef(SpatialBodyRef):
+    """A handle on a ``flexible3`` body: its interfaces by name (their undeformed points)."""
+
+    interfaces: Dict[str, Any] = None  # type: ignore[assignment]
+
+    def interface(self, name: str, z: Optional[Sequence[float]] = None, x: Optional[Sequence[float]] = None) -> SpatialMarker:
+        """The marker on the interface ``name`` (axes ``z``, ``x`` in the body frame)."""
+        if name not in (self.interfaces or {}):
+            raise InvalidSceneError(f"body '{self.name}' has no interface {name!r}; interfaces: {sorted(self.interfaces or {})}")
+        return self.marker(self.interfaces[name], z, x)
+
+
 class SpatialScene:
     """Builder of a spatial scene description (``"dim": 3``); see the module docstring."""
 
@@ -117,6 +130,29 @@ class SpatialScene:
             b["orientation"] = o.tolist() if o.shape in ((4,), (3, 3)) else _vec("orientation", o, 4)
         self._d["bodies"].append(b)
         return SpatialBodyRef(name)
+
+    def flexible_body(self, name: str, data: Any, *, position: Sequence[float] = (0, 0, 0), orientation: Any = None,
+                      velocity: Sequence[float] = (0, 0, 0), angular_velocity: Sequence[float] = (0, 0, 0),
+                      elastic: Optional[Sequence[float]] = None, elastic_rates: Optional[Sequence[float]] = None) -> "SpatialFlexibleRef":
+        """A 3D floating-frame modal body (kind ``flexible3``, docs/spatial-flexible.md) from its
+        data (:class:`ukflex.fe3.FlexibleData3`, e.g. :func:`ukflex.fe3.from_mesh`, or the
+        description dict of its invariants): ``position``, ``orientation``, ``velocity`` and
+        ``angular_velocity`` (world axes) of its floating frame, ``elastic`` and ``elastic_rates``
+        the initial modal coordinates (default zero). Markers sit on its interfaces:
+        ``ref.interface("A", z=...)``."""
+        d = data.to_dict() if hasattr(data, "to_dict") else dict(data)
+        b: Dict[str, Any] = {"kind": "flexible3", "name": name, **d, "position": _vec("position", position),
+                             "velocity": _vec("velocity", velocity), "angular_velocity": _vec("angular_velocity", angular_velocity)}
+        if orientation is not None:
+            o = np.asarray(orientation, dtype=float)
+            b["orientation"] = o.tolist() if o.shape in ((4,), (3, 3)) else _vec("orientation", o, 4)
+        for key, v in (("elastic", elastic), ("elastic_rates", elastic_rates)):
+            if v is not None:
+                b[key] = [float(x) for x in np.asarray(v, dtype=float).reshape(-1)]
+        self._d["bodies"].append(b)
+        names = list(getattr(data, "interfaces", {}) or {})
+        points = [tuple(f["point"]) for f in d.get("interfaces", [])]
+        return SpatialFlexibleRef(name, dict(zip(names, points)) if names else {})
 
     def point_mass(self, name: str, mass: float, *, position: Sequence[float] = (0, 0, 0),
                    velocity: Sequence[float] = (0, 0, 0)) -> SpatialBodyRef:

@@ -26,7 +26,7 @@ impl PySystem {
     /// tolerance, and the power `-lambda^T A qd`), `reaction_columns`, `reaction_names`,
     /// `reaction_bodies`; `momentum` (nt, 6: linear, angular about the origin);
     /// `kinetic_energy`, `potential_energy` (nt,); `body_energies` (nt, n_bodies, 3: kinetic,
-    /// strain (0), gravity); `force_names`, `force_kinds`, `force_potentials`, `force_powers` (nt, n_forces);
+    /// strain (flexible3 bodies; 0 for rigid kinds), gravity); `force_names`, `force_kinds`, `force_potentials`, `force_powers` (nt, n_forces);
     /// `dissipation_power` (nt,); `driver_values` (nt, n_constraints; NaN for non-drivers).
     #[pyo3(signature = (t, q, qd, reactions=true))]
     fn spatial_outputs<'py>(&self, py: Python<'py>, t: Vector<'py>, q: &Bound<'py, PyAny>, qd: &Bound<'py, PyAny>, reactions: bool) -> PyResult<Bound<'py, PyDict>> {
@@ -68,8 +68,9 @@ impl PySystem {
                     outputs::count_turns(model, &ws.data.turns, &mut fp[k * nf..(k + 1) * nf]);
                     outputs::force_powers(model, &ws.data.turns, ts[k], qk, qdk, &mut v, &mut fw[k * nf..(k + 1) * nf]);
                     ke[k] = dynamics::kinetic_energy(model, &mut ws.data, qk, qdk);
-                    // spatial bodies carry no strain and no body gravity: the force elements' potentials
-                    pe[k] = fp[k * nf..(k + 1) * nf].iter().sum();
+                    // the force elements' potentials (gravity is one) and the flexible3 bodies'
+                    // strain energies (rigid kinds carry none)
+                    pe[k] = fp[k * nf..(k + 1) * nf].iter().sum::<f64>() + (0..nb).map(|i| bek[3 * i + 1]).sum::<f64>();
                     dp[k] = sensors::dissipation_power(model, &mut ws.data, ts[k], qk, qdk, &mut v, &mut f, &mut g)?;
                     dv[k * nc..(k + 1) * nc].copy_from_slice(&outputs::driver_values(model, ts[k], qk, &mut scratch));
                 }
