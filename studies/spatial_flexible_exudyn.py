@@ -37,7 +37,7 @@ def model() -> Tuple[fe3.FlexibleData3, Any]:
     mesh = fe3.bar_mesh(LENGTH, 0.02, 0.02, (10, 1, 1))
     data = fe3.from_mesh(mesh, density=7850.0, youngs_modulus=2.1e9, poisson_ratio=0.3,
                          interfaces={"A": lambda x: x[:, 0] < 1e-9, "B": lambda x: x[:, 0] > LENGTH - 1e-9},
-                         modes=4, frame="clamped", reference="A")
+                         modes=4, frame=("clamped", "A"))
     return data, mesh
 
 

@@ -55,7 +55,7 @@ def test_reduced_frequencies_match_full_fe():
     # clamped modes: the kept modes are eigenvectors of the clamped model, so the fixed joint at
     # the held face gives the full FE frequencies exactly
     d = fe3.from_mesh(mesh, density=RHO, youngs_modulus=E, poisson_ratio=NU, interfaces={"A": _face(0.0)},
-                      modes=6, frame="clamped", reference="A")
+                      modes=6, frame=("clamped", "A"))
     w = np.asarray(_cantilever(d).frequencies()) / (2 * np.pi)
     np.testing.assert_allclose(w[:6], ref, rtol=1e-6)
     # Craig-Bampton with the free end as interface (6 static modes, its face moving rigidly) and
@@ -63,7 +63,7 @@ def test_reduced_frequencies_match_full_fe():
     errs = []
     for modes in (4, 12):
         d = fe3.from_mesh(mesh, density=RHO, youngs_modulus=E, poisson_ratio=NU,
-                          interfaces={"A": _face(0.0), "B": _face(L)}, modes=modes, frame="craig-bampton", reference="A")
+                          interfaces={"A": _face(0.0), "B": _face(L)}, modes=modes, frame=("clamped", "A"), reduction="craig-bampton")
         assert d.n_modes == modes + 6
         w = np.asarray(_cantilever(d).frequencies())[:4] / (2 * np.pi)
         errs.append(w / ref[:4] - 1)
@@ -83,7 +83,7 @@ def test_free_body_frequencies_are_the_free_free_modes():
 def _pendulum_bar(youngs_modulus, modes=4):
     mesh = fe3.bar_mesh(0.5, 0.02, 0.02, (10, 1, 1))
     return fe3.from_mesh(mesh, density=RHO, youngs_modulus=youngs_modulus, poisson_ratio=NU,
-                         interfaces={"A": _face(0.0), "B": _face(0.5)}, modes=modes, frame="clamped", reference="A")
+                         interfaces={"A": _face(0.0), "B": _face(0.5)}, modes=modes, frame=("clamped", "A"))
 
 
 def _swing(youngs_modulus):
@@ -143,6 +143,12 @@ def test_bad_input_named_errors():
         fe3.from_mesh(mesh, interfaces={"A": _face(0.0)}, modes=10 ** 6, **ok)
     with pytest.raises(InvalidArgumentError, match="selects no node"):
         fe3.from_mesh(mesh, interfaces={"A": _face(7.0)}, **ok)
+    # the frame words are every FFRF body's: a 3D body takes mean-axis or clamped
+    for kw, match in ((dict(frame="pinned-pinned"), "planar"), (dict(frame="free"), "unknown frame"),
+                      (dict(frame=("clamped", "Z")), "holds one interface"),
+                      (dict(reduction="craig-bampton"), "clamped frame"), (dict(reduction="x"), "unknown reduction")):
+        with pytest.raises(InvalidArgumentError, match=match):
+            fe3.from_mesh(mesh, interfaces={"A": _face(0.0)}, **kw, **ok)
     axis = lambda x: (np.abs(x[:, 1]) < 1e-9) & (np.abs(x[:, 2]) < 1e-9)  # noqa: E731 - nodes on a line
     with pytest.raises(InvalidArgumentError, match="on a line"):
         fe3.from_mesh(mesh, interfaces={"A": axis}, **ok)
@@ -197,7 +203,7 @@ def test_static_sag_under_gravity_matches_full_fe():
     # joint at the held face, against the full FE static solution (4 modes: 0.09 % truncation)
     mesh = fe3.bar_mesh(0.5, 0.02, 0.02, (10, 1, 1))
     ok = dict(density=RHO, youngs_modulus=2.1e9, poisson_ratio=NU)
-    d = fe3.from_mesh(mesh, interfaces={"A": _face(0.0), "B": _face(0.5)}, modes=4, frame="clamped", reference="A", **ok)
+    d = fe3.from_mesh(mesh, interfaces={"A": _face(0.0), "B": _face(0.5)}, modes=4, frame=("clamped", "A"), **ok)
     nodes, k, ms = fe3.solid_matrices(mesh, **ok)
     g = np.array([0.0, 0.0, -9.81])
     free = np.nonzero(~np.repeat(nodes[:, 0] < 1e-9, 3))[0]

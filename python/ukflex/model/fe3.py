@@ -22,23 +22,25 @@ interpolation elements. Solid elements have no rotational dofs: a single node gi
 whose frame is attached rigidly to the floating frame (no elastic rotation), right for a
 spherical joint, wrong for a joint that transmits a moment (use a face's node set there).
 
-Reduction (``frame``):
+The floating frame (``frame``) takes the words of every FFRF body (``ukflex.fe.FRAMES``); a 3D
+body's frame is one of two:
 
-* ``"free"`` -- free-free eigenmodes without the six rigid-body modes (mean-axis frame: the
-  modes are mass-orthogonal to the rigid motions, so ``S_bar q = 0`` and
-  ``int rho u0 x S q dV = 0``);
-* ``"clamped"`` -- the node set of the interface ``reference`` held (the frame is attached to
-  it), then the eigenmodes of the held model;
-* ``"craig-bampton"`` -- the reference interface held; every other interface's node set moves
-  rigidly in six static constraint modes (unit translations and rotations about its centroid,
-  the rest statically condensed), followed by the fixed-interface normal modes.
+* ``"mean-axis"`` (default) -- free-free eigenmodes without the six rigid-body modes (the modes
+  are mass-orthogonal to the rigid motions, so ``S_bar q = 0`` and ``int rho u0 x S q dV = 0``);
+* ``"clamped"`` -- an interface's node set held (``("clamped", "A")``; the word alone: the first
+  interface), the frame attached to it.
+
+Reduction (``reduction``, ``ukflex.fe.REDUCTIONS``): ``"modes"`` (default) keeps the eigenmodes
+of the model in its frame; ``"craig-bampton"`` (a clamped frame) moves every other interface's
+node set rigidly in six static constraint modes (unit translations and rotations about its
+centroid, the rest statically condensed), followed by the fixed-interface normal modes.
 """
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import scipy.sparse as sp
@@ -46,6 +48,7 @@ import scipy.sparse.linalg as spla
 
 from ..arguments import count, non_negative, positive, real
 from ..errors import InvalidArgumentError, require
+from .fe import FRAMES, REDUCTIONS
 
 __all__ = ["FlexibleData3", "Interface3", "solid_matrices", "from_mesh", "bar_mesh"]
 
@@ -287,14 +290,34 @@ def _eigs(k: sp.spmatrix, m: sp.spmatrix, count_: int) -> Tuple[np.ndarray, np.n
     return lam, x
 
 
+def _held(frame: Any, names: List[str]) -> Optional[str]:
+    """The interface a frame holds (``None``: the mean axes), its words those of every FFRF body."""
+    word, on = frame, []
+    if not isinstance(frame, str) and isinstance(frame, (tuple, list)) and frame and isinstance(frame[0], str):
+        word, on = frame[0], list(frame[1:])
+    if not isinstance(word, str) or word not in FRAMES:
+        raise InvalidArgumentError("frame", f"unknown frame {frame!r}; a 3D body's frame is 'mean-axis' or 'clamped' "
+                                   "(('clamped', NAME): that interface held)")
+    if word not in ("mean-axis", "clamped"):
+        raise InvalidArgumentError("frame", f"frame {word!r} is a planar body's; a 3D body's frame is 'mean-axis' or "
+                                   "'clamped'")
+    if word == "mean-axis":
+        if on:
+            raise InvalidArgumentError("frame", "the mean axes are not defined on interfaces")
+        return None
+    if len(on) > 1 or (on and on[0] not in names) or not names:
+        raise InvalidArgumentError("frame", f"frame 'clamped' holds one interface of {names}, got {on or 'none'}")
+    return on[0] if on else names[0]
+
+
 def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio: float,
-              interfaces: Mapping[str, InterfaceSpec], modes: int = 8, frame: str = "free",
-              reference: Optional[str] = None, order: int = 2, damping_ratio: float = 0.0) -> FlexibleData3:
+              interfaces: Mapping[str, InterfaceSpec], modes: int = 8, frame: Any = "mean-axis",
+              reduction: str = "modes", order: int = 2, damping_ratio: float = 0.0) -> FlexibleData3:
     """The ``flexible3`` body of an FE solid reduced to ``modes`` normal modes (module docs).
     ``interfaces``: name -> node index, indices, mask, ``select(nodes) -> mask`` or
-    ``{"point": (x, y, z)}`` (a node must sit there). ``frame``: ``"free"``, ``"clamped"`` or
-    ``"craig-bampton"`` (both with ``reference``, the interface held). ``damping_ratio``:
-    modal damping of the kept modes."""
+    ``{"point": (x, y, z)}`` (a node must sit there). ``frame``: ``"mean-axis"`` or
+    ``"clamped"`` (``("clamped", NAME)``: that interface held); ``reduction``: ``"modes"`` or
+    ``"craig-bampton"`` (module docs). ``damping_ratio``: modal damping of the kept modes."""
     zeta = non_negative("damping_ratio", damping_ratio)
     nmodes = count("modes", modes)
     nodes, k, ms = solid_matrices(mesh, density=density, youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, order=order)
@@ -304,21 +327,24 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
     sets = {name: _select(name, spec, nodes) for name, spec in interfaces.items()}
     rows = {name: _interface_rows(nodes, idx) for name, idx in sets.items()}
     mfull = sp.kron(ms, sp.eye(3), format="csr")
-    if frame == "free":
+    reference = _held(frame, list(sets))
+    if reduction not in REDUCTIONS:
+        raise InvalidArgumentError("reduction", f"unknown reduction {reduction!r}; expected one of {list(REDUCTIONS)}")
+    if reduction == "craig-bampton" and reference is None:
+        raise InvalidArgumentError("reduction", "the craig-bampton reduction needs a clamped frame (an interface held)")
+    if reference is None:
         if nmodes + 6 >= n3:
             raise InvalidArgumentError("modes", f"{nmodes} modes do not fit a model with {n3} dofs")
         lam, x = _eigs(k, mfull, nmodes + 6)
         if lam[5] > 1e-6 * lam[6]:
             raise InvalidArgumentError("mesh", f"the free part does not have six rigid-body modes (eigenvalues {lam[:7].tolist()}): is the mesh connected?")
         basis, normal = x[:, 6:], lam[6:]
-    elif frame in ("clamped", "craig-bampton"):
-        if reference not in sets:
-            raise InvalidArgumentError("reference", f"frame {frame!r} needs reference = the name of the held interface, one of {sorted(sets)}; got {reference!r}")
+    else:
         held = np.zeros(n3, dtype=bool)
         for i in sets[reference]:
             held[3 * i:3 * i + 3] = True
         boundary = []
-        if frame == "craig-bampton":
+        if reduction == "craig-bampton":
             for name, idx in sets.items():
                 if name == reference:
                     continue
@@ -354,8 +380,6 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
                     static.append(u)
         basis = np.column_stack(static + [normal_x]) if static else normal_x
         normal = lam
-    else:
-        raise InvalidArgumentError("frame", f"unknown frame {frame!r}; expected 'free', 'clamped' or 'craig-bampton'")
     return _reduced(nodes, k, ms, basis, rows, sets, normal, zeta)
 
 
