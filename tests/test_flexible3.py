@@ -145,7 +145,7 @@ def test_bad_input_named_errors():
         fe3.from_mesh(mesh, interfaces={"A": _face(7.0)}, **ok)
     # the frame words are every FFRF body's: a 3D body takes mean-axis or clamped
     for kw, match in ((dict(frame="pinned-pinned"), "planar"), (dict(frame="free"), "unknown frame"),
-                      (dict(frame=("clamped", "Z")), "holds one interface"),
+                      (dict(frame=("clamped", "Z")), "defined on 1 interface"),
                       (dict(reduction="craig-bampton"), "clamped frame"), (dict(reduction="x"), "unknown reduction")):
         with pytest.raises(InvalidArgumentError, match=match):
             fe3.from_mesh(mesh, interfaces={"A": _face(0.0)}, **kw, **ok)

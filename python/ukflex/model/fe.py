@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import os
 import reprlib
-from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import scipy.linalg as sla
@@ -128,30 +128,39 @@ def _scalar_mass(mm: np.ndarray) -> np.ndarray:
     return m
 
 
-def _reference_rows(frame: Any, iface: Dict[str, Any]) -> Optional[np.ndarray]:
-    """The rows ``c`` (3, 2N) of the frame's reference conditions ``c u = 0`` (``None``: the mean
-    axes), checked independent."""
-    names = list(iface)
+def frame_interfaces(frame: Any, names: List[str], accepted: Sequence[str] = FRAMES) -> Optional[Tuple[str, List[str]]]:
+    """``(word, interfaces)`` of a frame given by a word of :data:`FRAMES` among ``accepted``, or
+    by ``(word, NAME, ...)``: on those interfaces (the word alone: the first ones it needs; the
+    mean axes need none); ``None`` when ``frame`` is not a word (explicit reference conditions)."""
     word, on = frame, None
     if not isinstance(frame, str) and isinstance(frame, (tuple, list)) and frame and isinstance(frame[0], str):
         word, on = frame[0], list(frame[1:])  # ("pinned-pinned", "A", "B"), ("clamped", "A")
-    if isinstance(word, str):
-        if word not in FRAMES:
-            raise InvalidArgumentError("frame", f"unknown frame {word!r}; expected one of {list(FRAMES)} or three "
-                                       "(interface, 'x'|'y'|'rotation') reference conditions")
-        if word == "mean-axis":
-            if on:
-                raise InvalidArgumentError("frame", "the mean axes are not defined on interfaces")
-            return None
-        need = 2 if word == "pinned-pinned" else 1
-        if on is not None:
-            if len(on) != need or any(nm not in iface for nm in on):
-                raise InvalidArgumentError("frame", f"frame {word!r} is defined on {need} interface(s) of {names}, got {on}")
-            names = on
-        elif len(names) < need:
+    if not isinstance(word, str):
+        return None
+    if word not in FRAMES:
+        more = " or three (interface, 'x'|'y'|'rotation') reference conditions" if set(accepted) == set(FRAMES) else ""
+        raise InvalidArgumentError("frame", f"unknown frame {word!r}; expected one of {list(accepted)}{more}")
+    if word not in accepted:
+        raise InvalidArgumentError("frame", f"frame {word!r} is a planar body's; here the frame is one of {list(accepted)}")
+    need = {"mean-axis": 0, "clamped": 1, "pinned-pinned": 2}[word]
+    if on is None:
+        if len(names) < need:
             raise InvalidArgumentError("frame", f"frame {word!r} is defined on the first {need} interface(s); the body "
                                        f"has {len(names)}")
-        frame = word
+        return word, names[:need]
+    if len(on) != need or any(nm not in names for nm in on):
+        raise InvalidArgumentError("frame", f"frame {word!r} is defined on {need} interface(s) of {names}, got {on}")
+    return word, on
+
+
+def _reference_rows(frame: Any, iface: Dict[str, Any]) -> Optional[np.ndarray]:
+    """The rows ``c`` (3, 2N) of the frame's reference conditions ``c u = 0`` (``None``: the mean
+    axes), checked independent."""
+    words = frame_interfaces(frame, list(iface))
+    if words is not None:
+        frame, names = words
+        if frame == "mean-axis":
+            return None
         (pa, da, ra) = iface[names[0]]
         if frame == "clamped":
             if ra is None:
@@ -177,7 +186,7 @@ def _reference_rows(frame: Any, iface: Dict[str, Any]) -> Optional[np.ndarray]:
     for name, ax in entries:
         if name not in iface or ax not in _AXES:
             raise InvalidArgumentError("frame", f"reference condition ({name!r}, {ax!r}): expected an interface name "
-                                       f"{names} and one of {list(_AXES)}")
+                                       f"{list(iface)} and one of {list(_AXES)}")
         _, d, rot = iface[name]
         if ax == "rotation" and rot is None:
             raise InvalidArgumentError("frame", f"reference condition ({name!r}, 'rotation'): the interface is a single node "

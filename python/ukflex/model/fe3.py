@@ -48,7 +48,7 @@ import scipy.sparse.linalg as spla
 
 from ..arguments import count, non_negative, positive, real
 from ..errors import InvalidArgumentError, require
-from .fe import FRAMES, REDUCTIONS
+from .fe import REDUCTIONS, frame_interfaces
 
 __all__ = ["FlexibleData3", "Interface3", "solid_matrices", "from_mesh", "bar_mesh"]
 
@@ -292,22 +292,11 @@ def _eigs(k: sp.spmatrix, m: sp.spmatrix, count_: int) -> Tuple[np.ndarray, np.n
 
 def _held(frame: Any, names: List[str]) -> Optional[str]:
     """The interface a frame holds (``None``: the mean axes), its words those of every FFRF body."""
-    word, on = frame, []
-    if not isinstance(frame, str) and isinstance(frame, (tuple, list)) and frame and isinstance(frame[0], str):
-        word, on = frame[0], list(frame[1:])
-    if not isinstance(word, str) or word not in FRAMES:
+    words = frame_interfaces(frame, names, accepted=("mean-axis", "clamped"))
+    if words is None:
         raise InvalidArgumentError("frame", f"unknown frame {frame!r}; a 3D body's frame is 'mean-axis' or 'clamped' "
                                    "(('clamped', NAME): that interface held)")
-    if word not in ("mean-axis", "clamped"):
-        raise InvalidArgumentError("frame", f"frame {word!r} is a planar body's; a 3D body's frame is 'mean-axis' or "
-                                   "'clamped'")
-    if word == "mean-axis":
-        if on:
-            raise InvalidArgumentError("frame", "the mean axes are not defined on interfaces")
-        return None
-    if len(on) > 1 or (on and on[0] not in names) or not names:
-        raise InvalidArgumentError("frame", f"frame 'clamped' holds one interface of {names}, got {on or 'none'}")
-    return on[0] if on else names[0]
+    return words[1][0] if words[0] == "clamped" else None
 
 
 def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio: float,
