@@ -318,85 +318,18 @@ def simulate(
             system = system.copy()
         label, proj_tol, interval = configure(system, stabilization, rank_tolerance, pseudoinverse)
     n = system.n_coords
-    if t_span is not None:
-        if t_end is not None:
-            raise InvalidArgumentError("t_span", "give t_end or t_span, not both")
-        if isinstance(t_span, (str, bytes)) or np.ndim(t_span) != 1 or len(t_span) != 2:
-            raise InvalidArgumentError("t_span", f"must be a pair (t0, tf), got {t_span!r}")
-        t0 = real("t_span[0]", t_span[0])
-        t_end = t_span[1]
-        if t0 != system.t0 and (q0 is None or qd0 is None):
-            raise InvalidArgumentError(
-                "t_span", f"t0 = {t0} differs from the system's initial time {system.t0}: give q0 and qd0 for it")
-    else:
-        t0 = system.t0
-    if t_end is None:
-        raise InvalidArgumentError("t_end", "missing: give t_end or t_span=(t0, tf)")
-    t_end_f = real("t_end", t_end)
-    if t_end_f <= t0:
-        raise InvalidArgumentError("t_end", f"must be greater than t0 = {t0}, got {t_end!r}")
-    rtol = real("rtol", rtol)
-    _core.check_tolerances(rtol, [0.0], 1)  # the one tolerance rule (rust/integrate/options.rs)
-    if rtol < RTOL_MIN:  # as solve_ivp does: below it the error norm divides by rounding
-        warnings.warn(f"rtol = {rtol:g} is below {RTOL_MIN:.3g} (100 x machine epsilon); using {RTOL_MIN:.3g}",
-                      UserWarning, stacklevel=2)
-        rtol = RTOL_MIN
-    if atol is None:
-        atol_v: Any = RUN_OPTIONS["defaults"]["atol_per_rtol"] * rtol
-    elif np.ndim(atol) == 0 and not isinstance(atol, np.ma.MaskedArray):
-        atol_v = real("atol", atol)
-        _core.check_tolerances(rtol, [atol_v], 1)
-    else:
-        atol_v = real_array("atol", atol, (2 * n,))
-        _core.check_tolerances(rtol, atol_v, 2 * n)
-    t_eval_v: Optional[np.ndarray] = None
-    if t_eval is not None:
-        t_eval_v = real_array("t_eval", t_eval)
-        if t_eval_v.ndim != 1 or t_eval_v.size == 0:
-            raise InvalidArgumentError("t_eval", f"must be a non-empty 1-D array, got shape {t_eval_v.shape}")
-        if np.any(np.diff(t_eval_v) <= 0):
-            raise InvalidArgumentError("t_eval", "must be strictly increasing")
-        if t_eval_v[0] < t0 or t_eval_v[-1] > t_end_f:
-            raise InvalidArgumentError("t_eval", f"must lie within [t0, t_end] = [{t0}, {t_end_f}]")
+    t0, t_end_f = _checked_span(system, t_end, t_span, q0, qd0)
+    rtol, atol_v = _checked_tolerances(rtol, atol, n)
+    t_eval_v = _checked_t_eval(t_eval, t0, t_end_f)
     q_init = system.q0 if q0 is None else real_array("q0", q0, (n,))
     qd_init = system.qd0 if qd0 is None else real_array("qd0", qd0, (n,))
     budget = _Budget(count("max_steps", max_steps), count("max_nfev", max_nfev),
                      None if max_wall_time is None else positive("max_wall_time", max_wall_time),
                      0.0 if min_step == 0 else positive("min_step", min_step), call_start)
-    if options.get("first_step") is not None:  # every method's: a positive number (scipy's compare it as given)
-        options = dict(options, first_step=positive("first_step", options["first_step"]))
-    for key in ("max_step", "step"):  # a step size that cannot reach t_end within the step budget
-        if options.get(key) is not None:
-            h = positive(key, options[key])
-            options = dict(options, **{key: h})
-            if (t_end_f - t0) / h > budget.max_steps:
-                raise InvalidArgumentError(
-                    key, f"{key} = {h:g} needs {(t_end_f - t0) / h:.3g} steps to reach t_end, more than max_steps = "
-                    f"{budget.max_steps}")
-            if h < budget.min_step:
-                raise InvalidArgumentError(key, f"{key} = {h:g} is below min_step = {budget.min_step:g}")
+    options = _checked_steps(options, budget, t0, t_end_f)
     if not isinstance(dense_output, (bool, np.bool_)):
         raise InvalidArgumentError("dense_output", f"must be True or False, got {dense_output!r}")
-    if args is not None:
-        if isinstance(args, (str, bytes)) or not isinstance(args, (tuple, list)):
-            args = (args,)  # solve_ivp: "If the function has a single argument, wrap it in a tuple"
-        args = tuple(args)
-    ev_list: List[Callable] = []
-    if events is not None:
-        ev_list = list(events) if isinstance(events, (list, tuple)) else [cast(Callable, events)]
-        for k, ev in enumerate(ev_list):
-            if not callable(ev):
-                raise InvalidArgumentError("events", f"entry {k} is not callable: {ev!r}")
-            terminal = getattr(ev, "terminal", None)
-            if terminal is not None and not (isinstance(terminal, (bool, np.bool_)) or (
-                    isinstance(terminal, numbers.Integral) and 0 <= terminal <= 2 ** 53)):
-                raise InvalidArgumentError("events", f"entry {k}: terminal must be a boolean or a whole number of "
-                                           f"occurrences up to 2**53 (solve_ivp's rule), got {terminal!r:.60}")
-            direction = getattr(ev, "direction", None)
-            if direction is not None:
-                real(f"events[{k}].direction", direction)
-        if args is not None:
-            ev_list = [_with_args(ev, args) for ev in ev_list]
+    ev_list, args = _checked_events(events, args)
     if args is not None and callable(options.get("jac")):
         options = dict(options, jac=_with_args(options["jac"], args))
     if formulation != "uk" and (ev_list or dense_output or args is not None):
@@ -468,6 +401,105 @@ def simulate(
         raise IntegrationFailure(f"integration failed at t = {t_fail:.6g} s ({res.method}, {kind}): {res.message}; "
                                  f"the partial result ({res.t.size} outputs) is in .result", res, res.message, t_fail)
     return res
+
+
+def _checked_span(system: System, t_end: Any, t_span: Any, q0: Any, qd0: Any) -> Tuple[float, float]:
+    """``(t0, t_end)`` of a run from ``t_end`` or solve_ivp's ``t_span``, checked."""
+    if t_span is not None:
+        if t_end is not None:
+            raise InvalidArgumentError("t_span", "give t_end or t_span, not both")
+        if isinstance(t_span, (str, bytes)) or np.ndim(t_span) != 1 or len(t_span) != 2:
+            raise InvalidArgumentError("t_span", f"must be a pair (t0, tf), got {t_span!r}")
+        t0 = real("t_span[0]", t_span[0])
+        t_end = t_span[1]
+        if t0 != system.t0 and (q0 is None or qd0 is None):
+            raise InvalidArgumentError(
+                "t_span", f"t0 = {t0} differs from the system's initial time {system.t0}: give q0 and qd0 for it")
+    else:
+        t0 = system.t0
+    if t_end is None:
+        raise InvalidArgumentError("t_end", "missing: give t_end or t_span=(t0, tf)")
+    t_end_f = real("t_end", t_end)
+    if t_end_f <= t0:
+        raise InvalidArgumentError("t_end", f"must be greater than t0 = {t0}, got {t_end!r}")
+    return t0, t_end_f
+
+
+def _checked_tolerances(rtol: Any, atol: Any, n: int) -> Tuple[float, Any]:
+    """``(rtol, atol)`` checked by the core's one rule, ``atol`` defaulted from ``rtol``."""
+    rtol = real("rtol", rtol)
+    _core.check_tolerances(rtol, [0.0], 1)  # the one tolerance rule (rust/integrate/options.rs)
+    if rtol < RTOL_MIN:  # as solve_ivp does: below it the error norm divides by rounding
+        warnings.warn(f"rtol = {rtol:g} is below {RTOL_MIN:.3g} (100 x machine epsilon); using {RTOL_MIN:.3g}",
+                      UserWarning, stacklevel=3)
+        rtol = RTOL_MIN
+    if atol is None:
+        atol_v: Any = RUN_OPTIONS["defaults"]["atol_per_rtol"] * rtol
+    elif np.ndim(atol) == 0 and not isinstance(atol, np.ma.MaskedArray):
+        atol_v = real("atol", atol)
+        _core.check_tolerances(rtol, [atol_v], 1)
+    else:
+        atol_v = real_array("atol", atol, (2 * n,))
+        _core.check_tolerances(rtol, atol_v, 2 * n)
+    return rtol, atol_v
+
+
+def _checked_t_eval(t_eval: Any, t0: float, t_end_f: float) -> Optional[np.ndarray]:
+    """The output times: ``None`` or a strictly increasing array within ``[t0, t_end]``."""
+    t_eval_v: Optional[np.ndarray] = None
+    if t_eval is not None:
+        t_eval_v = real_array("t_eval", t_eval)
+        if t_eval_v.ndim != 1 or t_eval_v.size == 0:
+            raise InvalidArgumentError("t_eval", f"must be a non-empty 1-D array, got shape {t_eval_v.shape}")
+        if np.any(np.diff(t_eval_v) <= 0):
+            raise InvalidArgumentError("t_eval", "must be strictly increasing")
+        if t_eval_v[0] < t0 or t_eval_v[-1] > t_end_f:
+            raise InvalidArgumentError("t_eval", f"must lie within [t0, t_end] = [{t0}, {t_end_f}]")
+    return t_eval_v
+
+
+def _checked_steps(options: Dict[str, Any], budget: "_Budget", t0: float, t_end_f: float) -> Dict[str, Any]:
+    """``options`` with ``first_step``, ``max_step`` and ``step`` checked positive and within the
+    step budget."""
+    if options.get("first_step") is not None:  # every method's: a positive number (scipy's compare it as given)
+        options = dict(options, first_step=positive("first_step", options["first_step"]))
+    for key in ("max_step", "step"):  # a step size that cannot reach t_end within the step budget
+        if options.get(key) is not None:
+            h = positive(key, options[key])
+            options = dict(options, **{key: h})
+            if (t_end_f - t0) / h > budget.max_steps:
+                raise InvalidArgumentError(
+                    key, f"{key} = {h:g} needs {(t_end_f - t0) / h:.3g} steps to reach t_end, more than max_steps = "
+                    f"{budget.max_steps}")
+            if h < budget.min_step:
+                raise InvalidArgumentError(key, f"{key} = {h:g} is below min_step = {budget.min_step:g}")
+    return options
+
+
+def _checked_events(events: Any, args: Any) -> Tuple[List[Callable], Optional[Tuple]]:
+    """solve_ivp's ``events`` (each callable, with its ``terminal`` and ``direction`` checked,
+    ``args`` bound) and ``args`` as a tuple."""
+    if args is not None:
+        if isinstance(args, (str, bytes)) or not isinstance(args, (tuple, list)):
+            args = (args,)  # solve_ivp: "If the function has a single argument, wrap it in a tuple"
+        args = tuple(args)
+    ev_list: List[Callable] = []
+    if events is not None:
+        ev_list = list(events) if isinstance(events, (list, tuple)) else [cast(Callable, events)]
+        for k, ev in enumerate(ev_list):
+            if not callable(ev):
+                raise InvalidArgumentError("events", f"entry {k} is not callable: {ev!r}")
+            terminal = getattr(ev, "terminal", None)
+            if terminal is not None and not (isinstance(terminal, (bool, np.bool_)) or (
+                    isinstance(terminal, numbers.Integral) and 0 <= terminal <= 2 ** 53)):
+                raise InvalidArgumentError("events", f"entry {k}: terminal must be a boolean or a whole number of "
+                                           f"occurrences up to 2**53 (solve_ivp's rule), got {terminal!r:.60}")
+            direction = getattr(ev, "direction", None)
+            if direction is not None:
+                real(f"events[{k}].direction", direction)
+        if args is not None:
+            ev_list = [_with_args(ev, args) for ev in ev_list]
+    return ev_list, args
 
 
 #: the drift bound: a run whose constraint residual passes this many times (rtol x length scale
