@@ -181,7 +181,8 @@ def solid_matrices(mesh: Any, *, density: float, youngs_modulus: float, poisson_
     hexahedra Q1/Q2 by ``order``); the nodes are the element's dof locations (vertices, then
     edge, face and cell nodes)."""
     skfem = require("skfem", "ukflex.fe3.solid_matrices", extra="fe")
-    from skfem.models.elasticity import lame_parameters, linear_elasticity
+    elasticity = require("skfem.models.elasticity", "ukflex.fe3.solid_matrices", extra="fe")
+    lame_parameters = elasticity.lame_parameters
 
     rho = positive("density", density)
     e = positive("youngs_modulus", youngs_modulus)

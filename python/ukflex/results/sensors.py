@@ -182,7 +182,7 @@ class Sensors:
         """The contact of the revolute joint with clearance ``name``, each (nt,):
         ``eccentricity``, ``penetration`` (negative in free flight), ``normal_force``,
         ``tangential_force`` and ``force`` (the contact force's magnitude)."""
-        names = list(self._raw["clearance_names"])
+        names = list(self._raw.get("clearance_names", []))
         if name not in names:
             raise UnknownNameError.of("revolute joint with clearance", name, names)
         c = np.asarray(self._raw["clearance"])[:, names.index(name), :]
@@ -290,7 +290,7 @@ class Sensors:
                 out[f"energy({b}).{k}"] = v
         for k, v in self.energies().items():
             out[f"energy.{k}"] = v
-        for j in self._raw["clearance_names"]:
+        for j in self._raw.get("clearance_names", []):
             for k, v in self.clearance(j).items():
                 out[f"clearance({j}).{k}"] = v
         bal = self.energy_balance()
