@@ -168,6 +168,27 @@ def test_friction_work_closes_the_energy_balance():
     assert bal["relative_error"] < 1e-6
 
 
+def test_projections_do_not_see_the_friction():
+    """The projections onto the constraints (after each native step, `System.core.project_step`;
+    the full one, `project`) are kinematic, in the mass metric: the same with and without the
+    friction element, to the bit, at a drifted, moving state (the closure lives in the
+    acceleration calls, not in the UK solve these projections call with the forces zeroed)."""
+    a = _pendulum(0.4, 2.0).build()
+    s = Scene(gravity=(0.0, -G))
+    rod = s.rigid_body("rod", mass=M_ROD, inertia=M_ROD * L_ROD**2 / 12, com=(L_ROD / 2, 0.0), angle=0.4,
+                       angular_velocity=2.0)
+    s.revolute(rod.point(0, 0), s.ground.point(0, 0), name="pin")
+    b = s.build()
+    q = np.asarray(a.q0) + np.array([1e-4, -2e-4, 3e-4])
+    qd = np.asarray(a.qd0) + np.array([0.01, -0.02, 0.0])
+    assert abs(a.qdd(0.0, a.q0, a.qd0)[2] - b.qdd(0.0, b.q0, b.qd0)[2]) > 1e-3  # the friction acts
+    for project in (lambda sy: sy.core.project_step(0.0, q, qd, 1e-12, 10)[:2], lambda sy: sy.core.project(0.0, q, qd)[:2]):
+        (qa, va), (qb, vb) = project(a), project(b)
+        assert np.abs(qa - q).max() > 1e-5  # it moved
+        np.testing.assert_array_equal(qa, qb)
+        np.testing.assert_array_equal(va, vb)
+
+
 def test_viscous_part_equals_the_rotational_damper():
     # mu = 0: the joint friction is the hinge's viscous damper (tests/test_loads.py checks its
     # decay rate against the closed form)
