@@ -34,6 +34,10 @@ Reduction (``reduction``, ``ukflex.fe.REDUCTIONS``): ``"modes"`` (default) keeps
 of the model in its frame; ``"craig-bampton"`` (a clamped frame) moves every other interface's
 node set rigidly in six static constraint modes (unit translations and rotations about its
 centroid, the rest statically condensed), followed by the fixed-interface normal modes.
+
+Stress stiffening (``stress_stiffening=True``, a clamped frame): the modal geometric stiffness
+of twelve unit inertia load cases (:mod:`ukflex.model.fe3_stiffening`), which the body scales by
+its frame's motion (docs/spatial-flexible.md, "Stress stiffening").
 """
 
 from __future__ import annotations
