@@ -53,7 +53,7 @@ import scipy.sparse.linalg as spla
 from ..arguments import count, non_negative, positive, real
 from ..errors import InvalidArgumentError, require
 from .fe import REDUCTIONS, frame_interfaces
-from .fe3_stiffening import geometric_stiffness, held_mask
+from .fe3_stiffening import geometric_stiffness, held_mask, stress_modes
 
 __all__ = ["FlexibleData3", "Interface3", "solid_matrices", "from_mesh", "bar_mesh"]
 
@@ -82,7 +82,8 @@ class FlexibleData3:
     """The data of a ``flexible3`` body: ``mass``, ``first_moment`` (n + 1, 3),
     ``second_moment`` (n + 1, n + 1, 3, 3), ``k_ff`` and optional ``d_ff`` (n, n), the
     ``interfaces`` by name; ``info`` holds what the reduction found (``frequencies`` of the
-    kept normal modes in Hz, the basis ``modes`` (3N, n), ``nodes``, the VTK ``cells``);
+    kept normal modes in Hz, the basis ``modes`` (3N, n), ``nodes``, the VTK ``cells``, the
+    nodal ``stress_modes`` (N, 6, n): ``xx, yy, zz, yz, zx, xy`` per unit modal coordinate);
     ``geometric_stiffness`` (12, n, n), with ``stress_stiffening=True``, the modal geometric
     stiffness of the unit load cases (:data:`ukflex.model.fe3_stiffening.LOAD_CASES`)."""
 
@@ -409,6 +410,7 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
         normal = lam
     data = _reduced(nodes, k, ms, basis, rows, sets, normal, zeta)
     data.info["cells"] = _vtk_cells(solid.mesh)
+    data.info["stress_modes"] = stress_modes(solid, basis)
     if stress_stiffening:
         data.geometric_stiffness, data.info["load_displacements"] = geometric_stiffness(solid, held_mask(sets, reference, n3), basis)
     return data

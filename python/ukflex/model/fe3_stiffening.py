@@ -1,6 +1,7 @@
-"""Stress stiffening of a ``flexible3`` body (docs/spatial-flexible.md, "Stress stiffening"):
-the modal geometric-stiffness matrices of the unit inertia load cases, from the FE solid of
-:func:`ukflex.fe3.from_mesh` (``stress_stiffening=True``).
+"""Stresses of the FE solid of a ``flexible3`` body: stress stiffening (docs/spatial-flexible.md,
+"Stress stiffening"), the modal geometric-stiffness matrices of the unit inertia load cases
+(:func:`ukflex.fe3.from_mesh` with ``stress_stiffening=True``), and the modes' nodal stress
+shapes (:func:`stress_modes`, for the fields and the VTK export).
 
 A load case is a body force per unit mass ``b(x) = B x + c`` in the frame's axes. The solid,
 held at the frame's interface, carries it statically (``K u = f``, ``f_i = int rho phi_i b``);
@@ -18,7 +19,7 @@ The cases, in :data:`LOAD_CASES` order (the order of the description's ``geometr
 
 from __future__ import annotations
 
-from typing import Any, Tuple
+from typing import Any, Dict, Tuple
 
 import numpy as np
 import scipy.sparse.linalg as spla
@@ -47,6 +48,37 @@ def _case(c: int) -> Tuple[np.ndarray, np.ndarray]:
     return np.zeros((3, 3)), e[c - 9].copy()
 
 
+def stress(solid: Any, u: np.ndarray) -> Dict[str, np.ndarray]:
+    """The stress ``s{ij}`` (i, j = 0..2) at the quadrature points of the displacement ``u``
+    (N, 3) of the solid: ``sigma = lam tr(eps) I + 2 mu eps``."""
+    grad = [solid.basis.interpolate(u[:, a]).grad for a in range(3)]  # grad[a][k] = d u_a / d x_k
+    eps = [[0.5 * (grad[i][j] + grad[j][i]) for j in range(3)] for i in range(3)]
+    tr = eps[0][0] + eps[1][1] + eps[2][2]
+    return {f"s{i}{j}": solid.lam * tr * (i == j) + 2.0 * solid.mu * eps[i][j] for i in range(3) for j in range(3)}
+
+
+#: The stress components of :func:`stress_modes`, in their order (Voigt's).
+STRESS_COMPONENTS = ("xx", "yy", "zz", "yz", "zx", "xy")
+
+
+def stress_modes(solid: Any, basis: np.ndarray) -> np.ndarray:
+    """The nodal stress shapes (N, 6, n) of the modes ``basis`` (3N, n): each component's L2
+    projection onto the element space (``M_1 s = int sigma phi``, ``M_1`` the mass matrix of
+    unit density), components in :data:`STRESS_COMPONENTS` order (Pa per unit modal coordinate)."""
+    skfem = require("skfem", "ukflex.fe3 (stress shapes)", extra="fe")
+    nn, n = solid.nodes.shape[0], basis.shape[1]
+    m1 = skfem.asm(skfem.BilinearForm(lambda u, v, w: u * v), solid.basis).tocsc()
+    lu = spla.splu(m1)
+    form = skfem.LinearForm(lambda v, w: w["s"] * v)
+    pairs = ((0, 0), (1, 1), (2, 2), (1, 2), (2, 0), (0, 1))
+    out = np.zeros((nn, 6, n))
+    for k in range(n):
+        sig = stress(solid, basis[:, k].reshape(nn, 3))
+        for c, (i, j) in enumerate(pairs):
+            out[:, c, k] = lu.solve(skfem.asm(form, solid.basis, s=sig[f"s{i}{j}"]))
+    return out
+
+
 def geometric_stiffness(solid: Any, held: np.ndarray, basis: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
     """The modal geometric stiffness ``K_c`` (12, n, n) of the :data:`LOAD_CASES` and the
     static displacements of the cases (12, N, 3), the solid held on the dofs ``held`` (mask of
@@ -69,11 +101,7 @@ def geometric_stiffness(solid: Any, held: np.ndarray, basis: np.ndarray) -> Tupl
         u[free] = lu.solve(f[free])
         u = u.reshape(nn, 3)
         disp[c] = u
-        grad = [sb.interpolate(u[:, a]).grad for a in range(3)]  # grad[a][k] = d u_a / d x_k
-        eps = [[0.5 * (grad[i][j] + grad[j][i]) for j in range(3)] for i in range(3)]
-        tr = eps[0][0] + eps[1][1] + eps[2][2]
-        sig = {f"s{i}{j}": solid.lam * tr * (i == j) + 2.0 * solid.mu * eps[i][j] for i in range(3) for j in range(3)}
-        g = skfem.asm(form, sb, **sig).tocsr()
+        g = skfem.asm(form, sb, **stress(solid, u)).tocsr()
         kc = sum(modes[a].T @ (g @ modes[a]) for a in range(3))
         out[c] = 0.5 * (kc + kc.T)
     return out, disp
@@ -87,4 +115,4 @@ def held_mask(sets: Any, reference: str, n3: int) -> np.ndarray:
     return held
 
 
-__all__ = ["LOAD_CASES", "geometric_stiffness", "held_mask"]
+__all__ = ["LOAD_CASES", "STRESS_COMPONENTS", "geometric_stiffness", "held_mask", "stress", "stress_modes"]

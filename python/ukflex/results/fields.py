@@ -7,8 +7,8 @@ stress is ``sigma = sum_k q_k sigma_k`` with the stress shapes ``sigma_k`` of th
 computed once when the body is built (``info["stress_modes"]``).
 
 A node of a spatial modal body (``flexible3``, built by :func:`ukflex.fe3.from_mesh`) is at
-``r + R(p) (u0 + Phi q_f)`` (docs/spatial-flexible.md); its data carry no stress shapes, so its
-fields are the displacements.
+``r + R(p) (u0 + Phi q_f)`` (docs/spatial-flexible.md); its stress ``sum_k q_k sigma_k`` from the
+modes' nodal stress shapes (``xx, yy, zz, yz, zx, xy``, frame axes; ``info["stress_modes"]``).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import InvalidArgumentError
 
-__all__ = ["modal_fields", "von_mises"]
+__all__ = ["modal_fields", "von_mises", "von_mises3"]
 
 
 def von_mises(stress: np.ndarray) -> np.ndarray:
@@ -27,6 +27,13 @@ def von_mises(stress: np.ndarray) -> np.ndarray:
     ``sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2)``."""
     sxx, syy, sxy = stress[..., 0], stress[..., 1], stress[..., 2]
     return np.sqrt(np.maximum(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy, 0.0))
+
+
+def von_mises3(stress: np.ndarray) -> np.ndarray:
+    """Von Mises stress of ``stress[..., 6]`` = ``(xx, yy, zz, yz, zx, xy)``."""
+    s = stress
+    d = (s[..., 0] - s[..., 1]) ** 2 + (s[..., 1] - s[..., 2]) ** 2 + (s[..., 2] - s[..., 0]) ** 2
+    return np.sqrt(0.5 * d + 3.0 * (s[..., 3] ** 2 + s[..., 4] ** 2 + s[..., 5] ** 2))
 
 
 def check_mesh_data(system: Any, body: str, data: Any) -> np.ndarray:
@@ -37,12 +44,12 @@ def check_mesh_data(system: Any, body: str, data: Any) -> np.ndarray:
     if kind not in ("flexible", "flexible3"):
         raise InvalidArgumentError("body", f"body {body!r} is a {kind}, not a flexible (modal) body")
     spatial = kind == "flexible3"
-    keys = ("cells", "nodes", "modes") if spatial else ("cells", "nodes", "modes", "stress_modes")
+    keys = ("cells", "nodes", "modes", "stress_modes")
     info = getattr(data, "info", None)
     if not isinstance(info, dict) or any(k not in info for k in keys):
         raise InvalidArgumentError("data", f"the data of body {body!r} must be the FlexibleData{'3' if spatial else ''} that "
                                    f"ukflex.{'fe3' if spatial else 'fe'}.from_mesh (or fe.reduce of it) returned: its info "
-                                   "holds the mesh, the nodal modes" + ("" if spatial else " and their stress shapes"))
+                                   "holds the mesh, the nodal modes and their stress shapes")
     entry = next(b for b in system.description["bodies"] if b["name"] == body)
     k_ff = np.asarray(entry["k_ff"], dtype=float)
     if np.shape(data.k_ff) != k_ff.shape or not np.allclose(np.asarray(data.k_ff, dtype=float), k_ff, rtol=1e-12, atol=0.0):
@@ -77,7 +84,8 @@ def modal_fields(system: Any, result: Any, body: str, data: Any) -> Dict[str, np
         the elastic displacement ``A Phi q_f`` in the world frame; ``stress`` (nt, N, 3)
         ``sigma_xx, sigma_yy, sigma_xy`` in the body frame (plane stress, Pa); ``von_mises``
         (nt, N). A ``flexible3`` body: the same with three components, ``cells`` a pair
-        (meshio cell type, vertex indices), and no stress.
+        (meshio cell type, vertex indices), ``stress`` (nt, N, 6) ``xx, yy, zz, yz, zx, xy`` in
+        the frame's axes.
     """
     modes = check_mesh_data(system, body, data)
     q = np.asarray(result.q if hasattr(result, "q") else result, dtype=float)
@@ -123,5 +131,6 @@ def _fields3(system: Any, q: np.ndarray, body: str, data: Any, modes: np.ndarray
     position = origin[:, None, :] + np.einsum("tij,nj->tni", rot, nodes) + elastic
     o0, r0 = _frame3(system, np.asarray(system.q0, dtype=float)[:, None], body)
     reference = o0[0] + nodes @ r0[0].T
+    stress = np.einsum("nkf,ft->tnk", np.asarray(data.info["stress_modes"], dtype=float), qf)
     return {"nodes": nodes, "cells": data.info["cells"], "position": position, "displacement": position - reference[None],
-            "elastic": elastic}
+            "elastic": elastic, "stress": stress, "von_mises": von_mises3(stress)}

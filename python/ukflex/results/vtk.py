@@ -20,8 +20,8 @@ folder next to a ``.pvd`` collection that lists them with their times (ParaView:
   mass to its marker points, with its axes ``x_axis``, ``y_axis``, ``z_axis`` (world) at every
   point (:func:`ukflex.spatial_outputs`); a ``flexible3`` body whose :func:`ukflex.fe3.from_mesh`
   data is given (``flexible=``): its mesh (tetrahedra or hexahedra on the vertex nodes) at its
-  deformed place with ``displacement`` and ``elastic_displacement`` (no stress: the 3D data
-  carry no stress shapes).
+  deformed place with ``displacement``, ``elastic_displacement`` (world), ``stress``
+  (``xx, yy, zz, yz, zx, xy``, frame axes) and ``von_mises``.
 
 Planar points get ``z = 0``; vectors have three components (ParaView's Warp By Vector).
 """
@@ -170,8 +170,7 @@ def export_vtk(system: Any, result: Any, path: str, *, flexible: Optional[Mappin
     flexible : dict, optional
         Body name -> the :class:`ukflex.FlexibleData` returned by :func:`ukflex.fe.from_mesh`
         for that modal body (the :class:`ukflex.fe3.FlexibleData3` of :func:`ukflex.fe3.from_mesh`
-        for a ``flexible3`` body): its mesh is written with the displacement (and, planar, the
-        stress) fields.
+        for a ``flexible3`` body): its mesh is written with the displacement and stress fields.
     frames : int, optional
         At most this many output times.
     points_per_element : int
