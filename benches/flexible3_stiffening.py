@@ -4,7 +4,6 @@ freshly built System, medians of interleaved repetitions), Southwell's coefficie
 Omega and the hub radius, the spin-up against the planar FFRF beam by mesh, the size of the
 angular-acceleration cases left out, and the energy drift of a free, spinning, stiffened body.
 Run: .venv/bin/python benches/flexible3_stiffening.py   (about 1 min)"""
-import copy
 import sys
 import time
 import pathlib
@@ -12,11 +11,11 @@ import pathlib
 import numpy as np
 
 import ukflex
-from ukflex import fe3
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
-from test_flexible3_stiffening import K1, K2, _bar, _hub, _kane, _lowest_two, _without  # noqa: E402
+from test_flexible3_stiffening import K1, K2, _bar, _hub, _kane, _lowest_two  # noqa: E402
 from ukflex.model.scene import CustomSection  # noqa: E402
+from ukflex.model.fe3_stiffening import LOAD_CASES  # noqa: E402
 
 
 def median_times(fns, reps=5):
@@ -39,7 +38,7 @@ for radius in (0.0, 0.5):
     w0 = _lowest_two(_hub(d, ukflex.ConstantSpeed(0.0), 0.0, radius))
     for om in (5.0, 20.0, 50.0):
         w = _lowest_two(_hub(d, ukflex.ConstantSpeed(om), om, radius))
-        wn = _lowest_two(_hub(_without(d), ukflex.ConstantSpeed(om), om, radius))
+        wn = _lowest_two(_hub(d, ukflex.ConstantSpeed(om), om, radius, stiffening=False))
         k, kn = (w ** 2 - w0 ** 2) / om ** 2, (wn ** 2 - w0 ** 2) / om ** 2
         ref = K1 + K2 * radius
         print(f"r/L {radius}, Omega {om}: with flap {k[0]:.4f} ({k[0] / ref - 1:+.2%} of {ref:.4f}), in-plane {k[1]:.4f} "
@@ -78,25 +77,25 @@ for cells, modes in (((20, 1, 1), 4), ((40, 2, 2), 4), ((40, 2, 2), 8), ((80, 2,
     print(f"3D {cells}, {modes} modes: first bending {w1:.4f} rad/s ({w1 / w_eb - 1:+.2%} of E-B), peak "
           f"{np.abs(tip).max():.5f}, history max diff {np.abs(tip - v).max() / peak:.2%} of the peak")
 dd = _bar((40, 2, 2), length, a, a, rho, e, modes=4, stress_stiffening=True)
-res0 = ukflex.simulate(_hub(_without(dd), expr), 20.0, t_eval=ts)
+res0 = ukflex.simulate(_hub(dd, expr, stiffening=False), 20.0, t_eval=ts)
 tip0 = (np.asarray(dd.interfaces["B"].phi).T @ res0.q[-4:])[1]
 print(f"without stiffening: stops at t = {res0.t[-1]:.2f} s ({res0.message}); |tip| at 10, 12, 13 s:",
       [f"{abs(tip0[np.searchsorted(res0.t, x)]):.3g}" for x in (10.0, 12.0, 13.0)])
 kg = dd.geometric_stiffness
 for c in range(12):
-    print(f"  case {fe3.__name__ and c}: diag K_c / M_ff (mode 1, 2): {kg[c, 0, 0] / dd.m_ff[0, 0]:+.4f} {kg[c, 1, 1] / dd.m_ff[1, 1]:+.4f}")
-f0, f1 = median_times([lambda: ukflex.simulate(_hub(_without(dd), _kane(15.0, 3.0)), 20.0, t_eval=ts),
+    print(f"  case {LOAD_CASES[c]}: diag K_c / M_ff (mode 1, 2): {kg[c, 0, 0] / dd.m_ff[0, 0]:+.4f} {kg[c, 1, 1] / dd.m_ff[1, 1]:+.4f}")
+f0, f1 = median_times([lambda: ukflex.simulate(_hub(dd, _kane(15.0, 3.0), stiffening=False), 20.0, t_eval=ts),
                        lambda: ukflex.simulate(_hub(dd, _kane(15.0, 3.0)), 20.0, t_eval=ts)])
 print(f"simulate (spin-up to 3 rad/s, where both stay bounded; fresh System): without {f0:.4f} s, with {f1:.4f} s, ratio {f1 / f0:.2f}")
 
 print("== energy of a free spinning body (no joint), DOPRI5 rtol 1e-10, 1 s")
-for dd_, lab in ((_without(d), "without"), (d, "with")):
+for on, lab in ((False, "without"), (True, "with")):
     s = ukflex.SpatialScene()
-    s.flexible_body("bar", dd_, angular_velocity=(0, 0, 50.0), elastic=[1e-4, 1e-4, 0, 0])
+    s.flexible_body("bar", d, angular_velocity=(0, 0, 50.0), elastic=[1e-4, 1e-4, 0, 0], stress_stiffening=on)
     sy = ukflex.System(s)
     r = ukflex.simulate(sy, 1.0, method="DOPRI5", rtol=1e-10, atol=1e-12, t_eval=np.linspace(0, 1, 201))
     en = ukflex.spatial_outputs(sy, r, reactions=False)
     ke = en["kinetic_energy"]
-    strain = np.array([0.5 * x @ dd_.k_ff @ x for x in r.q[-4:].T])
+    strain = np.array([0.5 * x @ d.k_ff @ x for x in r.q[-4:].T])
     tot = ke + strain
     print(f"{lab}: kinetic {ke[0]:.4g} J, max strain {strain.max():.3g} J, drift of kinetic + strain {np.abs(tot - tot[0]).max():.2e} J")

@@ -2,7 +2,6 @@
 Southwell's coefficients of a spinning cantilever from ``System.frequencies``, Kane's spin-up
 against the planar FFRF beam with geometric stiffening, and bad input."""
 
-import copy
 import math
 
 import numpy as np
@@ -31,21 +30,16 @@ def _bar(cells=(20, 2, 2), length=1.0, width=0.03, height=0.02, density=7850.0, 
                          frame=("clamped", "A"), **kw)
 
 
-def _without(data):
-    d = copy.copy(data)
-    d.geometric_stiffness = None
-    return d
-
-
-def _hub(data, motion, omega=0.0, radius=0.0):
+def _hub(data, motion, omega=0.0, radius=0.0, stiffening=None):
     """The bar welded to a hub at ``radius`` from the hub's axle (z), the hub driven by
-    ``motion``; started at the hub speed ``omega``."""
+    ``motion``; started at the hub speed ``omega``; ``stiffening`` the builder's
+    ``stress_stiffening``."""
     s = ukflex.SpatialScene()
     hub = s.rigid_body("hub", 1.0, [1.0, 1.0, 1.0], angular_velocity=(0, 0, omega))
     s.revolute(s.ground.marker((0, 0, 0)), hub.marker((0, 0, 0)), name="axle")
     s.rotation_driver(s.ground.marker((0, 0, 0)), hub.marker((0, 0, 0)), motion, name="spin")
     bar = s.flexible_body("bar", data, position=(radius, 0, 0), angular_velocity=(0, 0, omega),
-                          velocity=(0, omega * radius, 0))
+                          velocity=(0, omega * radius, 0), stress_stiffening=stiffening)
     s.fixed(hub.marker((radius, 0, 0)), bar.interface("A"), name="clamp")
     return ukflex.System(s)
 
@@ -71,7 +65,7 @@ def test_southwell_coefficients_of_a_spinning_cantilever():
         assert k[1] == pytest.approx(k_flap - 1.0, abs=1e-2), (radius, k)
         # without stiffening: flapwise unchanged, in-plane softened by Omega^2 (the linear
         # modes' defect)
-        wn = _lowest_two(_hub(_without(d), ukflex.ConstantSpeed(om), om, radius))
+        wn = _lowest_two(_hub(d, ukflex.ConstantSpeed(om), om, radius, stiffening=False))
         kn = (wn ** 2 - w0 ** 2) / om ** 2
         assert abs(kn[0]) < 1e-3 and kn[1] == pytest.approx(-1.0, abs=1e-3), (radius, kn)
 
@@ -91,7 +85,7 @@ def test_spin_up_against_the_planar_beam_with_geometric_stiffening():
     ts = np.linspace(0.0, 20.0, 201)
     d = _bar((40, 2, 2), length, a, a, rho, e, modes=4, stress_stiffening=True)
     phi = np.asarray(d.interfaces["B"].phi)
-    res = ukflex.simulate(_hub(d, expr), 20.0, t_eval=ts)
+    res = ukflex.simulate(_hub(d, expr, stiffening=True), 20.0, t_eval=ts)
     tip = (phi.T @ res.q[-4:])[1]  # in-plane tip deflection, frame axes
     s = ukflex.Scene()
     hub = s.rigid_body("hub", mass=1.0, inertia=1.0)
@@ -109,7 +103,7 @@ def test_spin_up_against_the_planar_beam_with_geometric_stiffening():
     assert np.abs(tip - v).max() < 0.015 * peak
     # without stiffening the deflection diverges once the speed passes the first frequency: the
     # run stops (the mass matrix loses definiteness) or the tip runs away
-    res0 = ukflex.simulate(_hub(_without(d), expr), 20.0, t_eval=ts)
+    res0 = ukflex.simulate(_hub(d, expr, stiffening=False), 20.0, t_eval=ts)
     tip0 = (phi.T @ res0.q[-4:])[1]
     assert res0.t[-1] < 20.0 or np.abs(tip0).max() > 10 * peak
     assert np.abs(tip0).max() > 5 * peak
@@ -132,6 +126,12 @@ def test_stress_stiffening_bad_input():
         return ukflex.System(s)
 
     scene()
+    # stress stiffening asked of data without the load cases, or a bad flag
+    plain = fe3.from_mesh(mesh, frame=("clamped", "A"), **kw)
+    with pytest.raises(InvalidArgumentError, match="stress_stiffening.*carry no geometric_stiffness"):
+        ukflex.SpatialScene().flexible_body("bar", plain, stress_stiffening=True)
+    with pytest.raises(InvalidArgumentError, match="stress_stiffening"):
+        ukflex.SpatialScene().flexible_body("bar", d, stress_stiffening=1)
     # data lacking the load cases (the centrifugal ones only)
     with pytest.raises(InvalidSceneError, match="geometric_stiffness must hold one n x n matrix per load case"):
         scene(geometric_stiffness=body["geometric_stiffness"][:6])
