@@ -53,6 +53,8 @@ def test_southwell_coefficients_of_a_spinning_cantilever():
     # bar 1 m x 30 mm (y, in the plane of rotation) x 20 mm (z, flapwise), spinning about z:
     # the lowest mode is flapwise (z), the next in-plane (y)
     d = _bar(stress_stiffening=True)
+    assert _hub(d, ukflex.ConstantSpeed(1.0), 1.0).body_info("bar")["stress_stiffening"] is True
+    assert _hub(d, ukflex.ConstantSpeed(1.0), 1.0, stiffening=False).body_info("bar")["stress_stiffening"] is False
     for radius, k_flap in ((0.0, K1), (0.5, K1 + 0.5 * K2)):
         w0 = _lowest_two(_hub(d, ukflex.ConstantSpeed(0.0), 0.0, radius))
         om = 20.0

@@ -637,5 +637,6 @@ impl Flexible3 {
         m.insert("n_modes".into(), self.n.into());
         m.insert("interfaces".into(), self.interfaces.iter().map(|f| f.point.to_vec()).collect::<Vec<_>>().into());
         m.insert("first_moment".into(), self.first[0].to_vec().into());
+        m.insert("stress_stiffening".into(), self.stiffening.is_some().into());
     }
 }
