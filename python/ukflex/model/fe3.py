@@ -83,7 +83,8 @@ class FlexibleData3:
     ``second_moment`` (n + 1, n + 1, 3, 3), ``k_ff`` and optional ``d_ff`` (n, n), the
     ``interfaces`` by name; ``info`` holds what the reduction found (``frequencies`` of the
     kept normal modes in Hz, the basis ``modes`` (3N, n), ``nodes``, the VTK ``cells``, the
-    nodal ``stress_modes`` (N, 6, n): ``xx, yy, zz, yz, zx, xy`` per unit modal coordinate);
+    nodal ``stress_modes`` (N, 6, n): ``xx, yy, zz, yz, zx, xy`` per unit modal coordinate; with
+    stress stiffening the static ``load_displacements`` (12, N, 3) of the unit load cases);
     ``geometric_stiffness`` (12, n, n), with ``stress_stiffening=True``, the modal geometric
     stiffness of the unit load cases (:data:`ukflex.model.fe3_stiffening.LOAD_CASES`)."""
 
