@@ -31,6 +31,7 @@ use crate::description::spatial::Flexible3Desc;
 use crate::error::{check_finite_item, positive, Error, Result};
 use crate::linalg::dense::cholesky;
 use crate::linalg::rot3::{cross, dot, mat_t_vec, mat_vec, rot_a, rot_e, rot_g, M3, V3};
+use super::flexible3_stiffening::GeometricStiffness;
 
 pub use super::rigid3::NORMALIZATION_COORD;
 
@@ -63,6 +64,8 @@ pub struct Flexible3 {
     pub interfaces: Vec<Interface3>,
     /// A length of the body (`sqrt(tr P_00 / m)`), the scale of the interface-point match.
     pub size: f64,
+    /// Stress stiffening (`flexible3_stiffening.rs`), when the data carry it.
+    pub stiffening: Option<GeometricStiffness>,
 }
 
 /// Workspace: the state of the last `mass_and_forces`, the velocity-space mass matrix and its
@@ -150,7 +153,8 @@ impl Flexible3 {
             }
             interfaces.push(Interface3 { point: f.point, phi: f.phi.clone(), psi });
         }
-        let body = Flexible3 { mass, n, first: d.first_moment.clone(), second: d.second_moment.clone(), m_ff, k_ff, d_ff, k, inv_sqrt_k: 1.0 / k.max(f64::MIN_POSITIVE).sqrt(), interfaces, size };
+        let stiffening = d.geometric_stiffness.as_ref().map(|g| GeometricStiffness::from_desc(item, g, n)).transpose()?;
+        let body = Flexible3 { mass, n, first: d.first_moment.clone(), second: d.second_moment.clone(), m_ff, k_ff, d_ff, k, inv_sqrt_k: 1.0 / k.max(f64::MIN_POSITIVE).sqrt(), interfaces, size, stiffening };
         body.check_definite(item)?;
         Ok(body)
     }
@@ -353,6 +357,9 @@ impl Flexible3 {
             }
             f[7 + j] = v;
         }
+        if let Some(g) = &self.stiffening {
+            g.add_forces(&w, &mat_t_vec(&r, &[qd[0], qd[1], qd[2]]), qf, &mut f[7..7 + n]);
+        }
         let fr = mat_vec(&r, &qr);
         f[0..3].copy_from_slice(&fr);
         self.put_rotational(bd, &qw, pd, &mut f[3..7]);
@@ -506,9 +513,14 @@ impl Flexible3 {
         0.5 * e
     }
 
-    /// `-dQ/dq_f = K_ff`, `-dQ/dqd_f = D_ff` (body coordinates).
-    pub fn tangent(&self, _q: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
+    /// `-dQ/dq_f = K_ff (+ K_g(w', v'))`, `-dQ/dqd_f = D_ff` (body coordinates; the stress
+    /// stiffening's dependence on the frame's rates is left to the differences).
+    pub fn tangent(&self, q: &[f64], qd: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
         let n = self.n;
+        if let Some(g) = &self.stiffening {
+            let (r, w, _) = Self::frame(&q[3..7], &qd[3..7]);
+            g.tangent(&w, &mat_t_vec(&r, &[qd[0], qd[1], qd[2]]), &mut |i, j, v| k(7 + i, 7 + j, v));
+        }
         for i in 0..n {
             for j in 0..n {
                 k(7 + i, 7 + j, self.k_ff[i * n + j]);
@@ -529,7 +541,10 @@ impl Flexible3 {
         for c in 0..3 {
             f[c] += self.mass * g[c];
         }
-        let qw = cross(&st, &gb);
+        let mut qw = cross(&st, &gb);
+        if let Some(s) = &self.stiffening {
+            s.add_gravity(&gb, &q[7..7 + n], &mut qw, &mut f[7..7 + n]);
+        }
         let gm = rot_g(p);
         for l in 0..4 {
             f[3 + l] += 2.0 * (gm[0][l] * qw[0] + gm[1][l] * qw[1] + gm[2][l] * qw[2]);
@@ -539,11 +554,12 @@ impl Flexible3 {
         }
     }
 
-    /// `-g . int rho r_P dV = -g . (m r + R S_t)`.
+    /// `-g . int rho r_P dV = -g . (m r + R S_t)` (and the prestress's `1/2 q_f^T K_g(R^T g) q_f`).
     pub fn gravity_potential(&self, q: &[f64], g: &V3) -> f64 {
         let (r, _, _) = Self::frame(&q[3..7], &[0.0; 4]);
         let c = mat_vec(&r, &self.first_moment(&q[7..7 + self.n]));
-        -(0..3).map(|i| g[i] * (self.mass * q[i] + c[i])).sum::<f64>()
+        let prestress = self.stiffening.as_ref().map_or(0.0, |s| s.gravity_potential(&mat_t_vec(&r, g), &q[7..7 + self.n]));
+        prestress - (0..3).map(|i| g[i] * (self.mass * q[i] + c[i])).sum::<f64>()
     }
 
     /// Linear momentum and angular momentum about the world origin (sensors; allocates).
@@ -621,5 +637,6 @@ impl Flexible3 {
         m.insert("n_modes".into(), self.n.into());
         m.insert("interfaces".into(), self.interfaces.iter().map(|f| f.point.to_vec()).collect::<Vec<_>>().into());
         m.insert("first_moment".into(), self.first[0].to_vec().into());
+        m.insert("stress_stiffening".into(), self.stiffening.is_some().into());
     }
 }

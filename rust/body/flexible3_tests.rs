@@ -4,6 +4,7 @@
 //! (virtual work), the explicit factor, and the markers' kinematics.
 
 use super::flexible3::Flexible3;
+use super::flexible3_stiffening::LOAD_CASES;
 use super::marker3::{add_jacobian, Marker3};
 use super::{Body, BodyKind};
 use crate::description::spatial::{Flexible3Desc, Interface3Desc, Marker3Desc};
@@ -66,6 +67,7 @@ fn desc(c: &Cloud) -> Flexible3Desc {
         second_moment: second,
         k_ff,
         d_ff: None,
+        geometric_stiffness: None,
         interfaces: vec![Interface3Desc { point: c.u[0], phi: c.s[0].clone(), psi: Some((0..N).map(|j| [0.1 * j as f64, -0.2, 0.3]).collect()) }],
         position: [0.0; 3],
         orientation: None,
@@ -186,6 +188,12 @@ fn velocity_forces_follow_from_lagrange() {
 #[test]
 fn gravity_is_the_gradient_of_its_potential() {
     let (b, _) = body();
+    check_gravity(&b);
+    // with stress stiffening: the prestress's potential 1/2 q_f^T K_g(R^T g) q_f as well
+    check_gravity(&stiffened().0);
+}
+
+fn check_gravity(b: &Flexible3) {
     let (q, _) = state();
     let g = [0.3, -9.81, 1.2];
     let mut f = vec![0.0; 7 + N];
@@ -276,6 +284,109 @@ fn marker_kinematics_by_differences() {
         for x in 0..3 {
             let dd = (kin(&mk.state(&bodies, &qp, &v)).vd[x] - kin(&mk.state(&bodies, &qm, &v)).vd[x]) / (2.0 * h);
             assert!((dd - k0.h[x]).abs() < 1e-6, "quantity {which}: h {} vs {dd}", k0.h[x]);
+        }
+    }
+}
+
+/// The cloud's body with random symmetric geometric stiffness matrices of the 12 load cases.
+fn stiffened() -> (Flexible3, Vec<Vec<Vec<f64>>>) {
+    let c = cloud();
+    let mut d = desc(&c);
+    let mut g = Lcg(11);
+    let kg: Vec<Vec<Vec<f64>>> = (0..LOAD_CASES.len())
+        .map(|_| {
+            let a: Vec<Vec<f64>> = (0..N).map(|_| (0..N).map(|_| g.next()).collect()).collect();
+            (0..N).map(|i| (0..N).map(|j| a[i][j] + a[j][i]).collect()).collect()
+        })
+        .collect();
+    d.geometric_stiffness = Some(kg.clone());
+    (Flexible3::from_desc(&d, "body 'f'").unwrap(), kg)
+}
+
+/// The body force per unit mass of load case `c` at `x` (fe3_stiffening.py's definitions).
+fn case_force(c: usize, x: &V3) -> V3 {
+    let e = |k: usize| -> V3 { [0, 1, 2].map(|i| if i == k { 1.0 } else { 0.0 }) };
+    if c < 6 {
+        let (k, l) = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0)][c];
+        // (tr E I - E) x, E = e_k e_l^T (+ e_l e_k^T)
+        let mut em = [[0.0; 3]; 3];
+        em[k][l] += 1.0;
+        if k != l {
+            em[l][k] += 1.0;
+        }
+        let tr = em[0][0] + em[1][1] + em[2][2];
+        let ex = mat_vec(&em, x);
+        return [0, 1, 2].map(|i| tr * x[i] - ex[i]);
+    }
+    if c < 9 {
+        let ek = e(c - 6);
+        return [0, 1, 2].map(|i| -(ek[(i + 1) % 3] * x[(i + 2) % 3] - ek[(i + 2) % 3] * x[(i + 1) % 3]));
+    }
+    e(c - 9)
+}
+
+#[test]
+fn stress_stiffening_forces_and_tangent() {
+    let (b, kg) = stiffened();
+    let (plain, _) = body();
+    let (q, qd) = state();
+    let (r, w, _) = Flexible3::frame(&q[3..7], &qd[3..7]);
+    let v = crate::linalg::rot3::mat_t_vec(&r, &[qd[0], qd[1], qd[2]]);
+    // the applied load factors, recovered from the body force they must reproduce: the
+    // centrifugal -w x (w x x) and the velocity part of the frame acceleration -(w x v)
+    let lambda = [w[0] * w[0], w[1] * w[1], w[2] * w[2], w[0] * w[1], w[1] * w[2], w[2] * w[0], 0.0, 0.0, 0.0];
+    let wv = crate::linalg::rot3::cross(&w, &v);
+    let mut g = Lcg(5);
+    for _ in 0..3 {
+        let x = g.v3();
+        let wx = crate::linalg::rot3::cross(&w, &x);
+        let want = crate::linalg::rot3::cross(&w, &wx).map(|y| -y);
+        let mut mine = [0.0; 3];
+        for c in 0..12 {
+            let l = if c < 9 { lambda[c] } else { -wv[c - 9] };
+            let f = case_force(c, &x);
+            (0..3).for_each(|i| mine[i] += l * f[i]);
+        }
+        for i in 0..3 {
+            assert!((mine[i] - (want[i] - wv[i])).abs() < 1e-12, "{mine:?} {want:?} {wv:?}");
+        }
+    }
+    let (mut bd, mut bd0) = (b.new_data(), plain.new_data());
+    let (mut f, mut f0) = (vec![0.0; 7 + N], vec![0.0; 7 + N]);
+    b.mass_and_forces(&mut bd, &q, &qd, None, &mut f);
+    plain.mass_and_forces(&mut bd0, &q, &qd, None, &mut f0);
+    for j in 0..7 + N {
+        let mut want = 0.0;
+        if j >= 7 {
+            for c in 0..12 {
+                let l = if c < 9 { lambda[c] } else { -wv[c - 9] };
+                want -= l * (0..N).map(|k| kg[c][j - 7][k] * q[7 + k]).sum::<f64>();
+            }
+        }
+        assert!((f[j] - f0[j] - want).abs() < 1e-12 * (1.0 + want.abs()), "coordinate {j}: {} vs {want}", f[j] - f0[j]);
+    }
+    // the tangent -dQ_f/dq_f against central differences
+    let mut kt = vec![0.0; (7 + N) * (7 + N)];
+    b.tangent(&q, &qd, &mut |i, j, x| kt[i * (7 + N) + j] += x, &mut |_, _, _| {});
+    let h = 1e-6;
+    for l in 7..7 + N {
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        qp[l] += h;
+        qm[l] -= h;
+        let (mut fp, mut fm) = (vec![0.0; 7 + N], vec![0.0; 7 + N]);
+        b.mass_and_forces(&mut bd, &qp, &qd, None, &mut fp);
+        b.mass_and_forces(&mut bd, &qm, &qd, None, &mut fm);
+        for j in 7..7 + N {
+            // the quadratic velocity forces depend on q_f as well: compare the difference to the
+            // plain body's
+            let (mut gp, mut gm) = (vec![0.0; 7 + N], vec![0.0; 7 + N]);
+            plain.mass_and_forces(&mut bd0, &qp, &qd, None, &mut gp);
+            plain.mass_and_forces(&mut bd0, &qm, &qd, None, &mut gm);
+            let num = -((fp[j] - gp[j]) - (fm[j] - gm[j])) / (2.0 * h);
+            let mut kp = vec![0.0; (7 + N) * (7 + N)];
+            plain.tangent(&q, &qd, &mut |i, jj, x| kp[i * (7 + N) + jj] += x, &mut |_, _, _| {});
+            let ana = kt[j * (7 + N) + l] - kp[j * (7 + N) + l];
+            assert!((num - ana).abs() < 1e-6 * (1.0 + ana.abs()), "({j}, {l}): {num} vs {ana}");
         }
     }
 }

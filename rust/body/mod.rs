@@ -19,6 +19,7 @@ pub mod frame;
 pub mod marker;
 pub mod flexible;
 pub mod flexible3;
+pub mod flexible3_stiffening;
 #[cfg(test)]
 mod flexible3_tests;
 pub mod inspect;
@@ -290,8 +291,15 @@ impl Body {
 
     /// Stiffness `-dQ_b/dq_b` and damping `-dQ_b/dqd_b` of the body's own forces that it knows
     /// analytically (elastic tangent, strain-rate damping), in body coordinates.
-    pub fn tangent(&self, _bd: &BodyData, q: &[f64], _qd: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
-        with_elastic_kind!(&self.kind, |b| b.tangent(self.seg(q), k, c), rigid => ())
+    pub fn tangent(&self, _bd: &BodyData, q: &[f64], qd: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
+        match &self.kind {
+            BodyKind::Beam(b) => b.tangent(self.seg(q), k, c),
+            BodyKind::Cable(b) => b.tangent(self.seg(q), k, c),
+            BodyKind::Flexible(b) => b.tangent(self.seg(q), k, c),
+            // its stress stiffening reads the frame's rates
+            BodyKind::Flexible3(b) => b.tangent(self.seg(q), self.seg(qd), k, c),
+            BodyKind::Rigid(_) | BodyKind::PointMass(_) | BodyKind::Rigid3(_) | BodyKind::Point3(_) => (),
+        }
     }
 
     /// `1/2 qd_b^T M_b qd_b` (after `mass_and_forces` at the same `q`).

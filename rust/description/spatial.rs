@@ -93,6 +93,10 @@ pub struct Flexible3Desc {
     pub k_ff: Vec<Vec<f64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub d_ff: Option<Vec<Vec<f64>>>,
+    /// Stress stiffening (docs/spatial-flexible.md): the modal geometric stiffness (n x n) of
+    /// each unit load case, in the order of `body::flexible3::LOAD_CASES` (12 matrices).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometric_stiffness: Option<Vec<Vec<Vec<f64>>>>,
     /// Interface nodes (the only places markers may sit): undeformed point, per-mode nodal
     /// displacement `phi` (n x 3) and rotation `psi` (n x 3, default zero).
     #[serde(default)]

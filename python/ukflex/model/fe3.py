@@ -34,6 +34,10 @@ Reduction (``reduction``, ``ukflex.fe.REDUCTIONS``): ``"modes"`` (default) keeps
 of the model in its frame; ``"craig-bampton"`` (a clamped frame) moves every other interface's
 node set rigidly in six static constraint modes (unit translations and rotations about its
 centroid, the rest statically condensed), followed by the fixed-interface normal modes.
+
+Stress stiffening (``stress_stiffening=True``, a clamped frame): the modal geometric stiffness
+of twelve unit inertia load cases (:mod:`ukflex.model.fe3_stiffening`), which the body scales by
+its frame's motion (docs/spatial-flexible.md, "Stress stiffening").
 """
 
 from __future__ import annotations
@@ -49,6 +53,7 @@ import scipy.sparse.linalg as spla
 from ..arguments import count, non_negative, positive, real
 from ..errors import InvalidArgumentError, require
 from .fe import REDUCTIONS, frame_interfaces
+from .fe3_stiffening import geometric_stiffness, held_mask, stress_modes
 
 __all__ = ["FlexibleData3", "Interface3", "solid_matrices", "from_mesh", "bar_mesh"]
 
@@ -77,7 +82,11 @@ class FlexibleData3:
     """The data of a ``flexible3`` body: ``mass``, ``first_moment`` (n + 1, 3),
     ``second_moment`` (n + 1, n + 1, 3, 3), ``k_ff`` and optional ``d_ff`` (n, n), the
     ``interfaces`` by name; ``info`` holds what the reduction found (``frequencies`` of the
-    kept normal modes in Hz, the basis ``modes`` (3N, n), ``nodes``)."""
+    kept normal modes in Hz, the basis ``modes`` (3N, n), ``nodes``, the VTK ``cells``, the
+    nodal ``stress_modes`` (N, 6, n): ``xx, yy, zz, yz, zx, xy`` per unit modal coordinate; with
+    stress stiffening the static ``load_displacements`` (12, N, 3) of the unit load cases);
+    ``geometric_stiffness`` (12, n, n), with ``stress_stiffening=True``, the modal geometric
+    stiffness of the unit load cases (:data:`ukflex.model.fe3_stiffening.LOAD_CASES`)."""
 
     mass: float
     first_moment: np.ndarray
@@ -86,6 +95,7 @@ class FlexibleData3:
     d_ff: Optional[np.ndarray] = None
     interfaces: Dict[str, Interface3] = field(default_factory=dict)
     info: Dict[str, Any] = field(default_factory=dict)
+    geometric_stiffness: Optional[np.ndarray] = None
 
     @property
     def n_modes(self) -> int:
@@ -118,6 +128,8 @@ class FlexibleData3:
                              "interfaces": [f.to_dict() for f in self.interfaces.values()]}
         if self.d_ff is not None:
             d["d_ff"] = np.asarray(self.d_ff, float).tolist()
+        if self.geometric_stiffness is not None:
+            d["geometric_stiffness"] = np.asarray(self.geometric_stiffness, float).tolist()
         return d
 
 
@@ -180,6 +192,25 @@ def solid_matrices(mesh: Any, *, density: float, youngs_modulus: float, poisson_
     ``M_s`` (N x N) of an isotropic linear-elastic solid on ``mesh`` (tetrahedra P1/P2,
     hexahedra Q1/Q2 by ``order``); the nodes are the element's dof locations (vertices, then
     edge, face and cell nodes)."""
+    s = _solid(mesh, density=density, youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, order=order)
+    return s.nodes, s.k, s.ms
+
+
+@dataclass
+class _Solid:
+    """The assembled solid: nodes, ``K``, ``M_s``, the scalar scikit-fem basis, the mesh and the
+    Lame parameters (what the geometric stiffness and the VTK cells need besides the matrices)."""
+
+    nodes: np.ndarray
+    k: sp.csr_matrix
+    ms: sp.csr_matrix
+    basis: Any
+    mesh: Any
+    lam: float
+    mu: float
+
+
+def _solid(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio: float, order: int = 2) -> _Solid:
     skfem = require("skfem", "ukflex.fe3.solid_matrices", extra="fe")
     elasticity = require("skfem.models.elasticity", "ukflex.fe3.solid_matrices", extra="fe")
     lame_parameters = elasticity.lame_parameters
@@ -217,7 +248,7 @@ def solid_matrices(mesh: Any, *, density: float, youngs_modulus: float, poisson_
             e_ab = sp.csr_matrix(([1.0], ([a_], [b_])), shape=(3, 3))
             k = k + sp.kron(block, e_ab, format="csr")
     ms = skfem.asm(skfem.BilinearForm(lambda u, v, w: rho * u * v), basis).tocsr()
-    return nodes, k, ms
+    return _Solid(nodes, k, ms, basis, m, float(lam), float(mu))
 
 
 def _select(name: str, spec: InterfaceSpec, nodes: np.ndarray) -> np.ndarray:
@@ -302,15 +333,22 @@ def _held(frame: Any, names: List[str]) -> Optional[str]:
 
 def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio: float,
               interfaces: Mapping[str, InterfaceSpec], modes: int = 8, frame: Any = "mean-axis",
-              reduction: str = "modes", order: int = 2, damping_ratio: float = 0.0) -> FlexibleData3:
+              reduction: str = "modes", order: int = 2, damping_ratio: float = 0.0,
+              stress_stiffening: bool = False) -> FlexibleData3:
     """The ``flexible3`` body of an FE solid reduced to ``modes`` normal modes (module docs).
     ``interfaces``: name -> node index, indices, mask, ``select(nodes) -> mask`` or
     ``{"point": (x, y, z)}`` (a node must sit there). ``frame``: ``"mean-axis"`` or
     ``"clamped"`` (``("clamped", NAME)``: that interface held); ``reduction``: ``"modes"`` or
-    ``"craig-bampton"`` (module docs). ``damping_ratio``: modal damping of the kept modes."""
+    ``"craig-bampton"`` (module docs). ``damping_ratio``: modal damping of the kept modes.
+    ``stress_stiffening``: also the modal geometric stiffness of the unit inertia load cases
+    (:mod:`ukflex.model.fe3_stiffening`; a clamped frame: the solid carries the loads held at
+    its frame's interface), stored as ``geometric_stiffness`` (12, n, n)."""
     zeta = non_negative("damping_ratio", damping_ratio)
     nmodes = count("modes", modes)
-    nodes, k, ms = solid_matrices(mesh, density=density, youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, order=order)
+    if not isinstance(stress_stiffening, bool):
+        raise InvalidArgumentError("stress_stiffening", f"expected True or False, got {stress_stiffening!r}")
+    solid = _solid(mesh, density=density, youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, order=order)
+    nodes, k, ms = solid.nodes, solid.k, solid.ms
     n3 = 3 * nodes.shape[0]
     if not isinstance(interfaces, Mapping):
         raise InvalidArgumentError("interfaces", f"expected a dict name -> nodes, got {type(interfaces).__name__}")
@@ -322,6 +360,9 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
         raise InvalidArgumentError("reduction", f"unknown reduction {reduction!r}; expected one of {list(REDUCTIONS)}")
     if reduction == "craig-bampton" and reference is None:
         raise InvalidArgumentError("reduction", "the craig-bampton reduction needs a clamped frame (an interface held)")
+    if stress_stiffening and reference is None:
+        raise InvalidArgumentError("stress_stiffening", "stress stiffening needs a clamped frame (('clamped', NAME)): the "
+                                   "inertia loads are carried by the solid held at its frame's interface")
     if reference is None:
         if nmodes + 6 >= n3:
             raise InvalidArgumentError("modes", f"{nmodes} modes do not fit a model with {n3} dofs")
@@ -330,9 +371,7 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
             raise InvalidArgumentError("mesh", f"the free part does not have six rigid-body modes (eigenvalues {lam[:7].tolist()}): is the mesh connected?")
         basis, normal = x[:, 6:], lam[6:]
     else:
-        held = np.zeros(n3, dtype=bool)
-        for i in sets[reference]:
-            held[3 * i:3 * i + 3] = True
+        held = held_mask(sets, reference, n3)
         boundary = []
         if reduction == "craig-bampton":
             for name, idx in sets.items():
@@ -370,7 +409,20 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
                     static.append(u)
         basis = np.column_stack(static + [normal_x]) if static else normal_x
         normal = lam
-    return _reduced(nodes, k, ms, basis, rows, sets, normal, zeta)
+    data = _reduced(nodes, k, ms, basis, rows, sets, normal, zeta)
+    data.info["cells"] = _vtk_cells(solid.mesh)
+    data.info["stress_modes"] = stress_modes(solid, basis)
+    if stress_stiffening:
+        data.geometric_stiffness, data.info["load_displacements"] = geometric_stiffness(solid, held_mask(sets, reference, n3), basis)
+    return data
+
+
+def _vtk_cells(mesh: Any) -> Tuple[str, np.ndarray]:
+    """The mesh's cells on the vertex nodes in VTK's order (meshio's cell type and indices): the
+    vertices are the first nodes of every element space, numbered as the mesh's points."""
+    to_meshio = require("skfem.io.meshio", "ukflex.fe3 (VTK cells)", extra="fe").to_meshio
+    block = to_meshio(mesh).cells[0]
+    return block.type, np.asarray(block.data, dtype=np.int64)
 
 
 def _reduced(nodes: np.ndarray, k: sp.spmatrix, ms: sp.spmatrix, basis: np.ndarray, rows: Dict[str, Any],

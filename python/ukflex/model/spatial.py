@@ -37,7 +37,7 @@ from typing import Any, Dict, List, Optional, Sequence
 import numpy as np
 
 from .. import _core
-from ..errors import InvalidSceneError
+from ..errors import InvalidArgumentError, InvalidSceneError
 
 __all__ = ["SpatialScene", "SpatialMarker", "SpatialBodyRef", "SpatialFlexibleRef", "outputs", "normalize_spatial", "NATIVE_METHODS_3D"]
 
@@ -133,14 +133,25 @@ class SpatialScene:
 
     def flexible_body(self, name: str, data: Any, *, position: Sequence[float] = (0, 0, 0), orientation: Any = None,
                       velocity: Sequence[float] = (0, 0, 0), angular_velocity: Sequence[float] = (0, 0, 0),
-                      elastic: Optional[Sequence[float]] = None, elastic_rates: Optional[Sequence[float]] = None) -> "SpatialFlexibleRef":
+                      elastic: Optional[Sequence[float]] = None, elastic_rates: Optional[Sequence[float]] = None,
+                      stress_stiffening: Optional[bool] = None) -> "SpatialFlexibleRef":
         """A 3D floating-frame modal body (kind ``flexible3``, docs/spatial-flexible.md) from its
         data (:class:`ukflex.fe3.FlexibleData3`, e.g. :func:`ukflex.fe3.from_mesh`, or the
         description dict of its invariants): ``position``, ``orientation``, ``velocity`` and
         ``angular_velocity`` (world axes) of its floating frame, ``elastic`` and ``elastic_rates``
         the initial modal coordinates (default zero). Markers sit on its interfaces:
-        ``ref.interface("A", z=...)``."""
+        ``ref.interface("A", z=...)``. ``stress_stiffening``: ``None`` (default) uses the data's
+        ``geometric_stiffness`` if they carry it, ``True`` requires it, ``False`` leaves it out
+        (docs/spatial-flexible.md, "Stress stiffening")."""
         d = data.to_dict() if hasattr(data, "to_dict") else dict(data)
+        if stress_stiffening is not None and not isinstance(stress_stiffening, bool):
+            raise InvalidArgumentError("stress_stiffening", f"expected None, True or False, got {stress_stiffening!r}")
+        if stress_stiffening is False:
+            d.pop("geometric_stiffness", None)
+        elif stress_stiffening and d.get("geometric_stiffness") is None:
+            raise InvalidArgumentError("stress_stiffening", f"body {name!r}: its data carry no geometric_stiffness (the "
+                                       "load cases of stress stiffening): build them with ukflex.fe3.from_mesh(..., "
+                                       "frame=('clamped', NAME), stress_stiffening=True)")
         b: Dict[str, Any] = {"kind": "flexible3", "name": name, **d, "position": _vec("position", position),
                              "velocity": _vec("velocity", velocity), "angular_velocity": _vec("angular_velocity", angular_velocity)}
         if orientation is not None:

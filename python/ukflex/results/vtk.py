@@ -18,7 +18,10 @@ folder next to a ``.pvd`` collection that lists them with their times (ParaView:
   where a joint, driver or force attaches) or a point;
 * spatial scenes (:class:`ukflex.SpatialScene`): each body as the polyline from its centre of
   mass to its marker points, with its axes ``x_axis``, ``y_axis``, ``z_axis`` (world) at every
-  point (:func:`ukflex.spatial_outputs`).
+  point (:func:`ukflex.spatial_outputs`); a ``flexible3`` body whose :func:`ukflex.fe3.from_mesh`
+  data is given (``flexible=``): its mesh (tetrahedra or hexahedra on the vertex nodes) at its
+  deformed place with ``displacement``, ``elastic_displacement`` (world), ``stress``
+  (``xx, yy, zz, yz, zx, xy``, frame axes) and ``von_mises``.
 
 Planar points get ``z = 0``; vectors have three components (ParaView's Warp By Vector).
 """
@@ -45,6 +48,23 @@ def _xyz(p: np.ndarray) -> np.ndarray:
     if p.shape[-1] == 3:
         return p
     return np.concatenate([p, np.zeros(p.shape[:-1] + (1,))], axis=-1)
+
+
+def _modal_parts(f: Dict[str, Any]) -> List[Part]:
+    """The mesh of a modal body at each time of its :func:`ukflex.results.fields.modal_fields`
+    (planar: triangles or quads, with stress; spatial: its (cell type, cells) pair)."""
+    cells = f["cells"]
+    if isinstance(cells, tuple):
+        block = [cells]
+    else:
+        block = [("triangle" if cells.shape[1] == 3 else "quad", cells)]
+    parts = []
+    for j in range(f["position"].shape[0]):
+        data = {"displacement": _xyz(f["displacement"][j]), "elastic_displacement": _xyz(f["elastic"][j])}
+        if "stress" in f:
+            data.update(stress=f["stress"][j], von_mises=f["von_mises"][j])
+        parts.append((_xyz(f["position"][j]), block, data))
+    return parts
 
 
 def _line_cells(k: int) -> List[Tuple[str, np.ndarray]]:
@@ -74,13 +94,7 @@ def _planar_parts(system: Any, q: np.ndarray, idx: np.ndarray, flexible: Mapping
                                                          "xi": xi})
                          for j in range(qs.shape[1])]
         elif kind == "flexible" and name in flexible:
-            f = modal_fields(system, qs, name, flexible[name])
-            cells = f["cells"]
-            ctype = "triangle" if cells.shape[1] == 3 else "quad"
-            out[name] = [(_xyz(f["position"][j]), [(ctype, cells)],
-                          {"displacement": _xyz(f["displacement"][j]), "elastic_displacement": _xyz(f["elastic"][j]),
-                           "stress": f["stress"][j], "von_mises": f["von_mises"][j]})
-                         for j in range(qs.shape[1])]
+            out[name] = _modal_parts(modal_fields(system, qs, name, flexible[name]))
         else:
             parts = []
             for j in range(qs.shape[1]):
@@ -104,7 +118,9 @@ def _spatial_markers(description: Dict[str, Any]) -> Dict[str, List[List[float]]
     return pts
 
 
-def _spatial_parts(system: Any, t: np.ndarray, q: np.ndarray, qd: np.ndarray) -> Dict[str, List[Part]]:
+def _spatial_parts(system: Any, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
+                   flexible: Mapping[str, Any]) -> Dict[str, List[Part]]:
+    from .fields import modal_fields
     from .spatial import outputs
 
     out = outputs(system, t, q.T, qd.T, reactions=False)
@@ -112,6 +128,9 @@ def _spatial_parts(system: Any, t: np.ndarray, q: np.ndarray, qd: np.ndarray) ->
     parts: Dict[str, List[Part]] = {}
     for b in system.description["bodies"]:
         name = b["name"]
+        if b["kind"] == "flexible3" and name in flexible:
+            parts[name] = _modal_parts(modal_fields(system, q, name, flexible[name]))
+            continue
         o = out["bodies"][name]
         com = np.asarray(b.get("com", (0.0, 0.0, 0.0)), dtype=float)
         local = np.asarray(markers.get(name, []), dtype=float).reshape(-1, 3) - com
@@ -150,7 +169,8 @@ def export_vtk(system: Any, result: Any, path: str, *, flexible: Optional[Mappin
         without the suffix (``run.pvd`` -> ``run/BODY_00000.vtu``).
     flexible : dict, optional
         Body name -> the :class:`ukflex.FlexibleData` returned by :func:`ukflex.fe.from_mesh`
-        for that modal body: its mesh is written with the displacement and stress fields.
+        for that modal body (the :class:`ukflex.fe3.FlexibleData3` of :func:`ukflex.fe3.from_mesh`
+        for a ``flexible3`` body): its mesh is written with the displacement and stress fields.
     frames : int, optional
         At most this many output times.
     points_per_element : int
@@ -181,7 +201,7 @@ def export_vtk(system: Any, result: Any, path: str, *, flexible: Optional[Mappin
     idx = np.unique(np.linspace(0, t.size - 1, nt).round().astype(int))
     q, qd = np.asarray(result.q, dtype=float), np.asarray(result.qd, dtype=float)
     if system.description.get("dim") == 3:
-        parts = _spatial_parts(system, t[idx], q[:, idx], qd[:, idx])
+        parts = _spatial_parts(system, t[idx], q[:, idx], qd[:, idx], flexible)
     else:
         parts = _planar_parts(system, q, idx, flexible, points_per_element)
     folder = path[:-4]
