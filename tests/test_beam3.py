@@ -35,15 +35,23 @@ def _cantilever(n, length=1.0, loads=()):
     return s, b
 
 
+def _node(sys, q, b, i, offset=None):
+    """Point and Euler parameters of node ``i``: a node body's ``r`` is the centre of mass of its
+    segment, a quarter element inwards at the two end nodes (``offset`` from the node, body x)."""
+    k = sys.body_names.index(b.node_name(i))
+    le = 1.0 / b.elements  # the tests' beams are 1 m long
+    c = offset if offset is not None else (0.25 * le if k == 0 else -0.25 * le if k == b.elements else 0.0)
+    p = q[7 * k + 3:7 * k + 7]
+    return q[7 * k:7 * k + 3] - c * ref.rotation(p)[:, 0], p
+
+
 def _tip(sys, q, b):
-    i = sys.body_names.index(b.node_name(-1))
-    o = 7 * i
-    return q[o:o + 3], q[o + 3:o + 7]
+    return _node(sys, q, b, -1)
 
 
 def test_element_forces_match_the_numpy_reference():
     s = ukflex.SpatialScene()
-    s.beam("b", (0, 0, 0), (0.5, 0, 0), SEC, elements=1)
+    s.beam("b", (0, 0, 0), (0.5, 0, 0), SEC, elements=1)  # both nodes are end nodes: offsets +-L/4
     sys = ukflex.System(s)
     rng = np.random.default_rng(3)
     c_n, c_m = (EA, GAY, GAZ), (GJ, EIY, EIZ)
@@ -54,10 +62,11 @@ def test_element_forces_match_the_numpy_reference():
         q[3:7] = q[3:7] * 1.3 + 0.3 * rng.standard_normal(4)  # not unit: R = A(p) / |p|^2
         q[10:14] = q[3:7] + 0.3 * rng.standard_normal(4)
         Q = np.asarray(sys.Q(0.0, q, np.zeros(14)))
-        g = ref.gradient(q, 0.5, c_n, c_m)
+        offsets = ((0.125, 0, 0), (-0.125, 0, 0))
+        g = ref.gradient(q, 0.5, c_n, c_m, offsets)
         assert np.max(np.abs(Q + g)) <= 1e-12 * np.max(np.abs(g)), np.max(np.abs(Q + g)) / np.max(np.abs(g))
         u = ukflex.spatial_outputs(sys, np.array([0.0]), q[None, :], np.zeros((1, 14)), reactions=False)["potential_energy"][0]
-        assert abs(u - ref.energy(q, 0.5, c_n, c_m)) <= 1e-12 * abs(u)
+        assert abs(u - ref.energy(q, 0.5, c_n, c_m, offsets)) <= 1e-12 * abs(u)
 
 
 def _static(s, q=None):
@@ -118,9 +127,23 @@ def test_end_moment_rolls_the_cantilever_into_a_circle():
     # every node on the polygon's circle, radius L / (2 n sin(pi / n)) about (0, radius, 0)
     rad = length / (2 * n * np.sin(np.pi / n))
     for i in range(n + 1):
-        o = 7 * sys.body_names.index(b.node_name(i))
-        x = q[o:o + 3]
+        x, _ = _node(sys, q, b, i)
         assert abs(np.hypot(x[0], x[1] - rad) - rad) < 1e-9 and abs(x[2]) < 1e-12
+
+
+@pytest.mark.parametrize("n", [1, 2, 5])
+def test_rigid_motion_carries_the_exact_inertia_for_any_number_of_elements(n):
+    # the node bodies are the rigid segments around the nodes: spinning about z through the
+    # start, T = w^2 / 2 (mu L^3 / 3 + j_z L) exactly (point masses at the nodes: 1 / (2 N^2) more)
+    w, length = 3.0, 1.0
+    s = ukflex.SpatialScene()
+    s.beam("b", (0, 0, 0), (length, 0, 0), SEC, elements=n, velocity=(0, 0, 0), angular_velocity=(0, 0, w))
+    sys = ukflex.System(s)
+    out = ukflex.spatial_outputs(sys, np.array([0.0]), np.asarray(sys.q0)[None, :], np.asarray(sys.qd0)[None, :],
+                                 reactions=False)
+    exact = 0.5 * w * w * (2.0 * length**3 / 3 + 1.2e-4 * length)
+    assert abs(out["kinetic_energy"][0] / exact - 1) < 1e-14
+    assert np.allclose(out["angular_momentum"][0], [0, 0, w * (2.0 * length**3 / 3 + 1.2e-4 * length)], rtol=1e-14, atol=0)
 
 
 def test_free_tumbling_beam_conserves_energy():

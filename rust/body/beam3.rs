@@ -1,9 +1,14 @@
 //! The geometrically exact 3D beam (issue 31, docs/spatial-flexible.md): a Simo-Reissner beam of
 //! two-node elements with one-point integration (`beam3/element.rs`), whose nodes carry the
 //! coordinates of the spatial rigid body, `[r (3), p (4)]`, with its normalization row and its
-//! regularization. A node *is* a `rigid3` body of the node's lumped mass (the mass per length
-//! times its tributary length) and lumped rotary inertia (the section's rotary inertia per length
-//! times the same length), with its centre of mass at the node: the mass blocks, the explicit
+//! regularization. A node *is* a `rigid3` body: the rigid segment of the beam around it (its
+//! tributary segment `[x_i - L_e / 2, x_i + L_e / 2]` cut at the ends), with that segment's exact
+//! mass, centre of mass (at the node for the interior nodes, a quarter element inwards for the
+//! two end nodes) and inertia (the section's rotary inertia per length times the segment's
+//! length, plus `m l^2 / 12` about the section's `y` and `z`). In a rigid motion of the beam
+//! these segments carry exactly the beam's mass, first and second moments, whatever the number
+//! of elements (point masses at the nodes would carry the second moment by the trapezoidal rule,
+//! `1 / (2 N^2)` too large about the end). The mass blocks, the explicit
 //! factor, the normalization row (eliminated in closed form by the UK kernel), gravity, markers,
 //! joints, sensors and the scene format of `rigid3` serve the beam unchanged. The elements are
 //! elastic force elements between consecutive node bodies (`force::spatial`,
@@ -122,9 +127,9 @@ pub fn section_frame(item: &str, t: &V3, y_hint: Option<&V3>) -> Result<M3> {
     Ok([[t[0], y[0], z[0]], [t[1], y[1], z[1]], [t[2], y[2], z[2]]])
 }
 
-/// A beam description's node bodies (`name[i]`, kind `rigid3`, in order from `start`), the
-/// element constants (every element the same) and the number of elements.
-pub fn expand(item: &str, d: &Beam3Desc) -> Result<(Vec<Rigid3Desc>, ElementConsts)> {
+/// A beam description's node bodies (`name[i]`, kind `rigid3`, in order from `start`) and the
+/// constants of its elements (element `j` between nodes `j` and `j + 1`).
+pub fn expand(item: &str, d: &Beam3Desc) -> Result<(Vec<Rigid3Desc>, Vec<ElementConsts>)> {
     for (what, v) in [("start", &d.start), ("end", &d.end), ("velocity", &d.velocity), ("angular_velocity", &d.angular_velocity)] {
         check_finite_item(item, what, v)?;
     }
@@ -142,17 +147,24 @@ pub fn expand(item: &str, d: &Beam3Desc) -> Result<(Vec<Rigid3Desc>, ElementCons
     let sec = section3(item, d)?;
     let le = length / ne as f64;
     let w = d.angular_velocity;
+    // the tributary segment of node i, [x_i - L_e / 2, x_i + L_e / 2] within [0, L], from the node
+    let segment = |i: usize| -> (f64, f64) {
+        let lo = if i == 0 { 0.0 } else { -0.5 * le };
+        let hi = if i == ne { 0.0 } else { 0.5 * le };
+        (hi - lo, 0.5 * (lo + hi))
+    };
     let nodes = (0..=ne)
         .map(|i| {
-            let trib = if i == 0 || i == ne { 0.5 * le } else { le };
-            let x = [0, 1, 2].map(|c| d.start[c] + axis[c] * i as f64 / ne as f64);
+            let (l, c) = segment(i);
+            let x = [0, 1, 2].map(|k| d.start[k] + axis[k] * i as f64 / ne as f64);
             let wx = cross(&w, &sub(&x, &d.start));
-            let j = sec.rotary.map(|r| r * trib);
+            let m = sec.mass_per_length * l;
+            let j = [sec.rotary[0] * l, sec.rotary[1] * l + m * l * l / 12.0, sec.rotary[2] * l + m * l * l / 12.0];
             Rigid3Desc {
                 name: format!("{}[{i}]", d.name),
-                mass: sec.mass_per_length * trib,
+                mass: m,
                 inertia: [[j[0], 0.0, 0.0], [0.0, j[1], 0.0], [0.0, 0.0, j[2]]],
-                com: [0.0; 3],
+                com: [c, 0.0, 0.0],
                 position: x,
                 orientation: Some(OrientationDesc::Matrix(frame)),
                 velocity: [0, 1, 2].map(|c| d.velocity[c] + wx[c]),
@@ -160,7 +172,8 @@ pub fn expand(item: &str, d: &Beam3Desc) -> Result<(Vec<Rigid3Desc>, ElementCons
             }
         })
         .collect();
-    Ok((nodes, ElementConsts { length: le, c_n: sec.c_n, c_m: sec.c_m }))
+    let elements = (0..ne).map(|j| ElementConsts { length: le, c_n: sec.c_n, c_m: sec.c_m, offsets: [[segment(j).1, 0.0, 0.0], [segment(j + 1).1, 0.0, 0.0]] }).collect();
+    Ok((nodes, elements))
 }
 
 #[cfg(test)]

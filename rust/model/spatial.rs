@@ -138,12 +138,12 @@ impl Builder {
 
     /// A beam: its node bodies `name[i]` (rigid3) and its elements `name[e j]` (`body/beam3.rs`).
     fn add_beam(&mut self, item: &str, d: &crate::description::spatial::Beam3Desc) -> Result<()> {
-        let (nodes, element) = crate::body::beam3::expand(item, d)?;
+        let (nodes, elements) = crate::body::beam3::expand(item, d)?;
         let first = self.bodies.len();
         for node in &nodes {
             self.add_body(item, &Body3Desc::Rigid3(node.clone()))?;
         }
-        for j in 0..nodes.len() - 1 {
+        for (j, element) in elements.into_iter().enumerate() {
             let name = self.take_name(item, None, format!("{}[e{j}]", d.name))?;
             let ab = [first + j, first + j + 1];
             let base = ab.map(SpatialForce::torque_marker);

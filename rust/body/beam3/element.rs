@@ -12,6 +12,10 @@
 //! * `U = L / 2 (Gamma^T C_N Gamma + kappa^T C_M kappa)`, `C_N = diag(EA, kGA_y, kGA_z)`,
 //!   `C_M = diag(GJ, EI_y, EI_z)`.
 //!
+//! `r_A`, `r_B` are the nodes' points: a node body's coordinate `r` is its centre of mass, which
+//! sits at `c'` (body axes) from the node for the two end nodes (`beam3.rs`), so the node's
+//! point is `r - R c'` (the `offsets`; zero for the interior nodes).
+//!
 //! The energy is written once over `T: Real` (`linalg::dual`): its gradient (the elastic forces
 //! `Q = -dU/dx`) comes exact to rounding from `Dual<14>` and its Hessian (the tangent stiffness
 //! `K = d^2 U / dx^2`) from `HyperDual<14>`, both on the stack. The strains are objective
@@ -31,6 +35,8 @@ pub struct ElementConsts {
     pub c_n: [f64; 3],
     /// `[GJ, EI_y, EI_z]`.
     pub c_m: [f64; 3],
+    /// `c'` of the two node bodies: the centre of mass from the node, body axes.
+    pub offsets: [[f64; 3]; 2],
 }
 
 /// `h(u) = atan(sqrt u) / sqrt u` and its first two derivatives.
@@ -69,9 +75,23 @@ fn rot_t_vec<T: Real>(p: &[T; 4], d: &[T; 3]) -> [T; 3] {
     [0, 1, 2].map(|i| s * d[i] + (e[i] * ed).scale(2.0) - (p[0] * c[i]).scale(2.0))
 }
 
+/// The node's point `r - A(p) c' / |p|^2` of a node body at `(r, p)`.
+#[inline]
+fn node_point<T: Real>(r: [T; 3], p: &[T; 4], c: &[f64; 3]) -> [T; 3] {
+    if *c == [0.0; 3] {
+        return r;
+    }
+    let e = [p[1], p[2], p[3]];
+    let s = p[0] * p[0] - dot3(&e, &e);
+    let ec = e[0].scale(c[0]) + e[1].scale(c[1]) + e[2].scale(c[2]);
+    let x = [e[1].scale(c[2]) - e[2].scale(c[1]), e[2].scale(c[0]) - e[0].scale(c[2]), e[0].scale(c[1]) - e[1].scale(c[0])];
+    let inv = dot4(p, p).recip();
+    [0, 1, 2].map(|i| r[i] - (s.scale(c[i]) + (e[i] * ec).scale(2.0) + (p[0] * x[i]).scale(2.0)) * inv)
+}
+
 /// `(Gamma, kappa)` of the element at `x` (module docs).
-pub fn strains<T: Real>(x: &[T; NX], length: f64) -> ([T; 3], [T; 3]) {
-    let inv_l = 1.0 / length;
+pub fn strains<T: Real>(x: &[T; NX], el: &ElementConsts) -> ([T; 3], [T; 3]) {
+    let inv_l = 1.0 / el.length;
     let pa = [x[3], x[4], x[5], x[6]];
     let pb = [x[10], x[11], x[12], x[13]];
     // p_r = conj(p_A) p_B (Hamilton product)
@@ -89,7 +109,9 @@ pub fn strains<T: Real>(x: &[T; NX], length: f64) -> ([T; 3], [T; 3]) {
     let (ia, ib) = (dot4(&pa, &pa).sqrt().recip(), dot4(&pb, &pb).sqrt().recip().scale(s));
     let pm = [0, 1, 2, 3].map(|k| pa[k] * ia + pb[k] * ib);
     let nm2 = dot4(&pm, &pm);
-    let d = [x[7] - x[0], x[8] - x[1], x[9] - x[2]];
+    let ra = node_point([x[0], x[1], x[2]], &pa, &el.offsets[0]);
+    let rb = node_point([x[7], x[8], x[9]], &pb, &el.offsets[1]);
+    let d = [rb[0] - ra[0], rb[1] - ra[1], rb[2] - ra[2]];
     let md = rot_t_vec(&pm, &d);
     let scale = nm2.recip().scale(inv_l);
     let gamma = [md[0] * scale - T::cst(1.0), md[1] * scale, md[2] * scale];
@@ -99,7 +121,7 @@ pub fn strains<T: Real>(x: &[T; NX], length: f64) -> ([T; 3], [T; 3]) {
 impl ElementConsts {
     /// `U(x)` over any scalar.
     pub fn energy<T: Real>(&self, x: &[T; NX]) -> T {
-        let (g, k) = strains(x, self.length);
+        let (g, k) = strains(x, self);
         let mut e = T::cst(0.0);
         for i in 0..3 {
             e = e + (g[i] * g[i]).scale(self.c_n[i]) + (k[i] * k[i]).scale(self.c_m[i]);
@@ -124,7 +146,7 @@ impl ElementConsts {
     /// strain rates of a motion `v` at `x` (no stress terms).
     pub fn material_energy(&self, x: &[f64; NX], v: &[f64; NX]) -> f64 {
         let xd: [Dual<1>; NX] = std::array::from_fn(|i| Dual { v: x[i], g: [v[i]] });
-        let (g, k) = strains(&xd, self.length);
+        let (g, k) = strains(&xd, self);
         let s: f64 = (0..3).map(|i| self.c_n[i] * g[i].g[0] * g[i].g[0] + self.c_m[i] * k[i].g[0] * k[i].g[0]).sum();
         0.5 * self.length * s
     }
@@ -132,7 +154,7 @@ impl ElementConsts {
     /// Section forces and moments `[N, Q_y, Q_z, M_t, M_y, M_z]` (section axes): `C_N Gamma`,
     /// `C_M kappa`.
     pub fn section_forces(&self, x: &[f64; NX]) -> [f64; 6] {
-        let (g, k) = strains(x, self.length);
+        let (g, k) = strains(x, self);
         [self.c_n[0] * g[0], self.c_n[1] * g[1], self.c_n[2] * g[2], self.c_m[0] * k[0], self.c_m[1] * k[1], self.c_m[2] * k[2]]
     }
 }
@@ -161,7 +183,7 @@ mod tests {
         x
     }
 
-    const EL: ElementConsts = ElementConsts { length: 0.5, c_n: [3.0e3, 1.0e3, 1.3e3], c_m: [7.0, 11.0, 13.0] };
+    const EL: ElementConsts = ElementConsts { length: 0.5, c_n: [3.0e3, 1.0e3, 1.3e3], c_m: [7.0, 11.0, 13.0], offsets: [[0.125, 0.0, 0.0], [-0.01, 0.02, 0.03]] };
 
     #[test]
     fn straight_reference_and_rigid_rotation_are_strain_free() {
@@ -172,7 +194,7 @@ mod tests {
         x[3..7].copy_from_slice(&p.map(|v| 2.0 * v));
         x[10..14].copy_from_slice(&p.map(|v| -0.5 * v));
         x[7..10].copy_from_slice(&ax);
-        let (g, k) = strains(&x, 0.5);
+        let (g, k) = strains(&x, &ElementConsts { offsets: [[0.0; 3]; 2], ..EL });
         for i in 0..3 {
             assert!(g[i].abs() < 1e-15 && k[i].abs() < 1e-15, "{g:?} {k:?}");
         }

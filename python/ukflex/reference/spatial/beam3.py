@@ -10,7 +10,9 @@ Element coordinates ``x = [r_A (3), p_A (4), r_B (3), p_B (4)]``, ``R(p) = A(p) 
 * ``kappa = log(R_A^T R_B) / L`` (``theta = arccos((tr - 1) / 2)``,
   ``log = theta / sin(theta) * vee(R - R^T) / 2``);
 * ``R_m = R_A exp(~kappa L / 2)``, ``Gamma = R_m^T (r_B - r_A) / L - e_1``;
-* ``U = L / 2 (Gamma . C_N Gamma + kappa . C_M kappa)``.
+* ``U = L / 2 (Gamma . C_N Gamma + kappa . C_M kappa)``;
+* the nodes' points are ``r - R c'`` (``offsets``: a node body's centre of mass from its node,
+  body axes; nonzero at the beam's two end nodes).
 
 Valid away from ``theta = 0`` and ``theta = pi`` (the test states are bent).
 """
@@ -41,31 +43,33 @@ def _expm_so3(a):
     return np.eye(3) + np.sin(t) / t * K + (1 - np.cos(t)) / t2 * (K @ K)
 
 
-def strains(x, length):
+def strains(x, length, offsets=((0, 0, 0), (0, 0, 0))):
     """``(Gamma, kappa)`` of the element at ``x``."""
     x = np.asarray(x)
     RA, RB = rotation(x[3:7]), rotation(x[10:14])
+    ra = x[0:3] - RA @ np.asarray(offsets[0], dtype=float)
+    rb = x[7:10] - RB @ np.asarray(offsets[1], dtype=float)
     Rr = RA.T @ RB
     c = (np.trace(Rr) - 1) / 2
     th = np.arccos(c)
     w = np.array([Rr[2, 1] - Rr[1, 2], Rr[0, 2] - Rr[2, 0], Rr[1, 0] - Rr[0, 1]]) / 2
     phi = th / np.sin(th) * w
     Rm = RA @ _expm_so3(phi / 2)
-    gamma = Rm.T @ (x[7:10] - x[0:3]) / length - np.array([1.0, 0.0, 0.0])
+    gamma = Rm.T @ (rb - ra) / length - np.array([1.0, 0.0, 0.0])
     return gamma, phi / length
 
 
-def energy(x, length, c_n, c_m):
-    g, k = strains(x, length)
+def energy(x, length, c_n, c_m, offsets=((0, 0, 0), (0, 0, 0))):
+    g, k = strains(x, length, offsets)
     return 0.5 * length * (g @ (np.asarray(c_n) * g) + k @ (np.asarray(c_m) * k))
 
 
-def gradient(x, length, c_n, c_m, h=1e-30):
+def gradient(x, length, c_n, c_m, offsets=((0, 0, 0), (0, 0, 0)), h=1e-30):
     """``dU/dx`` by the complex step (exact to rounding)."""
     x = np.asarray(x, dtype=float)
     out = np.zeros(x.size)
     for j in range(x.size):
         xc = x.astype(complex)
         xc[j] += 1j * h
-        out[j] = energy(xc, length, c_n, c_m).imag / h
+        out[j] = energy(xc, length, c_n, c_m, offsets).imag / h
     return out
