@@ -211,3 +211,24 @@ def test_flexible_pendulum_against_the_modal_body():
     out = ukflex.spatial_outputs(sys, res, reactions=False)
     e = out["energy"]
     assert np.max(np.abs(e - e[0])) < 1e-8 * np.max(out["kinetic_energy"])
+
+
+def test_revolute_at_a_node_keeps_the_swing_in_its_plane():
+    # a beam hinged at its first node about world y, welded at its last node to a rigid3 tip mass,
+    # released horizontal under gravity: it swings in the x z plane, bends, and keeps its energy
+    s = ukflex.SpatialScene(gravity=(0, 0, -9.81))
+    b = s.beam("b", (0, 0, 0), (0.5, 0, 0), ukflex.Circular(0.01), elements=3, density=7850.0, youngs_modulus=2e9,
+               shear_modulus=7.7e8)
+    tip = s.rigid_body("tip", 0.05, (1e-5, 1e-5, 1e-5), position=(0.5, 0, 0))
+    s.revolute(s.ground.marker((0, 0, 0), z=(0, 1, 0)), b.node(0, z=(0, 1, 0)), name="hinge")
+    s.fixed(b.node(-1), tip.marker((0, 0, 0)), name="weld")
+    sys = ukflex.System(s)
+    res = ukflex.simulate(sys, 0.2, method="DOPRI5", rtol=1e-10, atol=1e-12, t_eval=np.linspace(0, 0.2, 21))
+    q = np.asarray(res.q)
+    ys = [q[7 * k + 1] for k in range(len(sys.body_names))]
+    assert np.max(np.abs(ys)) < 1e-10
+    assert np.min(q[7 * sys.body_names.index("tip") + 2]) < -0.05  # it fell
+    out = ukflex.spatial_outputs(sys, res, reactions=False)
+    e = out["energy"]
+    assert np.max(np.abs(e - e[0])) < 1e-8 * np.max(out["kinetic_energy"])
+    assert np.max(res.sensors.energies()["strain"]) > 1e-6 * np.max(out["kinetic_energy"])  # it bent

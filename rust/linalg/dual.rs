@@ -73,6 +73,7 @@ macro_rules! neg_and_div {
         impl<const N: usize> Div for $t<N> {
             type Output = Self;
             #[inline]
+            #[allow(clippy::suspicious_arithmetic_impl)] // a / b = a * (1 / b), the chain rule of 1 / b
             fn div(self, o: Self) -> Self {
                 self * o.recip()
             }
