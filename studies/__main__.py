@@ -13,6 +13,8 @@ or their output folder:
   python -m studies simeon-crank [--nonlinear]
   python -m studies spatial-fe-bar
   python -m studies spatial-flexible-exudyn
+  python -m studies spatial-beam-pendulum
+  python -m studies spatial-beam-spin-up
   python -m studies sweeps --out results/sweeps [--small]
   python -m studies clearance [flores]
 """
@@ -190,6 +192,8 @@ def _build_parser() -> argparse.ArgumentParser:
     _passthrough(sub, "simeon-crank", "simeon_crank", "Simeon's flexible slider-crank test set (docs/flexible-bodies.md)")
     _passthrough(sub, "spatial-fe-bar", "spatial_fe_bar", "the modes of a 3D FE bar against closed forms (docs/spatial-flexible.md)")
     _passthrough(sub, "spatial-flexible-exudyn", "spatial_flexible_exudyn", "the 3D flexible pendulum against Exudyn's ObjectFFRFreducedOrder (docs/spatial-flexible.md)")
+    _passthrough(sub, "spatial-beam-pendulum", "spatial_beam_pendulum", "the 3D flexible pendulum: geometrically exact beam against the modal body (docs/spatial-flexible.md)")
+    _passthrough(sub, "spatial-beam-spin-up", "spatial_beam_spin_up", "Kane's spin-up beam: the 3D beam against the planar ANCF cable (docs/spatial-flexible.md)")
     _passthrough(sub, "sweeps", "sweeps", "the sweep study: serial, processes, Dask (docs/sweeps.md)")
     _passthrough(sub, "clearance", "clearance", "revolute joints with clearance: Flores's slider-crank, the flexible coupler (docs/loads.md)")
     return parser

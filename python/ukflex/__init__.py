@@ -56,7 +56,7 @@ from .results.simulation import SimulationResult
 from .run.simulate import simulate
 from .run.sweep import sweep
 from .model import scenes
-from .model.spatial import SpatialScene
+from .model.spatial import CustomSection3, SpatialScene
 from .model import spatial_scenes
 from .results.spatial import outputs as spatial_outputs
 from .results.vtk import export_vtk
@@ -92,6 +92,7 @@ __version__ = _version()
 __all__ = [
     "Scene",
     "SpatialScene",
+    "CustomSection3",
     "spatial_outputs",
     "export_vtk",
     "Marker",

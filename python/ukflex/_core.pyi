@@ -17,6 +17,7 @@ __all__ = [
     "SceneChecker",
     "item_name",
     "beam_elastic_dofs",
+    "beam3_default_elements",
     "frame_options",
     "motion_values",
     "dense_eval",
@@ -272,6 +273,9 @@ def item_name(section: str, kind: str, name: Optional[str], index: int) -> str:
 
 def motion_values(motion_json: str, t: _F64) -> _F64:
     """(f, f', f'') of a driver motion at the times t, shape (3, nt)."""
+    ...
+def beam3_default_elements() -> int:
+    """Number of elements of a 3D beam whose description gives none."""
     ...
 def beam_elastic_dofs(elements: int, frame: str) -> int:
     """Number of elastic coordinates of a beam."""

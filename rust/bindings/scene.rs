@@ -103,6 +103,12 @@ pub fn item_name(section: &str, kind: &str, name: Option<&str>, index: usize) ->
     Ok(crate::model::item_name(s, kind, name, index))
 }
 
+/// Number of elements of a 3D beam whose description gives none (`body::beam3`).
+#[pyfunction]
+pub fn beam3_default_elements() -> usize {
+    crate::body::beam3::DEFAULT_ELEMENTS
+}
+
 /// Number of elastic coordinates of a beam with `elements` elements and reference `frame`.
 #[pyfunction]
 pub fn beam_elastic_dofs(elements: usize, frame: &str) -> PyResult<usize> {

@@ -13,6 +13,7 @@
 //! remaining `match` (the compiler lists them).
 
 pub mod ancf_cable;
+pub mod beam3;
 pub mod ffrf;
 pub mod ffrf_beam;
 pub mod frame;

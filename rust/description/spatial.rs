@@ -23,6 +23,7 @@ pub enum Body3Desc {
     Rigid3(Rigid3Desc),
     Point3(Point3Desc),
     Flexible3(Flexible3Desc),
+    Beam3(Beam3Desc),
 }
 
 impl Body3Desc {
@@ -31,6 +32,7 @@ impl Body3Desc {
             Body3Desc::Rigid3(r) => &r.name,
             Body3Desc::Point3(p) => &p.name,
             Body3Desc::Flexible3(f) => &f.name,
+            Body3Desc::Beam3(b) => &b.name,
         }
     }
 }
@@ -115,6 +117,58 @@ pub struct Flexible3Desc {
     pub elastic: Option<Vec<f64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub elastic_rates: Option<Vec<f64>>,
+}
+
+/// A geometrically exact 3D beam (`body/beam3.rs`, docs/spatial-flexible.md): a straight
+/// reference axis from `start` to `end` cut into `elements` two-node Simo-Reissner elements.
+/// The model builder turns it into `elements + 1` node bodies `name[i]` (kind `rigid3`,
+/// coordinates `[r, p]`) and `elements` elastic elements `name[e j]` (force kind
+/// `beam3_element`). Sections `circular` and `rectangular` take the material (`density`,
+/// `youngs_modulus`, one of `shear_modulus` / `poisson_ratio`, optional `shear_factor`);
+/// `custom3` carries its own stiffnesses and inertia and takes none.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Beam3Desc {
+    pub name: String,
+    pub start: Vec3,
+    pub end: Vec3,
+    pub section: Section3Desc,
+    /// Default `beam3::DEFAULT_ELEMENTS`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elements: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub youngs_modulus: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_modulus: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub poisson_ratio: Option<f64>,
+    /// Default: Cowper's (`6 (1 + nu) / (7 + 6 nu)` circular, `10 (1 + nu) / (12 + 11 nu)`
+    /// rectangular).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_factor: Option<f64>,
+    /// Hint for the section's `y` axis (world; its part normal to the axis). Default: the
+    /// section's `z` axis as close to world `z` as the axis allows (`beam3::section_frame`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y_axis: Option<Vec3>,
+    /// Velocity of `start` and angular velocity (world): a rigid motion of the whole beam.
+    #[serde(default)]
+    pub velocity: Vec3,
+    #[serde(default)]
+    pub angular_velocity: Vec3,
+}
+
+/// Section of a 3D beam. `rectangular`: `width` along the section's `y`, `height` along its `z`
+/// (`I_y = width height^3 / 12`). `custom3`: axial and shear stiffnesses `ea`, `ga_y`, `ga_z`
+/// (`k G A`), torsional and bending stiffnesses `gj`, `ei_y`, `ei_z`, the mass per length and
+/// the rotary inertia per length about the section axes `[x, y, z]` (kg m).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Section3Desc {
+    Circular { diameter: f64 },
+    Rectangular { width: f64, height: f64 },
+    Custom3 { ea: f64, ga_y: f64, ga_z: f64, gj: f64, ei_y: f64, ei_z: f64, mass_per_length: f64, rotary_inertia: Vec3 },
 }
 
 /// One interface node of a `flexible3` body.

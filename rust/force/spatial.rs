@@ -14,9 +14,12 @@
 //!   `Data::turns`, as Chrono's rotational spring-damper counts its turns from call to call; a
 //!   native run starts from a fresh workspace), so the spring winds up through any number of
 //!   turns; `tau = -k (theta - theta0) - c thetad`, `Q = tau J_theta^T`,
-//!   `J_theta = (c J_s - s J_c) / (s^2 + c^2)`.
+//!   `J_theta = (c J_s - s J_c) / (s^2 + c^2)`;
+//! * an element of a geometrically exact beam between two node bodies (`body/beam3.rs`):
+//!   `Q = -dU/dx` on the two nodes' coordinates, its tangent `K = d^2 U / dx^2`.
 
 use crate::body::marker3::{add_jacobian, Marker3};
+use crate::body::beam3::element::{ElementConsts, NX};
 use crate::body::{Body, BodyKind, Marker, MarkerShape};
 use crate::constraint::spatial::prim;
 use crate::description::spatial::FrameDesc;
@@ -30,6 +33,25 @@ pub enum SpatialForce {
     Torque { body: usize, base: Marker, torque: V3, frame: FrameDesc },
     SpringDamper { a: Marker3, b: Marker3, stiffness: f64, damping: f64, rest_length: f64 },
     RotationalSpringDamper { a: Marker3, b: Marker3, stiffness: f64, damping: f64, angle0: f64 },
+    /// A 3D beam element between the node bodies `nodes` (`rigid3`, coordinates `[r, p]`).
+    Beam3 { nodes: [usize; 2], base: [Marker; 2], element: ElementConsts },
+}
+
+/// The 14 coordinates `[r_A, p_A, r_B, p_B]` of a beam element's nodes.
+#[inline]
+fn element_coords(nodes: &[usize; 2], bodies: &[Body], v: &[f64]) -> [f64; NX] {
+    let (oa, ob) = (bodies[nodes[0]].offset, bodies[nodes[1]].offset);
+    std::array::from_fn(|i| if i < 7 { v[oa + i] } else { v[ob + i - 7] })
+}
+
+/// The whole-`n` index of an element coordinate.
+#[inline]
+fn element_index(nodes: &[usize; 2], bodies: &[Body], i: usize) -> usize {
+    if i < 7 {
+        bodies[nodes[0]].offset + i
+    } else {
+        bodies[nodes[1]].offset + i - 7
+    }
 }
 
 /// `m` and the coordinate offset of a spatial body (`None` for planar kinds).
@@ -50,6 +72,7 @@ impl SpatialForce {
             SpatialForce::Torque { .. } => "torque",
             SpatialForce::SpringDamper { .. } => "spring_damper",
             SpatialForce::RotationalSpringDamper { .. } => "rotational_spring_damper",
+            SpatialForce::Beam3 { .. } => "beam3_element",
         }
     }
 
@@ -63,6 +86,7 @@ impl SpatialForce {
             SpatialForce::PointForce { point, .. } => [Some(&point.base), None],
             SpatialForce::Torque { base, .. } => [Some(base), None],
             SpatialForce::SpringDamper { a, b, .. } | SpatialForce::RotationalSpringDamper { a, b, .. } => [Some(&a.base), Some(&b.base)],
+            SpatialForce::Beam3 { base, .. } => [Some(&base[0]), Some(&base[1])],
         }
     }
 
@@ -152,12 +176,27 @@ impl SpatialForce {
                 prim::dot_jacobian(bodies, &sa, &sa.axes[1], &sb, &sb.axes[0], tau * c / r2, qv, None);
                 prim::dot_jacobian(bodies, &sa, &sa.axes[0], &sb, &sb.axes[0], -tau * s / r2, qv, None);
             }
+            SpatialForce::Beam3 { nodes, element, .. } => {
+                let (_, g) = element.gradient(&element_coords(nodes, bodies, q));
+                for (i, gi) in g.iter().enumerate() {
+                    qv[element_index(nodes, bodies, i)] -= gi;
+                }
+            }
+        }
+    }
+
+    /// Section forces and moments `[N, Q_y, Q_z, M_t, M_y, M_z]` of a beam element at `q`
+    /// (`ElementConsts::section_forces`); `None` for the other elements.
+    pub fn section_forces(&self, bodies: &[Body], q: &[f64]) -> Option<[f64; 6]> {
+        match self {
+            SpatialForce::Beam3 { nodes, element, .. } => Some(element.section_forces(&element_coords(nodes, bodies, q))),
+            _ => None,
         }
     }
 
     /// Whether `add_stiffness` adds anything (a spring-damper with stiffness or damping).
     pub fn has_stiffness(&self) -> bool {
-        matches!(self, SpatialForce::SpringDamper { stiffness, damping, .. } if *stiffness > 0.0 || *damping > 0.0)
+        matches!(self, SpatialForce::SpringDamper { stiffness, damping, .. } if *stiffness > 0.0 || *damping > 0.0) || matches!(self, SpatialForce::Beam3 { .. })
     }
 
     /// The spring-damper's position stiffness, as the planar one's (`Force::add_stiffness`):
@@ -166,6 +205,16 @@ impl SpatialForce {
     /// The rotational spring-damper adds nothing (left to the differences of the velocity terms
     /// and to Newton).
     pub fn add_stiffness(&self, bodies: &[Body], q: &[f64], qd: &[f64], p: &mut [f64], r: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        if let SpatialForce::Beam3 { nodes, element, .. } = self {
+            // the beam element's exact tangent (its Hessian)
+            let h = element.hessian(&element_coords(nodes, bodies, q));
+            for (i, row) in h.iter().enumerate() {
+                for (j, v) in row.iter().enumerate() {
+                    add(element_index(nodes, bodies, i), element_index(nodes, bodies, j), *v);
+                }
+            }
+            return;
+        }
         let SpatialForce::SpringDamper { a, b, stiffness, damping, rest_length } = self else { return };
         let (l, ld, u, [sa, sb]) = Self::spring(a, b, bodies, q, qd);
         let Some(u) = u else { return };
@@ -224,6 +273,7 @@ impl SpatialForce {
                 let th = Self::angle(a, b, *angle0, bodies, q, &zeros, None).0;
                 0.5 * stiffness * th * th
             }
+            SpatialForce::Beam3 { nodes, element, .. } => element.energy(&element_coords(nodes, bodies, q)),
         }
     }
 
@@ -232,6 +282,7 @@ impl SpatialForce {
         match self {
             SpatialForce::SpringDamper { a, b, stiffness, .. } => 0.5 * stiffness * Self::spring(a, b, bodies, q, v).1.powi(2),
             SpatialForce::RotationalSpringDamper { a, b, stiffness, angle0, .. } => 0.5 * stiffness * Self::angle(a, b, *angle0, bodies, q, v, None).1.powi(2),
+            SpatialForce::Beam3 { nodes, element, .. } => element.material_energy(&element_coords(nodes, bodies, q), &element_coords(nodes, bodies, v)),
             _ => 0.0,
         }
     }

@@ -8,7 +8,9 @@
 //!   matrices, real and complex; `lu`: their dense LU;
 //! * `small_svd`: the QR + one-sided Jacobi SVD of the UK pseudoinverse;
 //! * `rcm`: the reverse Cuthill-McKee order that makes the sparse matrices banded;
-//! * `quadrature`: the Gauss rule of the element integrals.
+//! * `quadrature`: the Gauss rule of the element integrals;
+//! * `dual`: forward-mode dual and hyper-dual numbers (exact gradients and Hessians of small
+//!   generic energies: the 3D beam element).
 //!
 //! Everything is allocation free after construction except `dense::pinv_solve` (faer's SVD,
 //! not on a per-step path).
@@ -16,6 +18,7 @@
 pub mod band_lu;
 pub mod banded;
 pub mod dense;
+pub mod dual;
 pub mod lu;
 pub mod quadrature;
 pub mod rcm;

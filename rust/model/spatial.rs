@@ -29,7 +29,7 @@ use crate::linalg::rot3::{norm, sub};
 
 /// Planar body kinds (refused in a spatial scene) and spatial ones (refused in a planar one).
 const PLANAR_KINDS: [&str; 4] = ["rigid", "point_mass", "beam", "flexible"];
-const SPATIAL_KINDS: [&str; 3] = ["rigid3", "point3", "flexible3"];
+const SPATIAL_KINDS: [&str; 4] = ["rigid3", "point3", "flexible3", "beam3"];
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -84,6 +84,8 @@ struct Builder {
     qd0: Vec<f64>,
     names: Vec<String>,
     used: HashMap<String, usize>,
+    /// The elements of the beams (`beam3`), named, in the order of their beams.
+    beam_elements: Vec<(String, SpatialForce)>,
 }
 
 impl Builder {
@@ -123,6 +125,7 @@ impl Builder {
                 let init = k.initial_state(f, item)?;
                 (BodyKind::Flexible3(k), init)
             }
+            Body3Desc::Beam3(bd) => return self.add_beam(item, bd),
         };
         let offset = self.q0.len();
         self.q0.extend_from_slice(&init.q);
@@ -130,6 +133,22 @@ impl Builder {
         self.names.extend(init.names.iter().map(|c| format!("{name}.{c}")));
         self.index.insert(name.to_string(), self.bodies.len());
         self.bodies.push(Body { name: name.to_string(), offset, n_coords: init.q.len(), kind });
+        Ok(())
+    }
+
+    /// A beam: its node bodies `name[i]` (rigid3) and its elements `name[e j]` (`body/beam3.rs`).
+    fn add_beam(&mut self, item: &str, d: &crate::description::spatial::Beam3Desc) -> Result<()> {
+        let (nodes, elements) = crate::body::beam3::expand(item, d)?;
+        let first = self.bodies.len();
+        for node in &nodes {
+            self.add_body(item, &Body3Desc::Rigid3(node.clone()))?;
+        }
+        for (j, element) in elements.into_iter().enumerate() {
+            let name = self.take_name(item, None, format!("{}[e{j}]", d.name))?;
+            let ab = [first + j, first + j + 1];
+            let base = ab.map(SpatialForce::torque_marker);
+            self.beam_elements.push((name, SpatialForce::Beam3 { nodes: ab, base, element }));
+        }
         Ok(())
     }
 
@@ -236,13 +255,13 @@ pub fn build(text: &str) -> Result<Model> {
     let raw: Raw3 = parse_json("scene", text)?;
     let gravity = raw.gravity.unwrap_or([0.0; 3]);
     check_finite_item("scene", "gravity", &gravity)?;
-    let mut b = Builder { bodies: Vec::new(), index: HashMap::new(), q0: Vec::new(), qd0: Vec::new(), names: Vec::new(), used: HashMap::new() };
+    let mut b = Builder { bodies: Vec::new(), index: HashMap::new(), q0: Vec::new(), qd0: Vec::new(), names: Vec::new(), used: HashMap::new(), beam_elements: Vec::new() };
     for (i, v) in raw.bodies.into_iter().enumerate() {
         let kind = kind_of(&v).to_string();
         let name = v.get("name").and_then(Value::as_str).map(str::to_string);
         let item = item_name(Section::Body, &kind, name.as_deref(), i);
         if PLANAR_KINDS.contains(&kind.as_str()) {
-            return Err(Error::invalid(item, format!("body kind '{kind}' is planar: a scene with \"dim\": 3 holds rigid3, point3 and flexible3 bodies (a scene does not mix dimensions)")));
+            return Err(Error::invalid(item, format!("body kind '{kind}' is planar: a scene with \"dim\": 3 holds rigid3, point3, flexible3 and beam3 bodies (a scene does not mix dimensions)")));
         }
         let d: Body3Desc = parse_item(Section::Body, i, v)?;
         b.add_body(&item, &d)?;
@@ -275,6 +294,9 @@ pub fn build(text: &str) -> Result<Model> {
     if gravity != [0.0; 3] {
         b.used.insert("gravity".into(), 1);
         forces.push(Force { name: "gravity".into(), kind: ForceKind::Spatial(SpatialForce::Gravity { g: gravity }) });
+    }
+    for (name, kind) in std::mem::take(&mut b.beam_elements) {
+        forces.push(Force { name, kind: ForceKind::Spatial(kind) });
     }
     for (i, v) in raw.forces.into_iter().enumerate() {
         let d: Force3Desc = parse_item(Section::Force, i, v)?;

@@ -39,7 +39,7 @@ import numpy as np
 from .. import _core
 from ..errors import InvalidArgumentError, InvalidSceneError
 
-__all__ = ["SpatialScene", "SpatialMarker", "SpatialBodyRef", "SpatialFlexibleRef", "outputs", "normalize_spatial", "NATIVE_METHODS_3D"]
+__all__ = ["SpatialScene", "SpatialMarker", "SpatialBodyRef", "SpatialFlexibleRef", "SpatialBeamRef", "CustomSection3", "outputs", "normalize_spatial", "NATIVE_METHODS_3D"]
 
 #: Native methods that run a spatial scene (the others are refused by name, see docs/spatial.md).
 NATIVE_METHODS_3D = ("DOPRI5", "RADAU5", "RADAU5M", "GENALPHA")
@@ -99,6 +99,57 @@ class SpatialFlexibleRef(SpatialBodyRef):
         if name not in (self.interfaces or {}):
             raise InvalidSceneError(f"body '{self.name}' has no interface {name!r}; interfaces: {sorted(self.interfaces or {})}")
         return self.marker(self.interfaces[name], z, x)
+
+
+@dataclass(frozen=True)
+class CustomSection3:
+    """Section of a 3D beam (:meth:`SpatialScene.beam`) given by its own data: axial stiffness
+    ``ea`` [N], shear stiffnesses ``ga_y``, ``ga_z`` (``k G A``) [N], torsional stiffness ``gj`` and
+    bending stiffnesses ``ei_y`` (about the section's ``y``: bending in the ``x z`` plane),
+    ``ei_z`` [N m^2], ``mass_per_length`` [kg/m] and ``rotary_inertia`` [kg m], the rotary
+    inertia per length about the section axes ``x, y, z``. The planar :class:`ukflex.CustomSection`
+    stays what it is (area and second moment)."""
+
+    ea: float
+    ga_y: float
+    ga_z: float
+    gj: float
+    ei_y: float
+    ei_z: float
+    mass_per_length: float
+    rotary_inertia: Sequence[float]
+
+    def to_dict(self) -> Dict[str, Any]:
+        d: Dict[str, Any] = {"shape": "custom3"}
+        for k in ("ea", "ga_y", "ga_z", "gj", "ei_y", "ei_z", "mass_per_length"):
+            d[k] = float(getattr(self, k))
+        d["rotary_inertia"] = _vec("rotary_inertia", self.rotary_inertia)
+        return d
+
+
+@dataclass(frozen=True)
+class SpatialBeamRef:
+    """A handle on a 3D beam (:meth:`SpatialScene.beam`): its node bodies ``name[i]`` (``i = 0``
+    at ``start``, ``elements`` at ``end``) and elements ``name[e j]``."""
+
+    name: str
+    elements: int
+
+    def node_name(self, i: int) -> str:
+        """The body name of node ``i`` (negative counts from the end)."""
+        k = int(i) + (self.elements + 1 if int(i) < 0 else 0)
+        if not 0 <= k <= self.elements:
+            raise InvalidSceneError(f"beam '{self.name}' has nodes 0..{self.elements}, got {i}")
+        return f"{self.name}[{k}]"
+
+    def node(self, i: int, z: Optional[Sequence[float]] = None, x: Optional[Sequence[float]] = None) -> SpatialMarker:
+        """A marker at node ``i`` (axes ``z``, ``x`` in the section frame ``[axis, y, z]``; default the
+        section frame itself): usable by every spatial joint, driver and force."""
+        return SpatialMarker(self.node_name(i), (0.0, 0.0, 0.0), None if z is None else tuple(z), None if x is None else tuple(x))
+
+    @property
+    def element_names(self) -> List[str]:
+        return [f"{self.name}[e{j}]" for j in range(self.elements)]
 
 
 class SpatialScene:
@@ -164,6 +215,42 @@ class SpatialScene:
         names = list(getattr(data, "interfaces", {}) or {})
         points = [tuple(f["point"]) for f in d.get("interfaces", [])]
         return SpatialFlexibleRef(name, dict(zip(names, points)) if names else {})
+
+    def beam(self, name: str, start: Sequence[float], end: Sequence[float], section: Any, *,
+             elements: Optional[int] = None, density: Optional[float] = None, youngs_modulus: Optional[float] = None,
+             shear_modulus: Optional[float] = None, poisson_ratio: Optional[float] = None,
+             shear_factor: Optional[float] = None, y_axis: Optional[Sequence[float]] = None,
+             velocity: Sequence[float] = (0, 0, 0), angular_velocity: Sequence[float] = (0, 0, 0)) -> SpatialBeamRef:
+        """A geometrically exact 3D beam (Simo-Reissner, kind ``beam3``, docs/spatial-flexible.md),
+        straight from ``start`` to ``end`` (world), cut into ``elements`` two-node elements (default:
+        the core's, 10). Each node is a body ``name[i]`` of kind ``rigid3`` (``[x, y, z, e0..e3]``)
+        carrying the lumped mass and rotary inertia of its part of the beam; the elements are the
+        force elements ``name[e j]``.
+
+        ``section``: :class:`ukflex.Circular`, :class:`ukflex.Rectangular` (``width`` along the
+        section's ``y``, ``height`` along its ``z``), both with the material ``density``,
+        ``youngs_modulus`` and one of ``shear_modulus``/``poisson_ratio`` (``shear_factor``
+        default: Cowper's); or :class:`CustomSection3` (no material). ``y_axis``: hint for the
+        section's ``y`` axis (default: the section's ``z`` as close to world ``z`` as the axis
+        allows). ``velocity`` (of ``start``) and ``angular_velocity``: a rigid initial motion.
+        Markers: ``ref.node(i)``."""
+        sec = section.to_dict() if hasattr(section, "to_dict") else dict(section)
+        b: Dict[str, Any] = {"kind": "beam3", "name": name, "start": _vec("start", start), "end": _vec("end", end),
+                             "section": sec, "velocity": _vec("velocity", velocity),
+                             "angular_velocity": _vec("angular_velocity", angular_velocity)}
+        for key, v in (("density", density), ("youngs_modulus", youngs_modulus), ("shear_modulus", shear_modulus),
+                       ("poisson_ratio", poisson_ratio), ("shear_factor", shear_factor)):
+            if v is not None:
+                b[key] = float(v)
+        if elements is not None:
+            if isinstance(elements, bool) or not isinstance(elements, (int, np.integer)):
+                raise InvalidSceneError(f"body '{name}': elements must be an integer, got {elements!r}")
+            b["elements"] = int(elements)
+        if y_axis is not None:
+            b["y_axis"] = _vec("y_axis", y_axis)
+        self._d["bodies"].append(b)
+        n = int(elements) if elements is not None else int(_core.beam3_default_elements())
+        return SpatialBeamRef(name, n)
 
     def point_mass(self, name: str, mass: float, *, position: Sequence[float] = (0, 0, 0),
                    velocity: Sequence[float] = (0, 0, 0)) -> SpatialBodyRef:

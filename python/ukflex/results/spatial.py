@@ -35,6 +35,9 @@ REACTION_COLUMNS_3D = ("fx", "fy", "fz", "tx", "ty", "tz", "fx_joint", "fy_joint
 #: Force kinds whose energy is potential (``springs``); the other elements (point forces,
 #: torques) are loads whose work is the integral of their power.
 _SPRING_KINDS = ("spring_damper", "rotational_spring_damper")
+#: Force kinds that are the elastic elements of a body (a 3D beam's): their potential is strain
+#: energy, neither a spring's nor a load's.
+_STRAIN_KINDS = ("beam3_element",)
 
 
 def is_spatial(system: Any) -> bool:
@@ -73,7 +76,9 @@ def outputs(system: Any, t: Any, q: Any = None, qd: Any = None, reactions: bool 
     minimum-norm multipliers at the system's rank tolerance (``System.set_rank_tolerance`` if
     set, else the default, tied to each state's drift); ``momentum`` (nt, 3) and
     ``angular_momentum`` (about the origin); ``kinetic_energy``, ``potential_energy``,
-    ``energy``; ``driver_values``. Computed by the System's compiled model
+    ``energy``; ``driver_values``; ``beams[element]`` -> (nt, 6) section forces and moments
+    ``N, Q_y, Q_z, M_t, M_y, M_z`` of each 3D beam element (section axes, element midpoint;
+    ``beam[e j]`` is element ``j`` of beam ``beam``). Computed by the System's compiled model
     (``System.core.spatial_outputs``)."""
     t, q, qd = _states(system, t, q, qd)
     raw = system.core.spatial_outputs(t, q, qd, reactions)
@@ -86,6 +91,8 @@ def outputs(system: Any, t: Any, q: Any = None, qd: Any = None, reactions: bool 
         out["reactions"] = {name: {"force": r[:, k, 0:3], "torque": r[:, k, 3:6], "force_joint": r[:, k, 6:9],
                                    "torque_joint": r[:, k, 9:12], "power": r[:, k, 12]}
                             for k, name in enumerate(raw["reaction_names"]) if not name.endswith(".normalization")}
+    bf = raw["beam_forces"]
+    out["beams"] = {name: bf[:, k, :] for k, name in enumerate(raw["beam_element_names"])}
     dv = raw["driver_values"]
     out["driver_values"] = {name: dv[:, k] for k, name in enumerate(raw["reaction_names"]) if not np.all(np.isnan(dv[:, k]))}
     return out
@@ -158,15 +165,19 @@ class SpatialSensors(Sensors):
         """Sum of ``key`` (``force_potentials`` or ``force_powers``) over the springs
         (``springs=True``) or the loads; gravity is neither (``energies()["gravity"]``)."""
         a = np.asarray(self._raw[key])
-        cols = [i for i, k in enumerate(self._raw["force_kinds"]) if k != "gravity" and (k in _SPRING_KINDS) == springs]
+        cols = [i for i, k in enumerate(self._raw["force_kinds"])
+                if k != "gravity" and k not in _STRAIN_KINDS and (k in _SPRING_KINDS) == springs]
         return a[:, cols].sum(axis=1) if cols else np.zeros(a.shape[0])
 
     def energies(self) -> Dict[str, np.ndarray]:
-        """Energies by kind, each (nt,): ``kinetic``, ``strain`` (0: rigid bodies), ``gravity``,
-        ``springs``, ``loads`` (minus the loads' work from ``t_0``) and ``total = kinetic +
-        gravity + springs``."""
+        """Energies by kind, each (nt,): ``kinetic``, ``strain`` (0: rigid bodies; a 3D beam's is
+        the sum of its elements' energies), ``gravity``, ``springs``, ``loads`` (minus the loads'
+        work from ``t_0``) and ``total = kinetic + strain + gravity + springs``."""
         e = np.asarray(self._raw["body_energies"])
-        out = {"kinetic": e[:, :, 0].sum(axis=1), "strain": e[:, :, 1].sum(axis=1), "gravity": e[:, :, 2].sum(axis=1),
+        fp = np.asarray(self._raw["force_potentials"])
+        beams = [i for i, k in enumerate(self._raw["force_kinds"]) if k in _STRAIN_KINDS]
+        strain = e[:, :, 1].sum(axis=1) + (fp[:, beams].sum(axis=1) if beams else 0.0)
+        out = {"kinetic": e[:, :, 0].sum(axis=1), "strain": strain, "gravity": e[:, :, 2].sum(axis=1),
                "springs": self._forces(True, "force_potentials"), "loads": -self.external_work()}
         out["total"] = out["kinetic"] + out["strain"] + out["gravity"] + out["springs"]
         return out

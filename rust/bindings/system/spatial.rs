@@ -45,6 +45,9 @@ impl PySystem {
         let (mut fp, mut fw) = (vec![0.0; nt * nf], vec![0.0; nt * nf]);
         let mut dv = vec![0.0; nt * nc];
         let mut gravity = vec![0.0; nb];
+        // the beam elements' section forces [N, Q_y, Q_z, M_t, M_y, M_z] (body/beam3.rs)
+        let beams: Vec<usize> = (0..nf).filter(|&i| matches!(&self.model.forces[i].kind, ForceKind::Spatial(sf) if sf.kind() == "beam3_element")).collect();
+        let mut sf6 = vec![0.0; nt * beams.len() * 6];
         let scratch_len = self.model.constraints.iter().map(|c| c.scratch_len()).max().unwrap_or(0);
         self.with_ws(|model, ws| {
             let (mut scratch, mut v, mut f, mut g) = (vec![0.0; scratch_len], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
@@ -73,13 +76,19 @@ impl PySystem {
                     pe[k] = fp[k * nf..(k + 1) * nf].iter().sum::<f64>() + (0..nb).map(|i| bek[3 * i + 1]).sum::<f64>();
                     dp[k] = sensors::dissipation_power(model, &mut ws.data, ts[k], qk, qdk, &mut v, &mut f, &mut g)?;
                     dv[k * nc..(k + 1) * nc].copy_from_slice(&outputs::driver_values(model, ts[k], qk, &mut scratch));
+                    for (e, &fi) in beams.iter().enumerate() {
+                        if let ForceKind::Spatial(sf) = &model.forces[fi].kind {
+                            let s = sf.section_forces(&model.bodies, qk).unwrap_or([f64::NAN; 6]);
+                            sf6[(k * beams.len() + e) * 6..(k * beams.len() + e + 1) * 6].copy_from_slice(&s);
+                        }
+                    }
                 }
                 Ok(())
             };
             let pass = pass();
             ws.data.turns = saved;
             pass?;
-            for (what, x) in [("spatial body outputs", &bo), ("spatial reactions", &rx), ("spatial energies", &be), ("spatial force potentials", &fp), ("spatial force powers", &fw), ("spatial dissipation power", &dp)] {
+            for (what, x) in [("spatial body outputs", &bo), ("spatial reactions", &rx), ("spatial energies", &be), ("spatial force potentials", &fp), ("spatial force powers", &fw), ("spatial dissipation power", &dp), ("beam section forces", &sf6)] {
                 finite_out(what, x)?;
             }
             Ok::<(), Error>(())
@@ -108,6 +117,9 @@ impl PySystem {
         d.set_item("force_powers", mat(py, fw, nt, nf)?)?;
         d.set_item("dissipation_power", PyArray1::from_vec(py, dp))?;
         d.set_item("driver_values", PyArray1::from_vec(py, dv).reshape([nt, nc])?)?;
+        d.set_item("beam_element_names", beams.iter().map(|&i| self.model.forces[i].name.clone()).collect::<Vec<_>>())?;
+        d.set_item("beam_forces", PyArray1::from_vec(py, sf6).reshape([nt, beams.len(), 6])?)?;
+        d.set_item("beam_force_columns", vec!["N", "Q_y", "Q_z", "M_t", "M_y", "M_z"])?;
         Ok(d)
     }
 }
