@@ -15,6 +15,7 @@ or their output folder:
   python -m studies spatial-flexible-exudyn
   python -m studies sweeps --out results/sweeps [--small]
   python -m studies clearance [flores]
+  python -m studies engine [--figure PNG]
 """
 
 from __future__ import annotations
@@ -102,7 +103,7 @@ def _cmd_geometric(args: argparse.Namespace) -> int:
 #: ``main`` hands them their arguments before parsing (an ``argparse.REMAINDER`` does not take
 #: arguments that start with ``-``, so ``flexible-coupler --nonlinear`` was refused).
 _PASSTHROUGH = {"flexible-coupler": "flexible_coupler", "simeon-crank": "simeon_crank", "sweeps": "sweeps",
-                "clearance": "clearance"}
+                "clearance": "clearance", "engine": "engine"}
 
 
 def _passthrough(sub, name: str, module: str, help: str) -> None:
@@ -192,6 +193,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _passthrough(sub, "spatial-flexible-exudyn", "spatial_flexible_exudyn", "the 3D flexible pendulum against Exudyn's ObjectFFRFreducedOrder (docs/spatial-flexible.md)")
     _passthrough(sub, "sweeps", "sweeps", "the sweep study: serial, processes, Dask (docs/sweeps.md)")
     _passthrough(sub, "clearance", "clearance", "revolute joints with clearance: Flores's slider-crank, the flexible coupler (docs/loads.md)")
+    _passthrough(sub, "engine", "engine", "a four-stroke engine with a flexible rod and joint friction started by a DC motor (docs/loads.md)")
     return parser
 
 
