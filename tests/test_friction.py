@@ -300,11 +300,14 @@ def _chain(links, friction, drift=0.0):
 
 def test_initial_correction_on_the_sparse_path_does_not_see_the_friction():
     """The initial-state correction's minimum-mass-norm steps (`correct::initial::metric_step`)
-    take the sparse UK path when no coordinate is held and the workspace has it: there they run
-    the plain UK solve with `Q = 0`, which must not close the friction (its slip rates are not
-    zero at the moving guess). A chain of 12 links (24 constraint rows; the sparse path asked for), guess
-    off by 3 mm and moving: the corrected state with friction on the sparse path equals the one
-    on the dense path and the one without friction."""
+    take the sparse UK path when no coordinate is held and the workspace has it (the plain UK
+    solve with `Q = 0`). A chain of 12 links with friction in every pin (24 constraint rows;
+    the sparse path asked for), its guess off by 3 mm and moving: the corrected state with the
+    friction elements on the sparse path equals the one on the dense path and the ones without
+    friction. (The correction evaluates its mass blocks at zero velocity, where the friction's
+    slip rates and forces vanish: a friction closure put into the sparse branch leaves this
+    test unchanged, which I checked; it guards the branch with friction elements present, not
+    the closure's place.)"""
     systems = {(fr, solver): _chain(12, fr, drift=3e-3).build(uk_solver=solver, hold=None)
                for fr in (True, False) for solver in ("sparse", "dense")}
     ref = systems[(True, "dense")]
@@ -315,7 +318,7 @@ def test_initial_correction_on_the_sparse_path_does_not_see_the_friction():
         np.testing.assert_allclose(sy.qd0, ref.qd0, rtol=0, atol=1e-10, err_msg=str(key))
     sp = systems[(True, "sparse")]
     assert sp.core.uk_solver == ("sparse", "sparse") and ref.core.uk_solver[1] == "dense"
-    # the friction acts on this state (so a closure in the correction would have moved it)
+    # the friction acts in this scene's dynamics
     y = np.concatenate([sp.q0, sp.qd0])
     plain = systems[(False, "sparse")]
     assert np.abs(sp.rhs(0.0, y) - plain.rhs(0.0, y)).max() > 1e-3
