@@ -270,13 +270,16 @@ pub struct Structure {
     pub c: Vec<f64>,
     pub a: Vec<f64>,
     pub bv: Vec<f64>,
+    /// What the top-right block adds to `A^T` (in `A`'s pattern): `-dQ/dlambda`, the forces
+    /// that read the multipliers (joint friction; `fill_multiplier_terms`), zero without them.
+    pub af: Vec<f64>,
     pub v: Vec<f64>,
 }
 
 impl Structure {
     pub fn new(pattern: Pattern) -> Structure {
         let (nnz, annz, n) = (pattern.nnz(), pattern.annz(), pattern.n);
-        Structure { pattern, m: vec![0.0; nnz], k: vec![0.0; nnz], c: vec![0.0; nnz], a: vec![0.0; annz], bv: vec![0.0; annz], v: vec![0.0; n] }
+        Structure { pattern, m: vec![0.0; nnz], k: vec![0.0; nnz], c: vec![0.0; nnz], a: vec![0.0; annz], bv: vec![0.0; annz], af: vec![0.0; annz], v: vec![0.0; n] }
     }
 
     /// `out = X x` for a coordinate-block value array `vals` (`M`, `K` or `C`).
@@ -347,6 +350,19 @@ pub fn fill_a(data: &Data, s: &mut Structure) {
     for (a, &k) in s.a.iter_mut().zip(&s.pattern.aseg) {
         *a = data.ajac.vals[k];
     }
+}
+
+/// `-dQ/dlambda` of the joint friction at the multipliers `lam` and `(q, qd)` into `s.af`
+/// (`FrictionWork::add_multiplier_jacobian`; nothing without friction). A friction element's
+/// generalized direction lies on its joint's bodies, so its entries are in `A`'s pattern.
+pub fn fill_multiplier_terms(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], lam: &[f64], s: &mut Structure) {
+    let Some(w) = data.friction.as_mut() else { return };
+    s.af.fill(0.0);
+    let (p, af) = (&s.pattern, &mut s.af);
+    w.add_multiplier_jacobian(&model.forces, &model.bodies, q, qd, lam, &mut |r, j, v| {
+        let e = (p.acol_ptr[j]..p.acol_ptr[j + 1]).find(|&e| p.arow[e] == r).expect("a friction element's direction lies on its joint's bodies");
+        af[e] += v;
+    });
 }
 
 /// `C = -dQ/dqd` and `db/dqd` at `(t, q, qd)` by central differences in `qd`, one pair of
@@ -535,7 +551,7 @@ impl BandNewton {
         }
         for (e, (&pr, &pt)) in self.ar.iter().zip(&self.at).enumerate() {
             ab[pr] = s.a[e] - gc * s.bv[e];
-            ab[pt] = s.a[e];
+            ab[pt] = s.a[e] + s.af[e];
         }
         for &pos in &self.diag {
             ab[pos] = reg;
@@ -554,7 +570,7 @@ impl BandNewton {
         }
         for (e, (&pr, &pt)) in self.ar.iter().zip(&self.at).enumerate() {
             ab[pr] = C64::new(s.a[e] - gc.re * s.bv[e], -gc.im * s.bv[e]);
-            ab[pt] = C64::new(s.a[e], 0.0);
+            ab[pt] = C64::new(s.a[e] + s.af[e], 0.0);
         }
         for &pos in &self.diag {
             ab[pos] = C64::new(reg, 0.0);

@@ -17,6 +17,7 @@ or their output folder:
   python -m studies spatial-beam-spin-up
   python -m studies sweeps --out results/sweeps [--small]
   python -m studies clearance [flores]
+  python -m studies engine [--figure PNG]
 """
 
 from __future__ import annotations
@@ -104,7 +105,7 @@ def _cmd_geometric(args: argparse.Namespace) -> int:
 #: ``main`` hands them their arguments before parsing (an ``argparse.REMAINDER`` does not take
 #: arguments that start with ``-``, so ``flexible-coupler --nonlinear`` was refused).
 _PASSTHROUGH = {"flexible-coupler": "flexible_coupler", "simeon-crank": "simeon_crank", "sweeps": "sweeps",
-                "clearance": "clearance"}
+                "clearance": "clearance", "engine": "engine"}
 
 
 def _passthrough(sub, name: str, module: str, help: str) -> None:
@@ -196,6 +197,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _passthrough(sub, "spatial-beam-spin-up", "spatial_beam_spin_up", "Kane's spin-up beam: the 3D beam against the planar ANCF cable (docs/spatial-flexible.md)")
     _passthrough(sub, "sweeps", "sweeps", "the sweep study: serial, processes, Dask (docs/sweeps.md)")
     _passthrough(sub, "clearance", "clearance", "revolute joints with clearance: Flores's slider-crank, the flexible coupler (docs/loads.md)")
+    _passthrough(sub, "engine", "engine", "a four-stroke engine with a flexible rod and joint friction started by a DC motor (docs/loads.md)")
     return parser
 
 

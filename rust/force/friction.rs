@@ -261,6 +261,33 @@ impl FrictionWork {
         }
     }
 
+    /// The multipliers' block of the implicit methods' Newton matrices: the friction forces'
+    /// dependence on their joints' multipliers, `-dQ_f/dlambda` at `lam` (all m) with the slip
+    /// rates and directions at `(q, qd)` (this calls `prepare`). `Q_f = sum_i F_i g_i` and
+    /// `dF_i/dlambda_r = -k_i s_i dN_i/dlambda_r` on the joint's two rows, so `add(r, j, v)`
+    /// receives `v = k_i s_i (dN_i/dlambda_r) g_ij` for each row `r` of element `i`'s joint and
+    /// coordinate `j` with `g_ij != 0`: it belongs on `A^T`'s entry `(j, r)` of the residual's
+    /// derivative `A^T - dQ_f/dlambda` (docs/loads.md, "What the methods see").
+    pub fn add_multiplier_jacobian(&mut self, forces: &[super::Force], bodies: &[Body], q: &[f64], qd: &[f64], lam: &[f64], add: &mut impl FnMut(usize, usize, f64)) {
+        self.prepare(forces, bodies, q, qd);
+        let n = self.n;
+        for i in 0..self.items.len() {
+            let (_, slope, grad) = self.force_at(forces, i, lam);
+            let r0 = self.items[i].1;
+            for (dr, dn) in grad.iter().enumerate() {
+                let c = -slope * dn;
+                if c == 0.0 {
+                    continue;
+                }
+                for (j, &g) in self.g[i * n..(i + 1) * n].iter().enumerate() {
+                    if g != 0.0 {
+                        add(r0 + dr, j, c * g);
+                    }
+                }
+            }
+        }
+    }
+
     /// `out += sum_i F_i g_i` with the forces of the last closure (`f`).
     pub fn add_closed_forces(&self, out: &mut [f64]) {
         let n = self.n;

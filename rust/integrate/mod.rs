@@ -149,6 +149,17 @@ pub trait SecondOrderSystem {
     fn stiff_structure(&mut self, _q: &[f64], _qd: &[f64], _m: &mut [f64], _k: &mut [f64], _a: &mut [f64]) -> Result<bool> {
         Ok(false)
     }
+    /// The forces that read the multipliers (joint friction) in the Newton matrices: `af`
+    /// (m x n, as `structure`'s `a`) receives `-dQ/dlambda` at `(q, qd)` and the multipliers of
+    /// the last `augmented_residual` (or `acc`) call, the part the top-right block adds to
+    /// `A^T`. `false`: no such forces (`af` untouched).
+    fn multiplier_terms(&mut self, _q: &[f64], _qd: &[f64], _af: &mut [f64]) -> bool {
+        false
+    }
+    /// `multiplier_terms` into `s.af` of a `sparse_structure`.
+    fn multiplier_terms_sparse(&mut self, _q: &[f64], _qd: &[f64], _s: &mut Structure) -> bool {
+        false
+    }
     /// The structure in sparse form (`sparse_newton::Structure`: its pattern, values zero), or
     /// `None` when the system has none (the implicit methods then use the dense `structure`).
     fn sparse_structure(&mut self) -> Result<Option<Structure>> {

@@ -83,6 +83,10 @@ struct Dense {
     cc: Vec<f64>,
     aa: Vec<f64>,
     bv: Vec<f64>,
+    /// What the top-right block adds to `A^T` (m x n, as `aa`): `-dQ/dlambda` of the forces
+    /// that read the multipliers (joint friction), when `has_af`.
+    af: Vec<f64>,
+    has_af: bool,
     /// Real matrix, column-major LU, pivots; its inverse (row-major) when `inverse`.
     lu: Vec<f64>,
     piv: Vec<usize>,
@@ -112,7 +116,7 @@ impl NewtonMatrices {
     pub fn dense_bytes(n: usize, m: usize, complex: bool, inverse: bool) -> u64 {
         let (n, m) = (n as u64, m as u64);
         let nm = n + m;
-        8 * (3 * n * n + 2 * m * n + nm * nm + if complex { 2 * nm * nm } else { 0 } + if inverse && nm <= INVERSE_MAX as u64 { nm * nm } else { 0 })
+        8 * (3 * n * n + 3 * m * n + nm * nm + if complex { 2 * nm * nm } else { 0 } + if inverse && nm <= INVERSE_MAX as u64 { nm * nm } else { 0 })
     }
 
     pub fn dense(n: usize, m: usize, complex: bool, inverse: bool) -> Self {
@@ -128,6 +132,8 @@ impl NewtonMatrices {
                 cc: z(n * n),
                 aa: z(m * n),
                 bv: z(m * n),
+                af: z(m * n),
+                has_af: false,
                 lu: z(nm * nm),
                 piv: vec![0; nm],
                 inv: z(if inverse && nm <= INVERSE_MAX { nm * nm } else { 0 }),
@@ -212,19 +218,34 @@ impl NewtonMatrices {
         }
     }
 
-    /// `M`, `K`, `C`, `A`, `db/dqd` at `(t, q, qd)`.
+    /// `M`, `K`, `C`, `A`, `db/dqd` at `(t, q, qd)`, and the multipliers' terms.
     pub fn read<S: SecondOrderSystem>(&mut self, sys: &mut S, t: f64, q: &[f64], qd: &[f64]) -> Result<bool> {
-        match &mut self.inner {
-            Inner::Dense(d) => sys.structure(t, q, qd, &mut d.mm, &mut d.kk, &mut d.cc, &mut d.aa, &mut d.bv),
-            Inner::Sparse(b) => sys.structure_sparse(t, q, qd, &mut b.s),
-        }
+        let ok = match &mut self.inner {
+            Inner::Dense(d) => sys.structure(t, q, qd, &mut d.mm, &mut d.kk, &mut d.cc, &mut d.aa, &mut d.bv)?,
+            Inner::Sparse(b) => sys.structure_sparse(t, q, qd, &mut b.s)?,
+        };
+        self.read_multiplier_terms(sys, q, qd);
+        Ok(ok)
     }
 
-    /// `M`, `K`, `A` where the system's last evaluation left them.
+    /// `M`, `K`, `A` where the system's last evaluation left them, and the multipliers' terms.
     pub fn read_stiff<S: SecondOrderSystem>(&mut self, sys: &mut S, q: &[f64], qd: &[f64]) -> Result<bool> {
+        let ok = match &mut self.inner {
+            Inner::Dense(d) => sys.stiff_structure(q, qd, &mut d.mm, &mut d.kk, &mut d.aa)?,
+            Inner::Sparse(b) => sys.stiff_structure_sparse(q, qd, &mut b.s)?,
+        };
+        self.read_multiplier_terms(sys, q, qd);
+        Ok(ok)
+    }
+
+    /// `-dQ/dlambda` at `(q, qd)` and the system's last multipliers
+    /// (`SecondOrderSystem::multiplier_terms`): the forces that read the multipliers.
+    fn read_multiplier_terms<S: SecondOrderSystem>(&mut self, sys: &mut S, q: &[f64], qd: &[f64]) {
         match &mut self.inner {
-            Inner::Dense(d) => sys.stiff_structure(q, qd, &mut d.mm, &mut d.kk, &mut d.aa),
-            Inner::Sparse(b) => sys.stiff_structure_sparse(q, qd, &mut b.s),
+            Inner::Dense(d) => d.has_af = sys.multiplier_terms(q, qd, &mut d.af),
+            Inner::Sparse(b) => {
+                sys.multiplier_terms_sparse(q, qd, &mut b.s);
+            }
         }
     }
 
@@ -254,6 +275,11 @@ impl NewtonMatrices {
                 for r in 0..m {
                     let col = &mut d.lu[(n + r) * nm..(n + r + 1) * nm];
                     col[..n].copy_from_slice(&d.aa[r * n..(r + 1) * n]);
+                    if d.has_af {
+                        for (x, f) in col[..n].iter_mut().zip(&d.af[r * n..(r + 1) * n]) {
+                            *x += f;
+                        }
+                    }
                     for s in 0..m {
                         col[n + s] = if r == s { reg } else { 0.0 };
                     }
@@ -282,7 +308,7 @@ impl NewtonMatrices {
                         let (arj, brj) = (d.aa[r * n + j], d.bv[r * n + j]);
                         d.lu_cr[(n + r) * nm + j] = arj - gr * brj;
                         d.lu_ci[(n + r) * nm + j] = -gi * brj;
-                        d.lu_cr[j * nm + n + r] = arj;
+                        d.lu_cr[j * nm + n + r] = if d.has_af { arj + d.af[r * n + j] } else { arj };
                         d.lu_ci[j * nm + n + r] = 0.0;
                     }
                 }

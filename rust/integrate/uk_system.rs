@@ -52,6 +52,9 @@ pub struct UkSystem<'a> {
     zeros: Vec<f64>,
     rm: Vec<f64>,
     lam: Vec<f64>,
+    /// With joint friction: the multipliers of the last `augmented_residual` or `acc` call, at
+    /// which `multiplier_terms` linearizes the friction.
+    flam: Vec<f64>,
 }
 
 /// Positions this close (relative to their size) share their conditioning for
@@ -69,7 +72,7 @@ impl<'a> UkSystem<'a> {
         UkSystem {
             model, data, jws, projection: None, pws: ProjectWorkspace::new(model), jac_full_evals: 0, jac_cheap_evals: 0,
             acc_q: vec![0.0; n], acc_t: f64::NAN, ready: false, fact_q: vec![0.0; n], fact_info: None,
-            res_q: vec![0.0; n], res_t: f64::NAN, res_norm: 0.0, res_valid: false, zeros: vec![0.0; n], rm: vec![0.0; m], lam: vec![0.0; m],
+            res_q: vec![0.0; n], res_t: f64::NAN, res_norm: 0.0, res_valid: false, zeros: vec![0.0; n], rm: vec![0.0; m], lam: vec![0.0; m], flam: vec![0.0; m],
         }
     }
 
@@ -106,6 +109,9 @@ impl SecondOrderSystem for UkSystem<'_> {
         } else {
             uk::acceleration_with_phi(self.model, &mut self.data, t, q, qd)?;
             self.record_factorization(t, q);
+            if self.data.friction.is_some() {
+                self.flam.copy_from_slice(&self.data.lambda);
+            }
         }
         qdd.copy_from_slice(&self.data.qdd);
         check_state_finite(t, q, qd, qdd)
@@ -143,6 +149,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         if let Some(w) = &data.friction {
             // joint friction at the iterate's multipliers: the loop closes in the Newton iteration
             w.add_forces(&model.forces, lambda, &mut data.force);
+            self.flam.copy_from_slice(lambda);
         }
         dynamics::constraints(model, data, t, q, qd, false);
         dynamics::mass_times(model, data, qdd, r1);
@@ -279,6 +286,23 @@ impl SecondOrderSystem for UkSystem<'_> {
         dynamics::stiffness_into(model, data, q, qd, k);
         a.copy_from_slice(&data.jac);
         Ok(true)
+    }
+    fn multiplier_terms(&mut self, q: &[f64], qd: &[f64], af: &mut [f64]) -> bool {
+        let (model, data) = (self.model, &mut self.data);
+        let Some(w) = data.friction.as_mut() else { return false };
+        self.ready = false;
+        af.fill(0.0);
+        let n = model.n;
+        w.add_multiplier_jacobian(&model.forces, &model.bodies, q, qd, &self.flam, &mut |r, j, v| af[r * n + j] += v);
+        true
+    }
+    fn multiplier_terms_sparse(&mut self, q: &[f64], qd: &[f64], s: &mut Structure) -> bool {
+        if self.data.friction.is_none() {
+            return false;
+        }
+        self.ready = false;
+        sparse_newton::fill_multiplier_terms(self.model, &mut self.data, q, qd, &self.flam, s);
+        true
     }
     fn sparse_structure(&mut self) -> Result<Option<Structure>> {
         let p = Pattern::new(self.model, &self.data.ajac, false, self.data.memory_limit)?;
