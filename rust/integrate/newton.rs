@@ -220,10 +220,11 @@ impl NewtonMatrices {
         }
     }
 
-    /// `M`, `K`, `A` where the system's last evaluation left them.
+    /// `M`, `K`, `A` (and the force elements' damping in `C`) where the system's last
+    /// evaluation left them.
     pub fn read_stiff<S: SecondOrderSystem>(&mut self, sys: &mut S, q: &[f64], qd: &[f64]) -> Result<bool> {
         match &mut self.inner {
-            Inner::Dense(d) => sys.stiff_structure(q, qd, &mut d.mm, &mut d.kk, &mut d.aa),
+            Inner::Dense(d) => sys.stiff_structure(q, qd, &mut d.mm, &mut d.kk, &mut d.cc, &mut d.aa),
             Inner::Sparse(b) => sys.stiff_structure_sparse(q, qd, &mut b.s),
         }
     }

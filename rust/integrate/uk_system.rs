@@ -52,6 +52,11 @@ pub struct UkSystem<'a> {
     zeros: Vec<f64>,
     rm: Vec<f64>,
     lam: Vec<f64>,
+    /// The force elements' analytic damping (`dynamics::add_force_damping`) that the Newton
+    /// matrices' `C` holds now, as `(i, j, C_ij)`: `stiff_structure` takes it out and puts in the
+    /// one of its own state, so `C` is the differences of the last `structure` with the dampers
+    /// moved to the latest positions.
+    damping: Vec<(usize, usize, f64)>,
 }
 
 /// Positions this close (relative to their size) share their conditioning for
@@ -70,6 +75,26 @@ impl<'a> UkSystem<'a> {
             model, data, jws, projection: None, pws: ProjectWorkspace::new(model), jac_full_evals: 0, jac_cheap_evals: 0,
             acc_q: vec![0.0; n], acc_t: f64::NAN, ready: false, fact_q: vec![0.0; n], fact_info: None,
             res_q: vec![0.0; n], res_t: f64::NAN, res_norm: 0.0, res_valid: false, zeros: vec![0.0; n], rm: vec![0.0; m], lam: vec![0.0; m],
+            damping: Vec::new(),
+        }
+    }
+
+    /// Record the force elements' analytic damping at `(q, qd)` (`self.damping`), which `C`
+    /// (just read by differences there) holds.
+    fn record_damping(&mut self, q: &[f64], qd: &[f64]) {
+        let Self { model, data, damping, .. } = self;
+        damping.clear();
+        dynamics::add_force_damping(model, data, q, qd, &mut |i, j, v| damping.push((i, j, v)));
+    }
+
+    /// Move the force elements' analytic damping in `C` to `(q, qd)`: `add(i, j, dC_ij)`.
+    fn move_damping(&mut self, q: &[f64], qd: &[f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        for &(i, j, v) in &self.damping {
+            add(i, j, -v);
+        }
+        self.record_damping(q, qd);
+        for &(i, j, v) in &self.damping {
+            add(i, j, v);
         }
     }
 
@@ -270,7 +295,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         self.res_valid = true;
         Ok(self.res_norm)
     }
-    fn stiff_structure(&mut self, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], a: &mut [f64]) -> Result<bool> {
+    fn stiff_structure(&mut self, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], c: &mut [f64], a: &mut [f64]) -> Result<bool> {
         // `uk::acceleration` / `augmented_residual` left the body blocks and A of (q, qd) in `data`
         self.ready = false;
         let (model, data) = (self.model, &mut self.data);
@@ -278,6 +303,8 @@ impl SecondOrderSystem for UkSystem<'_> {
         dynamics::dense_mass_into(model, data, m);
         dynamics::stiffness_into(model, data, q, qd, k);
         a.copy_from_slice(&data.jac);
+        let n = model.n;
+        self.move_damping(q, qd, &mut |i, j, v| c[i * n + j] += v);
         Ok(true)
     }
     fn sparse_structure(&mut self) -> Result<Option<Structure>> {
@@ -287,6 +314,7 @@ impl SecondOrderSystem for UkSystem<'_> {
     fn structure_sparse(&mut self, t: f64, q: &[f64], qd: &[f64], s: &mut Structure) -> Result<bool> {
         self.ready = false;
         sparse_newton::fill_structure(self.model, &mut self.data, t, q, qd, s);
+        self.record_damping(q, qd);
         Ok(true)
     }
     fn stiff_structure_sparse(&mut self, q: &[f64], qd: &[f64], s: &mut Structure) -> Result<bool> {
@@ -295,6 +323,8 @@ impl SecondOrderSystem for UkSystem<'_> {
         sparse_newton::fill_mass(self.model, &self.data, s);
         sparse_newton::fill_stiffness(self.model, &mut self.data, q, qd, s);
         sparse_newton::fill_a(&self.data, s);
+        let (p, c) = (&s.pattern, &mut s.c);
+        self.move_damping(q, qd, &mut |i, j, v| c[p.find(i, j)] += v);
         Ok(true)
     }
     fn check_memory(&self, what: &str, bytes: u64) -> Result<()> {
@@ -313,6 +343,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         dynamics::constraints(model, data, t, q, qd, false);
         a.copy_from_slice(&data.jac);
         dynamics::velocity_jacobians_into(model, data, t, q, qd, &mut self.pws.v, c, bv);
+        self.record_damping(q, qd);
         Ok(true)
     }
 }
