@@ -161,6 +161,17 @@ pub fn add_force_stiffness(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
     }
 }
 
+/// The analytic damping of the force elements that have one (`Force::add_damping`: the
+/// spring-dampers) at `(q, qd)`.
+pub fn add_force_damping(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], add: &mut dyn FnMut(usize, usize, f64)) {
+    if data.load_rows.is_empty() {
+        return;
+    }
+    for f in model.forces.iter().filter(|f| f.has_damping()) {
+        f.add_damping(&model.bodies, q, qd, &mut data.load_rows, add);
+    }
+}
+
 /// The stiffness `k = -dQ/dq` and damping `c = -dQ/dqd` that the bodies know analytically
 /// (elastic tangent stiffness and strain-rate damping; not the inertial velocity terms, the
 /// gravity or the force elements), plus the loads' analytic position stiffness

@@ -35,6 +35,9 @@ use crate::dynamics::{constraints, mass_and_forces, mass_times};
 use crate::error::{Error, Result};
 use crate::model::Model;
 
+mod velocity;
+pub use velocity::{fill_velocity_terms, velocity_differences};
+
 /// Symbolic analysis of the structure (once per model).
 #[derive(Debug, Clone)]
 pub struct Pattern {
@@ -363,40 +366,6 @@ pub fn fill_multiplier_terms(model: &Model, data: &mut Data, q: &[f64], qd: &[f6
         let e = (p.acol_ptr[j]..p.acol_ptr[j + 1]).find(|&e| p.arow[e] == r).expect("a friction element's direction lies on its joint's bodies");
         af[e] += v;
     });
-}
-
-/// `C = -dQ/dqd` and `db/dqd` at `(t, q, qd)` by central differences in `qd`, one pair of
-/// evaluations per colour (as `dynamics::velocity_jacobians_into` does per column, with the
-/// same steps and the same arithmetic: the same values). Leaves `data` at a perturbed state.
-pub fn fill_velocity_terms(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], s: &mut Structure) {
-    let Structure { pattern: p, c, bv, v, .. } = s;
-    v.copy_from_slice(qd);
-    let step = |x: f64| 1e-3 * x.abs().max(1.0);
-    for col in 0..p.colors() {
-        let cols = &p.color_cols[p.color_ptr[col]..p.color_ptr[col + 1]];
-        for sign in [1.0, -1.0] {
-            for &j in cols {
-                v[j] = qd[j] + sign * step(qd[j]);
-            }
-            mass_and_forces(model, data, t, q, v);
-            crate::dynamics::add_friction_at_last_multipliers(model, data);
-            constraints(model, data, t, q, v, false);
-            for &j in cols {
-                let s2 = 2.0 * step(qd[j]);
-                for e in p.col_ptr[j]..p.col_ptr[j + 1] {
-                    let f = data.force[p.row[e]];
-                    c[e] = if sign > 0.0 { -f } else { (c[e] + f) / s2 };
-                }
-                for e in p.acol_ptr[j]..p.acol_ptr[j + 1] {
-                    let g = data.gamma[p.arow[e]];
-                    bv[e] = if sign > 0.0 { g } else { (bv[e] - g) / s2 };
-                }
-            }
-        }
-        for &j in cols {
-            v[j] = qd[j];
-        }
-    }
 }
 
 /// Everything at `(t, q, qd)`: `M`, `K`, `A`, then `C`, `db/dqd` (as the dense `structure`).

@@ -315,6 +315,16 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
     y = min(RADAU_MAX_STEP_OMEGA, (phase / (RADAU_DECAY * omega_c * span)) ** 0.2)
     h = min(y / omega_c, span / MIN_STEPS)
     if h * omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO:
+        # changed deliberately with the core (i26-def): an overdamped lowest elastic mode has no
+        # oscillation for the fixed step to resolve, so the overdamped rule decides first
+        if omega.size >= system.n_dof and _has_damping(system):
+            qd0 = system.qd0 if qd is None else np.asarray(qd, dtype=float)
+            zeta = damping_ratios(system, t0, q, qd0, omega, shapes, np.asarray(system.M(q)))
+            kc = np.flatnonzero(omega == omega_c)
+            if kc.size and zeta[kc[0]] > 1.0:
+                damped = _overdamped_choice(system, t0, q, qd, omega, shapes, shares, phase, span)
+                if damped is not None:
+                    return damped
         floor: Dict[str, Any] = {}
         if omega.size >= system.n_dof:  # every mode known (small systems): the floor
             qd0 = system.qd0 if qd is None else np.asarray(qd, dtype=float)

@@ -83,11 +83,13 @@ fn the_sparse_structure_is_the_dense_one_to_the_bit() {
             // the cheap part where an acceleration evaluation leaves it
             dense.acc(t, &q, &qd, &mut vec![0.0; n]).unwrap();
             sparse.acc(t, &q, &qd, &mut vec![0.0; n]).unwrap();
-            assert!(dense.stiff_structure(&q, &qd, &mut mm, &mut kk, &mut aa).unwrap());
+            assert!(dense.stiff_structure(&q, &qd, &mut mm, &mut kk, &mut cc, &mut aa).unwrap());
             assert!(sparse.stiff_structure_sparse(&q, &qd, &mut s).unwrap());
             let p = &s.pattern;
             for (e, (i, j)) in p.entries().enumerate() {
                 assert!(bits_equal(s.m[e], mm[i * n + j]) && bits_equal(s.k[e], kk[i * n + j]), "{name}: stiff part ({i}, {j})");
+                // the dampers' analytic share of C moved to (q, qd) the same way in both
+                assert!(bits_equal(s.c[e], cc[i * n + j]), "{name}: C after the stiff part ({i}, {j})");
             }
             for (e, (r, j)) in p.a_entries().enumerate() {
                 assert!(bits_equal(s.a[e], aa[r * n + j]), "{name}: stiff A[{r}][{j}]");

@@ -252,6 +252,39 @@ impl Force {
         }
     }
 
+    /// Whether [`Force::add_damping`] adds anything: a spring-damper (planar or spatial) with
+    /// damping.
+    pub fn has_damping(&self) -> bool {
+        match &self.kind {
+            ForceKind::SpringDamper { damping, .. } => *damping > 0.0,
+            ForceKind::Spatial(f) => f.has_damping(),
+            _ => false,
+        }
+    }
+
+    /// `add(i, j, C_ij)` of this force's analytic damping `C = -dQ/dqd` through the markers'
+    /// Jacobians: a spring-damper's `c p p^T`, `p = G^T e` (`e` its unit direction). The implicit
+    /// methods refresh it with `K` at every factorization (`UkSystem::stiff_structure`): a stiff
+    /// damper's line turns with the mechanism (A05's governor), and a `C` read once per step (or
+    /// per Newton failure, by differences) left Newton contracting slowly (docs/spatial.md).
+    /// `rows` is a `2 n` scratch; nothing for the other kinds (their velocity terms come from the
+    /// differences of `dynamics::velocity_jacobians_into`).
+    pub fn add_damping(&self, bodies: &[Body], q: &[f64], qd: &[f64], rows: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        let n = q.len();
+        let p = &mut rows[..n];
+        match &self.kind {
+            ForceKind::SpringDamper { a, b, damping, .. } if *damping > 0.0 => {
+                let Some(Line { sa, sb, e, .. }) = Line::of(a, b, bodies, q, qd) else { return };
+                p.fill(0.0);
+                a.add_point_jacobian(bodies, &sa, e, p);
+                b.add_point_jacobian(bodies, &sb, [-e[0], -e[1]], p);
+                outer(p, p, *damping, add);
+            }
+            ForceKind::Spatial(f) => f.add_damping(bodies, q, qd, p, add),
+            _ => {}
+        }
+    }
+
     /// Evaluation scratch this force needs (`Data::load_scratch`).
     pub fn scratch_len(&self) -> usize {
         match &self.kind {
@@ -427,12 +460,18 @@ mod tests {
     }
 
     /// `K` of `stiffness_into` against central differences of the forces.
-    fn stiffness_against_differences(text: &str, dq: f64, qd0: f64) -> Vec<f64> {
+    /// The scene of `text` at its `q0` moved by `dq (i + 1)` and the velocities `qd0 (1 - 0.4 i)`.
+    fn moving(text: &str, dq: f64, qd0: f64) -> (Model, Data, Vec<f64>, Vec<f64>) {
         let model = Model::from_json(text).unwrap();
-        let mut data = Data::new(&model);
-        let n = model.n;
+        let data = Data::new(&model);
         let q: Vec<f64> = model.q0.iter().enumerate().map(|(i, x)| x + dq * (i as f64 + 1.0)).collect();
-        let qd: Vec<f64> = (0..n).map(|i| qd0 * (1.0 - 0.4 * i as f64)).collect();
+        let qd: Vec<f64> = (0..model.n).map(|i| qd0 * (1.0 - 0.4 * i as f64)).collect();
+        (model, data, q, qd)
+    }
+
+    fn stiffness_against_differences(text: &str, dq: f64, qd0: f64) -> Vec<f64> {
+        let (model, mut data, q, qd) = moving(text, dq, qd0);
+        let n = model.n;
         let mut k = vec![0.0; n * n];
         dynamics::mass_and_forces(&model, &mut data, 0.0, &q, &qd);
         dynamics::stiffness_into(&model, &mut data, &q, &qd, &mut k);
@@ -478,5 +517,51 @@ mod tests {
             {"kind": "point3", "name": "b", "mass": 2.0, "position": [0.1, -0.3, 0.4]}],
           "forces": [{"kind": "spring_damper", "a": {"body": "a"}, "b": {"body": "b"}, "stiffness": 1e4, "damping": 30.0, "rest_length": 0.5}]}"#, 0.02, 0.5);
         assert!(k[0] > 1e3 && k[1] != 0.0 && k[2] != 0.0, "{k:?}");
+    }
+    /// `C` of `add_force_damping` against central differences in `qd` of the force elements'
+    /// generalized forces alone (the bodies' own velocity terms left out).
+    fn damping_against_differences(text: &str, dq: f64, qd0: f64) -> Vec<f64> {
+        let (model, mut data, q, qd) = moving(text, dq, qd0);
+        let n = model.n;
+        let mut c = vec![0.0; n * n];
+        dynamics::add_force_damping(&model, &mut data, &q, &qd, &mut |i, j, v| c[i * n + j] += v);
+        let forces = |v: &[f64]| {
+            let (mut out, mut turn) = (vec![0.0; n], f64::NAN);
+            for f in &model.forces {
+                f.add_to(&model.bodies, 0.0, &q, v, &mut [], &mut turn, &mut out);
+            }
+            out
+        };
+        let (mut v, h) = (qd.clone(), 1e-4);
+        for j in 0..n {
+            v[j] = qd[j] + h;
+            let fp = forces(&v);
+            v[j] = qd[j] - h;
+            let fm = forces(&v);
+            v[j] = qd[j];
+            for i in 0..n {
+                let fd = -(fp[i] - fm[i]) / (2.0 * h);
+                assert!((c[i * n + j] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "C[{i}][{j}] = {} vs {fd}", c[i * n + j]);
+            }
+        }
+        c
+    }
+
+    #[test]
+    fn spring_damping_matches_differences() {
+        // planar: a moving spring-damper between point masses (the damping is linear in qd: exact)
+        let c = damping_against_differences(r#"{"bodies": [
+            {"kind": "point_mass", "name": "m", "mass": 1.0, "position": [1.0, 0.5]},
+            {"kind": "point_mass", "name": "p", "mass": 1.0, "position": [0.2, -0.3]}],
+          "forces": [{"kind": "spring_damper", "a": {"body": "m"}, "b": {"body": "p"}, "stiffness": 1e4, "damping": 30.0, "rest_length": 0.5}]}"#, 0.02, 0.5);
+        assert!(c[0] > 1.0 && c[1] != 0.0, "{c:?}");
+        // spatial: from a point mass to a point off a turned rigid body's centre (Euler parameters)
+        let c = damping_against_differences(r#"{"dim": 3, "bodies": [
+            {"kind": "point3", "name": "a", "mass": 1.0, "position": [1.0, 0.5, 0.2]},
+            {"kind": "rigid3", "name": "b", "mass": 2.0, "inertia": [[0.1, 0, 0], [0, 0.2, 0], [0, 0, 0.3]],
+             "position": [0.1, -0.3, 0.4], "orientation": [0.3, 0.8, 0.2, -0.4]}],
+          "forces": [{"kind": "spring_damper", "a": {"body": "a"}, "b": {"body": "b", "point": [0.1, 0.2, -0.05]},
+                      "stiffness": 1e4, "damping": 4e4, "rest_length": 0.5}]}"#, 0.0, 0.5);
+        assert!(c[0] > 1e3 && c[3 * 10 + 6] != 0.0, "{c:?}");
     }
 }

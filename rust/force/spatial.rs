@@ -241,6 +241,26 @@ impl SpatialForce {
         }
     }
 
+    /// Whether `add_damping` adds anything (a spring-damper with damping).
+    pub fn has_damping(&self) -> bool {
+        matches!(self, SpatialForce::SpringDamper { damping, .. } if *damping > 0.0)
+    }
+
+    /// The spring-damper's damping `C = c p p^T`, `p = G^T u` (as the planar one's,
+    /// `Force::add_damping`); nothing for the other elements.
+    pub fn add_damping(&self, bodies: &[Body], q: &[f64], qd: &[f64], p: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        let SpatialForce::SpringDamper { a, b, damping, .. } = self else { return };
+        if !(*damping > 0.0) {
+            return;
+        }
+        let (_, _, u, [sa, sb]) = Self::spring(a, b, bodies, q, qd);
+        let Some(u) = u else { return };
+        p.fill(0.0);
+        add_jacobian(bodies, &sb, &sb.point, &u, p, None);
+        add_jacobian(bodies, &sa, &sa.point, &scale(-1.0, &u), p, None);
+        super::outer(p, p, *damping, add);
+    }
+
     /// The potential `k (theta - theta0)^2 / 2` of a rotational spring-damper at its counted angle
     /// `turn` (`Data::turns` after an evaluation); `None` for the other elements.
     pub fn counted_potential(&self, turn: f64) -> Option<f64> {

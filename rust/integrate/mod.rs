@@ -143,10 +143,11 @@ pub trait SecondOrderSystem {
     fn constraint_residual(&mut self, _t: f64, _q: &[f64]) -> Result<f64> {
         Ok(0.0)
     }
-    /// The cheap, fast-varying part of `structure` -- `M`, `K`, `A` -- at the state of the last
+    /// The cheap, fast-varying part of `structure` -- `M`, `K`, `A`, and the analytic part of
+    /// `C` (the force elements' damping, moved in `c` to `(q, qd)`) -- at the state of the last
     /// `acc` or `augmented_residual` call `(q, qd)` (an implementation may reuse what that call
     /// computed).
-    fn stiff_structure(&mut self, _q: &[f64], _qd: &[f64], _m: &mut [f64], _k: &mut [f64], _a: &mut [f64]) -> Result<bool> {
+    fn stiff_structure(&mut self, _q: &[f64], _qd: &[f64], _m: &mut [f64], _k: &mut [f64], _c: &mut [f64], _a: &mut [f64]) -> Result<bool> {
         Ok(false)
     }
     /// The forces that read the multipliers (joint friction) in the Newton matrices: `af`

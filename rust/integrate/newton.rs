@@ -228,10 +228,11 @@ impl NewtonMatrices {
         Ok(ok)
     }
 
-    /// `M`, `K`, `A` where the system's last evaluation left them, and the multipliers' terms.
+    /// `M`, `K`, `A` (and the force elements' damping in `C`) where the system's last
+    /// evaluation left them, and the multipliers' terms.
     pub fn read_stiff<S: SecondOrderSystem>(&mut self, sys: &mut S, q: &[f64], qd: &[f64]) -> Result<bool> {
         let ok = match &mut self.inner {
-            Inner::Dense(d) => sys.stiff_structure(q, qd, &mut d.mm, &mut d.kk, &mut d.aa)?,
+            Inner::Dense(d) => sys.stiff_structure(q, qd, &mut d.mm, &mut d.kk, &mut d.cc, &mut d.aa)?,
             Inner::Sparse(b) => sys.stiff_structure_sparse(q, qd, &mut b.s)?,
         };
         self.read_multiplier_terms(sys, q, qd);

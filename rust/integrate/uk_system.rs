@@ -55,6 +55,15 @@ pub struct UkSystem<'a> {
     /// With joint friction: the multipliers of the last `augmented_residual` or `acc` call, at
     /// which `multiplier_terms` linearizes the friction.
     flam: Vec<f64>,
+    /// The force elements' analytic damping (`dynamics::add_force_damping`) that the Newton
+    /// matrices' `C` holds now, as `(i, j, C_ij)`: `stiff_structure` takes it out and puts in the
+    /// one of its own state, so `C` is the differences of the last `structure` with the dampers
+    /// moved to the latest positions.
+    damping: Vec<(usize, usize, f64)>,
+    /// The coordinates' pattern and its colouring (`sparse_newton::Pattern`, made at the first
+    /// dense `structure`; `None` inside when over the memory limit): the dense velocity terms
+    /// by colours, as the sparse form reads them.
+    vpat: Option<Option<Pattern>>,
 }
 
 /// Positions this close (relative to their size) share their conditioning for
@@ -73,6 +82,27 @@ impl<'a> UkSystem<'a> {
             model, data, jws, projection: None, pws: ProjectWorkspace::new(model), jac_full_evals: 0, jac_cheap_evals: 0,
             acc_q: vec![0.0; n], acc_t: f64::NAN, ready: false, fact_q: vec![0.0; n], fact_info: None,
             res_q: vec![0.0; n], res_t: f64::NAN, res_norm: 0.0, res_valid: false, zeros: vec![0.0; n], rm: vec![0.0; m], lam: vec![0.0; m], flam: vec![0.0; m],
+            damping: Vec::new(),
+            vpat: None,
+        }
+    }
+
+    /// Record the force elements' analytic damping at `(q, qd)` (`self.damping`), which `C`
+    /// (just read by differences there) holds.
+    fn record_damping(&mut self, q: &[f64], qd: &[f64]) {
+        let Self { model, data, damping, .. } = self;
+        damping.clear();
+        dynamics::add_force_damping(model, data, q, qd, &mut |i, j, v| damping.push((i, j, v)));
+    }
+
+    /// Move the force elements' analytic damping in `C` to `(q, qd)`: `add(i, j, dC_ij)`.
+    fn move_damping(&mut self, q: &[f64], qd: &[f64], add: &mut dyn FnMut(usize, usize, f64)) {
+        for &(i, j, v) in &self.damping {
+            add(i, j, -v);
+        }
+        self.record_damping(q, qd);
+        for &(i, j, v) in &self.damping {
+            add(i, j, v);
         }
     }
 
@@ -277,7 +307,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         self.res_valid = true;
         Ok(self.res_norm)
     }
-    fn stiff_structure(&mut self, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], a: &mut [f64]) -> Result<bool> {
+    fn stiff_structure(&mut self, q: &[f64], qd: &[f64], m: &mut [f64], k: &mut [f64], c: &mut [f64], a: &mut [f64]) -> Result<bool> {
         // `uk::acceleration` / `augmented_residual` left the body blocks and A of (q, qd) in `data`
         self.ready = false;
         let (model, data) = (self.model, &mut self.data);
@@ -285,6 +315,8 @@ impl SecondOrderSystem for UkSystem<'_> {
         dynamics::dense_mass_into(model, data, m);
         dynamics::stiffness_into(model, data, q, qd, k);
         a.copy_from_slice(&data.jac);
+        let n = model.n;
+        self.move_damping(q, qd, &mut |i, j, v| c[i * n + j] += v);
         Ok(true)
     }
     fn multiplier_terms(&mut self, q: &[f64], qd: &[f64], af: &mut [f64]) -> bool {
@@ -311,6 +343,7 @@ impl SecondOrderSystem for UkSystem<'_> {
     fn structure_sparse(&mut self, t: f64, q: &[f64], qd: &[f64], s: &mut Structure) -> Result<bool> {
         self.ready = false;
         sparse_newton::fill_structure(self.model, &mut self.data, t, q, qd, s);
+        self.record_damping(q, qd);
         Ok(true)
     }
     fn stiff_structure_sparse(&mut self, q: &[f64], qd: &[f64], s: &mut Structure) -> Result<bool> {
@@ -319,6 +352,8 @@ impl SecondOrderSystem for UkSystem<'_> {
         sparse_newton::fill_mass(self.model, &self.data, s);
         sparse_newton::fill_stiffness(self.model, &mut self.data, q, qd, s);
         sparse_newton::fill_a(&self.data, s);
+        let (p, c) = (&s.pattern, &mut s.c);
+        self.move_damping(q, qd, &mut |i, j, v| c[p.find(i, j)] += v);
         Ok(true)
     }
     fn check_memory(&self, what: &str, bytes: u64) -> Result<()> {
@@ -336,8 +371,35 @@ impl SecondOrderSystem for UkSystem<'_> {
         dynamics::tangent_into(model, data, q, qd, k, c);
         dynamics::constraints(model, data, t, q, qd, false);
         a.copy_from_slice(&data.jac);
-        dynamics::velocity_jacobians_into(model, data, t, q, qd, &mut self.pws.v, c, bv);
+        let vpat = self.vpat.get_or_insert_with(|| Pattern::new(model, &data.ajac, false, data.memory_limit).ok());
+        match vpat {
+            Some(p) => dense_velocity_terms(model, data, t, q, qd, p, &mut self.pws.v, c, bv),
+            None => dynamics::velocity_jacobians_into(model, data, t, q, qd, &mut self.pws.v, c, bv),
+        }
+        self.record_damping(q, qd);
         Ok(true)
     }
 }
 
+/// `c = -dQ/dqd` and `bv = d gamma/dqd` (dense, row-major) at `(t, q, qd)` by central
+/// differences in `qd`, one pair of evaluations per colour of `p`
+/// (`sparse_newton::velocity_differences`, as the sparse form reads them): the values of
+/// `dynamics::velocity_jacobians_into` in `2 colours` evaluations instead of `2 n` (A05: 34
+/// coordinates). Entries outside the pattern are zero. `v` is an n-long scratch. Leaves `data`
+/// at a perturbed state.
+#[allow(clippy::too_many_arguments)]
+fn dense_velocity_terms(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], p: &Pattern, v: &mut [f64], c: &mut [f64], bv: &mut [f64]) {
+    let n = model.n;
+    c.fill(0.0);
+    bv.fill(0.0);
+    sparse_newton::velocity_differences(model, data, t, q, qd, p, v, &mut |j, sign, s2, data| {
+        for &i in &p.row[p.col_ptr[j]..p.col_ptr[j + 1]] {
+            let (f, e) = (data.force[i], &mut c[i * n + j]);
+            *e = if sign > 0.0 { -f } else { (*e + f) / s2 };
+        }
+        for &r in &p.arow[p.acol_ptr[j]..p.acol_ptr[j + 1]] {
+            let (g, e) = (data.gamma[r], &mut bv[r * n + j]);
+            *e = if sign > 0.0 { g } else { (*e - g) / s2 };
+        }
+    });
+}

@@ -126,13 +126,17 @@ fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
     }
 }
 
-/// Complex LU (separate real and imaginary parts), partial pivoting by modulus.
+/// Complex LU (separate real and imaginary parts, row-major), partial pivoting by modulus. The
+/// trailing update runs on row slices (no index checks in the inner loop, which the compiler
+/// then vectorizes); the pivot search compares squared moduli (the same order as `hypot`'s).
 pub(crate) fn lu_cplx(ar: &mut [f64], ai: &mut [f64], piv: &mut [usize], n: usize) -> bool {
+    assert!(ar.len() >= n * n && ai.len() >= n * n && piv.len() >= n);
+    let (ar, ai) = (&mut ar[..n * n], &mut ai[..n * n]);
     for k in 0..n {
         let mut p = k;
-        let mut best = ar[k * n + k].hypot(ai[k * n + k]);
+        let mut best = ar[k * n + k] * ar[k * n + k] + ai[k * n + k] * ai[k * n + k];
         for i in k + 1..n {
-            let v = ar[i * n + k].hypot(ai[i * n + k]);
+            let v = ar[i * n + k] * ar[i * n + k] + ai[i * n + k] * ai[i * n + k];
             if v > best {
                 best = v;
                 p = i;
@@ -151,16 +155,18 @@ pub(crate) fn lu_cplx(ar: &mut [f64], ai: &mut [f64], piv: &mut [usize], n: usiz
         let (pr, pi) = (ar[k * n + k], ai[k * n + k]);
         let d = pr * pr + pi * pi;
         let (ir, ii) = (pr / d, -pi / d);
-        for i in k + 1..n {
-            let (xr, xi) = (ar[i * n + k], ai[i * n + k]);
+        let (ar_top, ar_bot) = ar.split_at_mut((k + 1) * n);
+        let (ai_top, ai_bot) = ai.split_at_mut((k + 1) * n);
+        let (ur, ui) = (&ar_top[k * n + k + 1..], &ai_top[k * n + k + 1..]);
+        for (rr, ri) in ar_bot.chunks_exact_mut(n).zip(ai_bot.chunks_exact_mut(n)) {
+            let (xr, xi) = (rr[k], ri[k]);
             let (lr, li) = (xr * ir - xi * ii, xr * ii + xi * ir);
-            ar[i * n + k] = lr;
-            ai[i * n + k] = li;
+            rr[k] = lr;
+            ri[k] = li;
             if lr != 0.0 || li != 0.0 {
-                for j in k + 1..n {
-                    let (ur, ui) = (ar[k * n + j], ai[k * n + j]);
-                    ar[i * n + j] -= lr * ur - li * ui;
-                    ai[i * n + j] -= lr * ui + li * ur;
+                for (((a, b), &u_r), &u_i) in rr[k + 1..].iter_mut().zip(ri[k + 1..].iter_mut()).zip(ur).zip(ui) {
+                    *a -= lr * u_r - li * u_i;
+                    *b -= lr * u_i + li * u_r;
                 }
             }
         }
@@ -169,26 +175,25 @@ pub(crate) fn lu_cplx(ar: &mut [f64], ai: &mut [f64], piv: &mut [usize], n: usiz
 }
 
 pub(crate) fn lu_cplx_solve(ar: &[f64], ai: &[f64], piv: &[usize], n: usize, xr: &mut [f64], xi: &mut [f64]) {
+    assert!(ar.len() >= n * n && ai.len() >= n * n && piv.len() >= n && xr.len() >= n && xi.len() >= n);
     for k in 0..n {
         xr.swap(k, piv[k]);
         xi.swap(k, piv[k]);
     }
     for i in 0..n {
         let (mut sr, mut si) = (0.0, 0.0);
-        for j in 0..i {
-            let (lr, li) = (ar[i * n + j], ai[i * n + j]);
-            sr += lr * xr[j] - li * xi[j];
-            si += lr * xi[j] + li * xr[j];
+        for (((&lr, &li), &yr), &yi) in ar[i * n..i * n + i].iter().zip(&ai[i * n..i * n + i]).zip(&xr[..i]).zip(&xi[..i]) {
+            sr += lr * yr - li * yi;
+            si += lr * yi + li * yr;
         }
         xr[i] -= sr;
         xi[i] -= si;
     }
     for i in (0..n).rev() {
         let (mut sr, mut si) = (xr[i], xi[i]);
-        for j in i + 1..n {
-            let (ur, ui) = (ar[i * n + j], ai[i * n + j]);
-            sr -= ur * xr[j] - ui * xi[j];
-            si -= ur * xi[j] + ui * xr[j];
+        for (((&ur, &ui), &yr), &yi) in ar[i * n + i + 1..(i + 1) * n].iter().zip(&ai[i * n + i + 1..(i + 1) * n]).zip(&xr[i + 1..n]).zip(&xi[i + 1..n]) {
+            sr -= ur * yr - ui * yi;
+            si -= ur * yi + ui * yr;
         }
         let (pr, pi) = (ar[i * n + i], ai[i * n + i]);
         let d = pr * pr + pi * pi;

@@ -7,9 +7,9 @@
 //! [`ELASTIC_SHARE`]) and everything slower; `omega_c` is the highest of those. RADAU5M at
 //! the fixed step `h = y / omega_c`, `y = min(1, (phi / (RADAU_DECAY omega_c T))^(1/5))`,
 //! `phi = min(1, 20 rtol)` (at most `T / 20`), when `h omega_max` exceeds what an explicit
-//! step may take at equal cost; otherwise DOPRI5, unless overdamped modes make it stiff
-//! ([`overdamped`]). The fast modes the start sets off and the step damps give the run an
-//! error floor ([`floor`]).
+//! step may take at equal cost, unless that mode is overdamped; otherwise DOPRI5, unless
+//! overdamped modes make it stiff ([`overdamped`]: adaptive RADAU5M). The fast modes the start
+//! sets off and the step damps give the run an error floor ([`floor`]).
 //!
 //! The whole analysis of a small system (below `System.SPARSE_MODES_MIN` coordinates) runs
 //! here in one call ([`spectrum::dense_spectrum`], [`choose`]); a large system's lowest modes
@@ -268,6 +268,13 @@ pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &
         return Ok(c);
     }
     if h * sp.omega_max > EXPLICIT_STEP_OMEGA * RADAU_COST_RATIO {
+        // a fixed step resolves the lowest elastic mode's oscillation: an overdamped one has
+        // none (its slow decay is the motion), so the overdamped rule decides
+        if sp.complete() && traits.damped && overdamped::decides(model, data, t0, q, qd, sp, omega_c)? {
+            if let Some(d) = overdamped::choice(model, data, t0, q, qd, sp, &shares, phase, span)? {
+                return Ok(d);
+            }
+        }
         c.verdict = Verdict::Stiff;
         c.method = "RADAU5M";
         c.newton_rtol = Some((NEWTON_PER_RTOL * rtol).min(NEWTON_MAX_RTOL));
