@@ -197,8 +197,7 @@ impl Data {
             let hint = "the sparse UK path could not certify full rank here (redundant or nearly dependent constraints) and the dense rank-revealing fallback is this large; remove redundant constraints or raise memory_limit";
             Error::check_memory("the dense UK fallback", dense_uk_bytes(model), self.memory_limit, hint)?;
         }
-        // the dense A is not needed here (B^T is built from the segment form): its readers
-        // (the implicit methods' matrices, `System.A`) allocate it with `ensure_dense_jac`
+        self.ensure_dense_jac()?;
         let k = n.min(m);
         let req = if m > 0 {
             svd_scratch::<f64>(n, m, ComputeSvdVectors::Thin, ComputeSvdVectors::Thin, Par::Seq, Default::default())

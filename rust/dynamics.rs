@@ -70,6 +70,17 @@ pub fn apply_finvt(model: &Model, bodies: &[BodyData], v: &mut [f64]) {
     }
 }
 
+/// `F^-1` applied only to the bodies whose segment of `v` is not all zero (constraint rows
+/// touch one or two bodies).
+pub fn apply_finv_sparse(model: &Model, bodies: &[BodyData], v: &mut [f64]) {
+    for (body, bd) in model.bodies.iter().zip(bodies) {
+        let seg = &mut v[body.offset..body.offset + body.n_coords];
+        if seg.iter().any(|x| *x != 0.0) {
+            body.finv(bd, seg);
+        }
+    }
+}
+
 /// Constraint terms: `A` (in segment form, `data.ajac`; also the dense `data.jac` when that
 /// exists), `Phi_t`, `gamma`, and `Phi` when `with_phi`. O(nnz(A)): no pass over `m x n`.
 pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], with_phi: bool) {

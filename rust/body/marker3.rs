@@ -173,8 +173,7 @@ impl Marker3 {
             }
             let ck = col(&self.c, k);
             let jp = rot_b(p, &ck);
-            // h = 2 A(pd) c (`quad_term`), with A(pd) computed once per marker
-            st.axes[k] = Kin3 { v: mat_vec(&a, &ck), vd: m34_vec(&jp, pd), h: scale(2.0, &mat_vec(&ad, &ck)), jr: 0.0, jp, ..Default::default() };
+            st.axes[k] = Kin3 { v: mat_vec(&a, &ck), vd: m34_vec(&jp, pd), h: quad_term(pd, &ck), jr: 0.0, jp, ..Default::default() };
         }
         st
     }

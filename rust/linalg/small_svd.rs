@@ -55,13 +55,6 @@ pub struct QrJacobi {
     permuted: bool,
     /// Scratch for permuted m-vectors.
     tp: Vec<f64>,
-    /// The profile of the internal columns below the unit rows (`householder_qr`): before the
-    /// QR, the first and last nonzero row of each column; during it, bounds of the rows a
-    /// column may fill; after it, `lo[j]` is the first row below the unit rows of `R`'s column
-    /// `j` that may be nonzero and `hi[k]` the last row reflector `k` touches. Exact zeros
-    /// outside them are skipped, never assumed.
-    lo: Vec<usize>,
-    hi: Vec<usize>,
     /// Jacobi sweeps used by the last factorization (including the final clean sweep).
     pub sweeps: usize,
     /// The complete orthogonal decomposition of `R` (rank-deficient `G` without an SVD: `cod`).
@@ -90,8 +83,6 @@ impl QrJacobi {
             n_unit: 0,
             permuted: false,
             tp: vec![0.0; m],
-            lo: vec![0; m],
-            hi: vec![n.saturating_sub(1); m],
             sweeps: 0,
             cod: cod::Cod::new(m),
         }
@@ -146,17 +137,6 @@ impl QrJacobi {
                 }
             }
         }
-        // the profile below the unit rows (reflectors never reach them; `R`'s rows there are
-        // read in full); an all-zero column: an empty profile (lo > hi)
-        let u = self.n_unit;
-        for (j, c) in self.qr.chunks_exact(n).enumerate() {
-            if j < u {
-                (self.lo[j], self.hi[j]) = (j, j);
-            } else {
-                self.lo[j] = c[u..].iter().position(|x| *x != 0.0).map_or(n, |i| i + u);
-                self.hi[j] = c[u..].iter().rposition(|x| *x != 0.0).map_or(0, |i| i + u);
-            }
-        }
         self.householder_qr();
     }
 
@@ -167,9 +147,8 @@ impl QrJacobi {
     pub fn full_rank_bounds(&mut self) -> (f64, f64) {
         let (n, m) = (self.n, self.m);
         let mut rf = 0.0;
-        let u = self.n_unit;
         for j in 0..m {
-            for i in (0..u.min(j)).chain(self.lo[j].max(u).min(j)..=j) {
+            for i in 0..=j {
                 let x = self.qr[j * n + i];
                 rf += x * x;
             }
@@ -181,21 +160,15 @@ impl QrJacobi {
         }
         self.w.fill(0.0);
         let mut invf = 0.0;
-        let (qr, tm, lo) = (&self.qr, &self.tm, &self.lo);
+        let (qr, tm) = (&self.qr, &self.tm);
         for (j, x) in self.w.chunks_exact_mut(m).enumerate() {
-            // solve R x = e_j (x[i] = 0 for i > j) by columns of R: contiguous axpys over the
-            // unit rows and the rows where R's column k may be nonzero (an axpy with an exact
-            // zero changes nothing: the result is the dense loop's, bit for bit)
+            // solve R x = e_j (x[i] = 0 for i > j) by columns of R: contiguous axpys
             x[j] = 1.0;
             for k in (0..=j).rev() {
                 let xk = x[k] * tm[k];
                 x[k] = xk;
                 invf += xk * xk;
-                let (uk, l) = (u.min(k), lo[k].max(u).min(k));
-                for (xi, r) in x[..uk].iter_mut().zip(&qr[k * n..k * n + uk]) {
-                    *xi -= xk * r;
-                }
-                for (xi, r) in x[l..k].iter_mut().zip(&qr[k * n + l..k * n + k]) {
+                for (xi, r) in x[..k].iter_mut().zip(&qr[k * n..k * n + k]) {
                     *xi -= xk * r;
                 }
             }
@@ -274,52 +247,34 @@ impl QrJacobi {
         ok && self.norms.iter().all(|x| x.is_finite())
     }
 
-    /// Householder QR on the columns' profile (`lo`, `hi` from `qr_cols`): reflector `k` spans
-    /// rows `k..=hi[k]` (below, column `k` is zero), and a column whose rows `k..=hi[k]` are all
-    /// zero is left alone; a column it does touch may fill rows `k..=hi[k]`. Constraint rows
-    /// touch one or two bodies, so `B^T` ordered by body is a staircase and most of the dense
-    /// QR's work is on exact zeros (spatial slider-crank: about a quarter of the flops remain).
-    /// Skipped, they change nothing: the axpys with zeros are no-ops and the dot products end
-    /// where `dot_end` puts them, so `R` and the reflectors are the dense loop's, bit for bit.
     fn householder_qr(&mut self) {
         let (n, m) = (self.n, self.m);
         for k in 0..m {
-            let h = self.hi[k].max(k);
             let (head, tail) = self.qr.split_at_mut((k + 1) * n);
             let ck = &mut head[k * n..];
             let alpha = ck[k];
-            let e = dot_end(k, h, n);
-            let xnorm2 = crate::linalg::dot4(&ck[k + 1..e], &ck[k + 1..e]);
+            let xnorm2 = crate::linalg::dot4(&ck[k + 1..n], &ck[k + 1..n]);
             if xnorm2 == 0.0 {
                 self.tau[k] = 0.0;
-                self.hi[k] = k;
                 continue;
             }
             let norm = (alpha * alpha + xnorm2).sqrt();
             let beta = if alpha >= 0.0 { -norm } else { norm };
             self.tau[k] = (beta - alpha) / beta;
             let scale = 1.0 / (alpha - beta);
-            for x in ck[k + 1..=h].iter_mut() {
+            for x in ck[k + 1..n].iter_mut() {
                 *x *= scale;
             }
             ck[k] = beta;
-            self.hi[k] = h;
-            let ck_v = &ck[k + 1..];
-            let vk = &ck[k + 1..=h];
+            let vk = &ck[k + 1..n];
             let tau = self.tau[k];
             for j in 0..(m - k - 1) {
-                let c = k + 1 + j;
-                if self.lo[c] > h || self.hi[c] < k {
-                    continue;
-                }
                 let cj = &mut tail[j * n..(j + 1) * n];
-                let s = (cj[k] + crate::linalg::dot4(&cj[k + 1..e], &ck_v[..e - k - 1])) * tau;
+                let s = (cj[k] + crate::linalg::dot4(&cj[k + 1..n], vk)) * tau;
                 cj[k] -= s;
-                for (a, b) in cj[k + 1..=h].iter_mut().zip(vk) {
+                for (a, b) in cj[k + 1..n].iter_mut().zip(vk) {
                     *a -= s * b;
                 }
-                self.lo[c] = self.lo[c].min(k);
-                self.hi[c] = self.hi[c].max(h);
             }
         }
     }
@@ -430,11 +385,10 @@ impl QrJacobi {
             if tau == 0.0 {
                 continue;
             }
-            let (h, e) = (self.hi[k], dot_end(k, self.hi[k], n));
-            let vk = &self.qr[k * n + k + 1..k * n + h + 1];
-            let s = (self.tn[k] + crate::linalg::dot4(&self.tn[k + 1..e], &self.qr[k * n + k + 1..k * n + e])) * tau;
+            let vk = &self.qr[k * n + k + 1..(k + 1) * n];
+            let s = (self.tn[k] + crate::linalg::dot4(&self.tn[k + 1..], vk)) * tau;
             self.tn[k] -= s;
-            for (a, b) in self.tn[k + 1..=h].iter_mut().zip(vk) {
+            for (a, b) in self.tn[k + 1..].iter_mut().zip(vk) {
                 *a -= s * b;
             }
         }
@@ -464,17 +418,6 @@ impl QrJacobi {
             }
         }
     }
-}
-
-/// The end of the rows `k + 1..` that a dot product of reflector `k` reads when its entries
-/// below row `h` are zero: `h + 1` rounded up to `dot4`'s blocks of four (counted from `k + 1`),
-/// or `n` when that passes the last whole block. The zeros past `h` then fall in the same
-/// partial sums as in the full-length `dot4`, and the sum is the dense loop's, bit for bit.
-#[inline]
-fn dot_end(k: usize, h: usize, n: usize) -> usize {
-    let (len, full) = (h - k, n - k - 1);
-    let up = len.div_ceil(4) * 4;
-    if up <= full - full % 4 { k + 1 + up } else { n }
 }
 
 #[cfg(test)]
@@ -593,89 +536,5 @@ mod tests {
         let mut s = QrJacobi::with_unit_columns(n, m, &units);
         s.factor_cols(|j| &g[j * n..(j + 1) * n]);
         assert!(s.sigma(m - 1) < 1e-14 * s.sigma(0));
-    }
-
-    /// Block-sparse `G` (the staircase of constraint columns on body rows, in order, reversed
-    /// and with a column nonzero only at its two ends; and the spatial pattern: bodies of 7
-    /// rows whose last row is a unit column's): the QR on the profile reconstructs `G`, and the
-    /// full-rank solve gives `G^T y = r` for `y = B^+ r` and `G^T G lambda = -r`.
-    #[test]
-    fn profile_qr_on_block_sparse_columns() {
-        let mut st = 99u64;
-        let mut rnd = || {
-            st = st.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((st >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
-        // three bodies of 7 rows; joint columns on bodies (0), (0, 1), (1, 2), (2); unit columns
-        // 17, 18, 19 on rows 6, 13, 20
-        let (n, m) = (21usize, 20usize);
-        let spans = [(0, 7), (0, 7), (0, 7), (0, 7), (0, 7), (0, 14), (0, 14), (0, 14), (7, 21), (7, 21), (7, 21), (7, 21), (14, 21), (14, 21), (14, 21), (14, 21), (14, 21)];
-        let units = [(17usize, 6usize), (18, 13), (19, 20)];
-        let mut g = vec![0.0; n * m];
-        for (j, &(a, b)) in spans.iter().enumerate() {
-            for i in a..b {
-                g[j * n + i] = rnd();
-            }
-        }
-        for &(c, r) in &units {
-            g[c * n + r] = 0.5 + rnd().abs();
-        }
-        for s in [QrJacobi::new(n, m), QrJacobi::with_unit_columns(n, m, &units)] {
-            check_with(s.clone(), &g);
-            check_solve(s, &g, &mut rnd);
-        }
-        block_sparse_staircase();
-    }
-
-    /// `full_rank_solve` of `G = B^T`: `G^T y = r` and `G^T G lambda = -r`.
-    fn check_solve(mut s: QrJacobi, g: &[f64], rnd: &mut impl FnMut() -> f64) {
-        let (n, m) = (s.n, s.m);
-        s.qr_cols(|j| &g[j * n..(j + 1) * n]);
-        let (upper, lower) = s.full_rank_bounds();
-        assert!(lower > 0.0 && upper >= lower);
-        let r: Vec<f64> = (0..m).map(|_| rnd()).collect();
-        let (mut y, mut lambda) = (vec![0.0; n], vec![0.0; m]);
-        s.full_rank_solve(&r, &mut y, &mut lambda);
-        let mut gl = vec![0.0; n];
-        for j in 0..m {
-            let gy: f64 = (0..n).map(|i| g[j * n + i] * y[i]).sum();
-            assert!((gy - r[j]).abs() < 1e-12, "(G^T y)[{j}] = {gy} vs {}", r[j]);
-            for i in 0..n {
-                gl[i] += g[j * n + i] * lambda[j];
-            }
-        }
-        for j in 0..m {
-            let ggl: f64 = (0..n).map(|i| g[j * n + i] * gl[i]).sum();
-            assert!((ggl + r[j]).abs() < 1e-10, "(G^T G lambda)[{j}] = {ggl} vs {}", -r[j]);
-        }
-    }
-
-    fn block_sparse_staircase() {
-        let mut st = 4242u64;
-        let mut rnd = || {
-            st = st.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((st >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
-        let (n, m) = (18usize, 15usize);
-        // columns touch rows of one or two bodies of 6 rows each
-        let spans = [(0, 6), (0, 6), (0, 6), (0, 12), (0, 12), (6, 12), (6, 18), (6, 18), (6, 18), (12, 18), (12, 18), (12, 18), (12, 18), (0, 18), (0, 18)];
-        let mut g = vec![0.0; n * m];
-        for (j, &(a, b)) in spans.iter().enumerate() {
-            for i in a..b {
-                g[j * n + i] = rnd();
-            }
-        }
-        // a column nonzero at its ends only
-        for i in 1..n - 1 {
-            g[13 * n + i] = 0.0;
-        }
-        let mut rev = vec![0.0; n * m];
-        for j in 0..m {
-            rev[j * n..(j + 1) * n].copy_from_slice(&g[(m - 1 - j) * n..(m - j) * n]);
-        }
-        for g in [&g, &rev] {
-            check(n, m, g);
-            check_solve(QrJacobi::new(n, m), g, &mut rnd);
-        }
     }
 }

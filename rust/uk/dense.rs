@@ -10,7 +10,7 @@ use faer::Par;
 
 use super::settings::{Factored, RankInfo, SvdBackend};
 use crate::data::Data;
-use crate::dynamics::apply_finvt;
+use crate::dynamics::{apply_finv_sparse, apply_finvt};
 use crate::error::{Error, Result};
 use crate::linalg::small_svd::{RankRule, MAX_SWEEPS};
 use crate::model::Model;
@@ -18,16 +18,11 @@ use crate::model::Model;
 /// The dense path of `factor_constraints`: `B^T` (n x m) and its certified QR / SVD.
 pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
     let (n, m) = (model.n, model.m);
-    // B^T = F^-1 A^T, column by column from the segment form of A (F is block diagonal: each
-    // body piece of a row maps onto itself)
+    // B^T = F^-1 A^T, column by column
     for i in 0..m {
         let col = data.bt.col_as_slice_mut(i);
-        col.fill(0.0);
-        for sg in data.ajac.row_segs(i) {
-            let seg = &mut col[sg.col..sg.col + sg.len];
-            seg.copy_from_slice(&data.ajac.vals[sg.val..sg.val + sg.len]);
-            model.bodies[sg.body].finv(&data.bodies[sg.body], seg);
-        }
+        col.copy_from_slice(&data.jac[i * n..(i + 1) * n]);
+        apply_finv_sparse(model, &data.bodies, col);
     }
     let rcond = data.tolerance.rcond_at(n, m, data.spatial_drift);
     let atol = data.tolerance.atol;
