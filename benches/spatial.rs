@@ -42,6 +42,9 @@ fn acceleration(c: &mut Criterion) {
         let (model, mut data, q, qd) = scene(json);
         g.bench_function(name, |b| b.iter(|| uk::acceleration(&model, &mut data, black_box(0.1), black_box(&q), black_box(&qd)).unwrap()));
     }
+    let (model, _, q, qd) = scene(SCENES[0].1);
+    let mut sparse = Data::build(&model, ukflex::UkSolver::Sparse, u64::MAX).unwrap();
+    g.bench_function("slider_crank_sparse", |b| b.iter(|| uk::acceleration(&model, &mut sparse, black_box(0.1), black_box(&q), black_box(&qd)).unwrap()));
     g.finish();
 }
 

@@ -325,6 +325,30 @@ pub enum Force3Desc {
     Torque(Torque3Desc),
     SpringDamper(SpringDamper3Desc),
     RotationalSpringDamper(RotSpring3Desc),
+    JointFriction(JointFriction3Desc),
+}
+
+/// Regularized Coulomb and viscous friction in the spatial revolute, prismatic or spherical
+/// joint named `joint` (docs/loads.md, "Joint friction"): `radius` the pin (revolute) or ball
+/// (spherical) radius, `collar_radius` the effective radius of a thrust collar that carries a
+/// revolute's axial reaction (none: the axial reaction makes no friction).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointFriction3Desc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub joint: String,
+    pub mu: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collar_radius: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<f64>,
+    #[serde(default)]
+    pub damping: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v_eps: Option<f64>,
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize)]
@@ -388,6 +412,7 @@ impl Force3Desc {
             Force3Desc::Torque(_) => "torque",
             Force3Desc::SpringDamper(_) => "spring_damper",
             Force3Desc::RotationalSpringDamper(_) => "rotational_spring_damper",
+            Force3Desc::JointFriction(_) => "joint_friction",
         }
     }
     pub fn name(&self) -> Option<&str> {
@@ -396,6 +421,7 @@ impl Force3Desc {
             Force3Desc::Torque(d) => d.name.as_deref(),
             Force3Desc::SpringDamper(d) => d.name.as_deref(),
             Force3Desc::RotationalSpringDamper(d) => d.name.as_deref(),
+            Force3Desc::JointFriction(d) => d.name.as_deref(),
         }
     }
 }

@@ -31,7 +31,11 @@ pub enum Contact {
     Pin { radius: f64 },
     /// Prismatic: the slider length (`None`: the reaction moment is left out).
     Slide { length: Option<f64> },
+    /// Spatial joints (`friction3.rs`, with the joint's markers in `JointFriction::pair`).
+    Spatial(super::friction3::Contact3),
 }
+
+pub use super::friction3::MAX_ROWS;
 
 #[derive(Debug, Clone)]
 pub struct JointFriction {
@@ -43,6 +47,8 @@ pub struct JointFriction {
     pub mu: f64,
     pub damping: f64,
     pub v_eps: f64,
+    /// A spatial joint's markers (`a`, `b` are then their planar handles, `Marker3::base`).
+    pub pair: Option<crate::constraint::spatial::Pair>,
 }
 
 impl JointFriction {
@@ -87,13 +93,25 @@ impl JointFriction {
                 return Err(Error::invalid(item, format!("joint friction works in revolute and prismatic joints; '{joint}' is a {kind} joint")));
             }
         };
-        Ok(JointFriction { joint: ji, a, b, contact, mu, damping, v_eps })
+        Ok(JointFriction { joint: ji, a, b, contact, mu, damping, v_eps, pair: None })
+    }
+
+    /// Friction in a spatial joint (`friction3.rs` checks it against its joint).
+    pub fn from_desc3(item: &str, constraints: &[Constraint], d: &crate::description::spatial::JointFriction3Desc) -> Result<Self> {
+        let p = super::friction3::parse(item, constraints, d)?;
+        let v_eps = positive(item, "v_eps", d.v_eps.unwrap_or(DEFAULT_V_EPS))?;
+        let (a, b) = (p.pair.i.base.clone(), p.pair.j.base.clone());
+        Ok(JointFriction { joint: p.joint, a, b, contact: Contact::Spatial(p.contact), mu: p.mu, damping: p.damping, v_eps, pair: Some(p.pair) })
     }
 
     /// The slip rate `v` at `(q, qd)` (relative angular rate of a revolute, sliding rate of a
-    /// prismatic along `b`'s axis) and its generalized direction `g = dv/dqd` added into `g`.
+    /// prismatic along `b`'s axis) and its generalized direction `g = dv/dqd` added into `g`;
+    /// `aux`: what the law needs of the state besides the multipliers (a spatial joint's axis).
     #[inline]
-    pub fn kinematics(&self, bodies: &[Body], q: &[f64], qd: &[f64], g: &mut [f64]) -> f64 {
+    pub fn kinematics(&self, bodies: &[Body], q: &[f64], qd: &[f64], g: &mut [f64], aux: &mut [f64; 3]) -> f64 {
+        if let (Contact::Spatial(c), Some(pair)) = (self.contact, &self.pair) {
+            return super::friction3::kinematics(c, pair, bodies, q, qd, g, aux);
+        }
         let (sa, sb) = (self.a.state(bodies, q, qd), self.b.state(bodies, q, qd));
         match self.contact {
             Contact::Pin { .. } => {
@@ -107,6 +125,7 @@ impl JointFriction {
                 self.b.add_point_jacobian(bodies, &sb, [-c, -s], g);
                 c * (sa.v[0] - sb.v[0]) + s * (sa.v[1] - sb.v[1])
             }
+            Contact::Spatial(_) => unreachable!("a spatial contact has its pair"),
         }
     }
 
@@ -123,24 +142,41 @@ impl JointFriction {
         match self.contact {
             Contact::Pin { radius } => self.mu * radius,
             Contact::Slide { .. } => self.mu,
+            Contact::Spatial(c) => self.mu * c.lever(),
         }
     }
 
-    /// The effective normal force `N_eff` from the joint's two multipliers and its gradient
-    /// `dN_eff / dlambda` (a subgradient at the kinks: 0 at a zero reaction).
+    /// The effective normal force `N_eff` from the joint's multipliers (its first rows) and
+    /// its gradient `dN_eff / dlambda` (a subgradient at the kinks: 0 at a zero reaction);
+    /// `aux` from `kinematics`.
     #[inline]
-    pub fn normal(&self, lam: &[f64]) -> (f64, [f64; 2]) {
-        match self.contact {
+    pub fn normal(&self, lam: &[f64], aux: &[f64; 3]) -> (f64, [f64; MAX_ROWS]) {
+        let mut g = [0.0; MAX_ROWS];
+        let n = match self.contact {
             Contact::Pin { .. } => {
                 let n = lam[0].hypot(lam[1]);
-                if n == 0.0 { (0.0, [0.0, 0.0]) } else { (n, [lam[0] / n, lam[1] / n]) }
+                if n != 0.0 {
+                    (g[0], g[1]) = (lam[0] / n, lam[1] / n);
+                }
+                n
             }
-            Contact::Slide { length: None } => (lam[0].abs(), [sign(lam[0]), 0.0]),
+            Contact::Slide { length: None } => {
+                g[0] = sign(lam[0]);
+                lam[0].abs()
+            }
             Contact::Slide { length: Some(l) } => {
                 let (n, m) = (lam[0].abs(), 2.0 * lam[1].abs() / l);
-                if n >= m { (n, [sign(lam[0]), 0.0]) } else { (m, [0.0, 2.0 * sign(lam[1]) / l]) }
+                if n >= m {
+                    g[0] = sign(lam[0]);
+                    n
+                } else {
+                    g[1] = 2.0 * sign(lam[1]) / l;
+                    m
+                }
             }
-        }
+            Contact::Spatial(c) => c.normal(lam, aux, &mut g),
+        };
+        (n, g)
     }
 }
 
@@ -162,6 +198,10 @@ fn sign(x: f64) -> f64 {
 pub struct FrictionWork {
     /// Per element: (index in `Model::forces`, the joint's first row).
     pub items: Vec<(usize, usize)>,
+    /// Per element: how many of its joint's rows the law reads (at most `MAX_ROWS`), and the
+    /// state its law needs besides them (`JointFriction::kinematics`).
+    pub rows: Vec<usize>,
+    pub aux: Vec<[f64; 3]>,
     pub n: usize,
     pub m: usize,
     pub g: Vec<f64>,
@@ -196,8 +236,17 @@ impl FrictionWork {
             return None;
         }
         let k = items.len();
+        let rows = items
+            .iter()
+            .map(|&(i, _)| match &forces[i].kind {
+                super::ForceKind::JointFriction(fr) => constraints[fr.joint].rows().min(MAX_ROWS),
+                _ => 0,
+            })
+            .collect();
         Some(Box::new(FrictionWork {
             items,
+            rows,
+            aux: vec![[0.0; 3]; k],
             n,
             m,
             g: vec![0.0; k * n],
@@ -232,7 +281,7 @@ impl FrictionWork {
             let fr = self.element(forces, i);
             let g = &mut self.g[i * n..(i + 1) * n];
             g.fill(0.0);
-            self.v[i] = fr.kinematics(bodies, q, qd, g);
+            self.v[i] = fr.kinematics(bodies, q, qd, g, &mut self.aux[i]);
             self.s[i] = fr.direction(self.v[i]);
         }
     }
@@ -240,10 +289,10 @@ impl FrictionWork {
     /// The friction force of item `i` at the multipliers `lam` (all m), with `dF/dN_eff` and
     /// the gradient of `N_eff` in the joint's two multipliers.
     #[inline]
-    pub fn force_at(&self, forces: &[super::Force], i: usize, lam: &[f64]) -> (f64, f64, [f64; 2]) {
+    pub fn force_at(&self, forces: &[super::Force], i: usize, lam: &[f64]) -> (f64, f64, [f64; MAX_ROWS]) {
         let fr = self.element(forces, i);
         let r0 = self.items[i].1;
-        let (neff, grad) = fr.normal(&lam[r0..r0 + 2]);
+        let (neff, grad) = fr.normal(&lam[r0..r0 + self.rows[i]], &self.aux[i]);
         let k = -fr.coulomb() * self.s[i];
         (k * neff - fr.damping * self.v[i], k, grad)
     }

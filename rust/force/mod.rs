@@ -9,6 +9,7 @@
 pub mod bushing;
 pub mod clearance;
 pub mod friction;
+pub mod friction3;
 pub mod load;
 pub mod motor;
 pub mod rotational_spring;

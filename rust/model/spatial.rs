@@ -241,6 +241,8 @@ impl Builder {
                     angle0: s.angle0,
                 }
             }
+            // built from its joint's rows with the joints (`force::friction3::from_desc`)
+            Force3Desc::JointFriction(_) => return Err(Error::invalid(item, "joint friction is built from its joint (JointFriction::from_desc3)")),
         })
     }
 }
@@ -301,9 +303,12 @@ pub fn build(text: &str) -> Result<Model> {
     for (i, v) in raw.forces.into_iter().enumerate() {
         let d: Force3Desc = parse_item(Section::Force, i, v)?;
         let item = item_name(Section::Force, d.kind(), d.name(), i);
-        let kind = b.force(&item, &d)?;
+        let kind = match &d {
+            Force3Desc::JointFriction(f) => ForceKind::JointFriction(Box::new(crate::force::friction::JointFriction::from_desc3(&item, &constraints, f)?)),
+            _ => ForceKind::Spatial(b.force(&item, &d)?),
+        };
         let name = b.take_name(&item, d.name(), format!("{}{i}", d.kind()))?;
-        forces.push(Force { name, kind: ForceKind::Spatial(kind) });
+        forces.push(Force { name, kind });
     }
     let (row, row_names) = assign_rows(&mut constraints);
     Ok(Model {

@@ -120,10 +120,11 @@ fn solve_forces(model: &Model, w: &mut FrictionWork, t: f64) -> Result<()> {
             w.res[i] = w.f[i] - phi;
             converged &= w.res[i].abs() <= CLOSURE_RTOL * scale;
             // dR_i/dF_j = delta_ij - slope grad . l_j[rows of i]
-            let r0 = w.items[i].1;
+            let (r0, rows) = (w.items[i].1, w.rows[i]);
             for j in 0..k {
-                let l = &w.dlam[j * m + r0..j * m + r0 + 2];
-                w.jac[i * k + j] = if i == j { 1.0 } else { 0.0 } - slope * (grad[0] * l[0] + grad[1] * l[1]);
+                let l = &w.dlam[j * m + r0..j * m + r0 + rows];
+                let d: f64 = grad.iter().zip(l).map(|(a, b)| a * b).sum();
+                w.jac[i * k + j] = if i == j { 1.0 } else { 0.0 } - slope * d;
             }
         }
         w.iterations = iter;

@@ -340,6 +340,24 @@ class SpatialScene:
         return self._force({"kind": "rotational_spring_damper", "a": a.to_dict(), "b": b.to_dict(),
                             "stiffness": float(stiffness), "damping": float(damping), "angle0": float(angle0)}, name)
 
+    def joint_friction(self, joint: str, *, mu: float, radius: Optional[float] = None,
+                       collar_radius: Optional[float] = None, damping: float = 0.0,
+                       v_eps: Optional[float] = None, name: Optional[str] = None) -> str:
+        """Regularized Coulomb and viscous friction in the revolute, prismatic or spherical joint
+        named ``joint`` (added before), from its reaction, as :meth:`ukflex.Scene.joint_friction`
+        in the plane: a revolute's torque about its axis
+        ``-mu (radius |F_radial| + collar_radius |F_axial|) sat(w / v_eps) - damping w``, a
+        prismatic's force along its axis ``-mu |N| sat(v / v_eps) - damping v`` (``N`` the
+        reaction across the axis), a spherical joint's torque about the relative rotation axis
+        ``-mu radius |F| sat(|w| / v_eps) - damping |w|``. ``sat(x) = clamp(x, -1, 1)``;
+        ``v_eps=None`` takes the core's default (docs/loads.md, "Joint friction in spatial
+        joints"). Closed with the reactions in every acceleration call."""
+        item: Dict[str, Any] = {"kind": "joint_friction", "joint": joint, "mu": mu, "damping": damping}
+        for key, value in (("radius", radius), ("collar_radius", collar_radius), ("v_eps", v_eps)):
+            if value is not None:
+                item[key] = value
+        return self._force(item, name)
+
     # -- description ----------------------------------------------------------------------
     def to_dict(self) -> Dict[str, Any]:
         return copy.deepcopy(self._d)
