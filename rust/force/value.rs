@@ -147,7 +147,10 @@ impl Scope<'_> {
         if self.coordinate_names.len() > 4 {
             s += ", ...";
         }
-        s += ") or its rate d:<coordinate>, x(BODY, XI), y(BODY, XI) or their rates d:x(...)";
+        s += ") or its rate d:<coordinate>";
+        if self.ctx.is_some() {
+            s += ", x(BODY, XI), y(BODY, XI) or their rates d:x(...)";
+        }
         for l in self.local {
             s += &format!(", {l}");
         }
