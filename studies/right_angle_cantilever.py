@@ -78,9 +78,10 @@ def ukflex_run(elements: int, t: np.ndarray, **run: Any) -> Tuple[np.ndarray, np
     return elbow, tip, dt
 
 
-def exudyn_run(elements: int, t: np.ndarray, steps: int) -> Tuple[np.ndarray, np.ndarray, float]:
+def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float = 1.0) -> Tuple[np.ndarray, np.ndarray, float]:
     """The same frame in Exudyn: elbow and tip displacements interpolated at ``t`` from its
-    ``steps`` steps over ``[0, t[-1]]``, and the wall time of ``mbs.SolveDynamic``."""
+    ``steps`` steps over ``[0, t[-1]]`` (generalized-alpha at ``spectral_radius``), and the wall
+    time of ``mbs.SolveDynamic``."""
     import exudyn as exu
     from exudyn.itemInterface import (Force, GenericJoint, MarkerNodeRigid, NodeRigidBodyEP, ObjectBeamGeometricallyExact,
                                       ObjectGround, MarkerBodyRigid, SensorNode)
@@ -119,7 +120,7 @@ def exudyn_run(elements: int, t: np.ndarray, steps: int) -> Tuple[np.ndarray, np
     t_end = float(t[-1])
     ss.timeIntegration.numberOfSteps = steps
     ss.timeIntegration.endTime = t_end
-    ss.timeIntegration.generalizedAlpha.spectralRadius = 1.0
+    ss.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
     ss.timeIntegration.verboseMode = 0
     ss.solutionSettings.writeSolutionToFile = False
     ss.solutionSettings.sensorsWritePeriod = t_end / steps
