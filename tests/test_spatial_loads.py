@@ -110,3 +110,25 @@ def test_named_errors():
     with pytest.raises(ukflex.InvalidSceneError, match="rigid3"):
         s.torque_load(m, [0, 0, "t"])
         ukflex.System(s)
+
+
+def test_beam_node_coordinates_are_read_by_callables_not_by_expressions():
+    """A beam node's coordinates (``a[1].z``) cannot be spelled in an expression (an
+    ``ExpressionError`` naming it), while an expression of ``t`` on a scene with a beam builds and a
+    callable reads them through ``inputs``."""
+    def scene(load, **kw):
+        s = SpatialScene()
+        sec = ukflex.CustomSection3(ea=1e6, ga_y=1e6, ga_z=1e6, gj=1e3, ei_y=1e3, ei_z=1e3, mass_per_length=1.0,
+                                    rotary_inertia=(2.0, 1.0, 1.0))
+        a = s.beam("a", (0, 0, 0), (1, 0, 0), sec, elements=2)
+        s.fixed(s.ground.marker((0, 0, 0)), a.node(0))
+        s.point_load(a.node(-1), [0, 0, load], **kw)
+        return ukflex.System(s)
+
+    seen = []
+    system = scene(lambda t, state: seen.append(state["a[1].z"]) or 1.0, inputs=["a[1].z"])
+    system.qdd(0.0, system.q0, np.zeros(len(system.q0)))
+    assert seen and seen[-1] == 0.0
+    scene("2 * t")
+    with pytest.raises(ukflex.ExpressionError, match="unknown state quantity 'a'"):
+        scene("a[1].z")
