@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::description::MotionDesc;
+use crate::description::{LoadValueDesc, MotionDesc};
 
 pub type Vec3 = [f64; 3];
 
@@ -323,6 +323,8 @@ pub enum FrameDesc {
 pub enum Force3Desc {
     PointForce(PointForce3Desc),
     Torque(Torque3Desc),
+    PointLoad(PointLoad3Desc),
+    TorqueLoad(TorqueLoad3Desc),
     SpringDamper(SpringDamper3Desc),
     RotationalSpringDamper(RotSpring3Desc),
     JointFriction(JointFriction3Desc),
@@ -373,6 +375,31 @@ pub struct Torque3Desc {
     pub frame: FrameDesc,
 }
 
+/// A force at a marker whose three components are functions (`force/spatial_load.rs`,
+/// docs/loads.md): each a number, an expression of `t` and coordinates, a table or a callable.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLoad3Desc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub point: Marker3Desc,
+    pub force: Vec<LoadValueDesc>,
+    #[serde(default)]
+    pub frame: FrameDesc,
+}
+
+/// A torque on a rigid3 body whose three components are functions (as [`PointLoad3Desc`]).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TorqueLoad3Desc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub body: String,
+    pub torque: Vec<LoadValueDesc>,
+    #[serde(default)]
+    pub frame: FrameDesc,
+}
+
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpringDamper3Desc {
@@ -410,6 +437,8 @@ impl Force3Desc {
         match self {
             Force3Desc::PointForce(_) => "point_force",
             Force3Desc::Torque(_) => "torque",
+            Force3Desc::PointLoad(_) => "point_load",
+            Force3Desc::TorqueLoad(_) => "torque_load",
             Force3Desc::SpringDamper(_) => "spring_damper",
             Force3Desc::RotationalSpringDamper(_) => "rotational_spring_damper",
             Force3Desc::JointFriction(_) => "joint_friction",
@@ -419,6 +448,8 @@ impl Force3Desc {
         match self {
             Force3Desc::PointForce(d) => d.name.as_deref(),
             Force3Desc::Torque(d) => d.name.as_deref(),
+            Force3Desc::PointLoad(d) => d.name.as_deref(),
+            Force3Desc::TorqueLoad(d) => d.name.as_deref(),
             Force3Desc::SpringDamper(d) => d.name.as_deref(),
             Force3Desc::RotationalSpringDamper(d) => d.name.as_deref(),
             Force3Desc::JointFriction(d) => d.name.as_deref(),

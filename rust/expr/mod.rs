@@ -35,7 +35,7 @@ mod parse;
 mod tape;
 
 pub use graph::{Func, Graph, Node, NodeId, TooLarge, MAX_NODES};
-pub use parse::{parse, ParseError, MAX_DEPTH, MAX_LENGTH};
+pub use parse::{is_variable_name, parse, ParseError, MAX_DEPTH, MAX_LENGTH};
 pub use tape::Tape;
 
 use crate::error::{Error, Result};

@@ -53,12 +53,17 @@ fn is_name_char(c: char) -> bool {
     c.is_ascii_alphanumeric() || c == '_' || c == '.' || c == ':'
 }
 
+/// Whether `v` can name a variable of an expression: letters, digits, `_ . :`, starting with a
+/// letter or `_`, not a constant or a function.
+pub fn is_variable_name(v: &str) -> bool {
+    v.chars().next().is_some_and(is_name_start) && v.chars().all(is_name_char) && !RESERVED.contains(&v) && Func::by_name(v).is_none()
+}
+
 /// Parse `text` into `g` over the variables `vars` (slot `k` is `vars[k]`); returns the root.
 pub fn parse(g: &mut Graph, text: &str, vars: &[&str]) -> Result<NodeId, ParseError> {
     debug_assert_eq!(vars.len(), g.n_vars());
     for v in vars {
-        let ok = v.chars().next().is_some_and(is_name_start) && v.chars().all(is_name_char);
-        if !ok || RESERVED.contains(v) || Func::by_name(v).is_some() {
+        if !is_variable_name(v) {
             return Err(ParseError { message: format!("'{v}' cannot name a variable (a name of letters, digits, _ . :, not a constant or a function)"), position: 0 });
         }
     }

@@ -16,6 +16,7 @@ pub mod rotational_spring;
 pub mod value;
 
 pub mod spatial;
+pub mod spatial_load;
 use crate::body::{Body, Marker};
 use crate::constraint::{BuildContext, Constraint};
 use crate::description::ForceDesc;
@@ -32,6 +33,8 @@ pub enum ForceKind {
     SpringDamper { a: Marker, b: Marker, stiffness: f64, damping: f64, rest_length: f64 },
     /// Spatial force elements, gravity included (`force/spatial.rs`).
     Spatial(spatial::SpatialForce),
+    /// A spatial force or torque that is a function of time and state (`spatial_load.rs`).
+    SpatialLoad(Box<spatial_load::SpatialLoad>),
     /// A force or torque that is a function of time and state (`load.rs`).
     Load(Box<load::Load>),
     Motor(Box<motor::Motor>),
@@ -125,6 +128,7 @@ impl Force {
             ForceKind::SpringDamper { a, b, .. } => [Some(a), Some(b)],
             ForceKind::Spatial(f) => f.markers(),
             ForceKind::Load(l) => [Some(l.marker()), None],
+            ForceKind::SpatialLoad(l) => [Some(l.marker()), None],
             ForceKind::Motor(m) => [Some(&m.a), Some(&m.b)],
             ForceKind::RotationalSpringDamper(r) => [Some(&r.a), Some(&r.b)],
             ForceKind::Bushing(b) => [Some(&b.a), Some(&b.b)],
@@ -152,6 +156,7 @@ impl Force {
                 load::Load::Torque { tau, .. } => vec![tau],
             },
             ForceKind::Motor(m) => vec![&m.torque],
+            ForceKind::SpatialLoad(l) => l.values().iter().collect(),
             _ => Vec::new(),
         }
     }
@@ -165,6 +170,7 @@ impl Force {
                 load::Load::Torque { tau, .. } => vec![tau],
             },
             ForceKind::Motor(m) => vec![&mut m.torque],
+            ForceKind::SpatialLoad(l) => l.values_mut().iter_mut().collect(),
             _ => Vec::new(),
         }
     }
@@ -179,6 +185,7 @@ impl Force {
             ForceKind::Bushing(b) => b.stiffness.iter().any(|k| *k > 0.0),
             ForceKind::Spatial(f) => f.has_stiffness(),
             ForceKind::RevoluteClearance(_) => true,
+            ForceKind::SpatialLoad(l) => l.has_stiffness(),
             _ => self.values().iter().any(|v| v.has_gradient()),
         }
     }
@@ -237,6 +244,7 @@ impl Force {
             ForceKind::RotationalSpringDamper(rs) => rs.add_stiffness(bodies, q, qd, p, add),
             ForceKind::Bushing(bu) => bu.add_stiffness(bodies, q, qd, p, add),
             ForceKind::Spatial(f) => f.add_stiffness(bodies, q, qd, p, r, add),
+            ForceKind::SpatialLoad(l) => l.add_stiffness(&value::Env { bodies, t, q, qd, local: [0.0; 2] }, scratch, p, r, add),
             ForceKind::RevoluteClearance(c) => c.add_stiffness(bodies, q, qd, p, r, add),
             ForceKind::Motor(m) if m.torque.has_gradient() => {
                 let (sa, sb, local) = motor::relative(bodies, &m.a, &m.b, q, qd);
@@ -291,6 +299,7 @@ impl Force {
         match &self.kind {
             ForceKind::Load(l) => l.scratch_len(),
             ForceKind::Motor(m) => m.torque.scratch_len(),
+            ForceKind::SpatialLoad(l) => l.scratch_len(),
             _ => 0,
         }
     }
@@ -316,6 +325,7 @@ impl Force {
             }
             ForceKind::Spatial(f) => f.add_to(bodies, q, qd, turn, qvec),
             ForceKind::Load(l) => l.add_to(bodies, t, q, qd, scratch, qvec),
+            ForceKind::SpatialLoad(l) => l.add_to(bodies, t, q, qd, scratch, qvec),
             ForceKind::Motor(m) => m.add_to(bodies, t, q, qd, scratch, qvec),
             ForceKind::RotationalSpringDamper(r) => r.add_to(bodies, q, qd, qvec),
             ForceKind::Bushing(b) => b.add_to(bodies, q, qd, qvec),
@@ -339,7 +349,7 @@ impl Force {
                 let ldot = (d[0] * (sa.v[0] - sb.v[0]) + d[1] * (sa.v[1] - sb.v[1])) / l;
                 0.5 * stiffness * ldot * ldot
             }
-            ForceKind::PointForce { .. } | ForceKind::Torque { .. } | ForceKind::Load(_) | ForceKind::Motor(_) | ForceKind::JointFriction(_) => 0.0,
+            ForceKind::PointForce { .. } | ForceKind::Torque { .. } | ForceKind::Load(_) | ForceKind::SpatialLoad(_) | ForceKind::Motor(_) | ForceKind::JointFriction(_) => 0.0,
             ForceKind::Spatial(f) => f.material_energy(bodies, q, v),
             ForceKind::RotationalSpringDamper(r) => r.material_energy(bodies, q, v),
             ForceKind::Bushing(b) => b.material_energy(bodies, q, v),
@@ -374,6 +384,7 @@ impl Force {
             // a load that is a function has no potential unless it is constant; a motor's work
             // is input, not stored (sensors: `external_work`)
             ForceKind::Load(l) => l.potential(bodies, q).unwrap_or(0.0),
+            ForceKind::SpatialLoad(l) => l.potential(bodies, q).unwrap_or(0.0),
             ForceKind::Motor(_) | ForceKind::JointFriction(_) => 0.0,
         }
     }

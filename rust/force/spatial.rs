@@ -141,25 +141,9 @@ impl SpatialForce {
             }
             SpatialForce::PointForce { point, force, frame } => {
                 let st = point.state(bodies, q, qd);
-                let f = if *frame == FrameDesc::Body && point.rigid {
-                    let o = bodies[point.body.expect("rigid")].offset;
-                    mat_vec(&rot_a(&q[o + 3..o + 7]), &mat_vec(&point.c, force))
-                } else if *frame == FrameDesc::Body {
-                    mat_vec(&point.c, force)
-                } else {
-                    *force
-                };
-                add_jacobian(bodies, &st, &st.point, &f, qv, None);
+                add_jacobian(bodies, &st, &st.point, &world_force(point, *frame, bodies, q, force), qv, None);
             }
-            SpatialForce::Torque { body, torque, frame, .. } => {
-                let o = bodies[*body].offset;
-                let p = &q[o + 3..o + 7];
-                let nb = if *frame == FrameDesc::Body { *torque } else { mat_t_vec(&rot_a(p), torque) };
-                let g = rot_g(p);
-                for l in 0..4 {
-                    qv[o + 3 + l] += 2.0 * (g[0][l] * nb[0] + g[1][l] * nb[1] + g[2][l] * nb[2]);
-                }
-            }
+            SpatialForce::Torque { body, torque, frame, .. } => add_torque(bodies, *body, *frame, q, torque, qv),
             SpatialForce::SpringDamper { a, b, stiffness, damping, rest_length } => {
                 let (l, ld, u, [sa, sb]) = Self::spring(a, b, bodies, q, qd);
                 let Some(u) = u else { return };
@@ -305,6 +289,33 @@ impl SpatialForce {
             SpatialForce::Beam3 { nodes, element, .. } => element.material_energy(&element_coords(nodes, bodies, q), &element_coords(nodes, bodies, v)),
             _ => 0.0,
         }
+    }
+}
+
+/// The world components of a force `f` at `point` given in `frame` (world, or the marker's
+/// axes: `A C f` on a rigid body, `C f` on the ground).
+#[inline]
+pub fn world_force(point: &Marker3, frame: FrameDesc, bodies: &[Body], q: &[f64], f: &V3) -> V3 {
+    match frame {
+        FrameDesc::World => *f,
+        FrameDesc::Body if point.rigid => {
+            let o = bodies[point.body.expect("rigid")].offset;
+            mat_vec(&rot_a(&q[o + 3..o + 7]), &mat_vec(&point.c, f))
+        }
+        FrameDesc::Body => mat_vec(&point.c, f),
+    }
+}
+
+/// `qv[p] += 2 G^T n'` of a torque `n` in `frame` on the rigid3 body `body` (`n' = A^T n` for
+/// world components).
+#[inline]
+pub fn add_torque(bodies: &[Body], body: usize, frame: FrameDesc, q: &[f64], n: &V3, qv: &mut [f64]) {
+    let o = bodies[body].offset;
+    let p = &q[o + 3..o + 7];
+    let nb = if frame == FrameDesc::Body { *n } else { mat_t_vec(&rot_a(p), n) };
+    let g = rot_g(p);
+    for l in 0..4 {
+        qv[o + 3 + l] += 2.0 * (g[0][l] * nb[0] + g[1][l] * nb[1] + g[2][l] * nb[2]);
     }
 }
 

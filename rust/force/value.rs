@@ -147,7 +147,10 @@ impl Scope<'_> {
         if self.coordinate_names.len() > 4 {
             s += ", ...";
         }
-        s += ") or its rate d:<coordinate>, x(BODY, XI), y(BODY, XI) or their rates d:x(...)";
+        s += ") or its rate d:<coordinate>";
+        if self.ctx.is_some() {
+            s += ", x(BODY, XI), y(BODY, XI) or their rates d:x(...)";
+        }
         for l in self.local {
             s += &format!(", {l}");
         }
@@ -259,7 +262,9 @@ impl Value {
                 names.extend(scope.coordinate_names.iter().cloned());
                 names.extend(scope.coordinate_names.iter().map(|c| format!("d:{c}")));
                 names.extend(points.iter().map(|(p, _)| p.clone()));
-                let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+                // a name an expression cannot spell (a beam node's `bar[3].x`) is left to the
+                // tables and callables, which name their input as a string
+                let refs: Vec<&str> = names.iter().map(String::as_str).filter(|n| crate::expr::is_variable_name(n)).collect();
                 let f = Function::parse_used(&parsed, &refs).map_err(|e| expression_error(item, what, text, scope, e))?;
                 let inputs = f
                     .vars()

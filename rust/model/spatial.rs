@@ -25,6 +25,7 @@ use crate::force::{Force, ForceKind};
 use crate::model::{assign_rows, item_name, parse_item, parse_json, take_name, Model, Section};
 use crate::description::spatial::{Body3Desc, Driver3Desc, Force3Desc, Joint3Desc, Marker3Desc};
 use crate::force::spatial::{marker_point, SpatialForce};
+use crate::force::spatial_load::SpatialLoad;
 use crate::linalg::rot3::{norm, sub};
 
 /// Planar body kinds (refused in a spatial scene) and spatial ones (refused in a planar one).
@@ -198,22 +199,17 @@ impl Builder {
         })
     }
 
-    fn force(&self, item: &str, d: &Force3Desc) -> Result<SpatialForce> {
-        Ok(match d {
+    fn force(&self, item: &str, d: &Force3Desc) -> Result<ForceKind> {
+        Ok(ForceKind::Spatial(match d {
+            Force3Desc::PointLoad(f) => return Ok(ForceKind::SpatialLoad(Box::new(SpatialLoad::force(item, &self.names, self.marker(item, &f.point)?, &f.force, f.frame)?))),
+            Force3Desc::TorqueLoad(t) => return Ok(ForceKind::SpatialLoad(Box::new(SpatialLoad::torque(item, &self.names, self.rigid3(item, &t.body, "torque")?, &t.torque, t.frame)?))),
             Force3Desc::PointForce(f) => {
                 check_finite_item(item, "force", &f.force)?;
                 SpatialForce::PointForce { point: self.marker(item, &f.point)?, force: f.force, frame: f.frame }
             }
             Force3Desc::Torque(t) => {
                 check_finite_item(item, "torque", &t.torque)?;
-                let Some(&bi) = self.index.get(&t.body) else {
-                    let mut known: Vec<&str> = vec![];
-                    known.extend(self.bodies.iter().map(|b| b.name.as_str()));
-                    return Err(Error::UnknownBody { item: item.to_string(), body: t.body.clone(), known: known.join(", ") });
-                };
-                if !matches!(self.bodies[bi].kind, BodyKind::Rigid3(_)) {
-                    return Err(Error::invalid(item, format!("a torque needs a rigid3 body; '{}' has no orientation", t.body)));
-                }
+                let bi = self.rigid3(item, &t.body, "torque")?;
                 SpatialForce::Torque { body: bi, base: SpatialForce::torque_marker(bi), torque: t.torque, frame: t.frame }
             }
             Force3Desc::SpringDamper(s) => {
@@ -243,7 +239,20 @@ impl Builder {
             }
             // built from its joint's rows with the joints (`force::friction3::from_desc`)
             Force3Desc::JointFriction(_) => return Err(Error::invalid(item, "joint friction is built from its joint (JointFriction::from_desc3)")),
-        })
+        }))
+    }
+
+    /// The rigid3 body `name` a torque acts on (an unknown body, or one without orientation,
+    /// named).
+    fn rigid3(&self, item: &str, name: &str, what: &str) -> Result<usize> {
+        let Some(&bi) = self.index.get(name) else {
+            let known: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+            return Err(Error::UnknownBody { item: item.to_string(), body: name.to_string(), known: known.join(", ") });
+        };
+        if !matches!(self.bodies[bi].kind, BodyKind::Rigid3(_)) {
+            return Err(Error::invalid(item, format!("a {what} needs a rigid3 body; '{name}' has no orientation")));
+        }
+        Ok(bi)
     }
 }
 
@@ -305,7 +314,7 @@ pub fn build(text: &str) -> Result<Model> {
         let item = item_name(Section::Force, d.kind(), d.name(), i);
         let kind = match &d {
             Force3Desc::JointFriction(f) => ForceKind::JointFriction(Box::new(crate::force::friction::JointFriction::from_desc3(&item, &constraints, f)?)),
-            _ => ForceKind::Spatial(b.force(&item, &d)?),
+            _ => b.force(&item, &d)?,
         };
         let name = b.take_name(&item, d.name(), format!("{}{i}", d.kind()))?;
         forces.push(Force { name, kind });

@@ -155,6 +155,7 @@ pub fn works_by_power(f: &crate::force::Force) -> bool {
     match &f.kind {
         ForceKind::Motor(_) => true,
         ForceKind::Load(l) => !l.is_constant(),
+        ForceKind::SpatialLoad(l) => !l.has_potential(),
         _ => false,
     }
 }

@@ -326,6 +326,54 @@ class SpatialScene:
     def torque(self, body: SpatialBodyRef, torque: Sequence[float], frame: str = "world", name: Optional[str] = None) -> str:
         return self._force({"kind": "torque", "body": body.name, "torque": _vec("torque", torque), "frame": frame}, name)
 
+    def point_load(self, point: SpatialMarker, force: Sequence[Any], frame: str = "world", name: Optional[str] = None, *,
+                   inputs: Sequence[str] = ()) -> str:
+        """A force at a marker whose three components (world axes, or the marker's with
+        ``frame="body"``) are each a number, an expression of ``t`` and the coordinates by name
+        (``"50 * sin(2 * t)"``, ``"-10 * m.x - 0.5 * d:m.x"``), a :class:`ukflex.LoadTable`, or a
+        Python callable ``f(t, state) -> float`` with ``state`` the dict of the quantities named
+        by ``inputs`` (docs/loads.md, "In 3D"). Expressions and tables are compiled in Rust; an
+        unknown quantity is an :class:`ukflex.ExpressionError`."""
+        values = self._values("force", force, inputs)
+        return self._force({"kind": "point_load", "point": point.to_dict(), "force": values, "frame": frame}, name)
+
+    def torque_load(self, body: SpatialBodyRef, torque: Sequence[Any], frame: str = "world", name: Optional[str] = None, *,
+                    inputs: Sequence[str] = ()) -> str:
+        """A torque on a rigid body whose three components (world or body axes) are functions, as
+        :meth:`point_load`'s."""
+        return self._force({"kind": "torque_load", "body": body.name, "torque": self._values("torque", torque, inputs),
+                            "frame": frame}, name)
+
+    @property
+    def callables(self) -> Dict[str, Any]:
+        """The Python callables of the loads, by the name the description gives them; the
+        System is given them when it is built (they are not part of :meth:`to_dict`)."""
+        return dict(getattr(self, "_callables", {}))
+
+    def _values(self, what: str, values: Any, inputs: Sequence[str]) -> List[Any]:
+        """The three components of a load as the description holds them: a table as its dict,
+        a callable as a reference ``{"callable": name, "inputs": [...]}``."""
+        if isinstance(values, (str, dict)) or callable(values) or not hasattr(values, "__len__"):
+            raise InvalidSceneError(f"{what} must have 3 components (numbers, expressions, tables or callables), got {values!r}")
+        if len(values) != 3:
+            raise InvalidSceneError(f"{what} must have 3 components, got {len(values)}")
+        out: List[Any] = []
+        for v in values:
+            if hasattr(v, "to_dict"):
+                out.append(v.to_dict())
+            elif callable(v):
+                self._callables = getattr(self, "_callables", {})
+                name = f"callable{len(self._callables)}"
+                self._callables[name] = v
+                out.append({"callable": name, "inputs": [str(i) for i in inputs]})
+            elif isinstance(v, str):
+                out.append(v)
+            else:
+                out.append(float(v))
+        if inputs and not any(isinstance(v, dict) and "callable" in v for v in out):
+            raise InvalidArgumentError("inputs", "name the state quantities of a Python callable only (an expression or a table names its own)")
+        return out
+
     def spring_damper(self, a: SpatialMarker, b: SpatialMarker, stiffness: float, damping: float = 0.0,
                       rest_length: Optional[float] = None, name: Optional[str] = None) -> str:
         item: Dict[str, Any] = {"kind": "spring_damper", "a": a.to_dict(), "b": b.to_dict(), "stiffness": float(stiffness),
@@ -375,7 +423,7 @@ class SpatialScene:
 
     def validate(self) -> None:
         """Build the description in the core (every rule is the core's; named errors)."""
-        normalize_spatial(self._d)
+        normalize_spatial(self._d, self.callables)
 
 
 def _check_transportable(v: Any, path: str) -> None:
@@ -390,13 +438,14 @@ def _check_transportable(v: Any, path: str) -> None:
             _check_transportable(x, f"{path}[{i}]")
 
 
-def normalize_spatial(description: Dict[str, Any]):
-    """Validate a spatial description dict in the core; returns ``(None, dict)`` like
-    :func:`ukflex.description.normalize` (spatial scenes have no item-by-item checker)."""
+def normalize_spatial(description: Dict[str, Any], callables: Optional[Dict[str, Any]] = None):
+    """Validate a spatial description dict in the core (with the loads' Python ``callables`` by
+    name); returns ``(None, dict)`` like :func:`ukflex.description.normalize` (spatial scenes
+    have no item-by-item checker)."""
     _check_transportable(description, "")
     try:
         text = json.dumps(description, allow_nan=False)
     except (TypeError, ValueError) as exc:
         raise InvalidSceneError(f"scene: not a JSON-compatible description ({exc})") from exc
-    _core.System(text)
+    _core.System(text, callables=callables)
     return None, copy.deepcopy(dict(description))
