@@ -136,9 +136,9 @@ def test_mass_hanging_on_a_load_of_its_height_has_the_closed_form_frequency_and_
         assert np.max(np.abs(res.q[2] - exact)) < 1e-7 * a0, method  # measured 1.3e-9, 8.7e-13
 
 
-def test_point_quantities_of_a_body_point_and_a_beam_node():
-    """``x(B, [sx, sy, sz])`` reads a body-fixed point, ``z(a[1])`` a beam node (the coordinate
-    ``a[1].z`` an expression cannot spell): a constant force that switches on past a height."""
+def test_point_quantities_of_a_body_point():
+    """``x(B, [sx, sy, sz])`` reads a body-fixed point (its frame's origin plus ``s`` in body
+    axes), ``d:y(B)`` and ``z(B)`` the reference point's velocity and position."""
     s = SpatialScene()
     b = s.rigid_body("b", 1.0, [0.1, 0.2, 0.3], orientation=_frame(E), position=(0.1, 0.2, 0.3))
     s.point_load(b.marker(), ["x(b, [0.1, 0, 0]) + 2 * d:y(b)", 0, "z(b)"])
@@ -180,3 +180,29 @@ def test_motor_from_a_description_dict():
                                 "forces": [{"kind": "motor", "joint": "h", "torque": "0.4", "rotor_inertia": 0.2}]})
     res = ukflex.simulate(ukflex.System(s), 1.0, method="DOPRI5", rtol=1e-10, t_eval=[0.0, 1.0])
     assert abs(res.sensors.body("w")["omega"][-1, 2] - 0.4 / 0.4) < 1e-9
+
+
+def test_beam_node_position_is_spelled_as_a_point_quantity():
+    """``z(a[1])`` is the node's position, the coordinate ``a[1].z`` (which an expression cannot
+    spell); ``d:z(a[1])`` its rate. An unknown body in a point quantity is named."""
+    def scene(load):
+        s = SpatialScene()
+        sec = ukflex.CustomSection3(ea=1e6, ga_y=1e6, ga_z=1e6, gj=1e3, ei_y=1e3, ei_z=1e3, mass_per_length=1.0,
+                                    rotary_inertia=(2.0, 1.0, 1.0))
+        a = s.beam("a", (0, 0, 0), (1, 0, 0), sec, elements=2)
+        s.fixed(s.ground.marker((0, 0, 0)), a.node(0))
+        s.point_load(a.node(-1), [0, 0, load])
+        return ukflex.System(s)
+
+    plain = scene(0.0)
+    spelled = scene("-3e4 * z(a[1]) - 20 * d:z(a[1]) + 5 * x(a[2])")
+    names = list(plain.coordinate_names)
+    iz, ix = names.index("a[1].z"), names.index("a[2].x")
+    q, qd = plain.q0.copy(), np.zeros(len(plain.q0))
+    q[iz], qd[iz] = 0.01, 0.3
+    # the load at the end node: the difference of the accelerations is its force over the node's
+    # mass block, i.e. the same as a constant load of the value the expression takes
+    value = -3e4 * 0.01 - 20 * 0.3 + 5 * q[ix]
+    np.testing.assert_allclose(spelled.qdd(0.0, q, qd), scene(value).qdd(0.0, q, qd), rtol=1e-12, atol=1e-9)
+    with pytest.raises(ukflex.InvalidSceneError, match="nobody"):
+        scene("z(nobody)")
