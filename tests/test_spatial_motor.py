@@ -206,3 +206,13 @@ def test_beam_node_position_is_spelled_as_a_point_quantity():
     np.testing.assert_allclose(spelled.qdd(0.0, q, qd), scene(value).qdd(0.0, q, qd), rtol=1e-12, atol=1e-9)
     with pytest.raises(ukflex.InvalidSceneError, match="nobody"):
         scene("z(nobody)")
+
+
+def test_scipy_runs_count_the_motor_angle_from_their_start():
+    """The counted angle lives in the System's workspace; a scipy run (through ``System.rhs``)
+    restarts it, so a second run on the same System is the first's (as a native run is)."""
+    system = _flywheel("0.4 * (30 - w) + 2.0 * (30 * t - angle)", 0.05)
+    t = np.linspace(0.0, 2.0, 201)
+    runs = [_speed(ukflex.simulate(system, 2.0, method=m, rtol=1e-8, atol=1e-10, t_eval=t)) for m in ("RK45", "RK45", "DOPRI5")]
+    np.testing.assert_array_equal(runs[0], runs[1])
+    assert np.max(np.abs(runs[0] - runs[2])) < 1e-4 * 30

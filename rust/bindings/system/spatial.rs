@@ -18,6 +18,17 @@ use crate::sensors::spatial as outputs;
 
 #[pymethods]
 impl PySystem {
+    /// Start the turn counts of the spatial rotational spring-dampers and motors afresh
+    /// (`Data::turns`: the next evaluation reads each angle within half a turn of its rest
+    /// angle): a run through `rhs` (scipy's methods) calls it at its start, as a native run
+    /// starts from a fresh workspace.
+    fn restart_turns(&self) -> PyResult<()> {
+        self.with_ws(|_, ws| {
+            ws.data.turns.fill(f64::NAN);
+            Ok::<(), Error>(())
+        })
+    }
+
     /// Spatial outputs at the states `(t, q, qd)` (`t` (nt,), q, qd (nt, n)) of a `"dim": 3`
     /// model: `bodies` (nt, n_bodies, 25: centre of mass, its velocity, unit quaternion, angular
     /// velocity world and body, rotation matrix rows), `body_columns`, `body_names`;
