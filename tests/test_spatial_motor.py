@@ -27,12 +27,13 @@ def _frame(z):
     return np.column_stack([x, np.cross(z, x), z])
 
 
-def _flywheel(torque, J, Jr=0.0, **kw):
-    """A flywheel (``J`` about its axis, ``J / 2`` across) on a revolute about ``E``."""
+def _flywheel(torque, J, Jr=0.0, joint="revolute", **kw):
+    """A flywheel (``J`` about its axis, ``J / 2`` across) on a revolute (or cylindrical joint:
+    it slides down the axis under gravity) about ``E``."""
     s = SpatialScene(gravity=(0.0, 0.0, -9.81))
     w = s.rigid_body("wheel", 3.0, [J / 2, J / 2, J], position=0.2 * E, orientation=_frame(E))
     # the markers' x axes agree at the start: the motor's angle starts at 0
-    s.revolute(w.marker((0, 0, 0)), s.ground.marker(0.2 * E, z=E, x=_frame(E)[:, 0]), name="hinge")
+    getattr(s, joint)(w.marker((0, 0, 0)), s.ground.marker(0.2 * E, z=E, x=_frame(E)[:, 0]), name="hinge")
     s.motor("hinge", torque, rotor_inertia=Jr, **kw)
     return ukflex.System(s)
 
@@ -58,11 +59,12 @@ def test_dc_motor_spins_a_flywheel_on_a_tilted_axis_up_as_the_closed_form():
     assert bal["external_work"][-1] > 0.5 * 0.5 * (J + Jr) * (V / k) ** 2
 
 
-def test_pi_speed_controller_as_an_expression_on_a_tilted_axis():
+@pytest.mark.parametrize("joint", ["revolute", "cylindrical"])
+def test_pi_speed_controller_as_an_expression_on_a_tilted_axis(joint):
     """``tau = Kp (w_ref - w) + Ki (w_ref t - angle)``: the angle, counted over the turns, is the
     integral of the speed; ``e = w_ref t - angle`` obeys ``J e'' + Kp e' + Ki e = 0``."""
     J, Kp, Ki, wr = 0.05, 0.4, 2.0, 30.0
-    system = _flywheel(f"{Kp} * ({wr} - w) + {Ki} * ({wr} * t - angle)", J)
+    system = _flywheel(f"{Kp} * ({wr} - w) + {Ki} * ({wr} * t - angle)", J, joint=joint)
     t = np.linspace(0.0, 2.0, 401)  # 30 rad/s: samples well within half a turn (the sensors count turns)
     res = ukflex.simulate(system, t[-1], method="DOPRI5", rtol=1e-10, atol=1e-12, t_eval=t)
     sigma, wd = Kp / (2 * J), math.sqrt(Ki / J - (Kp / (2 * J)) ** 2)
@@ -112,7 +114,7 @@ def test_linear_motor_on_a_prismatic_joint():
     b = s.rigid_body("cart", m, [0.1, 0.1, 0.1], orientation=_frame(E))
     s.prismatic(b.marker((0, 0, 0)), s.ground.marker((0, 0, 0), z=E), name="slide")
     s.motor("slide", f"{F0} * (1 - v / {v0})")
-    t = np.linspace(0.0, 3.0, 31)
+    t = np.linspace(0.0, 3.0, 151)  # the balance integrates the motor's power over the samples
     res = ukflex.simulate(ukflex.System(s), t[-1], method="DOPRI5", rtol=1e-10, atol=1e-12, t_eval=t)
     v = res.sensors.body("cart")["velocity"] @ E
     assert np.max(np.abs(v - v0 * (1 - np.exp(-F0 * t / (m * v0))))) < 1e-8 * v0
