@@ -93,10 +93,14 @@ fn point_quantity(s: &str) -> Option<(usize, bool, String, f64, usize)> {
     Some((axis, rate, body.to_string(), xi, consumed))
 }
 
+/// An expression's text with its point quantities replaced: the text, the placeholders with
+/// their inputs, the planar and the spatial points' markers.
+type Substituted = (String, Vec<(String, Input)>, Vec<Marker>, Vec<Marker3>);
+
 impl Scope<'_> {
     /// `text` with each point quantity replaced by a placeholder variable of the same length
     /// (`_p0_____`), and the points' markers with their inputs, by placeholder.
-    fn substitute_points(&self, item: &str, text: &str) -> Result<(String, Vec<(String, Input)>, Vec<Marker>, Vec<Marker3>)> {
+    fn substitute_points(&self, item: &str, text: &str) -> Result<Substituted> {
         let mut out = String::with_capacity(text.len());
         let (mut found, mut markers): (Vec<(String, Input)>, Vec<Marker>) = (Vec::new(), Vec::new());
         let mut markers3: Vec<Marker3> = Vec::new();

@@ -39,10 +39,13 @@ pub fn point_call<'s>(s: &'s str, axes: &[u8]) -> Option<(usize, bool, &'s str, 
     Some((axis, rate, &inner[..close], (s.len() - inner.len()) + close + 1))
 }
 
+/// A spatial point quantity as parsed: `(axis, rate, body, point, length of the text)`.
+pub type PointQuantity = (usize, bool, String, Option<[f64; 3]>, usize);
+
 /// A spatial point quantity parsed from the start of `s`: `(axis, rate, body, point, length of
 /// the text)`; `None` when `s` does not start with one. A body name may hold brackets (a beam's
 /// node `a[3]`) but no parentheses or commas.
-pub fn point_quantity(s: &str) -> Option<(usize, bool, String, Option<[f64; 3]>, usize)> {
+pub fn point_quantity(s: &str) -> Option<PointQuantity> {
     let (axis, rate, args, consumed) = point_call(s, b"xyz")?;
     let (body, point) = match args.split_once(',') {
         None => (args.trim(), None),

@@ -122,7 +122,18 @@ impl PySystem {
         d.set_item("potential_energy", PyArray1::from_vec(py, pe))?;
         d.set_item("body_energies", PyArray1::from_vec(py, be).reshape([nt, nb, 3])?)?;
         d.set_item("force_names", self.model.forces.iter().map(|f| f.name.clone()).collect::<Vec<_>>())?;
-        let kinds: Vec<&str> = self.model.forces.iter().map(|f| if let ForceKind::Spatial(sf) = &f.kind { sf.kind() } else { "planar" }).collect();
+        let kinds: Vec<&str> = self
+            .model
+            .forces
+            .iter()
+            .map(|f| match &f.kind {
+                ForceKind::Spatial(sf) => sf.kind(),
+                ForceKind::Motor3(_) => "motor",
+                ForceKind::SpatialLoad(_) => "load",
+                ForceKind::JointFriction(_) => "joint_friction",
+                _ => "planar",
+            })
+            .collect();
         d.set_item("force_kinds", kinds)?;
         d.set_item("force_potentials", mat(py, fp, nt, nf)?)?;
         d.set_item("force_powers", mat(py, fw, nt, nf)?)?;
