@@ -220,3 +220,34 @@ def test_scipy_runs_count_the_motor_angle_from_their_start():
     runs = [_speed(ukflex.simulate(system, 2.0, method=m, rtol=1e-8, atol=1e-10, t_eval=t)) for m in ("RK45", "RK45", "DOPRI5")]
     np.testing.assert_array_equal(runs[0], runs[1])
     assert np.max(np.abs(runs[0] - runs[2])) < 1e-4 * 30
+
+
+def test_motor_and_point_quantities_from_a_scene_file():
+    """A TOML scene file with ``dim = 3`` takes a motor and a load reading point quantities: the
+    DC motor's closed form at 2 s (rotor inertia included)."""
+    from ukflex.model.scenefile import loads
+
+    text = """dim = 3
+[[bodies]]
+kind = "rigid3"
+name = "wheel"
+mass = 2.0
+inertia = [0.05, 0.05, 0.1]
+[[joints]]
+kind = "revolute"
+name = "hinge"
+a = { body = "wheel" }
+b = { body = "ground" }
+[[forces]]
+kind = "motor"
+joint = "hinge"
+torque = "0.05 * (12 - 0.05 * w) / 0.8"
+rotor_inertia = 0.01
+[[forces]]
+kind = "point_load"
+point = { body = "wheel" }
+force = [0.0, 0.0, "-10 * z(wheel) - 0.1 * d:z(wheel)"]
+"""
+    res = ukflex.simulate(ukflex.System(loads(text).scene), 2.0, method="DOPRI5", rtol=1e-10, atol=1e-12, t_eval=[0.0, 2.0])
+    exact = 12 / 0.05 * (1 - math.exp(-2.0 * 0.05**2 / ((0.1 + 0.01) * 0.8)))
+    assert abs(res.sensors.body("wheel")["omega"][-1, 2] - exact) < 1e-8 * exact
