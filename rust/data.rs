@@ -99,9 +99,10 @@ pub struct Data {
     /// consistent state dropped (`RankTolerance::decides_redundancy`); far off the manifold
     /// they are dropped up to the drift (`RankTolerance::redundant_rcond`, `uk::dense`).
     pub redundant: usize,
-    /// Per force element: the angle `theta - angle0` a spatial rotational spring-damper read at
-    /// the last evaluation, continuous over any number of turns (NaN until its first reading;
-    /// `force::spatial`); unused by the other elements.
+    /// Per force element: the angle `theta - angle0` a spatial rotational spring-damper (the
+    /// angle a spatial motor, `force::motor3`) read at the last evaluation, continuous over any
+    /// number of turns (NaN until its first reading; `force::spatial`); unused by the other
+    /// elements.
     pub turns: Vec<f64>,
     pub stabilization: Stabilization,
     pub rank_info: RankInfo,

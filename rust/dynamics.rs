@@ -156,8 +156,8 @@ pub fn add_force_stiffness(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
         return;
     }
     let t = data.t_forces;
-    for f in model.forces.iter().filter(|f| f.has_stiffness()) {
-        f.add_stiffness(&model.bodies, t, q, qd, &mut data.load_scratch, &mut data.load_rows, add);
+    for (f, &turn) in model.forces.iter().zip(&data.turns).filter(|(f, _)| f.has_stiffness()) {
+        f.add_stiffness(&model.bodies, t, q, qd, turn, &mut data.load_scratch, &mut data.load_rows, add);
     }
 }
 

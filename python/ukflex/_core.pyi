@@ -199,6 +199,9 @@ class System:
     def sensors(self, t: _F64, q: _F64, qd: _F64, reactions: bool = True) -> Dict[str, Any]:
         """Reactions (nt, items, 6), body energies (nt, bodies, 3), force potentials, dissipation power, load power, clearance (nt, clearance joints, 5)."""
         ...
+    def restart_turns(self) -> None:
+        """Start the spatial rotational springs' and motors' turn counts afresh (a scipy run's start)."""
+        ...
     def spatial_outputs(self, t: _F64, q: Any, qd: Any, reactions: bool = True) -> Dict[str, Any]:
         """Spatial outputs at stored states: bodies (nt, bodies, 25), reactions (nt, items, 13), momentum, energies, force potentials and powers, dissipation power, driver values (ukflex.spatial_outputs, res.sensors)."""
         ...

@@ -187,6 +187,23 @@ impl Rigid3 {
         Ok(Rigid3 { mass, inertia, com: d.com, inv_sqrt_m: 1.0 / mass.sqrt(), l_inv: lower_inverse(&l), k, inv_sqrt_k: 1.0 / k.sqrt() })
     }
 
+    /// Add `extra` (body axes, symmetric, positive semi-definite: a motor's rotor `J_r z z^T`,
+    /// `force/motor3.rs`) to the inertia tensor and refresh its factor and regularization
+    /// weight. The sum need not obey the triangle inequality (a rotor's inertia across its axis
+    /// is left to the body's tensor); it stays positive definite.
+    pub fn add_inertia(&mut self, item: &str, extra: &M3) -> Result<()> {
+        let mut j = self.inertia;
+        for a in 0..3 {
+            for b in 0..3 {
+                j[a][b] += extra[a][b];
+            }
+        }
+        let l = cholesky3(&j).ok_or_else(|| Error::invalid(item, "inertia tensor with the rotor's is not positive definite"))?;
+        let k = (j[0][0] + j[1][1] + j[2][2]) / 3.0;
+        (self.inertia, self.l_inv, self.k, self.inv_sqrt_k) = (j, lower_inverse(&l), k, 1.0 / k.sqrt());
+        Ok(())
+    }
+
     pub fn initial_state(&self, d: &Rigid3Desc, item: &str) -> Result<InitialState> {
         for (what, v) in [("position", &d.position), ("velocity", &d.velocity), ("angular_velocity", &d.angular_velocity)] {
             check_finite_item(item, what, v)?;

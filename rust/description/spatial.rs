@@ -328,6 +328,22 @@ pub enum Force3Desc {
     SpringDamper(SpringDamper3Desc),
     RotationalSpringDamper(RotSpring3Desc),
     JointFriction(JointFriction3Desc),
+    Motor(Motor3Desc),
+}
+
+/// A motor on the spatial joint named `joint` (`force/motor3.rs`, docs/loads.md, "Motors in
+/// 3D"): on a revolute or cylindrical joint a torque about its axis, on a prismatic joint a
+/// force along it; `torque` a load value that may read `angle`, `w` (rotation) or `s`, `v`
+/// (slide); `rotor_inertia` about the axis, on the body of the joint's marker `a`.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Motor3Desc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub joint: String,
+    pub torque: LoadValueDesc,
+    #[serde(default)]
+    pub rotor_inertia: f64,
 }
 
 /// Regularized Coulomb and viscous friction in the spatial revolute, prismatic or spherical
@@ -442,6 +458,7 @@ impl Force3Desc {
             Force3Desc::SpringDamper(_) => "spring_damper",
             Force3Desc::RotationalSpringDamper(_) => "rotational_spring_damper",
             Force3Desc::JointFriction(_) => "joint_friction",
+            Force3Desc::Motor(_) => "motor",
         }
     }
     pub fn name(&self) -> Option<&str> {
@@ -453,6 +470,7 @@ impl Force3Desc {
             Force3Desc::SpringDamper(d) => d.name.as_deref(),
             Force3Desc::RotationalSpringDamper(d) => d.name.as_deref(),
             Force3Desc::JointFriction(d) => d.name.as_deref(),
+            Force3Desc::Motor(d) => d.name.as_deref(),
         }
     }
 }

@@ -17,13 +17,13 @@ pub enum Load {
 
 impl Load {
     pub fn force(ctx: &BuildContext, item: &str, point: &MarkerDesc, fx: &LoadValueDesc, fy: &LoadValueDesc) -> Result<Load> {
-        let scope = Scope { coordinate_names: ctx.coordinate_names, local: &[], ctx: Some(ctx) };
+        let scope = Scope { coordinate_names: ctx.coordinate_names, local: &[], ctx: Some(ctx), spatial: None };
         let f = [Value::new(item, "fx", &scope, fx)?, Value::new(item, "fy", &scope, fy)?];
         Ok(Load::Force { point: ctx.marker(item, point)?, f })
     }
 
     pub fn torque(ctx: &BuildContext, item: &str, frame: &MarkerDesc, tau: &LoadValueDesc) -> Result<Load> {
-        let scope = Scope { coordinate_names: ctx.coordinate_names, local: &[], ctx: Some(ctx) };
+        let scope = Scope { coordinate_names: ctx.coordinate_names, local: &[], ctx: Some(ctx), spatial: None };
         Ok(Load::Torque { frame: ctx.oriented_marker(item, frame)?, tau: Value::new(item, "torque", &scope, tau)? })
     }
 

@@ -12,8 +12,10 @@ pub mod friction;
 pub mod friction3;
 pub mod load;
 pub mod motor;
+pub mod motor3;
 pub mod rotational_spring;
 pub mod value;
+pub mod value3;
 
 pub mod spatial;
 pub mod spatial_load;
@@ -38,6 +40,8 @@ pub enum ForceKind {
     /// A force or torque that is a function of time and state (`load.rs`).
     Load(Box<load::Load>),
     Motor(Box<motor::Motor>),
+    /// A motor on a spatial joint (`motor3.rs`).
+    Motor3(Box<motor3::Motor3>),
     RotationalSpringDamper(Box<rotational_spring::RotationalSpringDamper>),
     Bushing(Box<bushing::Bushing>),
     RevoluteClearance(Box<clearance::Clearance>),
@@ -130,6 +134,7 @@ impl Force {
             ForceKind::Load(l) => [Some(l.marker()), None],
             ForceKind::SpatialLoad(l) => [Some(l.marker()), None],
             ForceKind::Motor(m) => [Some(&m.a), Some(&m.b)],
+            ForceKind::Motor3(m) => [Some(&m.pair.i.base), Some(&m.pair.j.base)],
             ForceKind::RotationalSpringDamper(r) => [Some(&r.a), Some(&r.b)],
             ForceKind::Bushing(b) => [Some(&b.a), Some(&b.b)],
             ForceKind::RevoluteClearance(c) => [Some(&c.journal), Some(&c.bearing)],
@@ -156,6 +161,7 @@ impl Force {
                 load::Load::Torque { tau, .. } => vec![tau],
             },
             ForceKind::Motor(m) => vec![&m.torque],
+            ForceKind::Motor3(m) => vec![&m.value],
             ForceKind::SpatialLoad(l) => l.values().iter().collect(),
             _ => Vec::new(),
         }
@@ -170,6 +176,7 @@ impl Force {
                 load::Load::Torque { tau, .. } => vec![tau],
             },
             ForceKind::Motor(m) => vec![&mut m.torque],
+            ForceKind::Motor3(m) => vec![&mut m.value],
             ForceKind::SpatialLoad(l) => l.values_mut().iter_mut().collect(),
             _ => Vec::new(),
         }
@@ -198,7 +205,8 @@ impl Force {
     /// the implicit methods' Newton iteration needs, not an exact Jacobian. `rows` is a `2 n`
     /// scratch, `scratch` the force's evaluation scratch. A revolute joint with clearance adds its
     /// contact stiffness (`clearance.rs`); nothing for the other kinds.
-    pub fn add_stiffness(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], scratch: &mut [f64], rows: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_stiffness(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], turn: f64, scratch: &mut [f64], rows: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
         let n = q.len();
         let (p, r) = rows[..2 * n].split_at_mut(n);
         match &self.kind {
@@ -246,6 +254,7 @@ impl Force {
             ForceKind::Spatial(f) => f.add_stiffness(bodies, q, qd, p, r, add),
             ForceKind::SpatialLoad(l) => l.add_stiffness(&value::Env { bodies, t, q, qd, local: [0.0; 2] }, scratch, p, r, add),
             ForceKind::RevoluteClearance(c) => c.add_stiffness(bodies, q, qd, p, r, add),
+            ForceKind::Motor3(m) if m.value.has_gradient() => m.add_stiffness(bodies, t, q, qd, turn, scratch, p, r, add),
             ForceKind::Motor(m) if m.torque.has_gradient() => {
                 let (sa, sb, local) = motor::relative(bodies, &m.a, &m.b, q, qd);
                 r.fill(0.0);
@@ -299,6 +308,7 @@ impl Force {
         match &self.kind {
             ForceKind::Load(l) => l.scratch_len(),
             ForceKind::Motor(m) => m.torque.scratch_len(),
+            ForceKind::Motor3(m) => m.value.scratch_len(),
             ForceKind::SpatialLoad(l) => l.scratch_len(),
             _ => 0,
         }
@@ -327,6 +337,7 @@ impl Force {
             ForceKind::Load(l) => l.add_to(bodies, t, q, qd, scratch, qvec),
             ForceKind::SpatialLoad(l) => l.add_to(bodies, t, q, qd, scratch, qvec),
             ForceKind::Motor(m) => m.add_to(bodies, t, q, qd, scratch, qvec),
+            ForceKind::Motor3(m) => m.add_to(bodies, t, q, qd, scratch, turn, qvec),
             ForceKind::RotationalSpringDamper(r) => r.add_to(bodies, q, qd, qvec),
             ForceKind::Bushing(b) => b.add_to(bodies, q, qd, qvec),
             ForceKind::RevoluteClearance(c) => c.add_to(bodies, q, qd, qvec),
@@ -349,7 +360,7 @@ impl Force {
                 let ldot = (d[0] * (sa.v[0] - sb.v[0]) + d[1] * (sa.v[1] - sb.v[1])) / l;
                 0.5 * stiffness * ldot * ldot
             }
-            ForceKind::PointForce { .. } | ForceKind::Torque { .. } | ForceKind::Load(_) | ForceKind::SpatialLoad(_) | ForceKind::Motor(_) | ForceKind::JointFriction(_) => 0.0,
+            ForceKind::PointForce { .. } | ForceKind::Torque { .. } | ForceKind::Load(_) | ForceKind::SpatialLoad(_) | ForceKind::Motor(_) | ForceKind::Motor3(_) | ForceKind::JointFriction(_) => 0.0,
             ForceKind::Spatial(f) => f.material_energy(bodies, q, v),
             ForceKind::RotationalSpringDamper(r) => r.material_energy(bodies, q, v),
             ForceKind::Bushing(b) => b.material_energy(bodies, q, v),
@@ -385,7 +396,7 @@ impl Force {
             // is input, not stored (sensors: `external_work`)
             ForceKind::Load(l) => l.potential(bodies, q).unwrap_or(0.0),
             ForceKind::SpatialLoad(l) => l.potential(bodies, q).unwrap_or(0.0),
-            ForceKind::Motor(_) | ForceKind::JointFriction(_) => 0.0,
+            ForceKind::Motor(_) | ForceKind::Motor3(_) | ForceKind::JointFriction(_) => 0.0,
         }
     }
 }

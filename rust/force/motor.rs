@@ -40,7 +40,7 @@ pub fn relative(bodies: &[Body], a: &Marker, b: &Marker, q: &[f64], qd: &[f64]) 
 
 impl Motor {
     pub fn from_desc(ctx: &BuildContext, item: &str, a: &MarkerDesc, b: Option<&MarkerDesc>, torque: &LoadValueDesc, rotor_inertia: f64) -> Result<Motor> {
-        let scope = Scope { coordinate_names: ctx.coordinate_names, local: &LOCAL, ctx: Some(ctx) };
+        let scope = Scope { coordinate_names: ctx.coordinate_names, local: &LOCAL, ctx: Some(ctx), spatial: None };
         Ok(Motor {
             a: ctx.oriented_marker(item, a)?,
             b: frame_or_ground(ctx, item, b)?,

@@ -7,6 +7,7 @@
 
 use super::spatial::{add_torque, world_force};
 use super::value::{Env, Scope, Value};
+use super::value3::Spatial;
 use crate::body::marker3::{add_jacobian, Marker3};
 use crate::body::{Body, Marker};
 use crate::description::spatial::FrameDesc;
@@ -22,25 +23,26 @@ pub enum SpatialLoad {
 }
 
 /// The three values of a vector's components (`what`: `force`, `torque`); a wrong count is named.
-fn values(item: &str, what: &str, coordinate_names: &[String], d: &[LoadValueDesc]) -> Result<[Value; 3]> {
+fn values(item: &str, what: &str, coordinate_names: &[String], spatial: Spatial, d: &[LoadValueDesc]) -> Result<[Value; 3]> {
     if d.len() != 3 {
         return Err(Error::invalid(item, format!("{what} must have 3 components, got {}", d.len())));
     }
-    // the spatial values read `t` and the coordinates (and rates) by name; no point quantities
-    let scope = Scope { coordinate_names, local: &[], ctx: None };
+    // the spatial values read `t`, the coordinates (and rates) by name and the spatial point
+    // quantities (`value3.rs`)
+    let scope = Scope { coordinate_names, local: &[], ctx: None, spatial: Some(spatial) };
     let names = ["x", "y", "z"];
     let v = |c: usize| Value::new(item, &format!("{what}[{c}] ({})", names[c]), &scope, &d[c]);
     Ok([v(0)?, v(1)?, v(2)?])
 }
 
 impl SpatialLoad {
-    pub fn force(item: &str, coordinate_names: &[String], point: Marker3, d: &[LoadValueDesc], frame: FrameDesc) -> Result<SpatialLoad> {
-        Ok(SpatialLoad::Force { f: values(item, "force", coordinate_names, d)?, point, frame })
+    pub fn force(item: &str, coordinate_names: &[String], spatial: Spatial, point: Marker3, d: &[LoadValueDesc], frame: FrameDesc) -> Result<SpatialLoad> {
+        Ok(SpatialLoad::Force { f: values(item, "force", coordinate_names, spatial, d)?, point, frame })
     }
 
-    pub fn torque(item: &str, coordinate_names: &[String], body: usize, d: &[LoadValueDesc], frame: FrameDesc) -> Result<SpatialLoad> {
+    pub fn torque(item: &str, coordinate_names: &[String], spatial: Spatial, body: usize, d: &[LoadValueDesc], frame: FrameDesc) -> Result<SpatialLoad> {
         let base = Marker { body: Some(body), angle: 0.0, shape: crate::body::MarkerShape::Spatial };
-        Ok(SpatialLoad::Torque { tau: values(item, "torque", coordinate_names, d)?, body, base, frame })
+        Ok(SpatialLoad::Torque { tau: values(item, "torque", coordinate_names, spatial, d)?, body, base, frame })
     }
 
     pub fn marker(&self) -> &Marker {
@@ -89,7 +91,7 @@ impl SpatialLoad {
     /// scratch rows.
     pub fn add_stiffness(&self, env: &Env, scratch: &mut [f64], p: &mut [f64], r: &mut [f64], add: &mut dyn FnMut(usize, usize, f64)) {
         let (bodies, q) = (env.bodies, env.q);
-        for (c, v) in self.values().iter().enumerate().filter(|(_, v)| v.has_gradient() && !v.coords().is_empty()) {
+        for (c, v) in self.values().iter().enumerate().filter(|(_, v)| v.reads_positions()) {
             r.fill(0.0);
             v.add_position_gradient(env, scratch, r);
             p.fill(0.0);
@@ -124,8 +126,9 @@ impl SpatialLoad {
         matches!(self, SpatialLoad::Force { frame: FrameDesc::World, .. }) && self.values().iter().all(Value::is_const)
     }
 
-    /// Whether `add_stiffness` adds anything: a component whose gradient reads coordinates.
+    /// Whether `add_stiffness` adds anything: a component whose gradient reads coordinates or
+    /// points.
     pub fn has_stiffness(&self) -> bool {
-        self.values().iter().any(|v| v.has_gradient() && !v.coords().is_empty())
+        self.values().iter().any(Value::reads_positions)
     }
 }

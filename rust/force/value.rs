@@ -12,6 +12,8 @@
 
 use std::sync::Arc;
 
+use super::value3::Spatial;
+use crate::body::marker3::{add_jacobian, Marker3};
 use crate::body::{Body, Marker};
 use crate::constraint::BuildContext;
 use crate::description::{CallableDesc, LoadValueDesc, MarkerDesc, TableDesc};
@@ -32,6 +34,9 @@ pub enum Input {
     /// Component `axis` (0: x, 1: y) of the position (`rate`: velocity) of the value's point
     /// `k` (`Expr::points`).
     Point { k: usize, axis: usize, rate: bool },
+    /// Component `axis` (0: x, 1: y, 2: z) of the position (`rate`: velocity) of the value's
+    /// spatial point `k` (`Expr::points3`, `value3.rs`).
+    Point3 { k: usize, axis: usize, rate: bool },
 }
 
 /// The state a value is evaluated at.
@@ -46,7 +51,7 @@ pub struct Env<'a> {
 
 impl Env<'_> {
     #[inline]
-    fn get(&self, i: Input, points: &[Marker]) -> f64 {
+    fn get(&self, i: Input, points: &[Marker], points3: &[Marker3]) -> f64 {
         match i {
             Input::Time => self.t,
             Input::Coord(k) => self.q[k],
@@ -55,6 +60,10 @@ impl Env<'_> {
             Input::Point { k, axis, rate } => {
                 let s = points[k].state(self.bodies, self.q, self.qd);
                 if rate { s.v[axis] } else { s.r[axis] }
+            }
+            Input::Point3 { k, axis, rate } => {
+                let s = points3[k].state_axes(self.bodies, self.q, self.qd, 0).point;
+                if rate { s.vd[axis] } else { s.v[axis] }
             }
         }
     }
@@ -67,43 +76,51 @@ pub struct Scope<'a> {
     pub local: &'a [&'static str],
     /// Where point quantities are resolved (`None`: not available).
     pub ctx: Option<&'a BuildContext<'a>>,
+    /// Where the spatial point quantities `x(BODY)`, `z(BODY, [sx, sy, sz])` are resolved
+    /// (`value3.rs`; `None`: a planar scene).
+    pub spatial: Option<Spatial<'a>>,
 }
 
 /// A point quantity `x(BODY, XI)` / `y(...)` (optionally `d:`), parsed from the start of `s`:
 /// `(axis, rate, body, xi, length of the text)`.
 fn point_quantity(s: &str) -> Option<(usize, bool, String, f64, usize)> {
-    let (rate, rest) = match s.strip_prefix("d:") {
-        Some(r) => (true, r),
-        None => (false, s),
-    };
-    let axis = match rest.as_bytes().first()? {
-        b'x' => 0,
-        b'y' => 1,
-        _ => return None,
-    };
-    let inner = rest[1..].trim_start().strip_prefix('(')?;
-    let close = inner.find(')')?;
-    let (body, xi) = inner[..close].split_once(',')?;
+    let (axis, rate, args, consumed) = super::value3::point_call(s, b"xy")?;
+    let (body, xi) = args.split_once(',')?;
     let (body, xi) = (body.trim(), xi.trim().parse::<f64>().ok()?);
     if body.is_empty() || !body.chars().all(|c| c.is_alphanumeric() || "_.:-".contains(c)) {
         return None;
     }
-    let consumed = (s.len() - inner.len()) + close + 1;
     Some((axis, rate, body.to_string(), xi, consumed))
 }
+
+/// An expression's text with its point quantities replaced: the text, the placeholders with
+/// their inputs, the planar and the spatial points' markers.
+type Substituted = (String, Vec<(String, Input)>, Vec<Marker>, Vec<Marker3>);
 
 impl Scope<'_> {
     /// `text` with each point quantity replaced by a placeholder variable of the same length
     /// (`_p0_____`), and the points' markers with their inputs, by placeholder.
-    fn substitute_points(&self, item: &str, text: &str) -> Result<(String, Vec<(String, Input)>, Vec<Marker>)> {
+    fn substitute_points(&self, item: &str, text: &str) -> Result<Substituted> {
         let mut out = String::with_capacity(text.len());
         let (mut found, mut markers): (Vec<(String, Input)>, Vec<Marker>) = (Vec::new(), Vec::new());
+        let mut markers3: Vec<Marker3> = Vec::new();
         let mut i = 0;
         let bytes = text.as_bytes();
         while i < text.len() {
             // a quantity starts where a name could (not inside one)
             let boundary = i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_' || bytes[i - 1] == b'.' || bytes[i - 1] == b':');
-            if boundary {
+            if let (true, Some(sp)) = (boundary, self.spatial) {
+                if let Some((axis, rate, body, point, len)) = super::value3::point_quantity(&text[i..]) {
+                    let placeholder = format!("_p{}", found.len());
+                    if placeholder.len() <= len {
+                        markers3.push(super::value3::marker(item, sp, &body, point)?);
+                        found.push((format!("{placeholder:_<len$}"), Input::Point3 { k: markers3.len() - 1, axis, rate }));
+                        out.push_str(&found.last().expect("just pushed").0);
+                        i += len;
+                        continue;
+                    }
+                }
+            } else if boundary {
                 if let Some((axis, rate, body, xi, len)) = point_quantity(&text[i..]) {
                     let placeholder = format!("_p{}", found.len());
                     if let (Some(ctx), true) = (self.ctx, placeholder.len() <= len) {
@@ -122,7 +139,7 @@ impl Scope<'_> {
             out.push(c);
             i += c.len_utf8();
         }
-        Ok((out, found, markers))
+        Ok((out, found, markers, markers3))
     }
 
     fn resolve(&self, name: &str) -> Option<Input> {
@@ -151,6 +168,9 @@ impl Scope<'_> {
         if self.ctx.is_some() {
             s += ", x(BODY, XI), y(BODY, XI) or their rates d:x(...)";
         }
+        if self.spatial.is_some() {
+            s += super::value3::HELP;
+        }
         for l in self.local {
             s += &format!(", {l}");
         }
@@ -164,6 +184,8 @@ pub struct Expr {
     inputs: Vec<Input>,
     /// The markers of the point quantities it reads.
     points: Vec<Marker>,
+    /// The markers of the spatial point quantities it reads.
+    points3: Vec<Marker3>,
 }
 
 /// The natural cubic spline of `constraint::motion` (a driver's tabulated motion) through
@@ -256,7 +278,7 @@ impl Value {
                 Ok(Value::Const(*v))
             }
             LoadValueDesc::Expression(text) => {
-                let (parsed, points, markers) = scope.substitute_points(item, text)?;
+                let (parsed, points, markers, markers3) = scope.substitute_points(item, text)?;
                 let mut names: Vec<String> = vec!["t".into()];
                 names.extend(scope.local.iter().map(|s| s.to_string()));
                 names.extend(scope.coordinate_names.iter().cloned());
@@ -271,7 +293,7 @@ impl Value {
                     .iter()
                     .map(|v| points.iter().find(|(p, _)| p == v).map(|(_, i)| *i).or_else(|| scope.resolve(v)).expect("a candidate name"))
                     .collect();
-                Ok(Value::Expr(Box::new(Expr { f, inputs, points: markers })))
+                Ok(Value::Expr(Box::new(Expr { f, inputs, points: markers, points3: markers3 })))
             }
             LoadValueDesc::Table(t) => Ok(Value::Table(Box::new(Table::new(item, scope, t)?))),
             LoadValueDesc::Callable(c) => Ok(Value::Callable(Box::new(Callable::new(item, scope, c)?))),
@@ -296,16 +318,26 @@ impl Value {
     /// `row += dF/dq` (row spans `q`) through the positions the value reads (coordinates and
     /// points), from the expression's symbolic gradient or the table's slope; returns
     /// `dF/d local` (the element's own quantities: a motor adds `dF/d angle` itself). The rates'
-    /// derivatives are not here (the velocity Jacobian differences them exactly).
+    /// derivatives are not here (the velocity Jacobian differences them exactly), but for a
+    /// spatial point's velocity, which changes with the positions as well (`value3::rate_kin`;
+    /// a planar point's `d:x(BODY, XI)` does too, and that is left out).
     pub fn add_position_gradient(&self, env: &Env, scratch: &mut [f64], row: &mut [f64]) -> [f64; 2] {
         let mut local = [0.0; 2];
-        let mut put = |i: Input, g: f64, points: &[Marker], row: &mut [f64]| match i {
+        let mut put = |i: Input, g: f64, points: &[Marker], points3: &[Marker3], row: &mut [f64]| match i {
             Input::Coord(j) => row[j] += g,
             Input::Point { k, axis, rate: false } => {
                 let s = points[k].state(env.bodies, env.q, env.qd);
                 let mut w = [0.0; 2];
                 w[axis] = g;
                 points[k].add_point_jacobian(env.bodies, &s, w, row);
+            }
+            Input::Point3 { k, axis, rate } => {
+                let s = points3[k].state_axes(env.bodies, env.q, env.qd, 0);
+                let mut w = [0.0; 3];
+                w[axis] = g;
+                // a velocity changes with the positions too (`value3::rate_kin`)
+                let kin = if rate { super::value3::rate_kin(&points3[k], env.bodies, env.qd, &points3[k].s) } else { s.point };
+                add_jacobian(env.bodies, &s, &kin, &w, row, None);
             }
             Input::Local(k) => local[k] += g,
             _ => {}
@@ -316,20 +348,26 @@ impl Value {
                 let (x, rest) = scratch.split_at_mut(k);
                 let (grad, buf) = rest.split_at_mut(k);
                 for (xi, &i) in x.iter_mut().zip(&e.inputs) {
-                    *xi = env.get(i, &e.points);
+                    *xi = env.get(i, &e.points, &e.points3);
                 }
                 e.f.eval_gradient(x, buf, grad);
                 for (&i, &g) in e.inputs.iter().zip(grad.iter()) {
-                    put(i, g, &e.points, row);
+                    put(i, g, &e.points, &e.points3, row);
                 }
             }
             Value::Table(t) => {
-                let (_, slope) = t.eval(env.get(t.input, &[]));
-                put(t.input, slope, &[], row);
+                let (_, slope) = t.eval(env.get(t.input, &[], &[]));
+                put(t.input, slope, &[], &[], row);
             }
             _ => {}
         }
         local
+    }
+
+    /// Whether the value has a gradient and reads coordinates (or their rates) or points: the
+    /// spatial loads' `add_stiffness` has something to add (a value of `t` alone adds nothing).
+    pub fn reads_positions(&self) -> bool {
+        self.has_gradient() && !(self.coords().is_empty() && self.points().is_empty())
     }
 
     /// The coordinates (positions or rates) the value reads.
@@ -346,11 +384,11 @@ impl Value {
         }
     }
 
-    /// The markers of the point quantities the value reads.
-    pub fn points(&self) -> &[Marker] {
+    /// The markers of the point quantities the value reads (a spatial point's: its `base`).
+    pub fn points(&self) -> Vec<&Marker> {
         match self {
-            Value::Expr(e) => &e.points,
-            _ => &[],
+            Value::Expr(e) => e.points.iter().chain(e.points3.iter().map(|m| &m.base)).collect(),
+            _ => Vec::new(),
         }
     }
 
@@ -367,15 +405,15 @@ impl Value {
             Value::Expr(e) => {
                 let (x, buf) = scratch.split_at_mut(e.inputs.len());
                 for (xi, &i) in x.iter_mut().zip(&e.inputs) {
-                    *xi = env.get(i, &e.points);
+                    *xi = env.get(i, &e.points, &e.points3);
                 }
                 e.f.eval(x, buf)
             }
-            Value::Table(tb) => tb.eval(env.get(tb.input, &[])).0,
+            Value::Table(tb) => tb.eval(env.get(tb.input, &[], &[])).0,
             Value::Callable(c) => {
                 let x = &mut scratch[..c.inputs.len()];
                 for (xi, &i) in x.iter_mut().zip(&c.inputs) {
-                    *xi = env.get(i, &[]);
+                    *xi = env.get(i, &[], &[]);
                 }
                 c.f.as_ref().map_or(f64::NAN, |f| f.call(env.t, x))
             }
@@ -400,7 +438,7 @@ mod tests {
     #[test]
     fn spline_reproduces_cubic_data_and_slopes() {
         // a natural spline through a straight line is that line; through a parabola it is close
-        let scope = Scope { coordinate_names: &["a.x".to_string()], local: &[], ctx: None };
+        let scope = Scope { coordinate_names: &["a.x".to_string()], local: &[], ctx: None, spatial: None };
         let d = TableDesc { of: "a.x".into(), x: vec![0.0, 1.0, 2.5, 4.0], y: vec![1.0, 3.0, 6.0, 9.0], period: None };
         let t = Table::new("t", &scope, &d).unwrap();
         for s in [0.3, 1.7, 3.9] {
@@ -421,7 +459,7 @@ mod tests {
     #[test]
     fn unknown_quantity_is_named() {
         let names = ["crank.theta".to_string()];
-        let scope = Scope { coordinate_names: &names, local: &["w"], ctx: None };
+        let scope = Scope { coordinate_names: &names, local: &["w"], ctx: None, spatial: None };
         let v = Value::new("force 'f'", "torque", &scope, &LoadValueDesc::Expression("2*w + sin(crank.theta) + d:crank.theta".into())).unwrap();
         let env = Env { bodies: &[], t: 0.0, q: &[0.5], qd: &[3.0], local: [7.0, 0.0] };
         let mut s = vec![0.0; v.scratch_len()];

@@ -25,7 +25,9 @@ use crate::force::{Force, ForceKind};
 use crate::model::{assign_rows, item_name, parse_item, parse_json, take_name, Model, Section};
 use crate::description::spatial::{Body3Desc, Driver3Desc, Force3Desc, Joint3Desc, Marker3Desc};
 use crate::force::spatial::{marker_point, SpatialForce};
+use crate::force::motor3::Motor3;
 use crate::force::spatial_load::SpatialLoad;
+use crate::force::value3::Spatial;
 use crate::linalg::rot3::{norm, sub};
 
 /// Planar body kinds (refused in a spatial scene) and spatial ones (refused in a planar one).
@@ -201,8 +203,8 @@ impl Builder {
 
     fn force(&self, item: &str, d: &Force3Desc) -> Result<ForceKind> {
         Ok(ForceKind::Spatial(match d {
-            Force3Desc::PointLoad(f) => return Ok(ForceKind::SpatialLoad(Box::new(SpatialLoad::force(item, &self.names, self.marker(item, &f.point)?, &f.force, f.frame)?))),
-            Force3Desc::TorqueLoad(t) => return Ok(ForceKind::SpatialLoad(Box::new(SpatialLoad::torque(item, &self.names, self.rigid3(item, &t.body, "torque")?, &t.torque, t.frame)?))),
+            Force3Desc::PointLoad(f) => return Ok(ForceKind::SpatialLoad(Box::new(SpatialLoad::force(item, &self.names, self.spatial(), self.marker(item, &f.point)?, &f.force, f.frame)?))),
+            Force3Desc::TorqueLoad(t) => return Ok(ForceKind::SpatialLoad(Box::new(SpatialLoad::torque(item, &self.names, self.spatial(), self.rigid3(item, &t.body, "torque")?, &t.torque, t.frame)?))),
             Force3Desc::PointForce(f) => {
                 check_finite_item(item, "force", &f.force)?;
                 SpatialForce::PointForce { point: self.marker(item, &f.point)?, force: f.force, frame: f.frame }
@@ -237,9 +239,14 @@ impl Builder {
                     angle0: s.angle0,
                 }
             }
-            // built from its joint's rows with the joints (`force::friction3::from_desc`)
-            Force3Desc::JointFriction(_) => return Err(Error::invalid(item, "joint friction is built from its joint (JointFriction::from_desc3)")),
+            // built from its joint with the joints (`force::friction3::from_desc`, `Motor3::from_desc`)
+            Force3Desc::JointFriction(_) | Force3Desc::Motor(_) => return Err(Error::invalid(item, "joint friction and motors are built from their joint (JointFriction::from_desc3, Motor3::from_desc)")),
         }))
+    }
+
+    /// Where the loads' spatial point quantities are resolved (`force/value3.rs`).
+    fn spatial(&self) -> Spatial<'_> {
+        Spatial { bodies: &self.bodies, index: &self.index }
     }
 
     /// The rigid3 body `name` a torque acts on (an unknown body, or one without orientation,
@@ -314,6 +321,11 @@ pub fn build(text: &str) -> Result<Model> {
         let item = item_name(Section::Force, d.kind(), d.name(), i);
         let kind = match &d {
             Force3Desc::JointFriction(f) => ForceKind::JointFriction(Box::new(crate::force::friction::JointFriction::from_desc3(&item, &constraints, f)?)),
+            Force3Desc::Motor(m) => {
+                let motor = Motor3::from_desc(&item, &b.names, b.spatial(), &constraints, m)?;
+                motor.add_rotor_inertia(&item, &mut b.bodies)?;
+                ForceKind::Motor3(Box::new(motor))
+            }
             _ => b.force(&item, &d)?,
         };
         let name = b.take_name(&item, d.name(), format!("{}{i}", d.kind()))?;

@@ -153,7 +153,7 @@ pub fn clearance_into(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64]) {
 pub fn works_by_power(f: &crate::force::Force) -> bool {
     use crate::force::ForceKind;
     match &f.kind {
-        ForceKind::Motor(_) => true,
+        ForceKind::Motor(_) | ForceKind::Motor3(_) => true,
         ForceKind::Load(l) => !l.is_constant(),
         ForceKind::SpatialLoad(l) => !l.has_potential(),
         _ => false,
@@ -170,9 +170,9 @@ pub fn load_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64],
 #[allow(clippy::too_many_arguments)]
 fn forces_power(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], w: &[f64], g: &mut [f64], pick: fn(&crate::force::Force) -> bool) -> f64 {
     g.fill(0.0);
-    let mut no_turn = f64::NAN; // loads, motors and contacts count no turns
-    for f in model.forces.iter().filter(|f| pick(f)) {
-        f.add_to(&model.bodies, t, q, qd, &mut data.load_scratch, &mut no_turn, g);
+    // a spatial motor reads its angle counted at the last `mass_and_forces` (not updated here)
+    for (f, turn) in model.forces.iter().zip(&data.turns).filter(|(f, _)| pick(f)) {
+        f.add_to(&model.bodies, t, q, qd, &mut data.load_scratch, &mut turn.clone(), g);
     }
     w.iter().zip(g.iter()).map(|(a, b)| a * b).sum()
 }

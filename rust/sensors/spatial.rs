@@ -195,11 +195,12 @@ pub fn driver_values(model: &Model, t: f64, q: &[f64], scratch: &mut [f64]) -> V
 /// (`model.forces.len()`): a load's work rate (a torque or a body-frame force has no potential
 /// in general, so its work is the integral of this), a spring-damper's `-(k x + c xd) xd`.
 /// `turns`: the workspace's counted spring angles at this state (`Data::turns`, read only);
-/// `scratch`: n numbers. (Spatial force elements read no load expressions: no load scratch.)
+/// `scratch`: n numbers (the loads' and motors' values evaluate in a scratch of their own).
 pub fn force_powers(model: &Model, turns: &[f64], t: f64, q: &[f64], qd: &[f64], scratch: &mut [f64], out: &mut [f64]) {
+    let mut values = vec![0.0; model.forces.iter().map(|f| f.scratch_len()).max().unwrap_or(0)];
     for ((f, o), turn) in model.forces.iter().zip(out.iter_mut()).zip(turns) {
         scratch.fill(0.0);
-        f.add_to(&model.bodies, t, q, qd, &mut [], &mut turn.clone(), scratch);
+        f.add_to(&model.bodies, t, q, qd, &mut values, &mut turn.clone(), scratch);
         *o = dot_n(scratch, qd);
     }
 }

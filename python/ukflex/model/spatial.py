@@ -357,22 +357,41 @@ class SpatialScene:
             raise InvalidSceneError(f"{what} must have 3 components (numbers, expressions, tables or callables), got {values!r}")
         if len(values) != 3:
             raise InvalidSceneError(f"{what} must have 3 components, got {len(values)}")
-        out: List[Any] = []
-        for v in values:
-            if hasattr(v, "to_dict"):
-                out.append(v.to_dict())
-            elif callable(v):
-                self._callables = getattr(self, "_callables", {})
-                name = f"callable{len(self._callables)}"
-                self._callables[name] = v
-                out.append({"callable": name, "inputs": [str(i) for i in inputs]})
-            elif isinstance(v, str):
-                out.append(v)
-            else:
-                out.append(float(v))
+        out = [self._value(v, inputs) for v in values]
         if inputs and not any(isinstance(v, dict) and "callable" in v for v in out):
             raise InvalidArgumentError("inputs", "name the state quantities of a Python callable only (an expression or a table names its own)")
         return out
+
+    def _value(self, v: Any, inputs: Sequence[str]) -> Any:
+        """One load value as the description holds it (a table's dict, a callable's reference)."""
+        if hasattr(v, "to_dict"):
+            return v.to_dict()
+        if callable(v):
+            self._callables = getattr(self, "_callables", {})
+            name = f"callable{len(self._callables)}"
+            self._callables[name] = v
+            return {"callable": name, "inputs": [str(i) for i in inputs]}
+        if isinstance(v, str):
+            return v
+        return float(v)
+
+    def motor(self, joint: str, torque: Any, rotor_inertia: float = 0.0, name: Optional[str] = None, *,
+              inputs: Sequence[str] = ()) -> str:
+        """A motor on the revolute, cylindrical or prismatic joint named ``joint`` (added
+        before): on a revolute or cylindrical joint a torque ``tau`` about its axis, on the body
+        of the joint's marker ``a`` (the rotor) and ``-tau`` on ``b``'s (the stator); on a
+        prismatic joint a force along its axis (a linear motor). ``torque`` is a load value as
+        :meth:`point_load`'s components: a number, an expression that may read ``angle`` and
+        ``w`` (the relative angle about the axis, counted over turns, and its rate; on a
+        prismatic joint ``s`` and ``v``, the slide and its rate) besides ``t``, the coordinates
+        and the point quantities (``ukflex.model.scene.dc_motor_torque`` writes a DC motor's),
+        a :class:`ukflex.LoadTable`, or a callable of ``inputs``. ``rotor_inertia`` [kg m^2]
+        about the axis is added to the inertia tensor of ``a``'s body (a rigid3 body;
+        docs/loads.md, "Motors in 3D")."""
+        value = self._value(torque, inputs)
+        if inputs and not (isinstance(value, dict) and "callable" in value):
+            raise InvalidArgumentError("inputs", "name the state quantities of a Python callable only (an expression or a table names its own)")
+        return self._force({"kind": "motor", "joint": joint, "torque": value, "rotor_inertia": float(rotor_inertia)}, name)
 
     def spring_damper(self, a: SpatialMarker, b: SpatialMarker, stiffness: float, damping: float = 0.0,
                       rest_length: Optional[float] = None, name: Optional[str] = None) -> str:

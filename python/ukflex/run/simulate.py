@@ -773,6 +773,9 @@ def _simulate_scipy(system, method, t0, tf, y0, rtol, atol, t_eval, options, bud
     n = system.n_coords
     rhs = system.rhs
     nfev = [0]
+    restart = getattr(getattr(system, "core", None), "restart_turns", None)
+    if restart is not None:  # the spatial angles are counted from this run's start (not a NumPy reference)
+        restart()
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
         nfev[0] += 1

@@ -18,6 +18,17 @@ use crate::sensors::spatial as outputs;
 
 #[pymethods]
 impl PySystem {
+    /// Start the turn counts of the spatial rotational spring-dampers and motors afresh
+    /// (`Data::turns`: the next evaluation reads each angle within half a turn of its rest
+    /// angle): a run through `rhs` (scipy's methods) calls it at its start, as a native run
+    /// starts from a fresh workspace.
+    fn restart_turns(&self) -> PyResult<()> {
+        self.with_ws(|_, ws| {
+            ws.data.turns.fill(f64::NAN);
+            Ok::<(), Error>(())
+        })
+    }
+
     /// Spatial outputs at the states `(t, q, qd)` (`t` (nt,), q, qd (nt, n)) of a `"dim": 3`
     /// model: `bodies` (nt, n_bodies, 25: centre of mass, its velocity, unit quaternion, angular
     /// velocity world and body, rotation matrix rows), `body_columns`, `body_names`;
@@ -111,7 +122,18 @@ impl PySystem {
         d.set_item("potential_energy", PyArray1::from_vec(py, pe))?;
         d.set_item("body_energies", PyArray1::from_vec(py, be).reshape([nt, nb, 3])?)?;
         d.set_item("force_names", self.model.forces.iter().map(|f| f.name.clone()).collect::<Vec<_>>())?;
-        let kinds: Vec<&str> = self.model.forces.iter().map(|f| if let ForceKind::Spatial(sf) = &f.kind { sf.kind() } else { "planar" }).collect();
+        let kinds: Vec<&str> = self
+            .model
+            .forces
+            .iter()
+            .map(|f| match &f.kind {
+                ForceKind::Spatial(sf) => sf.kind(),
+                ForceKind::Motor3(_) => "motor",
+                ForceKind::SpatialLoad(_) => "load",
+                ForceKind::JointFriction(_) => "joint_friction",
+                _ => "planar",
+            })
+            .collect();
         d.set_item("force_kinds", kinds)?;
         d.set_item("force_potentials", mat(py, fp, nt, nf)?)?;
         d.set_item("force_powers", mat(py, fw, nt, nf)?)?;
