@@ -107,7 +107,7 @@ def _cmd_geometric(args: argparse.Namespace) -> int:
 #: ``main`` hands them their arguments before parsing (an ``argparse.REMAINDER`` does not take
 #: arguments that start with ``-``, so ``flexible-coupler --nonlinear`` was refused).
 _PASSTHROUGH = {"flexible-coupler": "flexible_coupler", "simeon-crank": "simeon_crank", "sweeps": "sweeps",
-                "clearance": "clearance", "engine": "engine"}
+                "clearance": "clearance", "engine": "engine", "spatial-flexible-crank": "spatial_flexible_crank"}
 
 
 def _passthrough(sub, name: str, module: str, help: str) -> None:

@@ -200,7 +200,15 @@ def main(argv: Optional[List[str]] = None) -> int:
     crank speed; ukflex against Exudyn, error against wall time (medians of 3 interleaved
     repetitions). ``--quick``: fewer meshes, no speed table, one repetition."""
     global OMEGA
-    quick = bool(argv and "--quick" in argv)
+    args = list(argv or [])
+    if "-h" in args or "--help" in args:
+        print(__doc__)
+        return 0
+    unknown = [a for a in args if a != "--quick"]
+    if unknown:
+        print(f"python -m studies spatial-flexible-crank: unknown arguments {unknown} (options: --quick)", file=sys.stderr)
+        return 2
+    quick = "--quick" in args
     reps = 1 if quick else 3
     t = times()
     _log("ukflex beam3 32 elements, RADAU5 rtol 1e-9 (the reference)")
