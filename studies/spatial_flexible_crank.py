@@ -92,9 +92,67 @@ def _section() -> Dict[str, float]:
     return {"EA": e * a * a, "kGA": k * g * a * a, "GJ": g * j, "EI": e * i, "rhoA": rho * a * a, "rhoI": rho * i}
 
 
-def exudyn_run(t: np.ndarray, steps: int, elements: int = 8, spectral_radius: float = 1.0) -> Tuple[Dict[str, np.ndarray], float]:
+def _exudyn_beam(mbs: Any, elements: int, B: np.ndarray, Rr: np.ndarray) -> Tuple[int, int, List[int]]:
+    """The rod as ``elements`` ``ObjectBeamGeometricallyExact`` on ``NodeRigidBodyEP`` nodes:
+    the markers of its two ends (position, rigid) and the position sensors of its ends and
+    middle node."""
+    import exudyn as exu
+    from exudyn.itemInterface import MarkerNodePosition, MarkerNodeRigid, NodeRigidBodyEP, ObjectBeamGeometricallyExact, SensorNode
+    from exudyn.rigidBodyUtilities import RotationMatrix2EulerParameters
+
+    sec = _section()
+    ep = list(RotationMatrix2EulerParameters(Rr))
+    le = ROD / elements
+    nodes = [mbs.AddNode(NodeRigidBodyEP(referenceCoordinates=list(B + k * le * Rr[:, 0]) + ep)) for k in range(elements + 1)]
+    bs = exu.BeamSection()
+    bs.stiffnessMatrix = np.diag([sec["EA"], sec["kGA"], sec["kGA"], sec["GJ"], sec["EI"], sec["EI"]])
+    bs.massPerLength = sec["rhoA"]
+    bs.inertia = np.diag([2 * sec["rhoI"], sec["rhoI"], sec["rhoI"]])
+    for n0, n1 in zip(nodes[:-1], nodes[1:]):
+        mbs.AddObject(ObjectBeamGeometricallyExact(nodeNumbers=[n0, n1], physicsLength=le, sectionData=bs))
+    sensors = [mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=exu.OutputVariableType.Position, storeInternal=True))
+               for n in (nodes[0], nodes[elements // 2], nodes[-1])]
+    return mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[0])), mbs.AddMarker(MarkerNodeRigid(nodeNumber=nodes[-1])), sensors
+
+
+def _exudyn_modal(mbs: Any, data: Any, mesh: Tuple[int, int, int], B: np.ndarray, Rr: np.ndarray) -> Tuple[int, int, List[int]]:
+    """The rod as Exudyn's ``ObjectFFRFreducedOrder`` on the same FE model and mode basis as
+    ``data`` (``FEMinterface``; Exudyn computes its own invariants): the face ``A``'s centroid
+    (``MarkerSuperElementPosition``), the face ``B`` (``MarkerSuperElementRigid``, its own
+    weighted rotation) and the position sensors of the two faces and the mid-length section."""
+    import exudyn as exu
+    import scipy.sparse as sp
+    from exudyn.FEM import FEMinterface, ObjectFFRFreducedOrderInterface
+    from exudyn.itemInterface import MarkerSuperElementPosition, MarkerSuperElementRigid, SensorMarker
+    from ukflex import fe3
+
+    a, rho, e, nu = sps.ROD_SECTION
+    nodes, k, ms = fe3.solid_matrices(fe3.bar_mesh(ROD, a, a, mesh), density=rho, youngs_modulus=e, poisson_ratio=nu)
+    if not np.allclose(nodes, data.info["nodes"]):
+        raise ValueError("the FE model does not match the modal data's nodes")
+    fem = FEMinterface()
+    fem.nodes = {"Position": nodes}
+    fem.massMatrix = sp.kron(ms, sp.eye(3)).tocsr()
+    fem.stiffnessMatrix = k.tocsr()
+    fem.modeBasis = {"matrix": data.info["modes"], "type": "NormalModes"}
+    body = ObjectFFRFreducedOrderInterface(fem).AddObjectFFRFreducedOrder(mbs, positionRef=list(B), rotationMatrixRef=Rr)["oFFRFreducedOrder"]
+
+    def weights(idx: np.ndarray) -> Dict[str, Any]:
+        idx = [int(i) for i in idx]
+        return {"bodyNumber": body, "meshNodeNumbers": idx, "weightingFactors": [1.0 / len(idx)] * len(idx)}
+
+    face_a, face_b = np.asarray(data.interfaces["A"].nodes), np.asarray(data.interfaces["B"].nodes)
+    mid = np.nonzero(np.abs(nodes[:, 0] - 0.5 * ROD) < 1e-9 * ROD)[0]
+    pos = [mbs.AddMarker(MarkerSuperElementPosition(**weights(i))) for i in (face_a, mid, face_b)]
+    sensors = [mbs.AddSensor(SensorMarker(markerNumber=m, outputVariableType=exu.OutputVariableType.Position, storeInternal=True)) for m in pos]
+    return pos[0], mbs.AddMarker(MarkerSuperElementRigid(offset=[0.0, 0.0, 0.0], **weights(face_b))), sensors
+
+
+def exudyn_run(t: np.ndarray, steps: int, elements: int = 8, spectral_radius: float = 1.0, data: Any = None,
+               mesh: Optional[Tuple[int, int, int]] = None) -> Tuple[Dict[str, np.ndarray], float]:
     """The same slider-crank in Exudyn 1.13.6, the rod of ``elements``
-    ``ObjectBeamGeometricallyExact`` on ``NodeRigidBodyEP`` nodes; the crank a rigid body on a
+    ``ObjectBeamGeometricallyExact`` on ``NodeRigidBodyEP`` nodes (``data`` given: Exudyn's
+    ``ObjectFFRFreducedOrder`` of the same FE model, ``mesh`` its cells, and mode basis); the crank a rigid body on a
     ``NodeRigidBodyRxyz`` at the pivot, its six coordinates held by ``CoordinateConstraint`` (the
     rotation about ``x`` following the spin-up through a Python ``offsetUserFunction``); the
     spherical joint ``SphericalJoint``; the universal joint a ``GenericJoint`` with one rotation
@@ -104,15 +162,13 @@ def exudyn_run(t: np.ndarray, steps: int, elements: int = 8, spectral_radius: fl
     ``t``, interpolated) and the wall time of ``mbs.SolveDynamic``."""
     import exudyn as exu
     from exudyn.itemInterface import (CoordinateConstraint, GenericJoint, MarkerBodyPosition, MarkerBodyRigid, MarkerNodeCoordinate,
-                                      MarkerNodePosition, MarkerNodeRigid, NodePointGround, NodeRigidBodyEP, NodeRigidBodyRxyz,
-                                      ObjectBeamGeometricallyExact, ObjectGround, ObjectRigidBody, SensorNode, SphericalJoint)
-    from exudyn.rigidBodyUtilities import RotationMatrix2EulerParameters
+                                      NodePointGround, NodeRigidBodyEP, NodeRigidBodyRxyz, ObjectGround, ObjectRigidBody, SensorNode,
+                                      SphericalJoint)
 
     angle = sps.spin_up(OMEGA, SPIN_UP)
     theta = eval("lambda t: " + angle.replace("^", "**"), {"abs": abs, "cos": np.cos})  # the same expression
     A, _, B, C, Rr = sps.crank_geometry(CRANK, ROD, (0.0, 0.1, 0.12))
     mc, ms = 0.12, 0.1
-    sec = _section()
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     ground = mbs.AddObject(ObjectGround())
@@ -128,28 +184,18 @@ def exudyn_run(t: np.ndarray, steps: int, elements: int = 8, spectral_radius: fl
             mbs.AddObject(CoordinateConstraint(markerNumbers=[mg, mk], offsetUserFunction=lambda mbs, tt, item, off: float(theta(tt))))
         else:
             mbs.AddObject(CoordinateConstraint(markerNumbers=[mg, mk]))
-    # rod
-    ep = list(RotationMatrix2EulerParameters(Rr))
-    le = ROD / elements
-    nodes = [mbs.AddNode(NodeRigidBodyEP(referenceCoordinates=list(B + k * le * Rr[:, 0]) + ep)) for k in range(elements + 1)]
-    bs = exu.BeamSection()
-    bs.stiffnessMatrix = np.diag([sec["EA"], sec["kGA"], sec["kGA"], sec["GJ"], sec["EI"], sec["EI"]])
-    bs.massPerLength = sec["rhoA"]
-    bs.inertia = np.diag([2 * sec["rhoI"], sec["rhoI"], sec["rhoI"]])
-    for n0, n1 in zip(nodes[:-1], nodes[1:]):
-        mbs.AddObject(ObjectBeamGeometricallyExact(nodeNumbers=[n0, n1], physicsLength=le, sectionData=bs))
+    end_a, end_b, sensors = (_exudyn_beam(mbs, elements, B, Rr) if data is None else _exudyn_modal(mbs, data, mesh, B, Rr))
     sn = mbs.AddNode(NodeRigidBodyEP(referenceCoordinates=list(C) + [1.0, 0, 0, 0]))
     slider_b = mbs.AddObject(ObjectRigidBody(nodeNumber=sn, physicsMass=ms, physicsInertia=[1e-6, 1e-6, 1e-6, 0, 0, 0]))
     mbs.AddObject(SphericalJoint(markerNumbers=[mbs.AddMarker(MarkerBodyPosition(bodyNumber=crank_b, localPosition=[0, 0, CRANK])),
-                                                mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[0]))]))
+                                                end_a]))
     ex_, ey_, ez_ = np.eye(3)
-    mbs.AddObject(GenericJoint(markerNumbers=[mbs.AddMarker(MarkerBodyRigid(bodyNumber=slider_b)), mbs.AddMarker(MarkerNodeRigid(nodeNumber=nodes[-1]))],
+    mbs.AddObject(GenericJoint(markerNumbers=[mbs.AddMarker(MarkerBodyRigid(bodyNumber=slider_b)), end_b],
                                constrainedAxes=[1, 1, 1, 1, 0, 0], rotationMarker0=np.column_stack([ey_, ex_, -ez_]),
                                rotationMarker1=np.column_stack([ez_, ex_, ey_])))
     mbs.AddObject(GenericJoint(markerNumbers=[mbs.AddMarker(MarkerBodyRigid(bodyNumber=ground, localPosition=list(C))),
                                               mbs.AddMarker(MarkerBodyRigid(bodyNumber=slider_b))], constrainedAxes=[0, 1, 1, 1, 1, 1]))
-    sensors = [mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=exu.OutputVariableType.Position, storeInternal=True))
-               for n in (nodes[0], nodes[elements // 2], nodes[-1], sn)]
+    sensors.append(mbs.AddSensor(SensorNode(nodeNumber=sn, outputVariableType=exu.OutputVariableType.Position, storeInternal=True)))
     mbs.Assemble()
     ss = exu.SimulationSettings()
     t_end = float(t[-1])
@@ -272,7 +318,38 @@ def main(argv: Optional[List[str]] = None) -> int:
             continue
         e_s, e_d = errors(o, ref)
         print(f"| {name} | {e_s:.2e} | {e_d:.2e} | {dt:.2f} |")
+    print("\n".join(modal_table(t, reps)))
     return 0
+
+
+#: Exudyn's spectral radius for the modal rod: at 1 (no numerical damping) its answer wanders
+#: with the step count (6e-3, 1.2e-2 at 1000, 2000 steps) and 4000 steps fail
+FFRF_SPECTRAL_RADIUS = 0.8
+
+
+def modal_table(t: np.ndarray, reps: int = 3, mesh: Tuple[int, int, int] = (16, 1, 1), modes: int = 4) -> List[str]:
+    """The modal rod in ukflex (``flexible3``) and in Exudyn (``ObjectFFRFreducedOrder`` of the
+    same FE model and mode basis): errors against ukflex RADAU5 at rtol 1e-10, wall times
+    (medians of ``reps`` interleaved runs)."""
+    data = sps.slider_crank_rod_data(mesh, modes)
+    _log(f"modal rod {mesh}, {modes} modes: ukflex RADAU5 rtol 1e-10 (the reference)")
+    ref, _ = ukflex_run("modal", t, data=data, method="RADAU5", rtol=1e-10, atol=1e-12)
+    runs = [("ukflex flexible3, default simulate()", lambda: ukflex_run("modal", t, data=data)),
+            ("ukflex flexible3, RADAU5M rtol 1e-8", lambda: ukflex_run("modal", t, data=data, method="RADAU5M", rtol=1e-8))]
+    runs += [(f"Exudyn ObjectFFRFreducedOrder, {k} steps", (lambda k=k: exudyn_run(t, k, data=data, mesh=mesh, spectral_radius=FFRF_SPECTRAL_RADIUS)))
+             for k in (1000, 2000, 4000)]
+    timed: Dict[str, List[Tuple[Dict[str, np.ndarray], float]]] = {name: [] for name, _ in runs}
+    for r in range(reps):
+        for name, f in runs:
+            _log(f"repetition {r + 1}/{reps}: {name}")
+            timed[name].append(f())
+    out = [f"\nthe modal rod ({mesh} mesh, {modes} modes) in both codes (Exudyn generalized-alpha at spectral radius "
+           f"{FFRF_SPECTRAL_RADIUS}); error against ukflex RADAU5 rtol 1e-10, median of {reps} interleaved runs:\n",
+           "| run | slider error | deflection error | wall time [s] |", "|---|---:|---:|---:|"]
+    for name, _ in runs:
+        e_s, e_d = errors(timed[name][-1][0], ref)
+        out.append(f"| {name} | {e_s:.2e} | {e_d:.2e} | {float(np.median([x[1] for x in timed[name]])):.2f} |")
+    return out
 
 
 if __name__ == "__main__":

@@ -2,7 +2,8 @@
 ``studies/spatial_flexible_crank.py``): ``ukflex.spatial_scenes.flexible_slider_crank`` builds
 it with the rod as a geometrically exact beam (``beam3``) or as a 3D modal body (``flexible3``,
 Craig-Bampton); a short run of the spin-up gives the same slider motion and rod deflection with
-both (and with Exudyn's ``ObjectBeamGeometricallyExact``); bad arguments are named."""
+both, and the same as Exudyn's ``ObjectBeamGeometricallyExact`` and ``ObjectFFRFreducedOrder``;
+bad arguments are named."""
 
 from __future__ import annotations
 
@@ -69,6 +70,16 @@ def test_beam_against_exudyn_on_the_same_mesh(runs):
     # measured: 4.5e-7 and 1.8e-2 (the two codes' 8-element meshes; 4.5e-3 at 16 elements)
     assert e_s < 1e-5, e_s
     assert e_d < 0.03, e_d
+
+
+def test_modal_rod_against_exudyn_ffrf_on_the_same_fe_model(runs):
+    pytest.importorskip("exudyn")
+    ex, _ = sfc.exudyn_run(T, 300, data=sps.slider_crank_rod_data((16, 1, 1), 4), mesh=(16, 1, 1),
+                           spectral_radius=sfc.FFRF_SPECTRAL_RADIUS)
+    e_s, e_d = sfc.errors(ex, runs[1])
+    # measured: 8.0e-9 and 1.6e-4 (6.2e-4 at 150 steps, 4.0e-5 at 600: Exudyn's second order)
+    assert e_s < 1e-7, e_s
+    assert e_d < 5e-4, e_d
 
 
 @pytest.mark.parametrize("kwargs, argument", [
