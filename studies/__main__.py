@@ -16,6 +16,7 @@ or their output folder:
   python -m studies spatial-beam-pendulum
   python -m studies spatial-beam-spin-up
   python -m studies right-angle-cantilever
+  python -m studies spatial-flexible-crank [--quick]
   python -m studies sweeps --out results/sweeps [--small]
   python -m studies clearance [flores]
   python -m studies engine [--figure PNG]
@@ -106,7 +107,7 @@ def _cmd_geometric(args: argparse.Namespace) -> int:
 #: ``main`` hands them their arguments before parsing (an ``argparse.REMAINDER`` does not take
 #: arguments that start with ``-``, so ``flexible-coupler --nonlinear`` was refused).
 _PASSTHROUGH = {"flexible-coupler": "flexible_coupler", "simeon-crank": "simeon_crank", "sweeps": "sweeps",
-                "clearance": "clearance", "engine": "engine"}
+                "clearance": "clearance", "engine": "engine", "spatial-flexible-crank": "spatial_flexible_crank"}
 
 
 def _passthrough(sub, name: str, module: str, help: str) -> None:
@@ -197,6 +198,8 @@ def _build_parser() -> argparse.ArgumentParser:
     _passthrough(sub, "spatial-beam-pendulum", "spatial_beam_pendulum", "the 3D flexible pendulum: geometrically exact beam against the modal body (docs/spatial-flexible.md)")
     _passthrough(sub, "spatial-beam-spin-up", "spatial_beam_spin_up", "Kane's spin-up beam: the 3D beam against the planar ANCF cable (docs/spatial-flexible.md)")
     _passthrough(sub, "right-angle-cantilever", "right_angle_cantilever", "Simo and Vu-Quoc's right-angle cantilever: beam3 against Exudyn (docs/spatial-flexible.md)")
+    _passthrough(sub, "spatial-flexible-crank", "spatial_flexible_crank",
+                 "the spatial slider-crank with a flexible rod: beam3 against flexible3 and against Exudyn (docs/spatial-flexible.md)")
     _passthrough(sub, "sweeps", "sweeps", "the sweep study: serial, processes, Dask (docs/sweeps.md)")
     _passthrough(sub, "clearance", "clearance", "revolute joints with clearance: Flores's slider-crank, the flexible coupler (docs/loads.md)")
     _passthrough(sub, "engine", "engine", "a four-stroke engine with a flexible rod and joint friction started by a DC motor (docs/loads.md)")

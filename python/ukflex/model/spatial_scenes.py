@@ -3,9 +3,12 @@
 * :func:`flyball_governor` -- MBS benchmark A05, the stiff flyball governor (spring-damper rods,
   ``K = 8e5`` N/m, ``C = 4e4`` N s/m);
 * :func:`bricard` -- MBS benchmark A04, Bricard's over-constrained mechanism;
-* :func:`slider_crank` -- the spatial slider-crank of Haug's textbook (IFToMM library).
+* :func:`slider_crank` -- the spatial slider-crank of Haug's textbook (IFToMM library);
+* :func:`flexible_slider_crank` -- the same with a flexible connecting rod, a ``beam3`` or a
+  ``flexible3`` modal body (:func:`slider_crank_rod_data`), the crank spun up smoothly
+  (:func:`spin_up`) to a constant speed (issue 31; docs/spatial-flexible.md).
 
-Each function returns a :class:`ukflex.SpatialScene` whose initial state is consistent (so
+Each scene function returns a :class:`ukflex.SpatialScene` whose initial state is consistent (so
 ``ukflex.System(scene)`` corrects nothing); ``TRACKED`` names the point each benchmark follows
 (a body and a point in its frame) and its characteristic length. The data and where each number
 comes from: docs/spatial-design.md (section 6) and docs/spatial.md. The independent NumPy
@@ -15,15 +18,18 @@ give the same state and accelerations.
 
 from __future__ import annotations
 
+import functools
 import math
-from typing import Dict, Tuple
+from typing import Any, Dict, Sequence, Tuple
 
 import numpy as np
 
-from .scene import ConstantSpeed
+from ..arguments import count, non_negative, positive, real
+from ..errors import InvalidArgumentError
+from .scene import ConstantSpeed, Rectangular
 from .spatial import SpatialScene
 
-__all__ = ["flyball_governor", "bricard", "slider_crank", "TRACKED"]
+__all__ = ["flyball_governor", "bricard", "slider_crank", "flexible_slider_crank", "slider_crank_rod_data", "spin_up", "crank_geometry", "TRACKED"]
 
 G = 9.81
 
@@ -137,15 +143,9 @@ def slider_crank(driven: bool = False, omega: float = 6.0, crank: float = 0.08, 
     and the velocities that the joints then imply (``driven=True``: the crank is driven at
     ``omega``)."""
     s = SpatialScene(gravity=(0.0, 0.0, -gravity))
-    A = np.asarray(pivot, float)
+    A, Rc, B, C, Rr = crank_geometry(crank, rod, pivot)
     ex = np.array([1.0, 0.0, 0.0])
-    Rc = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])           # crank y along world z
-    B = A + crank * Rc[:, 1]
-    C = np.array([B[0] + math.sqrt(rod ** 2 - B[1] ** 2 - B[2] ** 2), 0.0, 0.0])
-    u = (C - B) / rod
-    yr = np.cross(u, ex)
-    yr /= np.linalg.norm(yr)
-    Rr = np.column_stack([u, yr, np.cross(u, yr)])
+    u, yr = Rr[:, 0], Rr[:, 1]
     # velocities: crank about x at omega, the slider from |C - B| = rod, the rod's spin from the
     # universal joint (d/dt (e_x . y_rod) = 0)
     wc = omega * ex
@@ -169,6 +169,124 @@ def slider_crank(driven: bool = False, omega: float = 6.0, crank: float = 0.08, 
     s.spherical(crank_b.marker(Rc.T @ (B - cc)), rod_b.marker(Rr.T @ (B - 0.5 * (B + C))), name="crank_rod")
     s.universal(slider_b.marker((0, 0, 0), z=np.cross(ex, yr), x=ex),
                 rod_b.marker(Rr.T @ (C - 0.5 * (B + C))), name="rod_slider")
+    s.prismatic(s.ground.marker((0, 0, 0), z=ex, x=(0, 1, 0)), slider_b.marker((0, 0, 0), z=ex, x=(0, 1, 0)),
+                name="slider_ground")
+    return s
+
+
+def crank_geometry(crank: float, rod: float, pivot: Sequence[float]) -> Tuple[np.ndarray, ...]:
+    """The spatial slider-crank at crank angle 0: the pivot ``A``, the crank's rotation ``Rc``
+    (its ``y`` along world ``z``), the crank pin ``B``, the slider's point ``C`` on world ``x``
+    and the rod's rotation ``Rr`` (``x`` from ``B`` to ``C``, ``y`` the universal joint's arm
+    ``x_rod x e_x / |.|``)."""
+    ex = np.array([1.0, 0.0, 0.0])
+    A = np.asarray(pivot, float)
+    Rc = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+    B = A + crank * Rc[:, 1]
+    C = np.array([B[0] + math.sqrt(rod ** 2 - B[1] ** 2 - B[2] ** 2), 0.0, 0.0])
+    u = (C - B) / rod
+    yr = np.cross(u, ex)
+    yr /= np.linalg.norm(yr)
+    return A, Rc, B, C, np.column_stack([u, yr, np.cross(u, yr)])
+
+
+#: the flexible slider-crank's rod: a square steel bar (side, density, Young's modulus, Poisson's ratio)
+ROD_SECTION = (0.008, 7850.0, 2.1e11, 0.3)
+RODS = ("beam", "modal")
+
+
+def spin_up(omega: float, duration: float) -> str:
+    """The crank angle of a smooth start (Kane's profile, as for the spin-up beam): the speed
+    rises from 0 to ``omega`` over ``duration`` with an acceleration ``omega/T (1 - cos(2 pi
+    t/T))`` that starts and ends at zero, then stays at ``omega``. An expression of ``t``
+    (``h = min(t, T)`` written with ``abs``), for a rotation driver."""
+    T = duration
+    h = f"(t + {T!r} - abs(t - {T!r})) / 2"
+    return (f"{omega!r} * (({h})^2 / (2 * {T!r}) + {T / (4 * math.pi ** 2)!r} * (cos({2 * math.pi / T!r} * {h}) - 1)"
+            f" + t - {h})")
+
+
+@functools.lru_cache(maxsize=4)
+def _rod_data_cached(length: float, mesh: Tuple[int, int, int], modes: int, section: Tuple[float, float, float, float],
+                     stress_stiffening: bool) -> Any:
+    from . import fe3
+
+    side, rho, e, nu = section
+    bar = fe3.bar_mesh(length, side, side, mesh)
+    return fe3.from_mesh(bar, density=rho, youngs_modulus=e, poisson_ratio=nu, modes=modes,
+                         interfaces={"A": lambda x: x[:, 0] < 1e-9 * length, "B": lambda x: x[:, 0] > length * (1 - 1e-9)},
+                         frame=("clamped", "A"), reduction="craig-bampton", stress_stiffening=stress_stiffening)
+
+
+def slider_crank_rod_data(mesh: Sequence[int] = (16, 1, 1), modes: int = 4, rod: float = 0.3,
+                          section: Tuple[float, float, float, float] = ROD_SECTION, stress_stiffening: bool = False) -> Any:
+    """The modal data (:func:`ukflex.fe3.from_mesh`) of :func:`flexible_slider_crank`'s rod:
+    the square bar (``section = (side, density, E, nu)``) of length ``rod`` along its ``x``,
+    meshed with ``mesh`` boxes of P2 tetrahedra, the frame clamped at the crank end's face
+    (interface ``A``), Craig-Bampton with the slider end's face (interface ``B``): six static
+    constraint modes and ``modes`` fixed-interface normal modes. Cached (the same arguments give
+    the same object)."""
+    mesh_t = tuple(count("mesh", c) for c in mesh)
+    if len(mesh_t) != 3:
+        raise InvalidArgumentError("mesh", f"expected 3 cell counts (x, y, z), got {len(mesh_t)}")
+    sec = tuple(positive("section", v) for v in section)
+    if len(sec) != 4 or sec[3] >= 0.5:
+        raise InvalidArgumentError("section", f"expected (side, density, E, nu) with nu < 0.5, got {section!r}")
+    return _rod_data_cached(positive("rod", rod), mesh_t, count("modes", modes), sec, bool(stress_stiffening))
+
+
+def flexible_slider_crank(rod_model: str = "beam", *, elements: int = 8, data: Any = None, omega: float = 150.0,
+                          spin_up_time: float = 0.05, crank: float = 0.08, rod: float = 0.3,
+                          pivot: Tuple[float, float, float] = (0.0, 0.1, 0.12), section: Tuple[float, float, float, float] = ROD_SECTION,
+                          masses: Tuple[float, float] = (0.12, 0.1), gravity: float = 0.0) -> SpatialScene:
+    """Haug's spatial slider-crank (:func:`slider_crank`'s geometry) with a flexible connecting
+    rod: a square steel bar (``section = (side, density, E, nu)``, default 8 mm, first pinned
+    bending frequency about 1310 rad/s), the crank driven from rest to ``omega`` (150 rad/s)
+    over ``spin_up_time`` by :func:`spin_up`'s smooth profile, then at constant speed. The rod
+    sits on a spherical joint at the crank pin and a universal joint at the slider (arms: world
+    ``x`` on the slider, the rod's ``y``), as in the rigid scene: the rod's spin about its axis is
+    held by the universal joint alone, no row is redundant. ``rod_model``: ``"beam"`` (a
+    ``beam3`` of ``elements`` elements, an even number so that the midpoint is a node) or
+    ``"modal"`` (a ``flexible3`` body from ``data``, default :func:`slider_crank_rod_data`).
+    Crank and slider masses ``masses`` (the crank's inertia that of the rigid scene, the
+    slider's ``1e-6 I``). Everything starts at rest, undeformed, gravity ``-z`` (default 0).
+    Bodies ``crank``, ``rod`` (the beam's nodes ``rod[0] .. rod[N]``), ``slider``."""
+    if rod_model not in RODS:
+        raise InvalidArgumentError("rod_model", f"expected one of {list(RODS)}, got {rod_model!r}")
+    omega, t_up = real("omega", omega), non_negative("spin_up_time", spin_up_time)
+    crank, rod = positive("crank", crank), positive("rod", rod)
+    mc, ms = (positive("masses", m) for m in masses)
+    side, rho, e, nu = section
+    pivot = tuple(real("pivot", x) for x in pivot)
+    if rod <= math.hypot(pivot[1], pivot[2]) + crank:
+        raise InvalidArgumentError("rod", f"{rod} m does not reach the slider's line from every crank pin "
+                                   f"(needs more than {math.hypot(pivot[1], pivot[2]) + crank:.6g} m)")
+    A, Rc, B, C, Rr = crank_geometry(crank, rod, pivot)
+    ex = np.array([1.0, 0.0, 0.0])
+    s = SpatialScene(gravity=(0.0, 0.0, -real("gravity", gravity)))
+    cc = A + 0.5 * crank * Rc[:, 1]
+    crank_b = s.rigid_body("crank", mc, [1e-4, 1e-5, 1e-4], position=cc, orientation=Rc)
+    slider_b = s.rigid_body("slider", ms, [1e-6, 1e-6, 1e-6], position=C)
+    if rod_model == "beam":
+        n = count("elements", elements)
+        if n % 2:
+            raise InvalidArgumentError("elements", f"must be even (the rod's midpoint a node), got {n}")
+        beam = s.beam("rod", B, C, Rectangular(side, side), elements=n, density=rho, youngs_modulus=e,
+                      poisson_ratio=nu, y_axis=Rr[:, 1])
+        end_b, end_c = beam.node(0), beam.node(-1)
+    else:
+        if data is None:
+            data = slider_crank_rod_data(rod=rod, section=section)
+        if not {"A", "B"} <= set(getattr(data, "interfaces", {})):
+            raise InvalidArgumentError("data", "the rod's modal data need interfaces 'A' (crank end) and 'B' (slider end)")
+        body = s.flexible_body("rod", data, position=B, orientation=Rr)
+        end_b, end_c = body.interface("A"), body.interface("B")
+    ground_a = s.ground.marker(A, z=ex, x=(0, 1, 0))
+    crank_a = crank_b.marker(Rc.T @ (A - cc), z=Rc.T @ ex, x=Rc.T @ [0.0, 1.0, 0.0])
+    s.revolute(ground_a, crank_a, name="crank_ground")
+    s.rotation_driver(ground_a, crank_a, spin_up(omega, t_up) if t_up > 0 else ConstantSpeed(omega), name="crank_drive")
+    s.spherical(crank_b.marker(Rc.T @ (B - cc)), end_b, name="crank_rod")
+    s.universal(slider_b.marker((0, 0, 0), z=np.cross(ex, Rr[:, 1]), x=ex), end_c, name="rod_slider")
     s.prismatic(s.ground.marker((0, 0, 0), z=ex, x=(0, 1, 0)), slider_b.marker((0, 0, 0), z=ex, x=(0, 1, 0)),
                 name="slider_ground")
     return s
