@@ -208,6 +208,52 @@ def test_heavy_top_invariants_and_nutation_period():
     assert np.abs(periods - T_closed).max() < 1e-7 * T_closed, (periods, T_closed)
 
 
+def _omega_world(p, pd):
+    """Angular velocity (world axes) of the rotation ``p / |p|``: ``2 E(p) pd / |p|^2``."""
+    e0, e = p[0], p[1:]
+    ex = np.array([[0, -e[2], e[1]], [e[2], 0, -e[0]], [-e[1], e[0], 0]])
+    E = np.column_stack([-e, ex + e0 * np.eye(3)])
+    return 2.0 * E @ pd / (p @ p)
+
+
+def test_projection_keeps_the_angular_velocity_of_scaled_euler_parameters():
+    """(p, pd) -> (c p, c pd) is the same rotation and angular velocity; an integration step's
+    error along that scale (a Runge-Kutta step shrinks a turning p and pd alike) must not come
+    out of the projection as a loss of speed. Before the Euler parameters were normalized
+    together with their rates, the projection put p back on the unit sphere and left pd:
+    omega shrank by the scale (1e-3 here), the heavy top lost energy at every step."""
+    model, system = _top_system()
+    q0, qd0 = system.q0.copy(), system.qd0.copy()
+    w0 = _omega_world(q0[3:7], qd0[3:7])
+    q, qd = q0.copy(), qd0.copy()
+    q[3:7] *= 0.999
+    qd[3:7] *= 0.999
+    qn, qdn, phi, ok = system.core.project_step(0.0, q, qd, 1e-12)
+    assert ok and phi < 1e-12
+    w1 = _omega_world(qn[3:7], qdn[3:7])
+    assert np.abs(w1 - w0).max() < 1e-10 * np.abs(w0).max(), (w1, w0)
+    assert abs(qn[3:7] @ qn[3:7] - 1.0) < 1e-14
+    assert np.abs(qn[:3] - q0[:3]).max() < 1e-12       # the centre of mass stays
+    assert np.abs(qdn[:3] - qd0[:3]).max() < 1e-10
+
+
+def test_heavy_top_at_the_default_rtol():
+    """The heavy top (30 rad/s, 10 s) with defaults (auto: DOPRI5, rtol 1e-6): energy, L_z and
+    L.e3 within 15 rtol (docs/spatial.md, "The heavy top at the default rtol": 1.3e-5, 1.1e-5,
+    4.3e-6; 3.0e-5, 1.8e-5, 1.6e-5 before the Euler parameters' rates were normalized with them;
+    the issue's 10 rtol is not met: what is left is DOPRI5's own dissipation)."""
+    model, system = _top_system()
+    t = np.linspace(0.0, 10.0, 2001)
+    res = ukflex.simulate(system, 10.0, t_eval=t)
+    assert res.method == "DOPRI5"
+    out = ukflex.spatial_outputs(system, res, reactions=False)
+    L = out["angular_momentum"]
+    L3 = np.einsum("ij,ij->i", L, out["bodies"]["top"]["rotation"][:, :, 2])
+    rel = lambda x: np.abs(x - x[0]).max() / abs(x[0])  # noqa: E731
+    figures = rel(out["energy"]), rel(L[:, 2]), rel(L3)
+    assert max(figures) < 1.5e-5, figures
+
+
 def test_double_pendulum_run_matches_the_reference_run():
     model = sp.scenes.double_pendulum()
     system = ukflex.System(to_description(model), correct=False)

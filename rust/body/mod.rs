@@ -378,6 +378,19 @@ impl Body {
         }
     }
 
+    /// Euler parameters (spatial rigid and modal bodies: `q[3..7]` of the body) back to unit
+    /// length with their rates scaled alike (`rigid3::normalize_euler_parameters`: no physical
+    /// quantity moves). Other kinds have none. Returns whether anything changed.
+    pub fn normalize_orientation(&self, q: &mut [f64], qd: &mut [f64]) -> bool {
+        match &self.kind {
+            BodyKind::Rigid3(_) | BodyKind::Flexible3(_) => {
+                let o = self.offset + 3;
+                rigid3::normalize_euler_parameters(&mut q[o..o + 4], &mut qd[o..o + 4])
+            }
+            _ => false,
+        }
+    }
+
     /// Potential of gravity `-g . int rho r dV`.
     pub fn gravity_energy(&self, q: &[f64], g: [f64; 2]) -> f64 {
         let r = with_kind!(&self.kind, |k| k.mass_moment(self.seg(q)));

@@ -190,9 +190,11 @@ pub fn project_with_factorization(model: &Model, data: &mut Data, ws: &mut Proje
     }
     ws.lambda.copy_from_slice(&data.lambda);
     let mut out = ProjectOutcome::default();
+    let normalized = normalize_orientations(model, q, qd);
+    out.changed = normalized;
     let rhs = &mut ws.rhs;
     newton_positions(data, q, tol.position_tol, tol.max_iter, &mut out, |data, q, first| {
-        if !first {
+        if !first || normalized {
             // Phi, A, Phi_t at the corrected positions (the velocity residual needs the turned A)
             constraints(model, data, t, q, qd, true);
         }
@@ -236,6 +238,7 @@ pub fn project_in_place(model: &Model, data: &mut Data, ws: &mut ProjectWorkspac
         out.converged = true;
         return Ok(out);
     }
+    out.changed = normalize_orientations(model, q, qd);
     let zeros = &ws.zeros;
     newton_positions(data, q, p.position_tol, p.max_iter, &mut out, |data, q, _| {
         constraints(model, data, t, q, zeros, true);
@@ -260,6 +263,13 @@ pub fn project_in_place(model: &Model, data: &mut Data, ws: &mut ProjectWorkspac
     }
     out.converged &= out.phi_norm <= stalled_residual(p.position_tol, q);
     Ok(out)
+}
+
+/// Every body's Euler parameters to unit length, their rates alike (`Body::normalize_orientation`),
+/// before the projection: the normalization rows are then met and the projection moves only
+/// what the joints ask. Returns whether anything changed.
+fn normalize_orientations(model: &Model, q: &mut [f64], qd: &mut [f64]) -> bool {
+    model.bodies.iter().fold(false, |any, b| b.normalize_orientation(q, qd) | any)
 }
 
 /// The minimum mass-norm `dx` with `A dx = gamma` (`gamma` already in `data.gamma`) into

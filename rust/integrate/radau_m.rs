@@ -531,8 +531,11 @@ impl Stepper for RadauM {
             // on stale velocity terms; read them at the next step instead of waiting for a
             // failure (A05's dampers turn with the governor: read only on failures, their
             // directions went stale within ~0.03 s, Newton failed 105 times in 574 steps at rtol
-            // 1e-3 and the steps hardly followed rtol; docs/spatial.md)
-            if !fixed && self.theta > REFRESH_CONTRACTION {
+            // 1e-3 and the steps hardly followed rtol; docs/spatial.md). A Newton that converged
+            // at its first iteration measured no contraction (`theta` is an older step's, or the
+            // start's 1.0): the matrices served, nothing to read (A05's first 14 steps, the
+            // growth out of its stiff start, read them at every step: 14 of 36 passes)
+            if !fixed && newt > 1 && self.theta > REFRESH_CONTRACTION {
                 self.refresh = true;
             }
             if fixed {
