@@ -78,7 +78,8 @@ def ukflex_run(elements: int, t: np.ndarray, **run: Any) -> Tuple[np.ndarray, np
     return elbow, tip, dt
 
 
-def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float = 1.0) -> Tuple[np.ndarray, np.ndarray, float]:
+def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float = 1.0,
+               settings: Optional[Dict[str, Any]] = None) -> Tuple[np.ndarray, np.ndarray, float]:
     """The same frame in Exudyn: elbow and tip displacements interpolated at ``t`` from its
     ``steps`` steps over ``[0, t[-1]]`` (generalized-alpha at ``spectral_radius``), and the wall
     time of ``mbs.SolveDynamic``."""
@@ -124,6 +125,12 @@ def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float 
     ss.timeIntegration.verboseMode = 0
     ss.solutionSettings.writeSolutionToFile = False
     ss.solutionSettings.sensorsWritePeriod = t_end / steps
+    for key, value in (settings or {}).items():  # e.g. "timeIntegration.verboseMode": 1
+        *path, last = key.split(".")
+        obj = ss
+        for p in path:
+            obj = getattr(obj, p)
+        setattr(obj, last, value)
     t0 = time.perf_counter()
     mbs.SolveDynamic(ss)
     dt = time.perf_counter() - t0
