@@ -15,7 +15,7 @@ or their output folder:
   python -m studies spatial-flexible-exudyn
   python -m studies spatial-beam-pendulum
   python -m studies spatial-beam-spin-up
-  python -m studies right-angle-cantilever [--quick] [--meshes 5,10,20,40] [--exudyn-meshes 10,20,40,80] [--steps 1000,3000] [--repeat 3]
+  python -m studies right-angle-cantilever [--quick] [--meshes 5,10,20,40] [--exudyn-meshes 10,20,40,80] [--steps 500,1000,3000] [--repeat 3] [--exudyn-repeat 1]
   python -m studies sweeps --out results/sweeps [--small]
   python -m studies clearance [flores]
   python -m studies engine [--figure PNG]
