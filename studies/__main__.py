@@ -15,7 +15,7 @@ or their output folder:
   python -m studies spatial-flexible-exudyn
   python -m studies spatial-beam-pendulum
   python -m studies spatial-beam-spin-up
-  python -m studies right-angle-cantilever
+  python -m studies right-angle-cantilever [--quick] [--meshes 5,10,20,40] [--exudyn-meshes 10,20,40,80] [--steps 500,1000,3000] [--repeat 3] [--exudyn-repeat 1]
   python -m studies spatial-flexible-crank [--quick]
   python -m studies sweeps --out results/sweeps [--small]
   python -m studies clearance [flores]
@@ -107,7 +107,8 @@ def _cmd_geometric(args: argparse.Namespace) -> int:
 #: ``main`` hands them their arguments before parsing (an ``argparse.REMAINDER`` does not take
 #: arguments that start with ``-``, so ``flexible-coupler --nonlinear`` was refused).
 _PASSTHROUGH = {"flexible-coupler": "flexible_coupler", "simeon-crank": "simeon_crank", "sweeps": "sweeps",
-                "clearance": "clearance", "engine": "engine", "spatial-flexible-crank": "spatial_flexible_crank"}
+                "clearance": "clearance", "engine": "engine", "spatial-flexible-crank": "spatial_flexible_crank",
+                "right-angle-cantilever": "right_angle_cantilever"}
 
 
 def _passthrough(sub, name: str, module: str, help: str) -> None:

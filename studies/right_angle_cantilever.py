@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -29,9 +29,28 @@ import ukflex
 
 L, EA, GA, GJ, EI, RHO_A, RHO_J = 10.0, 1e6, 1e6, 1e3, 1e3, 1.0, (20.0, 10.0, 10.0)
 T_END = 30.0
-#: Exudyn's step counts over 30 s (at 20 elements per member every one of them fails Newton:
-#: "SolveDynamic terminated")
-STEPS = (3000, 6000, 12000, 24000)
+#: the meshes (elements per member) of each code: ukflex's default ``simulate()`` and its
+#: time-converged run (RADAU5 at rtol 1e-9) on each; Exudyn at each of ``STEPS`` steps over 30 s
+UK_MESHES = (5, 10, 20, 40)
+EX_MESHES = (10, 20, 40, 80)
+STEPS = (500, 1000, 3000)
+#: Exudyn's time-converged run: 3000 steps (within 1.3e-4 of 24000 at 10 elements per member,
+#: 9.1e-5 of 6000 at 20)
+EX_REF_STEPS = 3000
+
+
+def exudyn_newton_rtol(elements: int) -> float:
+    """Exudyn's Newton tolerance on a mesh of ``elements`` per member. Its default 1e-8 (relative
+    to the initial residual) is below what the residual reaches in rounding on fine meshes: in
+    the first steps, where the load is still small, it stalls at 1.0e-8 .. 2.6e-8 (20 elements per
+    member) and 3.7e-7 .. 4.0e-7 (80), at every step size ("SolveDynamic terminated"). 1e-7 runs
+    up to 40 elements (and moves the 10-element history by 2e-5 of its largest displacement),
+    1e-6 beyond (it moves the 20-element history by 4e-7)."""
+    return 1e-7 if elements <= 40 else 1e-6
+
+
+#: the accuracy targets on the history (issue 31)
+TARGETS = (5e-3, 1e-3)
 #: the triangular pulse 50 max(0, 1 - |t - 1|), written with abs
 PULSE = "25 * (1 - abs(t - 1) + abs(1 - abs(t - 1)))"
 
@@ -78,7 +97,8 @@ def ukflex_run(elements: int, t: np.ndarray, **run: Any) -> Tuple[np.ndarray, np
     return elbow, tip, dt
 
 
-def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float = 1.0) -> Tuple[np.ndarray, np.ndarray, float]:
+def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float = 1.0,
+               settings: Optional[Dict[str, Any]] = None) -> Tuple[np.ndarray, np.ndarray, float]:
     """The same frame in Exudyn: elbow and tip displacements interpolated at ``t`` from its
     ``steps`` steps over ``[0, t[-1]]`` (generalized-alpha at ``spectral_radius``), and the wall
     time of ``mbs.SolveDynamic``."""
@@ -124,6 +144,16 @@ def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float 
     ss.timeIntegration.verboseMode = 0
     ss.solutionSettings.writeSolutionToFile = False
     ss.solutionSettings.sensorsWritePeriod = t_end / steps
+    ss.timeIntegration.newton.relativeTolerance = exudyn_newton_rtol(elements)
+    # its sparse solver: the dense default factors the whole (n + m) matrix (at 40 elements per
+    # member and 3000 steps 59 s against 13 s, the same answer to 1e-9; one run each)
+    ss.linearSolver.solverType = exu.LinearSolverType.EigenSparse
+    for key, value in (settings or {}).items():  # e.g. "timeIntegration.verboseMode": 1
+        *path, last = key.split(".")
+        obj = ss
+        for p in path:
+            obj = getattr(obj, p)
+        setattr(obj, last, value)
     t0 = time.perf_counter()
     mbs.SolveDynamic(ss)
     dt = time.perf_counter() - t0
@@ -141,49 +171,104 @@ def gap(a: Tuple[np.ndarray, np.ndarray], b: Tuple[np.ndarray, np.ndarray]) -> f
     return float(d / max(np.max(np.linalg.norm(y, axis=1)) for y in b))
 
 
+def richardson(coarse: Tuple[np.ndarray, ...], fine: Tuple[np.ndarray, ...]) -> Tuple[np.ndarray, np.ndarray]:
+    """The mesh limit of two histories at ``n`` and ``2 n`` elements per member of a second-order
+    discretization: ``fine + (fine - coarse) / 3`` (both codes converge at second order, measured)."""
+    return fine[0] + (fine[0] - coarse[0]) / 3.0, fine[1] + (fine[1] - coarse[1]) / 3.0
+
+
 def _log(msg: str) -> None:
     print(f"[right-angle-cantilever {time.perf_counter() - _T0:7.1f} s] {msg}", file=sys.stderr, flush=True)
 
 
 _T0 = time.perf_counter()
+Run = Tuple[np.ndarray, np.ndarray, float]
+
+
+def _converged(t: np.ndarray, uk_meshes: Sequence[int], ex_meshes: Sequence[int], done: Dict[Tuple[str, int, int], List[Run]]
+               ) -> Tuple[Dict[int, Run], Dict[int, Run], List[str], Tuple[np.ndarray, np.ndarray]]:
+    """Each code's time-converged run on each of its meshes (Exudyn's from ``done``, the timed
+    runs, when there), the table of their gaps to the two mesh limits (Richardson on each code's
+    two finest meshes) and ukflex's mesh limit."""
+    ref_u: Dict[int, Run] = {}
+    ref_x: Dict[int, Run] = {}
+    for n in uk_meshes:
+        _log(f"ukflex {n} el./member, RADAU5 rtol 1e-9")
+        ref_u[n] = ukflex_run(n, t, method="RADAU5", rtol=1e-9, atol=1e-10)
+    for n in ex_meshes:
+        if ("Exudyn", n, EX_REF_STEPS) not in done:
+            _log(f"Exudyn {n} el./member, {EX_REF_STEPS} steps")
+        ref_x[n] = done[("Exudyn", n, EX_REF_STEPS)][0] if ("Exudyn", n, EX_REF_STEPS) in done else exudyn_run(n, t, EX_REF_STEPS)
+    nu, nx = sorted(ref_u)[-2:], sorted(ref_x)[-2:]
+    lim_u, lim_x = richardson(ref_u[nu[0]], ref_u[nu[1]]), richardson(ref_x[nx[0]], ref_x[nx[1]])
+    lines = [f"mesh limits: ukflex's Richardson {nu[0]}/{nu[1]} (the reference below) against Exudyn's {nx[0]}/{nx[1]}: "
+             f"gap {gap(lim_x, lim_u):.2e}; elbow max u_z {np.max(np.abs(lim_u[0][:, 2])):.4f} / {np.max(np.abs(lim_x[0][:, 2])):.4f}, "
+             f"tip max u_z {np.max(np.abs(lim_u[1][:, 2])):.4f} / {np.max(np.abs(lim_x[1][:, 2])):.4f}",
+             "", "| code | el./member | time-converged run | elbow max u_z | tip max u_z | to ukflex's mesh limit | to Exudyn's mesh limit |",
+             "|---|---:|---|---:|---:|---:|---:|"]
+    for code, refs, run in (("ukflex", ref_u, "RADAU5 rtol 1e-9"), ("Exudyn", ref_x, f"{EX_REF_STEPS} steps")):
+        for n, r in refs.items():
+            lines.append(f"| {code} | {n} | {run} | {np.max(np.abs(r[0][:, 2])):.4f} | {np.max(np.abs(r[1][:, 2])):.4f} | "
+                         f"{gap(r[:2], lim_u):.2e} | {gap(r[:2], lim_x):.2e} |")
+    return ref_u, ref_x, lines + ["", f"reference: ukflex's mesh limit; elbow max u_z {np.max(np.abs(lim_u[0][:, 2])):.4f}"], lim_u
 
 
 def main(argv: Optional[List[str]] = None) -> int:
-    """Per mesh (elements per member): ukflex's default ``simulate()`` and a tight RADAU5 run,
-    Exudyn at ``STEPS`` steps; each run's error against its own code's tightest run
-    on that mesh (time convergence), the gap between the codes' tightest runs (the physics), the
-    elbow's and the tip's out-of-plane peaks and the wall times (one run each)."""
+    """The converged comparison (each code's time-converged runs on its meshes, the mesh limits by
+    Richardson extrapolation of the two finest) and the speed at equal accuracy: ukflex's default
+    ``simulate()`` on each mesh and Exudyn at ``STEPS`` on each of its meshes, each run's error
+    against ukflex's mesh limit and its wall time (medians of ``--repeat`` interleaved runs of
+    ukflex, ``--exudyn-repeat`` of Exudyn, a fresh System / SystemContainer each), and per target
+    the fastest run of each code within it."""
+    import argparse
+
+    ap = argparse.ArgumentParser(prog="python -m studies right-angle-cantilever")
+    ap.add_argument("--meshes", default=",".join(map(str, UK_MESHES)), help="ukflex's elements per member")
+    ap.add_argument("--exudyn-meshes", default=",".join(map(str, EX_MESHES)), help="Exudyn's elements per member")
+    ap.add_argument("--steps", default=",".join(map(str, STEPS)), help="Exudyn's step counts over 30 s")
+    ap.add_argument("--repeat", type=int, default=3, help="interleaved repetitions of ukflex's timed runs")
+    ap.add_argument("--exudyn-repeat", type=int, default=1, help="... of Exudyn's (a minute and more each on the fine meshes)")
+    ap.add_argument("--quick", action="store_true", help="meshes 5, 10, 20 (Exudyn 10, 20, 40), one repetition")
+    args = ap.parse_args(argv)
+
+    def ints(text: str) -> Tuple[int, ...]:
+        return tuple(int(x) for x in text.split(","))
+
+    uk_meshes, ex_meshes, steps, repeat = ints(args.meshes), ints(args.exudyn_meshes), ints(args.steps), args.repeat
+    if args.quick:
+        uk_meshes, ex_meshes, repeat = (5, 10, 20), (10, 20, 40), 1
     t = np.linspace(0.0, T_END, 301)
-    lines = ["| mesh (el./member) | run | elbow max u_z | tip max u_z | to its own code's tightest run | to the other code's tightest run | wall time [s] |",
-             "|---:|---|---:|---:|---:|---:|---:|"]
-    finest: Dict[int, Tuple[Tuple[np.ndarray, np.ndarray, float], ...]] = {}
-    for n in (5, 10):
-        runs: Dict[str, Tuple[np.ndarray, np.ndarray, float]] = {}
-        _log(f"{n} el./member: ukflex default simulate()")
-        runs["ukflex default simulate()"] = ukflex_run(n, t)
-        _log(f"{n} el./member: ukflex RADAU5 rtol 1e-9")
-        runs["ukflex RADAU5 rtol 1e-9"] = ukflex_run(n, t, method="RADAU5", rtol=1e-9, atol=1e-10)
-        for steps in STEPS:
-            _log(f"{n} el./member: Exudyn {steps} steps")
-            try:
-                runs[f"Exudyn gen-alpha {steps} steps"] = exudyn_run(n, t, steps)
-            except Exception as exc:  # Exudyn's Newton failing at too large a step: reported
-                lines.append(f"| {n} | Exudyn gen-alpha {steps} steps | failed: {type(exc).__name__}: {str(exc)[:60]} | | | | |")
-        ref_u = runs["ukflex RADAU5 rtol 1e-9"]
-        ref_x = [r for k, r in runs.items() if k.startswith("Exudyn")][-1]
-        for name, r in runs.items():
-            own, other = (ref_u, ref_x) if name.startswith("ukflex") else (ref_x, ref_u)
-            lines.append(f"| {n} | {name} | {np.max(np.abs(r[0][:, 2])):.4f} | {np.max(np.abs(r[1][:, 2])):.4f} | "
-                         f"{gap(r[:2], own[:2]):.2e} | {gap(r[:2], other[:2]):.2e} | {r[2]:.2f} |")
-        finest[n] = (ref_u, ref_x)
-    _log("20 el./member: ukflex RADAU5 rtol 1e-9 (the mesh reference)")
-    fine = ukflex_run(20, t, method="RADAU5", rtol=1e-9, atol=1e-10)
-    lines += ["", "| mesh (el./member) | tightest run | to ukflex 20 el./member, RADAU5 rtol 1e-9 |", "|---:|---|---:|"]
-    for n, (ru, rx) in finest.items():
-        lines += [f"| {n} | ukflex RADAU5 rtol 1e-9 | {gap(ru[:2], fine[:2]):.2e} |", f"| {n} | Exudyn finest step | {gap(rx[:2], fine[:2]):.2e} |"]
-    lines.append(f"ukflex 20 el./member: elbow max u_z {np.max(np.abs(fine[0][:, 2])):.4f}, tip max u_z {np.max(np.abs(fine[1][:, 2])):.4f}")
-    print("gap = max over the 301 outputs (0.1 s) of |elbow and tip displacement - reference| / max |reference displacement|")
+    runs: Dict[Tuple[str, int, int], List[Run]] = {}
+    failed: List[str] = []
+    for k in range(repeat):
+        for n in uk_meshes:
+            _log(f"repetition {k + 1}/{repeat}: ukflex {n} el./member, default simulate()")
+            runs.setdefault(("ukflex default simulate()", n, 0), []).append(ukflex_run(n, t))
+        for n in ex_meshes if k < args.exudyn_repeat else ():
+            for st in steps:
+                _log(f"repetition {k + 1}/{repeat}: Exudyn {n} el./member, {st} steps")
+                try:
+                    runs.setdefault(("Exudyn", n, st), []).append(exudyn_run(n, t, st))
+                except Exception as exc:  # Exudyn's Newton failing at too large a step: reported
+                    failed.append(f"Exudyn {n} el./member, {st} steps failed: {type(exc).__name__}: {str(exc)[:60]}")
+    ref_u, ref_x, lines, lim = _converged(t, uk_meshes, ex_meshes, runs)
+    lines += failed + ["", "| code | el./member | steps | error (to the mesh limit) | to its own time-converged run | wall time [s], median |",
+              "|---|---:|---:|---:|---:|---:|"]
+    timed = []
+    for (code, n, st), rs in runs.items():
+        err, own = gap(rs[0][:2], lim), gap(rs[0][:2], (ref_u if code.startswith("ukflex") else ref_x)[n][:2])
+        wall = float(np.median([r[2] for r in rs]))
+        timed.append((code, n, st, err, wall))
+        lines.append(f"| {code} | {n} | {st or 'auto'} | {err:.2e} | {own:.2e} | {wall:.2f} |")
+    lines += ["", "| target | ukflex: fastest default run within it | Exudyn: fastest run within it | Exudyn / ukflex |", "|---|---|---|---:|"]
+    for target in TARGETS:
+        best = [min((r for r in timed if r[0].startswith(c) and r[3] <= target), key=lambda r: r[4], default=None) for c in ("ukflex", "Exudyn")]
+        cells = [f"{b[1]} el., {b[2] or 'auto'}: {b[3]:.2e} in {b[4]:.2f} s" if b else "none" for b in best]
+        ratio = f"{best[1][4] / best[0][4]:.1f}" if best[0] and best[1] else "n/a"
+        lines.append(f"| {target:.1%} | {cells[0]} | {cells[1]} | {ratio} |")
+    print("gap, error = max over the 301 outputs (0.1 s) of |elbow and tip displacement - reference| / max |reference displacement|")
     print("\n".join(lines))
+    _log("done")
     return 0
 
 

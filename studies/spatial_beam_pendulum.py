@@ -14,7 +14,7 @@ and relative to that elastic part.
 from __future__ import annotations
 
 import time
-from typing import List, Optional, Tuple
+from typing import Any, List, Optional, Tuple
 
 import numpy as np
 
@@ -33,15 +33,16 @@ def modal(mesh: Tuple[int, int, int], modes: int, stress_stiffening: bool = Fals
                          modes=modes, frame=("clamped", "A"), stress_stiffening=stress_stiffening)
 
 
-def beam_tip(elements: int, t: np.ndarray) -> Tuple[np.ndarray, float]:
-    """Tip positions (nt, 3) of the beam model and the wall time of ``ukflex.simulate``."""
+def beam_tip(elements: int, t: np.ndarray, **run: Any) -> Tuple[np.ndarray, float]:
+    """Tip positions (nt, 3) of the beam model and the wall time of ``ukflex.simulate`` (with
+    ``run``'s options, by default ``RUN``)."""
     s = ukflex.SpatialScene(gravity=GRAVITY)
     b = s.beam("bar", (0, 0, 0), (LENGTH, 0, 0), ukflex.Rectangular(SIDE, SIDE), elements=elements, density=RHO,
                youngs_modulus=E, poisson_ratio=NU, angular_velocity=OMEGA0)
     s.spherical(s.ground.marker((0, 0, 0)), b.node(0))
     system = ukflex.System(s)
     t0 = time.perf_counter()
-    res = ukflex.simulate(system, T_END, t_eval=t, **RUN)
+    res = ukflex.simulate(system, T_END, t_eval=t, **(run or RUN))
     dt = time.perf_counter() - t0
     i = system.body_names.index(b.node_name(-1))
     q = np.asarray(res.q)[7 * i:7 * i + 7].T

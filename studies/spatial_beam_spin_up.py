@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import List, Optional, Tuple
+from typing import Any, List, Optional, Tuple
 
 import numpy as np
 
@@ -50,7 +50,9 @@ def cable(t: np.ndarray, elements: int) -> Tuple[np.ndarray, np.ndarray, float]:
     return (*_in_hub_frame(t, np.asarray(x), np.asarray(y)), dt)
 
 
-def beam3(t: np.ndarray, elements: int) -> Tuple[np.ndarray, np.ndarray, float]:
+def beam3(t: np.ndarray, elements: int, **run: Any) -> Tuple[np.ndarray, np.ndarray, float]:
+    """The tip's ``(u, v)`` in the hub frame at ``t`` and the wall time of ``simulate`` (with
+    ``run``'s options, by default ``RUN``)."""
     s = ukflex.SpatialScene()
     hub = s.rigid_body("hub", 1.0, (1.0, 1.0, 1.0))
     s.revolute(s.ground.marker((0, 0, 0)), hub.marker((0, 0, 0)), name="axle")
@@ -65,7 +67,7 @@ def beam3(t: np.ndarray, elements: int) -> Tuple[np.ndarray, np.ndarray, float]:
     s.fixed(hub.marker((0, 0, 0)), b.node(0), name="clamp")
     system = ukflex.System(s)
     t0 = time.perf_counter()
-    res = ukflex.simulate(system, T_END, t_eval=t, **RUN)
+    res = ukflex.simulate(system, T_END, t_eval=t, **(run or RUN))
     dt = time.perf_counter() - t0
     i = system.body_names.index(b.node_name(-1))
     q = np.asarray(res.q)[7 * i:7 * i + 7]

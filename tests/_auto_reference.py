@@ -214,8 +214,13 @@ def _has_damping(system) -> bool:
 
 
 def _has_elastic_potential(system) -> bool:
-    """Whether any mode can store strain or spring energy: a flexible body or a spring."""
+    """Whether any mode can store strain or spring energy: a flexible body, a geometrically exact
+    beam (``beam3``: its elements store the strain energy between rigid node bodies; updated on
+    purpose with the core's ``SceneTraits``, which had left the beam out and run it with DOPRI5)
+    or a spring."""
     if any(system.capabilities(b)["elastic"] for b in system.body_names):
+        return True
+    if any(b.get("kind") == "beam3" for b in system.description.get("bodies", [])):
         return True
     return any(f.get("kind") == "spring_damper" and float(f.get("stiffness", 0.0)) > 0.0
                for f in system.description.get("forces", []))

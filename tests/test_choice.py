@@ -187,6 +187,16 @@ def test_a_spinning_cable_does_not_reject_most_of_its_steps():
     assert res.extra["nreject"] < 0.03 * res.extra["naccept"], res.extra
 
 
+def _beam3_pendulum():
+    """A geometrically exact beam (4 elements: 35 coordinates, the dense analysis) on a spherical
+    joint, spun and falling: its elements, not its node bodies, are elastic."""
+    s = ukflex.SpatialScene(gravity=(0, 0, -9.81))
+    bar = s.beam("bar", (0, 0, 0), (0.5, 0, 0), ukflex.Rectangular(0.02, 0.02), elements=4, density=7850,
+                 youngs_modulus=2.1e9, poisson_ratio=0.3, angular_velocity=(0, 0, 3))
+    s.spherical(s.ground.marker((0, 0, 0)), bar.node(0))
+    return s
+
+
 def _scenes_for_the_core_check():
     """Built-in scenes, ANCF and FFRF, spinning and falling beams, damped and overdamped ones:
     (label, system, t_end)."""
@@ -201,7 +211,8 @@ def _scenes_for_the_core_check():
            ("paper ANCF N=4", scenes.slider_crank(formulation="ancf", elements=4), 0.1),
            ("every_joint", scenes.every_joint(), 0.3),
            ("damped cantilever", scenes.cantilever(damping=1e-3), 0.8),
-           ("flyball governor", spatial_scenes.flyball_governor(), 0.2)]
+           ("flyball governor", spatial_scenes.flyball_governor(), 0.2),
+           ("beam3 pendulum", _beam3_pendulum(), 0.3)]
     for f in ("ffrf", "ancf"):
         out += [(f"cantilever {f}", scenes.cantilever(formulation=f), 0.8),
                 (f"spin_up {f}", scenes.spin_up(formulation=f), 2.0),

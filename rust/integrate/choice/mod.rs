@@ -23,6 +23,7 @@ use serde_json::Value;
 
 use crate::data::Data;
 use crate::error::Result;
+use crate::force::ForceKind;
 use crate::model::Model;
 pub use spectrum::Spectrum;
 
@@ -95,7 +96,8 @@ pub fn constants() -> Vec<(&'static str, f64)> {
 pub struct SceneTraits {
     /// A body or force dissipates (a nonzero `damping`, a modal body's `d_ff`).
     pub damped: bool,
-    /// A mode can store strain or spring energy: a flexible body or a spring-damper with stiffness.
+    /// A mode can store strain or spring energy: a flexible body, a geometrically exact beam
+    /// (`beam3_element`s) or a spring-damper with stiffness.
     pub elastic_potential: bool,
     /// Contacts (revolute joints with clearance): forces that switch on and off during the run,
     /// which the spectrum at the start does not see.
@@ -118,7 +120,10 @@ impl SceneTraits {
         let spring = forces.iter().any(|f| {
             f.get("kind").and_then(Value::as_str) == Some("spring_damper") && f.get("stiffness").and_then(Value::as_f64).unwrap_or(0.0) > 0.0
         });
-        let flexible = model.bodies.iter().any(|b| b.capabilities().elastic);
+        // a geometrically exact beam's elements (`beam3_element`) store strain energy between
+        // rigid node bodies: the beam is elastic though none of its bodies is
+        let beam = model.forces.iter().any(|f| matches!(&f.kind, ForceKind::Spatial(s) if s.kind() == "beam3_element"));
+        let flexible = beam || model.bodies.iter().any(|b| b.capabilities().elastic);
         let contact = forces.iter().any(|f| f.get("kind").and_then(Value::as_str) == Some("revolute_clearance"));
         SceneTraits { damped, elastic_potential: flexible || spring, contact }
     }
