@@ -50,6 +50,12 @@ use crate::model::Model;
 /// `eps |Y| |Y^T x|`, with a free acceleration 800 times the constrained one).
 pub const GRAM_MAX_COND: f64 = 3e3;
 
+/// After a refusal (condition estimate above `GRAM_MAX_COND`, or no certificate) this many
+/// factorizations go straight to the dense QR before the Gram path is tried again: a mechanism
+/// that stays badly conditioned (A05) then pays the refused attempt on one call in
+/// `GRAM_RETRY + 1` (it doubled A05's call when tried every call).
+pub const GRAM_RETRY: u32 = 64;
+
 /// A normalization row: its row of `A`, the unit coordinate `c` and where `B^T[c, row]` is in
 /// the values of its segment.
 #[derive(Debug, Clone, Copy)]
@@ -96,6 +102,8 @@ pub struct GramUk {
     /// `trace(S)`, `trace(S^-1)` of the last `factor`.
     pub trace_s: f64,
     pub trace_sinv: f64,
+    /// Factorizations left to the dense QR after the last refusal (`GRAM_RETRY`).
+    pub skip: u32,
 }
 
 impl GramUk {
@@ -202,6 +210,7 @@ impl GramUk {
             wn: vec![0.0; n],
             trace_s: 0.0,
             trace_sinv: f64::INFINITY,
+            skip: 0,
         }
     }
 
@@ -463,8 +472,13 @@ mod tests {
         uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
         assert_ne!(data.factored_with, Factored::Gram);
         assert_eq!(data.rank_info.rank, model.m - 1);
-        // and just below the certificate's reach (a factor sqrt 2 and the rounding), it passes
+        // and just below the certificate's reach (a factor sqrt 2 and the rounding), it passes,
+        // once the refused attempt's `GRAM_RETRY` calls on the QR are over
         data.tolerance = RankTolerance { rcond: Some(0.5 * ratio / (model.m as f64).sqrt()), atol: 0.0 };
+        for _ in 0..super::GRAM_RETRY {
+            uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
+            assert_eq!((data.factored_with, data.rank_info.rank), (Factored::FullRankQr, model.m));
+        }
         uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
         assert_eq!(data.factored_with, Factored::Gram);
         assert_eq!(data.rank_info.rank, model.m);

@@ -91,7 +91,7 @@ pub fn factor_constraints(model: &Model, data: &mut Data) -> Result<()> {
             return Ok(());
         }
     }
-    if factor_gram(model, data) {
+    if data.gram.is_some() && factor_gram(model, data) {
         return Ok(());
     }
     // no full-rank certificate: the dense rank-revealing path decides (and reports) the rank
@@ -100,14 +100,20 @@ pub fn factor_constraints(model: &Model, data: &mut Data) -> Result<()> {
 }
 
 /// The spatial Gram path (`gram`), where the model has one (`Data::gram`), no rows were found
-/// redundant and the backend is the certified one (`Auto`, `Cod`): `true` when it certified
-/// full rank (the factorization is then in `data.gram`).
-#[inline]
+/// redundant and the backend is the certified one (`Auto`, `Cod`), unless it was refused within
+/// the last `gram::GRAM_RETRY` factorizations: `true` when it certified full rank (the
+/// factorization is then in `data.gram`). Out of line: the planar path keeps
+/// its code.
+#[inline(never)]
 fn factor_gram(model: &Model, data: &mut Data) -> bool {
     if data.redundant != 0 || !matches!(data.svd_backend, SvdBackend::Auto | SvdBackend::Cod) {
         return false;
     }
     let Some(g) = data.gram.as_mut() else { return false };
+    if g.skip > 0 {
+        g.skip -= 1;
+        return false;
+    }
     let rcond = data.tolerance.rcond_at(model.n, model.m, data.spatial_drift);
     match g.factor(model, &data.bodies, &data.ajac, rcond, data.tolerance.atol) {
         Some(info) => {
@@ -116,7 +122,10 @@ fn factor_gram(model: &Model, data: &mut Data) -> bool {
             dense::record_redundancy(data, model.n, model.m);
             true
         }
-        None => false,
+        None => {
+            g.skip = gram::GRAM_RETRY;
+            false
+        }
     }
 }
 
@@ -131,16 +140,22 @@ pub fn correct(model: &Model, data: &mut Data) {
         return;
     }
     if data.factored_with == Factored::Gram {
-        let g = data.gram.as_mut().expect("factored by the Gram path");
-        g.correct(&data.gamma, &mut data.residual, &mut data.y, &mut data.lambda);
-        data.qdd.copy_from_slice(&data.y);
-        apply_finvt(model, &data.bodies, &mut data.qdd);
+        correct_gram(model, data);
         return;
     }
     for i in 0..model.m {
         data.residual[i] = data.gamma[i] - data.ajac.row_dot(i, &data.qdd_free);
     }
     correct_residual(model, data);
+}
+
+/// `correct` on the Gram path's factorization (out of line: the planar path keeps its code).
+#[inline(never)]
+fn correct_gram(model: &Model, data: &mut Data) {
+    let g = data.gram.as_mut().expect("factored by the Gram path");
+    g.correct(&data.gamma, &mut data.residual, &mut data.y, &mut data.lambda);
+    data.qdd.copy_from_slice(&data.y);
+    apply_finvt(model, &data.bodies, &mut data.qdd);
 }
 
 /// `qdd = UK(t, q, qd)` into `data.qdd` (and `data.lambda`). Allocation free.
