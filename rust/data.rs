@@ -11,6 +11,7 @@ use crate::constraint::jac::SegJac;
 use crate::model::Model;
 use crate::error::{Error, Result};
 use crate::linalg::small_svd::QrJacobi;
+use crate::uk::gram::GramUk;
 use crate::uk::sparse::SparseUk;
 use crate::force::friction::FrictionWork;
 /// The UK settings and rank types live in `uk::settings`; the workspace holds them (and
@@ -109,6 +110,9 @@ pub struct Data {
     /// The UK path asked for at build, and the sparse workspace when it is used.
     pub uk_solver: UkSolver,
     pub sparse: Option<Box<SparseUk>>,
+    /// The spatial Gram path's workspace (`uk::gram`): spatial models on the dense path with
+    /// `0 < m <= n`; `None` for planar models.
+    pub gram: Option<Box<GramUk>>,
     /// Whether the dense UK buffers (`bt`, `svd_*`, `qrj`, `mem`) are allocated: at build on
     /// the dense path, on the first certificate failure on the sparse one.
     pub dense_ready: bool,
@@ -141,13 +145,19 @@ impl Data {
         let base = SegJac::bytes(&model.constraints, &model.bodies, m) + 8 * (6 * n as u64 + 8 * m as u64);
         let dense = if sparse.is_none() { dense_uk_bytes(model) } else { 0 };
         let sparse_bytes = if sparse.is_some() { SparseUk::bytes(model) } else { 0 };
-        Error::check_memory("the UK workspace (constraint Jacobian and factorization buffers)", base + dense + sparse_bytes, memory_limit, hint)?;
+        // the spatial Gram path where the automatic choice stays dense (an explicit 'dense' keeps
+        // the pseudoinverse of `svd_backend` every call)
+        let with_gram = solver == UkSolver::Auto && sparse.is_none() && model.is_spatial() && m > 0 && m <= n;
+        let gram_bytes = if with_gram { GramUk::bytes(model) } else { 0 };
+        Error::check_memory("the UK workspace (constraint Jacobian and factorization buffers)", base + dense + sparse_bytes + gram_bytes, memory_limit, hint)?;
+        let ajac = SegJac::new(&model.constraints, &model.bodies, n, m);
+        let gram = with_gram.then(|| Box::new(GramUk::new(model, &ajac)));
         let bodies = model.bodies.iter().map(|b| b.new_data()).collect();
         let mut data = Data {
             bodies,
             force: vec![0.0; n],
             phi: vec![0.0; m],
-            ajac: SegJac::new(&model.constraints, &model.bodies, n, m),
+            ajac,
             jac: Vec::new(),
             dense_jac: false,
             phi_t: vec![0.0; m],
@@ -179,6 +189,7 @@ impl Data {
             uk_solver: solver,
             dense_ready: false,
             sparse,
+            gram,
             memory_limit,
             friction: FrictionWork::new(&model.forces, &model.constraints, n, m),
         };

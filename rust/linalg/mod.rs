@@ -4,6 +4,8 @@
 //!   the dense Cholesky and triangular solves, the pseudoinverse solve of the state correction;
 //! * `banded`: band storage, the banded Cholesky (constant FFRF and ANCF mass factors, the
 //!   Gram matrix of the sparse UK path) with its selected inverse and an inertia count;
+//! * `envelope`: envelope (profile) storage, its Cholesky factor and selected inverse (the
+//!   Gram matrix of the spatial UK path);
 //! * `band_lu`: the band LU with partial pivoting of the implicit methods' sparse Newton
 //!   matrices, real and complex; `lu`: their dense LU;
 //! * `small_svd`: the QR + one-sided Jacobi SVD of the UK pseudoinverse;
@@ -19,6 +21,7 @@ pub mod band_lu;
 pub mod banded;
 pub mod dense;
 pub mod dual;
+pub mod envelope;
 pub mod lu;
 pub mod quadrature;
 pub mod rcm;

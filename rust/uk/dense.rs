@@ -180,6 +180,12 @@ fn rank_decision(k: usize, sigma: impl Fn(usize) -> f64, rcond: f64, atol: f64, 
 /// `sqrt(trace(A M^-1 A^T))`, `sigma_min_kept` the lower bound
 /// `sqrt(1/(2 trace((A M^-1 A^T)^-1)) - delta)`, `exact == false`).
 pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
+    if data.factored_with == Factored::Gram && !data.rank_info.exact {
+        // the singular values by the dense QR + Jacobi SVD of the same B^T (its correction
+        // then serves: same q, same rank)
+        data.ensure_dense(model)?;
+        factor_dense(model, data)?;
+    }
     if data.factored_with == Factored::SparseGram && !data.rank_info.exact {
         if model.m > EXACT_RANK_MAX_ROWS {
             return Ok(data.rank_info);

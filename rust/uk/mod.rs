@@ -8,13 +8,15 @@
 //! tolerance. Multipliers (sign of eq. 42: `M qdd + A^T lambda = Q`):
 //! `lambda = (A M^-1 A^T)^+ (A a - b) = (B B^T)^+ (A a - b)`.
 //!
-//! Two paths factor `B^T`: `dense` (the pseudoinverse with an explicit rank decision) and
-//! `sparse` (a band Cholesky of `B B^T` with a certificate of full rank, for long chains);
-//! `settings` holds the types that choose between them and report the rank. This file is the
+//! Three paths factor `B^T`: `dense` (the pseudoinverse with an explicit rank decision),
+//! `sparse` (a band Cholesky of `B B^T` with a certificate of full rank, for long chains) and
+//! `gram` (small spatial models: the envelope Cholesky of `B B^T` with the normalization rows
+//! eliminated and the same certificate; `dense` when it fails); `settings` holds the types that choose between them and report the rank. This file is the
 //! algorithm: evaluate the terms, the free acceleration, factor, correct.
 
 pub mod dense;
 pub mod friction;
+pub mod gram;
 pub mod settings;
 pub mod sparse;
 
@@ -89,9 +91,42 @@ pub fn factor_constraints(model: &Model, data: &mut Data) -> Result<()> {
             return Ok(());
         }
     }
+    if data.gram.is_some() && factor_gram(model, data) {
+        return Ok(());
+    }
     // no full-rank certificate: the dense rank-revealing path decides (and reports) the rank
     data.ensure_dense(model)?;
     factor_dense(model, data)
+}
+
+/// The spatial Gram path (`gram`), where the model has one (`Data::gram`), no rows were found
+/// redundant and the backend is the certified one (`Auto`, `Cod`), unless it was refused within
+/// the last `gram::GRAM_RETRY` factorizations: `true` when it certified full rank (the
+/// factorization is then in `data.gram`). Out of line: the planar path keeps
+/// its code.
+#[inline(never)]
+fn factor_gram(model: &Model, data: &mut Data) -> bool {
+    if data.redundant != 0 || !matches!(data.svd_backend, SvdBackend::Auto | SvdBackend::Cod) {
+        return false;
+    }
+    let Some(g) = data.gram.as_mut() else { return false };
+    if g.skip > 0 {
+        g.skip -= 1;
+        return false;
+    }
+    let rcond = data.tolerance.rcond_at(model.n, model.m, data.spatial_drift);
+    match g.factor(model, &data.bodies, &data.ajac, rcond, data.tolerance.atol) {
+        Some(info) => {
+            data.factored_with = Factored::Gram;
+            data.rank_info = info;
+            dense::record_redundancy(data, model.n, model.m);
+            true
+        }
+        None => {
+            g.skip = gram::GRAM_RETRY;
+            false
+        }
+    }
 }
 
 /// The constraint correction with the current factorization: `r = b - A a`,
@@ -104,10 +139,23 @@ pub fn correct(model: &Model, data: &mut Data) {
         apply_finvt(model, &data.bodies, &mut data.qdd);
         return;
     }
+    if data.factored_with == Factored::Gram {
+        correct_gram(model, data);
+        return;
+    }
     for i in 0..model.m {
         data.residual[i] = data.gamma[i] - data.ajac.row_dot(i, &data.qdd_free);
     }
     correct_residual(model, data);
+}
+
+/// `correct` on the Gram path's factorization (out of line: the planar path keeps its code).
+#[inline(never)]
+fn correct_gram(model: &Model, data: &mut Data) {
+    let g = data.gram.as_mut().expect("factored by the Gram path");
+    g.correct(&data.gamma, &mut data.residual, &mut data.y, &mut data.lambda);
+    data.qdd.copy_from_slice(&data.y);
+    apply_finvt(model, &data.bodies, &mut data.qdd);
 }
 
 /// `qdd = UK(t, q, qd)` into `data.qdd` (and `data.lambda`). Allocation free.
@@ -140,7 +188,7 @@ pub fn min_norm_correction(model: &Model, data: &mut Data, r: &[f64]) {
     data.qdd_free.fill(0.0);
     data.y.fill(0.0);
     data.gamma.copy_from_slice(r);
-    if data.factored_with == Factored::SparseGram {
+    if matches!(data.factored_with, Factored::SparseGram | Factored::Gram) {
         correct(model, data);
     } else {
         // the residual is r itself (A 0 = 0)

@@ -70,6 +70,9 @@ pub enum Factored {
     Cod,
     /// Certified full-rank band Cholesky of `A M^-1 A^T` in `sparse` (`uk::sparse`).
     SparseGram,
+    /// Certified full-rank envelope Cholesky of `A M^-1 A^T`, the normalization rows
+    /// eliminated, in `gram` (`uk::gram`: small spatial models).
+    Gram,
 }
 
 /// Rank decision of the pseudoinverse: singular values below

@@ -1,0 +1,486 @@
+//! The spatial path of the UK correction for small mechanisms: the Cholesky factor of the Gram
+//! matrix `S = B B^T = A M^-1 A^T` on its envelope, the Euler-parameter normalization rows
+//! eliminated in closed form, with the full-rank certificate of the sparse path (`uk::sparse`)
+//! and one refinement step with `B`. The dense certified QR (`uk::dense`) stays the fallback,
+//! and the planar models never come here (`Data::gram` is `None` for them).
+//!
+//! Elimination. A rigid3 body's normalization row maps to a unit vector, `F^-1 A_u^T = d e_c`
+//! (`d = 1 / sqrt k`, `c` the body's `Rigid3::NORMALIZATION_COORD`; `Model::unit_columns`). With
+//! the unit rows first, `B^T = [E D, J]` (`E` the unit vectors, `J` the joint and driver
+//! columns), `S = [[D^2, D X], [X^T D, J^T J]]` with `X = E^T J` (each joint row's entries at
+//! the unit coordinates of its bodies), and its Cholesky factor is `[[D, 0], [X^T, L_22]]` with
+//! `L_22 L_22^T = S_22 = J^T J - X^T X = Y^T Y`, `Y` the rows of `J` off the unit coordinates.
+//! Only `S_22` is factored: its rows couple when they share a body, so in the reverse
+//! Cuthill-McKee order of that graph it lives on a narrow envelope (the spatial slider-crank's
+//! 17 joint rows: 4 blocks of 3 to 5 rows, each coupled to its neighbours; `linalg::envelope`).
+//! This is the factor the dense QR computes (`R = L^T` up to signs) without the Householder
+//! work on the exact zeros.
+//!
+//! Certificate. `trace(S^-1) = |L^-1|_F^2 = sum_b (1 + x_b^T S_22^-1 x_b) / d_b^2 +
+//! trace(S_22^-1)` (`x_b` the row of `X` of unit `b`: its entries are on rows that share body
+//! `b`, so the selected inverse of `S_22` on its envelope holds every product needed), and
+//! `trace(S) = |R|_F^2`. The computed `L` is the exact factor of `S + E`, `E` in the `S_22` block
+//! only (`D` and `X` are read off `B^T`), `|E|_2 <= delta = 2 (2 w - 1) (gamma_{w+1} +
+//! gamma_l) max_i (S_22)_ii` (`w` the widest row of the envelope, `l` the longest dot product of
+//! an entry of `S_22`; Higham, *Accuracy and Stability*, Thm 10.3, as in `uk::sparse`). Rank
+//! `m` is certified when `lower = 1 / (2 trace(S^-1)) - delta > tol^2`, `tol = max(atol, rcond
+//! sqrt(trace S))` with the dense path's `rcond` (`RankTolerance::rcond_at`); otherwise the
+//! dense rank-revealing path decides. The report is the dense QR's: `sigma_max = sqrt(trace S)
+//! = |R|_F`, `sigma_min_kept = 1 / sqrt(trace S^-1) = 1 / |R^-1|_F`, so the singular-passage
+//! monitor and the Newton floor read the same quantity on either path (equal up to rounding:
+//! where this certificate passes, `cond(B)^2 eps` is small).
+//!
+//! Accuracy. The unit rows fix the correction's unit coordinates exactly (`dy_c = r_u / d`, as
+//! the QR's identity reflectors do); solving with `S_22` squares the condition number of `Y`,
+//! and one refinement step with `Y` itself, `x += S_22^-1 (r~ - Y Y^T x)`, brings the error back
+//! to `O(cond(B) eps)` on the certified cases (as in `uk::sparse`).
+
+use super::settings::RankInfo;
+use crate::body::BodyData;
+use crate::constraint::jac::{Seg, SegJac};
+use crate::linalg::envelope::EnvelopeCholesky;
+use crate::model::Model;
+
+/// The Gram path serves `B` whose condition estimate `sqrt(trace S trace S^-1)` (at least
+/// `cond(B)`) is at most this; beyond it the dense QR keeps its `O(cond(B) eps)` constraint
+/// residual. Measured (`gram_path_matches_the_certified_qr`), a gate between two points: at an
+/// estimate of 1.4e3 (the spatial slider-crank) and 21 (the heavy top) the refined Gram
+/// solution's `|A qdd - b|` is below the QR's; at 9.8e3 (A05's thin rods, `|B^T|` up to 450
+/// times its smallest scale) it was 60 times the QR's (the refinement's floor,
+/// `eps |Y| |Y^T x|`, with a free acceleration 800 times the constrained one).
+pub const GRAM_MAX_COND: f64 = 3e3;
+
+/// After a refusal (condition estimate above `GRAM_MAX_COND`, or no certificate) this many
+/// factorizations go straight to the dense QR before the Gram path is tried again: a mechanism
+/// that stays badly conditioned (A05) then pays the refused attempt on one call in
+/// `GRAM_RETRY + 1` (it doubled A05's call when tried every call).
+pub const GRAM_RETRY: u32 = 64;
+
+/// A normalization row: its row of `A`, the unit coordinate `c` and where `B^T[c, row]` is in
+/// the values of its segment.
+#[derive(Debug, Clone, Copy)]
+struct Unit {
+    row: usize,
+    coord: usize,
+    seg: Seg,
+    local: usize,
+}
+
+/// Symbolic analysis (once per model) and numeric workspace of the spatial Gram path.
+#[derive(Debug, Clone)]
+pub struct GramUk {
+    m: usize,
+    /// The joint and driver rows in the envelope order: `rows[p]` is a row of `A`.
+    rows: Vec<usize>,
+    units: Vec<Unit>,
+    /// The segments of `A`'s rows (`SegJac`'s pattern) and `B^T` in the same layout.
+    seg_ptr: Vec<usize>,
+    segs: Vec<Seg>,
+    vals: Vec<f64>,
+    /// The entries of `X`: `(position p, unit b, index of B^T[c_b, rows[p]] in vals)`, and their
+    /// values (`factor` moves them out of `vals`, which then holds `Y`).
+    xs: Vec<(usize, usize, usize)>,
+    xval: Vec<f64>,
+    /// The quadratic forms `x_b^T Z x_b`: `(unit b, index of Z(p, q), index of x_p and of x_q in
+    /// xval, weight)`.
+    quad: Vec<(usize, usize, usize, usize, f64)>,
+    /// `S_22[entry] += vals_a . vals_b` over `(entry, a, b, len)`.
+    pairs: Vec<(usize, usize, usize, usize)>,
+    /// Longest dot product that makes one entry of `S_22`.
+    max_dot: usize,
+    env: EnvelopeCholesky,
+    /// Selected inverse of `S_22` (the layout of `env`).
+    z: Vec<f64>,
+    /// `d_b = B^T[c_b, row_b]`, and scratch per unit.
+    d: Vec<f64>,
+    zu: Vec<f64>,
+    /// Scratch: three by position of the joint rows, one n long.
+    rt: Vec<f64>,
+    xp: Vec<f64>,
+    dxp: Vec<f64>,
+    wn: Vec<f64>,
+    /// `trace(S)`, `trace(S^-1)` of the last `factor`.
+    pub trace_s: f64,
+    pub trace_sinv: f64,
+    /// Factorizations left to the dense QR after the last refusal (`GRAM_RETRY`).
+    pub skip: u32,
+}
+
+impl GramUk {
+    /// Symbolic analysis on the pattern of `ajac` (the model's `SegJac`).
+    pub fn new(model: &Model, ajac: &SegJac) -> GramUk {
+        let (n, m) = (model.n, model.m);
+        let mut unit_of_row = vec![None; m];
+        let mut unit_of_body = vec![None; model.bodies.len()];
+        let mut units = Vec::new();
+        for (row, coord) in model.unit_columns() {
+            let seg = *ajac.row_segs(row).iter().find(|s| s.col <= coord && coord < s.col + s.len).expect("a unit row touches its body");
+            unit_of_row[row] = Some(units.len());
+            unit_of_body[seg.body] = Some(units.len());
+            units.push(Unit { row, coord, seg, local: coord - seg.col });
+        }
+        let joint_rows: Vec<usize> = (0..m).filter(|&i| unit_of_row[i].is_none()).collect();
+        // rows of each body (joint rows only), and the reverse Cuthill-McKee order of the rows
+        let mut rows_of_body: Vec<Vec<usize>> = vec![Vec::new(); model.bodies.len()];
+        for (a, &i) in joint_rows.iter().enumerate() {
+            for s in ajac.row_segs(i) {
+                rows_of_body[s.body].push(a);
+            }
+        }
+        let mut adj: Vec<Vec<usize>> = vec![Vec::new(); joint_rows.len()];
+        for rs in &rows_of_body {
+            for &a in rs {
+                adj[a].extend(rs.iter().copied().filter(|&b| b != a));
+            }
+        }
+        for a in adj.iter_mut() {
+            a.sort_unstable();
+            a.dedup();
+        }
+        let perm = crate::linalg::rcm::rcm(&adj);
+        let mut order = vec![0; joint_rows.len()];
+        for (a, &p) in perm.iter().enumerate() {
+            order[p] = a;
+        }
+        let rows: Vec<usize> = order.iter().map(|&a| joint_rows[a]).collect();
+        // each row's envelope starts at the first row it shares a body with
+        let first: Vec<usize> = order.iter().enumerate().map(|(p, &a)| adj[a].iter().map(|&b| perm[b]).fold(p, usize::min)).collect();
+        let env = EnvelopeCholesky::new(first);
+        // the pairs of S_22 (off the unit coordinates) and the entries of X
+        let mut pairs = Vec::new();
+        let mut dots = vec![0usize; env.len()];
+        let mut xs = Vec::new();
+        let mut segs_of_body: Vec<Vec<(usize, Seg)>> = vec![Vec::new(); model.bodies.len()];
+        for (p, &i) in rows.iter().enumerate() {
+            for s in ajac.row_segs(i) {
+                segs_of_body[s.body].push((p, *s));
+                if let Some(b) = unit_of_body[s.body] {
+                    xs.push((p, b, s.val + units[b].local));
+                }
+            }
+        }
+        for (body, list) in segs_of_body.iter().enumerate() {
+            let skip = unit_of_body[body].map(|b| units[b].local);
+            for &(pa, sa) in list {
+                for &(pb, sb) in list.iter().filter(|(pb, _)| *pb <= pa) {
+                    let e = env.index(pa, pb);
+                    let ranges = match skip {
+                        Some(u) => [(0, u), (u + 1, sa.len)],
+                        None => [(0, sa.len), (0, 0)],
+                    };
+                    for (lo, hi) in ranges.into_iter().filter(|(lo, hi)| hi > lo) {
+                        pairs.push((e, sa.val + lo, sb.val + lo, hi - lo));
+                        dots[e] += hi - lo;
+                    }
+                }
+            }
+        }
+        pairs.sort_unstable_by_key(|p| p.0);
+        // x_b^T Z x_b = sum over the ordered pairs of X's entries of unit b
+        let mut quad = Vec::new();
+        for b in 0..units.len() {
+            let mine: Vec<(usize, usize)> = xs.iter().enumerate().filter(|(_, x)| x.1 == b).map(|(t, x)| (t, x.0)).collect();
+            for (a, &(s, ps)) in mine.iter().enumerate() {
+                for &(t, pt) in &mine[..=a] {
+                    let w = if pt == ps { 1.0 } else { 2.0 };
+                    quad.push((b, env.index(ps.max(pt), ps.min(pt)), s, t, w));
+                }
+            }
+        }
+        let (nu, mj, len) = (units.len(), rows.len(), env.len());
+        GramUk {
+            m,
+            rows,
+            units,
+            seg_ptr: ajac.seg_ptr.clone(),
+            segs: ajac.segs.clone(),
+            vals: vec![0.0; ajac.vals.len()],
+            xval: vec![0.0; xs.len()],
+            xs,
+            quad,
+            pairs,
+            max_dot: dots.into_iter().max().unwrap_or(0),
+            env,
+            z: vec![0.0; len],
+            d: vec![0.0; nu],
+            zu: vec![0.0; nu],
+            rt: vec![0.0; mj],
+            xp: vec![0.0; mj],
+            dxp: vec![0.0; mj],
+            wn: vec![0.0; n],
+            trace_s: 0.0,
+            trace_sinv: f64::INFINITY,
+            skip: 0,
+        }
+    }
+
+    /// Heap bytes of the workspace of `GramUk::new` (a bound without building it: the pattern,
+    /// the values, and an envelope and pair lists no larger than those of the dense `S`).
+    pub fn bytes(model: &Model) -> u64 {
+        let nnz: u64 = model.constraints.iter().map(|c| c.rows() as u64 * c.bodies().into_iter().flatten().map(|b| model.bodies[b].n_coords as u64).sum::<u64>()).sum();
+        let (n, m) = (model.n as u64, model.m as u64);
+        8 * (3 * nnz + 6 * m * m + 8 * m + n) + 48 * m * m + 48 * nnz
+    }
+
+    /// `B^T`, `S_22`, its envelope Cholesky factor and the full-rank certificate (module docs)
+    /// with the relative tolerance `rcond` and the absolute `atol`. `Some(info)` when rank = m
+    /// is certified (ready for `correct`), `None` otherwise.
+    pub fn factor(&mut self, model: &Model, bodies: &[BodyData], ajac: &SegJac, rcond: f64, atol: f64) -> Option<RankInfo> {
+        debug_assert_eq!(self.vals.len(), ajac.vals.len());
+        self.vals.copy_from_slice(&ajac.vals);
+        for s in &self.segs {
+            model.bodies[s.body].finv(&bodies[s.body], &mut self.vals[s.val..s.val + s.len]);
+        }
+        let mut trace_s = 0.0;
+        for (d, u) in self.d.iter_mut().zip(&self.units) {
+            *d = self.vals[u.seg.val + u.local];
+            trace_s += *d * *d;
+        }
+        // X out of the joint rows: `vals` keeps `Y`
+        for (x, &(_, _, e)) in self.xval.iter_mut().zip(&self.xs) {
+            *x = self.vals[e];
+            self.vals[e] = 0.0;
+            trace_s += *x * *x;
+        }
+        let data = &mut self.env.data;
+        data.fill(0.0);
+        for &(e, a, b, len) in &self.pairs {
+            data[e] += crate::linalg::dot4(&self.vals[a..a + len], &self.vals[b..b + len]);
+        }
+        let mut max_d = 0.0f64;
+        for p in 0..self.rows.len() {
+            let s = self.env.diag(p);
+            trace_s += s;
+            max_d = max_d.max(s);
+        }
+        self.trace_s = trace_s;
+        self.trace_sinv = f64::INFINITY;
+        if !trace_s.is_finite() || self.d.iter().any(|d| !(d.abs() > 0.0)) || !self.env.factor_in_place() {
+            return None;
+        }
+        let mut trace_sinv = self.env.selected_inverse_trace(&mut self.z);
+        self.zu.fill(1.0);
+        for &(b, e, s, t, w) in &self.quad {
+            self.zu[b] += w * self.z[e] * self.xval[s] * self.xval[t];
+        }
+        for (zu, d) in self.zu.iter().zip(&self.d) {
+            trace_sinv += zu / (d * d);
+        }
+        self.trace_sinv = trace_sinv;
+        let gamma = |k: usize| {
+            let ke = k as f64 * f64::EPSILON;
+            ke / (1.0 - ke)
+        };
+        let w = self.env.width.max(1);
+        let delta = 2.0 * (2 * w - 1) as f64 * (gamma(w + 1) + gamma(self.max_dot)) * max_d;
+        let lower = 0.5 / trace_sinv - delta;
+        let sigma_max = trace_s.sqrt();
+        let tol = atol.max(rcond * sigma_max);
+        let conditioned = trace_s * trace_sinv <= GRAM_MAX_COND * GRAM_MAX_COND;
+        if lower.is_finite() && lower > 0.0 && lower > tol * tol && conditioned {
+            Some(RankInfo { rank: self.m, sigma_max, sigma_min_kept: 1.0 / trace_sinv.sqrt(), sigma_max_dropped: 0.0, tolerance: tol, exact: false })
+        } else {
+            None
+        }
+    }
+
+    /// `(Y v)_p` for the joint row at position `p` (off the unit coordinates).
+    #[inline]
+    fn y_dot(&self, p: usize, v: &[f64]) -> f64 {
+        let i = self.rows[p];
+        let mut s = 0.0;
+        for sg in &self.segs[self.seg_ptr[i]..self.seg_ptr[i + 1]] {
+            s += crate::linalg::dot4(&self.vals[sg.val..sg.val + sg.len], &v[sg.col..sg.col + sg.len]);
+        }
+        s
+    }
+
+    /// `out += Y^T x` (x by position, out n long).
+    fn add_yt_times(&self, x: &[f64], out: &mut [f64]) {
+        for (&i, &xi) in self.rows.iter().zip(x) {
+            for sg in &self.segs[self.seg_ptr[i]..self.seg_ptr[i + 1]] {
+                for (o, b) in out[sg.col..sg.col + sg.len].iter_mut().zip(&self.vals[sg.val..sg.val + sg.len]) {
+                    *o += b * xi;
+                }
+            }
+        }
+    }
+
+    /// The correction with the current factorization, `y = F^-1 Q` on entry: the minimum-norm
+    /// `dy` with `B dy = r = b - B y` (`r` into `residual`), `y += dy`, `lambda = -S^-1 r`. The
+    /// unit rows fix `dy_c = r_u / d` exactly; the rest is `Y^T x` with `S_22 x = r_j - X^T dy_c`,
+    /// plus one refinement step with `Y` (`x += S_22^-1 (r~ - Y Y^T x)`); the unit rows'
+    /// multipliers are `-(dy_c - X x) / d`.
+    pub fn correct(&mut self, gamma: &[f64], residual: &mut [f64], y: &mut [f64], lambda: &mut [f64]) {
+        // r = b - B y
+        for (p, &i) in self.rows.iter().enumerate() {
+            residual[i] = gamma[i] - self.y_dot(p, y);
+        }
+        for (&(p, b, _), x) in self.xs.iter().zip(&self.xval) {
+            residual[self.rows[p]] -= x * y[self.units[b].coord];
+        }
+        for ((zu, u), d) in self.zu.iter_mut().zip(&self.units).zip(&self.d) {
+            residual[u.row] = gamma[u.row] - d * y[u.coord];
+            *zu = residual[u.row] / d;
+        }
+        // r~ = r_j - X^T dy_c, x = S_22^-1 r~
+        let (mut rt, mut xp, mut dxp, mut wn) = (std::mem::take(&mut self.rt), std::mem::take(&mut self.xp), std::mem::take(&mut self.dxp), std::mem::take(&mut self.wn));
+        for (r, &i) in rt.iter_mut().zip(&self.rows) {
+            *r = residual[i];
+        }
+        for (&(p, b, _), x) in self.xs.iter().zip(&self.xval) {
+            rt[p] -= x * self.zu[b];
+        }
+        xp.copy_from_slice(&rt);
+        self.env.solve(&mut xp);
+        // one refinement step with Y
+        wn.fill(0.0);
+        self.add_yt_times(&xp, &mut wn);
+        for (p, dx) in dxp.iter_mut().enumerate() {
+            *dx = rt[p] - self.y_dot(p, &wn);
+        }
+        self.env.solve(&mut dxp);
+        for (x, dx) in xp.iter_mut().zip(&dxp) {
+            *x += dx;
+        }
+        // y += Y^T x + dy_c; the multipliers
+        self.add_yt_times(&xp, y);
+        for (&i, x) in self.rows.iter().zip(&xp) {
+            lambda[i] = -x;
+        }
+        for (u, zu) in self.units.iter().zip(&self.zu) {
+            y[u.coord] += zu;
+            lambda[u.row] = *zu;
+        }
+        for (&(p, b, _), x) in self.xs.iter().zip(&self.xval) {
+            lambda[self.units[b].row] -= x * xp[p];
+        }
+        for (u, d) in self.units.iter().zip(&self.d) {
+            lambda[u.row] /= -d;
+        }
+        (self.rt, self.xp, self.dxp, self.wn) = (rt, xp, dxp, wn);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::correct::{correct, CorrectOptions};
+    use crate::data::{Data, Factored, RankTolerance, UkSolver};
+    use crate::model::Model;
+    use crate::uk;
+
+    fn scene(json: &str) -> (Model, Vec<f64>, Vec<f64>) {
+        let model = Model::from_json(json).unwrap();
+        let mut data = Data::build(&model, UkSolver::Dense, u64::MAX).unwrap();
+        let opts = CorrectOptions { hold: vec![false; model.n], rigid: false, position_tol: 1e-12, velocity_tol: 1e-10, max_iterations: 50 };
+        let c = correct(&model, &mut data, 0.0, &model.q0, &model.qd0, &opts).unwrap();
+        (model, c.q, c.qd)
+    }
+
+    /// The Gram path gives the accelerations, multipliers and rank report of the dense certified
+    /// QR (an explicit `UkSolver::Dense`) on the spatial slider-crank and the heavy top, on the
+    /// manifold and 1e-7 off it, with a constraint residual no larger; the flyball governor
+    /// (A05, condition estimate 1e4 > `GRAM_MAX_COND`) and Bricard's mechanism (A04, rank 34 of
+    /// 35) are refused and decided by the dense path as before.
+    #[test]
+    fn gram_path_matches_the_certified_qr() {
+        let scenes = [
+            (include_str!("../../benches/data/spatial/slider_crank.json"), Factored::Gram),
+            (include_str!("../../benches/data/spatial/heavy_top.json"), Factored::Gram),
+            (include_str!("../../benches/data/spatial/flyball.json"), Factored::FullRankQr),
+            (include_str!("../../benches/data/spatial/bricard.json"), Factored::Faer),
+        ];
+        for (si, (json, path)) in scenes.into_iter().enumerate() {
+            let full_rank = path != Factored::Faer;
+            let (model, q0, qd0) = scene(json);
+            let (n, m) = (model.n, model.m);
+            let mut data = Data::new(&model);
+            let mut plain = Data::build(&model, UkSolver::Dense, u64::MAX).unwrap();
+            // (A04's 35 rows take the sparse path, its certificate fails, the dense one decides)
+            assert!(data.gram.is_some() == full_rank && plain.gram.is_none());
+            for (k, off) in [(0usize, 0.0), (1, 1e-7)] {
+                let q: Vec<f64> = q0.iter().enumerate().map(|(i, x)| x + off * ((i * 7 + k) as f64).sin()).collect();
+                let qd: Vec<f64> = qd0.iter().enumerate().map(|(i, x)| x + 0.3 * ((i * 3 + k) as f64).cos()).collect();
+                uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
+                uk::acceleration(&model, &mut plain, 0.1, &q, &qd).unwrap();
+                let (a, b) = (data.rank_info, plain.rank_info);
+                assert_eq!(a.rank, b.rank);
+                assert_eq!(data.factored_with, path, "scene {si}");
+                if path != Factored::Gram {
+                    // the dense path as before, to the bit
+                    assert!(data.qdd == plain.qdd && data.lambda == plain.lambda);
+                    continue;
+                }
+                if full_rank {
+                    assert_eq!(plain.factored_with, Factored::FullRankQr);
+                    assert!((a.sigma_max - b.sigma_max).abs() < 1e-13 * b.sigma_max);
+                    assert!((a.sigma_min_kept - b.sigma_min_kept).abs() < 1e-9 * b.sigma_min_kept, "{} vs {}", a.sigma_min_kept, b.sigma_min_kept);
+                    assert!((a.tolerance - b.tolerance).abs() <= 1e-13 * b.tolerance);
+                } else {
+                    assert_ne!(data.factored_with, Factored::Gram);
+                    assert_eq!(a.rank, m - 1);
+                }
+                // both solutions err by O(cond(B) eps): compare at that scale, and compare
+                // their acceleration residuals A qdd - b
+                let tol = 64.0 * f64::EPSILON * b.sigma_max / b.sigma_min_kept.max(1e-300);
+                let amax = plain.qdd.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+                let lmax = plain.lambda.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+                for i in 0..n {
+                    assert!((data.qdd[i] - plain.qdd[i]).abs() < tol * amax, "scene {si}: qdd[{i}] {} vs {}", data.qdd[i], plain.qdd[i]);
+                }
+                for i in 0..m {
+                    assert!((data.lambda[i] - plain.lambda[i]).abs() < tol * lmax, "scene {si}: lambda[{i}] {} vs {}", data.lambda[i], plain.lambda[i]);
+                }
+                // (the rounding of A qdd itself: eps max_i |A_i| . |qdd|)
+                let res = |d: &Data| (0..m).map(|i| (d.ajac.row_dot(i, &d.qdd) - d.gamma[i]).abs()).fold(0.0f64, f64::max);
+                let abs_qdd: Vec<f64> = plain.qdd.iter().map(|x| x.abs()).collect();
+                let mut abs_a = plain.ajac.clone();
+                abs_a.vals.iter_mut().for_each(|x| *x = x.abs());
+                let floor = (0..m).map(|i| abs_a.row_dot(i, &abs_qdd)).fold(0.0f64, f64::max) * f64::EPSILON;
+                assert!(res(&data) <= 4.0 * res(&plain) + 16.0 * floor, "scene {si}: |A qdd - b| {:.2e} vs {:.2e}", res(&data), res(&plain));
+                // the minimum-norm correction of the projections: the same step
+                let r: Vec<f64> = (0..m).map(|i| 1e-6 * (i as f64).sin()).collect();
+                uk::min_norm_correction(&model, &mut data, &r);
+                uk::min_norm_correction(&model, &mut plain, &r);
+                let dmax = plain.qdd.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
+                for i in 0..n {
+                    assert!((data.qdd[i] - plain.qdd[i]).abs() < tol * dmax, "scene {si}: dq[{i}] {} vs {}", data.qdd[i], plain.qdd[i]);
+                }
+                // the exact report on demand: the singular values of the same B
+                if full_rank {
+                    let e = uk::exact_rank_info(&model, &mut data).unwrap();
+                    let f = uk::exact_rank_info(&model, &mut plain).unwrap();
+                    assert!(e.exact && f.exact && e.rank == f.rank);
+                    assert!((e.sigma_min_kept - f.sigma_min_kept).abs() < 1e-12 * f.sigma_max);
+                }
+            }
+        }
+    }
+
+    /// A tolerance above the smallest singular value: the certificate refuses and the dense
+    /// rank-revealing path drops it, as without the Gram path.
+    #[test]
+    fn the_certificate_refuses_below_the_tolerance() {
+        let (model, q, qd) = scene(include_str!("../../benches/data/spatial/slider_crank.json"));
+        let mut data = Data::new(&model);
+        uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
+        assert_eq!(data.factored_with, Factored::Gram);
+        let exact = uk::singular_values(&model, &mut data).unwrap().unwrap();
+        let ratio = exact[model.m - 1] / exact[0];
+        // just above sigma_min: the Gram certificate (and the QR's) cannot pass
+        data.tolerance = RankTolerance { rcond: Some(1.5 * ratio), atol: 0.0 };
+        uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
+        assert_ne!(data.factored_with, Factored::Gram);
+        assert_eq!(data.rank_info.rank, model.m - 1);
+        // and just below the certificate's reach (a factor sqrt 2 and the rounding), it passes,
+        // once the refused attempt's `GRAM_RETRY` calls on the QR are over
+        data.tolerance = RankTolerance { rcond: Some(0.5 * ratio / (model.m as f64).sqrt()), atol: 0.0 };
+        for _ in 0..super::GRAM_RETRY {
+            uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
+            assert_eq!((data.factored_with, data.rank_info.rank), (Factored::FullRankQr, model.m));
+        }
+        uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
+        assert_eq!(data.factored_with, Factored::Gram);
+        assert_eq!(data.rank_info.rank, model.m);
+    }
+}
