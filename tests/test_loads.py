@@ -394,15 +394,15 @@ def test_elastic_elements_forces_are_their_potentials_gradients():
     assert np.max(np.abs(Q)) > 1.0
 
 
-def _tip_spring_cantilever(k, elements=8):
+def _tip_cantilever(fy, elements=8):
     """A clamped Euler-Bernoulli FFRF cantilever (1 m steel strip 20 x 10 mm) with a tip load
-    ``fy = -k v(bar, 1)``: a spring on the tip deflection, written as a load's expression."""
+    ``fy`` (an expression of its tip deflection: a spring, a damper)."""
     s = Scene()
     b = s.beam("bar", length=1.0, section={"rectangular": {"width": 0.02, "height": 0.01}}, density=7800.0,
                youngs_modulus=2e11, elements=elements, theory="euler-bernoulli", strain="linear", frame="clamped",
                rotary_inertia=False)
     s.weld(s.ground.frame(), b.at(0.0), name="clamp")
-    s.point_load(b.at(1.0), fx=0.0, fy=f"-{k!r} * v(bar, 1)")
+    s.point_load(b.at(1.0), fx=0.0, fy=fy)
     return s.build()
 
 
@@ -417,9 +417,22 @@ def test_tip_deflection_spring_raises_the_first_frequency_as_the_closed_form(kap
     bl = brentq(f, 1.0, 3.9)
     closed = bl**2 * math.sqrt(EI / (rhoA * L**4))
     free = math.sqrt(EI / (rhoA * L**4)) * 1.8751**2
-    omega = np.sort(_tip_spring_cantilever(kappa * EI / L**3).frequencies())[0]
+    omega = np.sort(_tip_cantilever(f"-{kappa * EI / L**3!r} * v(bar, 1)").frequencies())[0]
     assert closed > 1.3 * free
     assert abs(omega / closed - 1) < 1e-4, (omega, closed)
+
+
+def test_velocity_feedback_on_the_tip_deflection_damps_the_first_mode_as_the_closed_form():
+    # fy = -c d:v(bar, 1): single-mode model of the cantilever's first mode (phi(L) = 2 for
+    # int phi^2 dx = L): sigma = c phi(L)^2 / (2 rho A L) = 2 c / (rho A L), at light damping
+    # (zeta = 1 %); the eigenvalue of the linearized motion (System.jac) nearest i w_1
+    EI, rhoA, L, c = 2e11 * 0.02 * 0.01**3 / 12, 7800.0 * 0.02 * 0.01, 1.0, 0.4
+    system = _tip_cantilever(f"-{c!r} * d:v(bar, 1)")
+    ev = np.linalg.eigvals(np.asarray(system.jac(0.0, system.y0)))
+    w1 = 1.8751041**2 * math.sqrt(EI / (rhoA * L**4))
+    lam = ev[np.argmin(np.abs(ev.imag - w1))]
+    sigma = 2 * c / (rhoA * L)
+    assert abs(lam.imag / w1 - 1) < 1e-4 and abs(-lam.real / sigma - 1) < 1e-3, (lam, sigma)
 
 
 def test_beam_deflection_input_of_the_paper_scene_runs_and_is_the_output():
