@@ -392,3 +392,88 @@ def test_elastic_elements_forces_are_their_potentials_gradients():
                      for e in np.eye(system.n_coords)])
     assert np.max(np.abs(Q + grad)) < 1e-7 * np.max(np.abs(Q))
     assert np.max(np.abs(Q)) > 1.0
+
+
+def _tip_cantilever(fy, elements=8):
+    """A clamped Euler-Bernoulli FFRF cantilever (1 m steel strip 20 x 10 mm) with a tip load
+    ``fy`` (an expression of its tip deflection: a spring, a damper)."""
+    s = Scene()
+    b = s.beam("bar", length=1.0, section={"rectangular": {"width": 0.02, "height": 0.01}}, density=7800.0,
+               youngs_modulus=2e11, elements=elements, theory="euler-bernoulli", strain="linear", frame="clamped",
+               rotary_inertia=False)
+    s.weld(s.ground.frame(), b.at(0.0), name="clamp")
+    s.point_load(b.at(1.0), fx=0.0, fy=fy)
+    return s.build()
+
+
+@pytest.mark.parametrize("kappa", [3.0, 30.0])
+def test_tip_deflection_spring_raises_the_first_frequency_as_the_closed_form(kappa):
+    # cantilever with a tip spring k: (bL)^3 (1 + cos bL cosh bL) + kappa (sin bL cosh bL -
+    # cos bL sinh bL) = 0, kappa = k L^3 / EI (kappa -> inf: clamped-pinned, bL = 3.9266)
+    from scipy.optimize import brentq
+
+    EI, rhoA, L = 2e11 * 0.02 * 0.01**3 / 12, 7800.0 * 0.02 * 0.01, 1.0
+    f = lambda b: b**3 * (1 + math.cos(b) * math.cosh(b)) + kappa * (math.sin(b) * math.cosh(b) - math.cos(b) * math.sinh(b))
+    bl = brentq(f, 1.0, 3.9)
+    closed = bl**2 * math.sqrt(EI / (rhoA * L**4))
+    free = math.sqrt(EI / (rhoA * L**4)) * 1.8751**2
+    omega = np.sort(_tip_cantilever(f"-{kappa * EI / L**3!r} * v(bar, 1)").frequencies())[0]
+    assert closed > 1.3 * free
+    assert abs(omega / closed - 1) < 1e-4, (omega, closed)
+
+
+def test_velocity_feedback_on_the_tip_deflection_damps_the_first_mode_as_the_closed_form():
+    # fy = -c d:v(bar, 1): single-mode model of the cantilever's first mode (phi(L) = 2 for
+    # int phi^2 dx = L): sigma = c phi(L)^2 / (2 rho A L) = 2 c / (rho A L), at light damping
+    # (zeta = 1 %); the eigenvalue of the linearized motion (System.jac) nearest i w_1
+    EI, rhoA, L, c = 2e11 * 0.02 * 0.01**3 / 12, 7800.0 * 0.02 * 0.01, 1.0, 0.4
+    system = _tip_cantilever(f"-{c!r} * d:v(bar, 1)")
+    ev = np.linalg.eigvals(np.asarray(system.jac(0.0, system.y0)))
+    w1 = 1.8751041**2 * math.sqrt(EI / (rhoA * L**4))
+    lam = ev[np.argmin(np.abs(ev.imag - w1))]
+    sigma = 2 * c / (rhoA * L)
+    assert abs(lam.imag / w1 - 1) < 1e-4 and abs(-lam.real / sigma - 1) < 1e-3, (lam, sigma)
+
+
+def test_beam_deflection_input_of_the_paper_scene_runs_and_is_the_output():
+    # the issue's example: a force on the slider that reads the coupler's midpoint deflection
+    from ukflex import scenes
+
+    def scene(fx):
+        s = scenes.slider_crank()
+        s.point_load(s["coupler"].at(1.0), fx=fx)
+        return s
+
+    a = scene("-(2000 * (1 + cos(crank.theta))^2 + 1e6 * v(coupler, 0.5) + 1e3 * d:psi(coupler, 1))").build(correct=False)
+    zero = scene(0.0).build(correct=False)
+    rng = np.random.default_rng(2)
+    q, qd = a.q0 + 1e-3 * rng.standard_normal(a.n_coords), rng.standard_normal(a.n_coords)
+    h = 1e-6
+    v = a.core.beam_point("coupler", 0.5, q)[3]
+    psid = (a.core.beam_point("coupler", 1.0, q + h * qd)[4] - a.core.beam_point("coupler", 1.0, q - h * qd)[4]) / (2 * h)
+    f = -(2000 * (1 + math.cos(q[a.coordinate_names.index("crank.theta")])) ** 2 + 1e6 * v + 1e3 * psid)
+    const = scenes.slider_crank()
+    const.point_force(const["coupler"].at(1.0), (f, 0.0))
+    want = const.build(correct=False).core.Q(0.0, q, qd) - zero.core.Q(0.0, q, qd)
+    got = a.core.Q(0.0, q, qd) - zero.core.Q(0.0, q, qd)
+    assert abs(v) > 1e-5 and np.max(np.abs(got - want)) < 1e-7 * np.max(np.abs(want))
+    res = ukflex.simulate(scene("-2000 * (1 + cos(crank.theta))^2 - 1e5 * v(coupler, 0.5)").build(), 0.02, method="RADAU5M")
+    assert res.success and np.all(np.isfinite(res.q))
+
+
+def test_beam_quantity_inputs_bad_input_is_named():
+    from ukflex import scenes
+
+    s = scenes.slider_crank()
+    p = s["coupler"].at(1.0)
+    with pytest.raises(ukflex.InvalidSceneError, match="unknown body 'rod'"):
+        s.point_load(p, fx="v(rod, 0.5)")
+    with pytest.raises(ukflex.ExpressionError, match=r"XI must be a number in \[0, 1\]") as e:
+        s.point_load(p, fx="2 * v(coupler, 1.5)")
+    assert e.value.position == 4
+    with pytest.raises(ukflex.ExpressionError, match="body 'crank' \\(rigid\\) has no beam axis"):
+        s.point_load(p, fx="v(crank, 0.5)")
+    with pytest.raises(ukflex.ExpressionError, match="algebraic loop.*joint_friction"):
+        s.point_load(p, fx="0.1 * reaction(slider).fx")
+    with pytest.raises(ukflex.ExpressionError, match="sensor M"):
+        s.point_load(p, fx="M(coupler, 0.5)")

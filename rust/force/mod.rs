@@ -16,6 +16,7 @@ pub mod motor3;
 pub mod rotational_spring;
 pub mod value;
 pub mod value3;
+pub mod value_beam;
 
 pub mod spatial;
 pub mod spatial_load;
@@ -484,7 +485,7 @@ mod tests {
 
     /// `K` of `stiffness_into` against central differences of the forces.
     /// The scene of `text` at its `q0` moved by `dq (i + 1)` and the velocities `qd0 (1 - 0.4 i)`.
-    fn moving(text: &str, dq: f64, qd0: f64) -> (Model, Data, Vec<f64>, Vec<f64>) {
+    pub(super) fn moving(text: &str, dq: f64, qd0: f64) -> (Model, Data, Vec<f64>, Vec<f64>) {
         let model = Model::from_json(text).unwrap();
         let data = Data::new(&model);
         let q: Vec<f64> = model.q0.iter().enumerate().map(|(i, x)| x + dq * (i as f64 + 1.0)).collect();
@@ -492,7 +493,12 @@ mod tests {
         (model, data, q, qd)
     }
 
-    fn stiffness_against_differences(text: &str, dq: f64, qd0: f64) -> Vec<f64> {
+    pub(super) fn stiffness_against_differences(text: &str, dq: f64, qd0: f64) -> Vec<f64> {
+        stiffness_rows_against_differences(text, dq, qd0, |_, _| true)
+    }
+
+    /// As `stiffness_against_differences`, on the rows `row(model, i)` selects only.
+    pub(super) fn stiffness_rows_against_differences(text: &str, dq: f64, qd0: f64, row: impl Fn(&Model, usize) -> bool + Copy) -> Vec<f64> {
         let (model, mut data, q, qd) = moving(text, dq, qd0);
         let n = model.n;
         let mut k = vec![0.0; n * n];
@@ -506,7 +512,7 @@ mod tests {
             qv[j] = q[j] - h;
             dynamics::mass_and_forces(&model, &mut data, 0.0, &qv, &qd);
             qv[j] = q[j];
-            for i in 0..n {
+            for i in (0..n).filter(|&i| row(&model, i)) {
                 let fd = -(fp[i] - data.force[i]) / (2.0 * h);
                 assert!((k[i * n + j] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "K[{i}][{j}] = {} vs {fd}", k[i * n + j]);
             }

@@ -5,7 +5,8 @@
 //! State quantities are spelled as the output expressions of docs/outputs.md: `t`, a
 //! coordinate name (`crank.theta`, `slider.x`, `coupler.qf1`) and its rate (`d:crank.theta`),
 //! the world position of a body's point `x(BODY, XI)`, `y(BODY, XI)` (a beam's axis point at
-//! `XI`, as the outputs'; the point of a marker at `xi`) and its rate `d:x(BODY, XI)`, plus the
+//! `XI`, as the outputs'; the point of a marker at `xi`) and its rate `d:x(BODY, XI)`, a beam's
+//! displacement `u/v/psi(BEAM, XI)` and its rate (`value_beam.rs`), plus the
 //! element's own quantities (a motor's `angle` and `w`, the relative angle and rate of its two
 //! markers). A point quantity is read into the expression as a variable: before parsing, its
 //! text is replaced by a placeholder name of the same length (so error positions stay).
@@ -13,6 +14,7 @@
 use std::sync::Arc;
 
 use super::value3::Spatial;
+use super::value_beam::BeamQuantity;
 use crate::body::marker3::{add_jacobian, Marker3};
 use crate::body::{Body, Marker};
 use crate::constraint::BuildContext;
@@ -37,6 +39,8 @@ pub enum Input {
     /// Component `axis` (0: x, 1: y, 2: z) of the position (`rate`: velocity) of the value's
     /// spatial point `k` (`Expr::points3`, `value3.rs`).
     Point3 { k: usize, axis: usize, rate: bool },
+    /// The value's beam quantity `k` (`Expr::beams`, `value_beam.rs`): `u`, `v`, `psi` or a rate.
+    Beam(usize),
 }
 
 /// The state a value is evaluated at.
@@ -51,7 +55,7 @@ pub struct Env<'a> {
 
 impl Env<'_> {
     #[inline]
-    fn get(&self, i: Input, points: &[Marker], points3: &[Marker3]) -> f64 {
+    fn get(&self, i: Input, points: &[Marker], points3: &[Marker3], beams: &[BeamQuantity]) -> f64 {
         match i {
             Input::Time => self.t,
             Input::Coord(k) => self.q[k],
@@ -65,6 +69,7 @@ impl Env<'_> {
                 let s = points3[k].state_axes(self.bodies, self.q, self.qd, 0).point;
                 if rate { s.vd[axis] } else { s.v[axis] }
             }
+            Input::Beam(k) => beams[k].value(self.q, self.qd),
         }
     }
 }
@@ -95,7 +100,7 @@ fn point_quantity(s: &str) -> Option<(usize, bool, String, f64, usize)> {
 
 /// An expression's text with its point quantities replaced: the text, the placeholders with
 /// their inputs, the planar and the spatial points' markers.
-type Substituted = (String, Vec<(String, Input)>, Vec<Marker>, Vec<Marker3>);
+type Substituted = (String, Vec<(String, Input)>, Vec<Marker>, Vec<Marker3>, Vec<BeamQuantity>);
 
 impl Scope<'_> {
     /// `text` with each point quantity replaced by a placeholder variable of the same length
@@ -104,6 +109,7 @@ impl Scope<'_> {
         let mut out = String::with_capacity(text.len());
         let (mut found, mut markers): (Vec<(String, Input)>, Vec<Marker>) = (Vec::new(), Vec::new());
         let mut markers3: Vec<Marker3> = Vec::new();
+        let mut beams: Vec<BeamQuantity> = Vec::new();
         let mut i = 0;
         let bytes = text.as_bytes();
         while i < text.len() {
@@ -121,6 +127,12 @@ impl Scope<'_> {
                     }
                 }
             } else if boundary {
+                if let Some(len) = self.beam_quantity(item, text, i, found.len(), &mut beams)? {
+                    found.push((format!("{:_<len$}", format!("_p{}", found.len())), Input::Beam(beams.len() - 1)));
+                    out.push_str(&found.last().expect("just pushed").0);
+                    i += len;
+                    continue;
+                }
                 if let Some((axis, rate, body, xi, len)) = point_quantity(&text[i..]) {
                     let placeholder = format!("_p{}", found.len());
                     if let (Some(ctx), true) = (self.ctx, placeholder.len() <= len) {
@@ -139,7 +151,23 @@ impl Scope<'_> {
             out.push(c);
             i += c.len_utf8();
         }
-        Ok((out, found, markers, markers3))
+        Ok((out, found, markers, markers3, beams))
+    }
+
+    /// A beam quantity `u/v/psi(B, XI)` (or its rate) at `text[i..]`, pushed on `beams`: the
+    /// length of its text; `None` if there is none (or no room for the placeholder of number
+    /// `k`). A sensor that is not an input is refused by name here.
+    fn beam_quantity(&self, item: &str, text: &str, i: usize, k: usize, beams: &mut Vec<BeamQuantity>) -> Result<Option<usize>> {
+        let err = |message: String| Error::Expression { item: item.to_string(), text: text.to_string(), message, position: i };
+        if let Some(m) = super::value_beam::refused_sensor(&text[i..]) {
+            return Err(err(m));
+        }
+        let (Some(ctx), Some((what, rate, body, xi, len))) = (self.ctx, super::value_beam::parse(&text[i..])) else { return Ok(None) };
+        if format!("_p{k}").len() > len {
+            return Ok(None);
+        }
+        beams.push(BeamQuantity::new(ctx, item, what, rate, body, xi, &err)?);
+        Ok(Some(len))
     }
 
     fn resolve(&self, name: &str) -> Option<Input> {
@@ -167,6 +195,7 @@ impl Scope<'_> {
         s += ") or its rate d:<coordinate>";
         if self.ctx.is_some() {
             s += ", x(BODY, XI), y(BODY, XI) or their rates d:x(...)";
+            s += super::value_beam::HELP;
         }
         if self.spatial.is_some() {
             s += super::value3::HELP;
@@ -186,6 +215,8 @@ pub struct Expr {
     points: Vec<Marker>,
     /// The markers of the spatial point quantities it reads.
     points3: Vec<Marker3>,
+    /// The beam quantities it reads.
+    beams: Vec<BeamQuantity>,
 }
 
 /// The natural cubic spline of `constraint::motion` (a driver's tabulated motion) through
@@ -278,7 +309,7 @@ impl Value {
                 Ok(Value::Const(*v))
             }
             LoadValueDesc::Expression(text) => {
-                let (parsed, points, markers, markers3) = scope.substitute_points(item, text)?;
+                let (parsed, points, markers, markers3, beams) = scope.substitute_points(item, text)?;
                 let mut names: Vec<String> = vec!["t".into()];
                 names.extend(scope.local.iter().map(|s| s.to_string()));
                 names.extend(scope.coordinate_names.iter().cloned());
@@ -293,7 +324,7 @@ impl Value {
                     .iter()
                     .map(|v| points.iter().find(|(p, _)| p == v).map(|(_, i)| *i).or_else(|| scope.resolve(v)).expect("a candidate name"))
                     .collect();
-                Ok(Value::Expr(Box::new(Expr { f, inputs, points: markers, points3: markers3 })))
+                Ok(Value::Expr(Box::new(Expr { f, inputs, points: markers, points3: markers3, beams })))
             }
             LoadValueDesc::Table(t) => Ok(Value::Table(Box::new(Table::new(item, scope, t)?))),
             LoadValueDesc::Callable(c) => Ok(Value::Callable(Box::new(Callable::new(item, scope, c)?))),
@@ -323,7 +354,7 @@ impl Value {
     /// a planar point's `d:x(BODY, XI)` does too, and that is left out).
     pub fn add_position_gradient(&self, env: &Env, scratch: &mut [f64], row: &mut [f64]) -> [f64; 2] {
         let mut local = [0.0; 2];
-        let mut put = |i: Input, g: f64, points: &[Marker], points3: &[Marker3], row: &mut [f64]| match i {
+        let mut put = |i: Input, g: f64, points: &[Marker], points3: &[Marker3], beams: &[BeamQuantity], row: &mut [f64]| match i {
             Input::Coord(j) => row[j] += g,
             Input::Point { k, axis, rate: false } => {
                 let s = points[k].state(env.bodies, env.q, env.qd);
@@ -340,6 +371,7 @@ impl Value {
                 add_jacobian(env.bodies, &s, &kin, &w, row, None);
             }
             Input::Local(k) => local[k] += g,
+            Input::Beam(k) => beams[k].add_gradient(env.q, env.qd, g, row),
             _ => {}
         };
         match self {
@@ -348,16 +380,16 @@ impl Value {
                 let (x, rest) = scratch.split_at_mut(k);
                 let (grad, buf) = rest.split_at_mut(k);
                 for (xi, &i) in x.iter_mut().zip(&e.inputs) {
-                    *xi = env.get(i, &e.points, &e.points3);
+                    *xi = env.get(i, &e.points, &e.points3, &e.beams);
                 }
                 e.f.eval_gradient(x, buf, grad);
                 for (&i, &g) in e.inputs.iter().zip(grad.iter()) {
-                    put(i, g, &e.points, &e.points3, row);
+                    put(i, g, &e.points, &e.points3, &e.beams, row);
                 }
             }
             Value::Table(t) => {
-                let (_, slope) = t.eval(env.get(t.input, &[], &[]));
-                put(t.input, slope, &[], &[], row);
+                let (_, slope) = t.eval(env.get(t.input, &[], &[], &[]));
+                put(t.input, slope, &[], &[], &[], row);
             }
             _ => {}
         }
@@ -378,7 +410,7 @@ impl Value {
         };
         match self {
             Value::Const(_) => Vec::new(),
-            Value::Expr(e) => e.inputs.iter().filter_map(of).collect(),
+            Value::Expr(e) => e.inputs.iter().filter_map(of).chain(e.beams.iter().flat_map(BeamQuantity::coords)).collect(),
             Value::Table(t) => of(&t.input).into_iter().collect(),
             Value::Callable(c) => c.inputs.iter().filter_map(of).collect(),
         }
@@ -405,15 +437,15 @@ impl Value {
             Value::Expr(e) => {
                 let (x, buf) = scratch.split_at_mut(e.inputs.len());
                 for (xi, &i) in x.iter_mut().zip(&e.inputs) {
-                    *xi = env.get(i, &e.points, &e.points3);
+                    *xi = env.get(i, &e.points, &e.points3, &e.beams);
                 }
                 e.f.eval(x, buf)
             }
-            Value::Table(tb) => tb.eval(env.get(tb.input, &[], &[])).0,
+            Value::Table(tb) => tb.eval(env.get(tb.input, &[], &[], &[])).0,
             Value::Callable(c) => {
                 let x = &mut scratch[..c.inputs.len()];
                 for (xi, &i) in x.iter_mut().zip(&c.inputs) {
-                    *xi = env.get(i, &[], &[]);
+                    *xi = env.get(i, &[], &[], &[]);
                 }
                 c.f.as_ref().map_or(f64::NAN, |f| f.call(env.t, x))
             }
