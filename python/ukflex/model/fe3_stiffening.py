@@ -1,7 +1,8 @@
 """Stresses of the FE solid of a ``flexible3`` body: stress stiffening (docs/spatial-flexible.md,
 "Stress stiffening"), the modal geometric-stiffness matrices of the unit inertia load cases
-(:func:`ukflex.fe3.from_mesh` with ``stress_stiffening=True``), and the modes' nodal stress
-shapes (:func:`stress_modes`, for the fields and the VTK export).
+(:func:`ukflex.fe3.from_mesh` with ``stress_stiffening=True``), the Green-Lagrange strain's
+energy terms of the modal field (:func:`quadratic_strain`, ``quadratic_strain=True``), and the
+modes' nodal stress shapes (:func:`stress_modes`, for the fields and the VTK export).
 
 A load case is a body force per unit mass ``b(x) = B x + c`` in the frame's axes. The solid,
 held at the frame's interface, carries it statically (``K u = f``, ``f_i = int rho phi_i b``);
