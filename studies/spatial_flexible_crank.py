@@ -1,7 +1,8 @@
-"""``python -m studies spatial-flexible-crank [--quick]``: Haug's spatial slider-crank with a
+"""``python -m studies spatial-flexible-crank [--quick | --gap]``: Haug's spatial slider-crank with a
 flexible connecting rod (``ukflex.spatial_scenes.flexible_slider_crank``, docs/spatial-flexible.md),
 the rod built once as a geometrically exact beam (``beam3``) and once as a 3D modal body from a
-solid FE model (``flexible3``, Craig-Bampton at the two end faces), and the beam side by side
+solid FE model (``flexible3``, Craig-Bampton at the two end faces; linear, and with the
+Green-Lagrange strain's cubic energy, ``quadratic_strain=True``), and the beam side by side
 with Exudyn 1.13.6 (``ObjectBeamGeometricallyExact`` on ``NodeRigidBodyEP`` nodes).
 
 Outputs, from the public results: the slider's position ``x(t)`` and the rod's deflection, the
@@ -244,16 +245,19 @@ def _table(rows: List[Tuple[str, Dict[str, np.ndarray], float]], refs: Dict[str,
 def main(argv: Optional[List[str]] = None) -> int:
     """Three tables: the two ukflex models converged and compared; the beam-modal gap against the
     crank speed; ukflex against Exudyn, error against wall time (medians of 3 interleaved
-    repetitions). ``--quick``: fewer meshes, no speed table, one repetition."""
-    global OMEGA
+    repetitions). ``--quick``: fewer meshes, no speed table, one repetition; ``--gap``: the
+    beam-modal gap against the crank speed alone."""
     args = list(argv or [])
     if "-h" in args or "--help" in args:
         print(__doc__)
         return 0
-    unknown = [a for a in args if a != "--quick"]
+    unknown = [a for a in args if a not in ("--quick", "--gap")]
     if unknown:
-        print(f"python -m studies spatial-flexible-crank: unknown arguments {unknown} (options: --quick)", file=sys.stderr)
+        print(f"python -m studies spatial-flexible-crank: unknown arguments {unknown} (options: --quick, --gap)", file=sys.stderr)
         return 2
+    if "--gap" in args:
+        print("\n".join(gap_table()))
+        return 0
     quick = "--quick" in args
     reps = 1 if quick else 3
     t = times()
@@ -273,23 +277,16 @@ def main(argv: Optional[List[str]] = None) -> int:
         rows.append((f"flexible3 {mesh}, {modes} modes | RADAU5 rtol 1e-9",
                      *ukflex_run("modal", t, data=sps.slider_crank_rod_data(mesh, modes), **TIGHT)))
     rows.append(("flexible3 (32, 2, 2), 8 modes | RADAU5 rtol 1e-9", mref, float("nan")))
+    for mesh, modes in (((16, 1, 1), 4),) if quick else (((16, 1, 1), 4), ((32, 2, 2), 8)):
+        _log(f"ukflex flexible3 {mesh}, {modes} modes, quadratic strain")
+        rows.append((f"flexible3 {mesh}, {modes} modes, quadratic strain | RADAU5 rtol 1e-9",
+                     *ukflex_run("modal", t, data=sps.slider_crank_rod_data(mesh, modes, quadratic_strain=True), **TIGHT)))
     print(f"crank {OMEGA} rad/s after a {SPIN_UP} s spin-up, {t[-1]:.4f} s; rod clamped-clamped modes (Hz): "
           f"{np.round(modal_ref_data.info['frequencies'][:4], 1).tolist()}")
     print("error = max |x - x_ref| / max |x_ref - x_ref(0)| (slider), max |d - d_ref| / max |d_ref| (deflection)\n")
     print("\n".join(_table(rows, refs)))
     if not quick:
-        print("\nbeam3 16 elements against flexible3 (32, 2, 2), 8 modes, by crank speed (RADAU5 rtol 1e-9):\n")
-        print("| crank speed [rad/s] | max \\|d\\| beam [mm] | max \\|d\\| modal [mm] | slider gap | deflection gap |\n|---:|---:|---:|---:|---:|")
-        for om in (150.0, 75.0, 37.5):
-            OMEGA = om
-            tt = times(SPIN_UP + 4 * np.pi / om)
-            _log(f"speed {om} rad/s")
-            ob, _ = ukflex_run("beam", tt, elements=16, **TIGHT)
-            om_, _ = ukflex_run("modal", tt, data=modal_ref_data, **TIGHT)
-            e_s, e_d = errors(om_, ob)
-            print(f"| {om} | {1e3 * np.max(np.linalg.norm(ob['deflection'], axis=1)):.4f} | "
-                  f"{1e3 * np.max(np.linalg.norm(om_['deflection'], axis=1)):.4f} | {e_s:.2e} | {e_d:.2e} |")
-        OMEGA = 150.0
+        print("\n".join(gap_table(modal_ref_data)))
     meshes = (8, 16) if quick else (8, 16, 24)
     runs = [(f"ukflex beam3 {n}, default simulate()", (lambda n=n: ukflex_run("beam", t, elements=n))) for n in meshes]
     runs += [(f"ukflex beam3 {n}, RADAU5M rtol 1e-6", (lambda n=n: ukflex_run("beam", t, elements=n, method="RADAU5M", rtol=1e-6)))
@@ -320,6 +317,33 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"| {name} | {e_s:.2e} | {e_d:.2e} | {dt:.2f} |")
     print("\n".join(modal_table(t, reps)))
     return 0
+
+
+def gap_table(modal_ref_data: Any = None) -> List[str]:
+    """The beam-modal gap against the crank speed: beam3 16 elements against flexible3
+    (32, 2, 2), 8 modes, linear, and with the quadratic strain at 8 and 16 modes (RADAU5 rtol
+    1e-9)."""
+    global OMEGA
+    if modal_ref_data is None:
+        modal_ref_data = sps.slider_crank_rod_data((32, 2, 2), 8)
+    models = [("8 modes", modal_ref_data), ("8 modes, quadratic strain", sps.slider_crank_rod_data((32, 2, 2), 8, quadratic_strain=True)),
+              ("16 modes, quadratic strain", sps.slider_crank_rod_data((32, 2, 2), 16, quadratic_strain=True))]
+    out = ["\nbeam3 16 elements against flexible3 (32, 2, 2), linear and with the quadratic strain, by crank speed (RADAU5 rtol "
+           "1e-9); each modal rod: max |d| [mm], slider gap, deflection gap:\n",
+           "| crank speed [rad/s] | max \\|d\\| beam [mm] | " + " | ".join(name for name, _ in models) + " |",
+           "|---:|---:|" + "---|" * len(models)]
+    for om in (150.0, 75.0, 37.5):
+        OMEGA = om
+        tt = times(SPIN_UP + 4 * np.pi / om)
+        _log(f"speed {om} rad/s")
+        ob, _ = ukflex_run("beam", tt, elements=16, **TIGHT)
+        cells = [f"{1e3 * np.max(np.linalg.norm(ob['deflection'], axis=1)):.4f}"]
+        for _, d in models:
+            om_, _ = ukflex_run("modal", tt, data=d, **TIGHT)
+            cells.append(f"{1e3 * np.max(np.linalg.norm(om_['deflection'], axis=1)):.4f}, " + ", ".join("{:.2e}".format(e) for e in errors(om_, ob)))
+        out.append(f"| {om} | " + " | ".join(cells) + " |")
+    OMEGA = 150.0
+    return out
 
 
 #: Exudyn's spectral radius for the modal rod: at 1 (no numerical damping) its answer wanders

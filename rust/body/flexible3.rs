@@ -32,6 +32,7 @@ use crate::error::{check_finite_item, positive, Error, Result};
 use crate::linalg::dense::cholesky;
 use crate::linalg::rot3::{cross, dot, mat_t_vec, mat_vec, rot_a, rot_e, rot_g, M3, V3};
 use super::flexible3_stiffening::GeometricStiffness;
+use super::flexible3_strain::QuadraticStrain;
 
 pub use super::rigid3::NORMALIZATION_COORD;
 
@@ -66,6 +67,8 @@ pub struct Flexible3 {
     pub size: f64,
     /// Stress stiffening (`flexible3_stiffening.rs`), when the data carry it.
     pub stiffening: Option<GeometricStiffness>,
+    /// The quadratic strain's cubic energy (`flexible3_strain.rs`), when the data carry it.
+    pub strain: Option<QuadraticStrain>,
 }
 
 /// Workspace: the state of the last `mass_and_forces`, the velocity-space mass matrix and its
@@ -154,7 +157,8 @@ impl Flexible3 {
             interfaces.push(Interface3 { point: f.point, phi: f.phi.clone(), psi });
         }
         let stiffening = d.geometric_stiffness.as_ref().map(|g| GeometricStiffness::from_desc(item, g, n)).transpose()?;
-        let body = Flexible3 { mass, n, first: d.first_moment.clone(), second: d.second_moment.clone(), m_ff, k_ff, d_ff, k, inv_sqrt_k: 1.0 / k.max(f64::MIN_POSITIVE).sqrt(), interfaces, size, stiffening };
+        let strain = d.quadratic_strain.as_ref().map(|g| QuadraticStrain::from_desc(item, g, d.quadratic_strain_quartic.as_ref(), n)).transpose()?;
+        let body = Flexible3 { mass, n, first: d.first_moment.clone(), second: d.second_moment.clone(), m_ff, k_ff, d_ff, k, inv_sqrt_k: 1.0 / k.max(f64::MIN_POSITIVE).sqrt(), interfaces, size, stiffening, strain };
         body.check_definite(item)?;
         Ok(body)
     }
@@ -360,6 +364,9 @@ impl Flexible3 {
         if let Some(g) = &self.stiffening {
             g.add_forces(&w, &mat_t_vec(&r, &[qd[0], qd[1], qd[2]]), qf, &mut f[7..7 + n]);
         }
+        if let Some(s) = &self.strain {
+            s.add_forces(qf, &mut f[7..7 + n]);
+        }
         let fr = mat_vec(&r, &qr);
         f[0..3].copy_from_slice(&fr);
         self.put_rotational(bd, &qw, pd, &mut f[3..7]);
@@ -495,9 +502,9 @@ impl Flexible3 {
         0.5 * e
     }
 
-    /// `1/2 q_f^T K_ff q_f`.
+    /// `1/2 q_f^T K_ff q_f` (+ the quadratic strain's `V3`, `flexible3_strain.rs`).
     pub fn strain_energy(&self, q: &[f64]) -> f64 {
-        self.material_energy(q, q)
+        self.material_energy(q, q) + self.strain.as_ref().map_or(0.0, |s| s.energy(&q[7..7 + self.n]))
     }
 
     /// `1/2 v_f^T K_ff v_f` (body segments).
@@ -513,10 +520,13 @@ impl Flexible3 {
         0.5 * e
     }
 
-    /// `-dQ/dq_f = K_ff (+ K_g(w', v'))`, `-dQ/dqd_f = D_ff` (body coordinates; the stress
-    /// stiffening's dependence on the frame's rates is left to the differences).
+    /// `-dQ/dq_f = K_ff (+ K_g(w', v')) (+ d2V3/dq_f^2)`, `-dQ/dqd_f = D_ff` (body coordinates;
+    /// the stress stiffening's dependence on the frame's rates is left to the differences).
     pub fn tangent(&self, q: &[f64], qd: &[f64], k: &mut impl FnMut(usize, usize, f64), c: &mut impl FnMut(usize, usize, f64)) {
         let n = self.n;
+        if let Some(s) = &self.strain {
+            s.tangent(&q[7..7 + n], &mut |i, j, v| k(7 + i, 7 + j, v));
+        }
         if let Some(g) = &self.stiffening {
             let (r, w, _) = Self::frame(&q[3..7], &qd[3..7]);
             g.tangent(&w, &mat_t_vec(&r, &[qd[0], qd[1], qd[2]]), &mut |i, j, v| k(7 + i, 7 + j, v));
@@ -638,5 +648,6 @@ impl Flexible3 {
         m.insert("interfaces".into(), self.interfaces.iter().map(|f| f.point.to_vec()).collect::<Vec<_>>().into());
         m.insert("first_moment".into(), self.first[0].to_vec().into());
         m.insert("stress_stiffening".into(), self.stiffening.is_some().into());
+        m.insert("quadratic_strain".into(), self.strain.is_some().into());
     }
 }

@@ -68,6 +68,8 @@ fn desc(c: &Cloud) -> Flexible3Desc {
         k_ff,
         d_ff: None,
         geometric_stiffness: None,
+        quadratic_strain: None,
+        quadratic_strain_quartic: None,
         interfaces: vec![Interface3Desc { point: c.u[0], phi: c.s[0].clone(), psi: Some((0..N).map(|j| [0.1 * j as f64, -0.2, 0.3]).collect()) }],
         position: [0.0; 3],
         orientation: None,
@@ -387,6 +389,69 @@ fn stress_stiffening_forces_and_tangent() {
             plain.tangent(&q, &qd, &mut |i, jj, x| kp[i * (7 + N) + jj] += x, &mut |_, _, _| {});
             let ana = kt[j * (7 + N) + l] - kp[j * (7 + N) + l];
             assert!((num - ana).abs() < 1e-6 * (1.0 + ana.abs()), "({j}, {l}): {num} vs {ana}");
+        }
+    }
+}
+
+#[test]
+fn quadratic_strain_force_and_tangent_by_differences() {
+    // random symmetric G_k (T_kij symmetric in (i, j) only, as the FE's are)
+    let c = cloud();
+    let mut d = desc(&c);
+    let mut g = Lcg(13);
+    let gk: Vec<Vec<Vec<f64>>> = (0..N)
+        .map(|_| {
+            let a: Vec<Vec<f64>> = (0..N).map(|_| (0..N).map(|_| g.next()).collect()).collect();
+            (0..N).map(|i| (0..N).map(|j| 50.0 * (a[i][j] + a[j][i])).collect()).collect()
+        })
+        .collect();
+    d.quadratic_strain = Some(gk);
+    // H_ijkl = sum_p w_p b_ij^p b_kl^p from random symmetric b^p: the symmetries of int B_ij : C : B_kl
+    let bs: Vec<Vec<f64>> = (0..4)
+        .map(|_| {
+            let a: Vec<f64> = (0..N * N).map(|_| g.next()).collect();
+            (0..N * N).map(|x| a[x] + a[(x % N) * N + x / N]).collect()
+        })
+        .collect();
+    d.quadratic_strain_quartic = Some((0..N * N).map(|r| (0..N * N).map(|c| bs.iter().map(|b| 30.0 * b[r] * b[c]).sum()).collect()).collect());
+    let b = Flexible3::from_desc(&d, "body 'f'").unwrap();
+    let (plain, _) = body();
+    let (q, qd) = state();
+    let m = 7 + N;
+    let v3 = |x: &[f64]| b.strain_energy(x) - plain.strain_energy(x);
+    let force = |x: &[f64]| {
+        let (mut f, mut f0) = (vec![0.0; m], vec![0.0; m]);
+        b.mass_and_forces(&mut b.new_data(), x, &qd, None, &mut f);
+        plain.mass_and_forces(&mut plain.new_data(), x, &qd, None, &mut f0);
+        (0..m).map(|j| f[j] - f0[j]).collect::<Vec<f64>>()
+    };
+    assert!(v3(&q).abs() > 1e-3, "the cubic energy is not exercised: {}", v3(&q));
+    let f = force(&q);
+    let mut kt = vec![0.0; m * m];
+    b.tangent(&q, &qd, &mut |i, j, x| kt[i * m + j] += x, &mut |_, _, _| {});
+    plain.tangent(&q, &qd, &mut |i, j, x| kt[i * m + j] -= x, &mut |_, _, _| {});
+    let h = 1e-5;
+    for l in 0..m {
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        qp[l] += h;
+        qm[l] -= h;
+        // the force is -dV3/dq (zero on the frame's coordinates)
+        let num = -(v3(&qp) - v3(&qm)) / (2.0 * h);
+        assert!((num - f[l]).abs() < 1e-6 * (1.0 + num.abs()), "force {l}: {} vs {num}", f[l]);
+        if l < 7 {
+            continue;
+        }
+        let (fp, fm) = (force(&qp), force(&qm));
+        for j in 0..m {
+            let num = -(fp[j] - fm[j]) / (2.0 * h);
+            let ana = kt[j * m + l];
+            assert!((num - ana).abs() < 1e-6 * (1.0 + ana.abs()), "tangent ({j}, {l}): {ana} vs {num}");
+        }
+    }
+    // the tangent is symmetric (a Hessian)
+    for i in 0..m {
+        for j in 0..m {
+            assert!((kt[i * m + j] - kt[j * m + i]).abs() < 1e-12 * (1.0 + kt[i * m + j].abs()));
         }
     }
 }

@@ -21,6 +21,7 @@ pub mod marker;
 pub mod flexible;
 pub mod flexible3;
 pub mod flexible3_stiffening;
+pub mod flexible3_strain;
 #[cfg(test)]
 mod flexible3_tests;
 pub mod inspect;

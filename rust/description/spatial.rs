@@ -99,6 +99,15 @@ pub struct Flexible3Desc {
     /// each unit load case, in the order of `body::flexible3::LOAD_CASES` (12 matrices).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub geometric_stiffness: Option<Vec<Vec<Vec<f64>>>>,
+    /// The quadratic (Green-Lagrange) strain (docs/spatial-flexible.md, "Quadratic strain"):
+    /// the modal geometric stiffness `G_k` (n x n) of each mode's linear stress (n matrices),
+    /// the cubic strain energy `1/2 sum_k q_k q^T G_k q`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quadratic_strain: Option<Vec<Vec<Vec<f64>>>>,
+    /// With `quadratic_strain`: the quartic energy's `H_ijkl = int B_ij : C : B_kl` (n^2 x n^2,
+    /// row `i n + j`, column `k n + l`), `V4 = 1/8 H_ijkl q_i q_j q_k q_l`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quadratic_strain_quartic: Option<Vec<Vec<f64>>>,
     /// Interface nodes (the only places markers may sit): undeformed point, per-mode nodal
     /// displacement `phi` (n x 3) and rotation `psi` (n x 3, default zero).
     #[serde(default)]

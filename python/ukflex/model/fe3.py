@@ -38,6 +38,11 @@ centroid, the rest statically condensed), followed by the fixed-interface normal
 Stress stiffening (``stress_stiffening=True``, a clamped frame): the modal geometric stiffness
 of twelve unit inertia load cases (:mod:`ukflex.model.fe3_stiffening`), which the body scales by
 its frame's motion (docs/spatial-flexible.md, "Stress stiffening").
+
+Quadratic strain (``quadratic_strain=True``): the Green-Lagrange strain's second-order part kept
+for the modal field, a St-Venant-Kirchhoff solid's cubic and quartic strain energy
+(docs/spatial-flexible.md, "Quadratic strain"): the stress the modes carry (a Craig-Bampton
+basis: the axial force from the joints) stiffens the body.
 """
 
 from __future__ import annotations
@@ -53,7 +58,7 @@ import scipy.sparse.linalg as spla
 from ..arguments import count, non_negative, positive, real
 from ..errors import InvalidArgumentError, require
 from .fe import REDUCTIONS, frame_interfaces
-from .fe3_stiffening import geometric_stiffness, held_mask, stress_modes
+from .fe3_stiffening import geometric_stiffness, held_mask, quadratic_strain as _quadratic_strain, stress_modes
 
 __all__ = ["FlexibleData3", "Interface3", "solid_matrices", "from_mesh", "bar_mesh"]
 
@@ -86,7 +91,10 @@ class FlexibleData3:
     nodal ``stress_modes`` (N, 6, n): ``xx, yy, zz, yz, zx, xy`` per unit modal coordinate; with
     stress stiffening the static ``load_displacements`` (12, N, 3) of the unit load cases);
     ``geometric_stiffness`` (12, n, n), with ``stress_stiffening=True``, the modal geometric
-    stiffness of the unit load cases (:data:`ukflex.model.fe3_stiffening.LOAD_CASES`)."""
+    stiffness of the unit load cases (:data:`ukflex.model.fe3_stiffening.LOAD_CASES`);
+    ``quadratic_strain`` (n, n, n) and ``quadratic_strain_quartic`` (n^2, n^2), with
+    ``quadratic_strain=True``, the cubic and quartic energy terms of the Green-Lagrange strain
+    (:func:`ukflex.model.fe3_stiffening.quadratic_strain`)."""
 
     mass: float
     first_moment: np.ndarray
@@ -96,6 +104,8 @@ class FlexibleData3:
     interfaces: Dict[str, Interface3] = field(default_factory=dict)
     info: Dict[str, Any] = field(default_factory=dict)
     geometric_stiffness: Optional[np.ndarray] = None
+    quadratic_strain: Optional[np.ndarray] = None
+    quadratic_strain_quartic: Optional[np.ndarray] = None
 
     @property
     def n_modes(self) -> int:
@@ -130,6 +140,9 @@ class FlexibleData3:
             d["d_ff"] = np.asarray(self.d_ff, float).tolist()
         if self.geometric_stiffness is not None:
             d["geometric_stiffness"] = np.asarray(self.geometric_stiffness, float).tolist()
+        if self.quadratic_strain is not None:
+            d["quadratic_strain"] = np.asarray(self.quadratic_strain, float).tolist()
+            d["quadratic_strain_quartic"] = np.asarray(self.quadratic_strain_quartic, float).tolist()
         return d
 
 
@@ -334,7 +347,7 @@ def _held(frame: Any, names: List[str]) -> Optional[str]:
 def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio: float,
               interfaces: Mapping[str, InterfaceSpec], modes: int = 8, frame: Any = "mean-axis",
               reduction: str = "modes", order: int = 2, damping_ratio: float = 0.0,
-              stress_stiffening: bool = False) -> FlexibleData3:
+              stress_stiffening: bool = False, quadratic_strain: bool = False) -> FlexibleData3:
     """The ``flexible3`` body of an FE solid reduced to ``modes`` normal modes (module docs).
     ``interfaces``: name -> node index, indices, mask, ``select(nodes) -> mask`` or
     ``{"point": (x, y, z)}`` (a node must sit there). ``frame``: ``"mean-axis"`` or
@@ -342,11 +355,17 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
     ``"craig-bampton"`` (module docs). ``damping_ratio``: modal damping of the kept modes.
     ``stress_stiffening``: also the modal geometric stiffness of the unit inertia load cases
     (:mod:`ukflex.model.fe3_stiffening`; a clamped frame: the solid carries the loads held at
-    its frame's interface), stored as ``geometric_stiffness`` (12, n, n)."""
+    its frame's interface), stored as ``geometric_stiffness`` (12, n, n). ``quadratic_strain``:
+    the Green-Lagrange strain's cubic and quartic energy, stored as ``quadratic_strain``
+    (n, n, n) and ``quadratic_strain_quartic`` (n^2, n^2) (module docs); not with ``stress_stiffening`` (both would count the stress the modes carry)."""
     zeta = non_negative("damping_ratio", damping_ratio)
     nmodes = count("modes", modes)
-    if not isinstance(stress_stiffening, bool):
-        raise InvalidArgumentError("stress_stiffening", f"expected True or False, got {stress_stiffening!r}")
+    for name, flag in (("stress_stiffening", stress_stiffening), ("quadratic_strain", quadratic_strain)):
+        if not isinstance(flag, bool):
+            raise InvalidArgumentError(name, f"expected True or False, got {flag!r}")
+    if stress_stiffening and quadratic_strain:
+        raise InvalidArgumentError("quadratic_strain", "quadratic_strain and stress_stiffening together would count the inertia "
+                                   "loads' stress twice (the modes carry it); choose one (docs/spatial-flexible.md, 'Quadratic strain')")
     solid = _solid(mesh, density=density, youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, order=order)
     nodes, k, ms = solid.nodes, solid.k, solid.ms
     n3 = 3 * nodes.shape[0]
@@ -360,6 +379,9 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
         raise InvalidArgumentError("reduction", f"unknown reduction {reduction!r}; expected one of {list(REDUCTIONS)}")
     if reduction == "craig-bampton" and reference is None:
         raise InvalidArgumentError("reduction", "the craig-bampton reduction needs a clamped frame (an interface held)")
+    if quadratic_strain and reference is None:
+        raise InvalidArgumentError("quadratic_strain", "the quadratic strain needs a clamped frame (('clamped', NAME)): the "
+                                   "displacement outside the basis is condensed on the solid held at its frame's interface")
     if stress_stiffening and reference is None:
         raise InvalidArgumentError("stress_stiffening", "stress stiffening needs a clamped frame (('clamped', NAME)): the "
                                    "inertia loads are carried by the solid held at its frame's interface")
@@ -414,6 +436,8 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
     data.info["stress_modes"] = stress_modes(solid, basis)
     if stress_stiffening:
         data.geometric_stiffness, data.info["load_displacements"] = geometric_stiffness(solid, held_mask(sets, reference, n3), basis)
+    if quadratic_strain:
+        data.quadratic_strain, data.quadratic_strain_quartic = _quadratic_strain(solid, basis, held_mask(sets, reference, n3))
     return data
 
 

@@ -1,7 +1,8 @@
 """Stresses of the FE solid of a ``flexible3`` body: stress stiffening (docs/spatial-flexible.md,
 "Stress stiffening"), the modal geometric-stiffness matrices of the unit inertia load cases
-(:func:`ukflex.fe3.from_mesh` with ``stress_stiffening=True``), and the modes' nodal stress
-shapes (:func:`stress_modes`, for the fields and the VTK export).
+(:func:`ukflex.fe3.from_mesh` with ``stress_stiffening=True``), the Green-Lagrange strain's
+energy terms of the modal field (:func:`quadratic_strain`, ``quadratic_strain=True``), and the
+modes' nodal stress shapes (:func:`stress_modes`, for the fields and the VTK export).
 
 A load case is a body force per unit mass ``b(x) = B x + c`` in the frame's axes. The solid,
 held at the frame's interface, carries it statically (``K u = f``, ``f_i = int rho phi_i b``);
@@ -84,14 +85,13 @@ def geometric_stiffness(solid: Any, held: np.ndarray, basis: np.ndarray) -> Tupl
     static displacements of the cases (12, N, 3), the solid held on the dofs ``held`` (mask of
     3N). ``solid``: the assembled model of :mod:`ukflex.model.fe3` (nodes, ``k``, ``ms``, the
     scalar ``basis``, ``lam``, ``mu``)."""
-    skfem = require("skfem", "ukflex.fe3 (stress stiffening)", extra="fe")
-    nodes, k, ms, sb = solid.nodes, solid.k, solid.ms, solid.basis
+    nodes, k, ms = solid.nodes, solid.k, solid.ms
     nn, n = nodes.shape[0], basis.shape[1]
     free = np.nonzero(~held)[0]
     lu = spla.splu(k[free][:, free].tocsc())
     mx, m1 = ms @ nodes, ms @ np.ones(nn)
     modes = [basis[a::3, :] for a in range(3)]  # (N, n) each
-    form = skfem.BilinearForm(lambda u, v, w: sum(w[f"s{i}{j}"] * u.grad[i] * v.grad[j] for i in range(3) for j in range(3)))
+    form = _geometric_form()
     out = np.zeros((len(LOAD_CASES), n, n))
     disp = np.zeros((len(LOAD_CASES), nn, 3))
     for c in range(len(LOAD_CASES)):
@@ -101,10 +101,74 @@ def geometric_stiffness(solid: Any, held: np.ndarray, basis: np.ndarray) -> Tupl
         u[free] = lu.solve(f[free])
         u = u.reshape(nn, 3)
         disp[c] = u
-        g = skfem.asm(form, sb, **stress(solid, u)).tocsr()
-        kc = sum(modes[a].T @ (g @ modes[a]) for a in range(3))
-        out[c] = 0.5 * (kc + kc.T)
+        out[c] = _modal_geometric(solid, form, modes, u)
     return out, disp
+
+
+def _modal_geometric(solid: Any, form: Any, modes: Any, u: np.ndarray) -> np.ndarray:
+    """``sum_a Phi_a^T G(sigma(u)) Phi_a`` (n, n), symmetrized: the modal geometric stiffness
+    of the linear stress of the displacement ``u`` (N, 3)."""
+    skfem = require("skfem", "ukflex.fe3 (geometric stiffness)", extra="fe")
+    g = skfem.asm(form, solid.basis, **stress(solid, u)).tocsr()
+    kc = sum(modes[a].T @ (g @ modes[a]) for a in range(3))
+    return 0.5 * (kc + kc.T)
+
+
+def _geometric_form() -> Any:
+    skfem = require("skfem", "ukflex.fe3 (geometric stiffness)", extra="fe")
+    return skfem.BilinearForm(lambda u, v, w: sum(w[f"s{i}{j}"] * u.grad[i] * v.grad[j] for i in range(3) for j in range(3)))
+
+
+def quadratic_strain(solid: Any, basis: np.ndarray, held: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """The Green-Lagrange strain's energy terms of the modal field ``u = Phi q`` of the solid
+    held on the dofs ``held`` (docs/spatial-flexible.md, "Quadratic strain";
+    ``rust/body/flexible3_strain.rs``): the modal geometric stiffness ``G_k`` (n, n, n) of each
+    mode's linear stress (the cubic energy ``1/2 sum_k q_k q^T G_k q``) and ``H`` (n^2, n^2),
+    the quartic energy ``1/8 H_ijkl q_i q_j q_k q_l``: ``int B_ij : C : B_kl`` (``B_ij =
+    sym(grad phi_i^T grad phi_j)``) less the static condensation of the displacement outside
+    the basis that the second-order load ``f2 = r_ij q_i q_j`` drives, ``4 r_ij^T K_c^+ r_kl``
+    (without it a basis that cannot shorten pointwise as it bends locks: docs)."""
+    skfem = require("skfem", "ukflex.fe3 (quadratic strain)", extra="fe")
+    nn, n = solid.nodes.shape[0], basis.shape[1]
+    modes = [basis[a::3, :] for a in range(3)]
+    form = _geometric_form()
+    gs = [skfem.asm(form, solid.basis, **stress(solid, basis[:, k].reshape(nn, 3))).tocsr() for k in range(n)]
+    g = np.stack([sum(modes[a].T @ (gk @ modes[a]) for a in range(3)) for gk in gs])
+    g = 0.5 * (g + g.transpose(0, 2, 1))
+    # grads[i, a, k] = d phi_i,a / d x_k at the quadrature points (E, Q)
+    shape = np.asarray(solid.basis.dx).shape
+    grads = np.stack([np.stack([np.stack(solid.basis.interpolate(basis[a::3, i]).grad) for a in range(3)]) for i in range(n)])
+    grads = grads.reshape(n, 3, 3, -1)
+    # B_ij = sym(grad phi_i^T grad phi_j) (the A_ij + A_ji of A_ij,kl = sum_a d_k phi_i,a d_l phi_j,a)
+    a_ = np.einsum("iakp,jalp->ijklp", grads, grads)
+    b = 0.5 * (a_ + a_.transpose(0, 1, 3, 2, 4)).reshape(n * n, 9, -1)
+    del a_
+    # H = sum_p B_ij(p) : C : B_kl(p) dx(p) (the rule's weights may be negative: no square root)
+    dx = np.asarray(solid.basis.dx).reshape(-1)
+    tr = b[:, 0] + b[:, 4] + b[:, 8]
+    flat = b.reshape(n * n, -1)
+    h = solid.lam * ((tr * dx) @ tr.T) + 2.0 * solid.mu * ((flat * np.tile(dx, 9)) @ flat.T)
+    # r_ij: the nodal load of the gradient of V3 over the full field at u = Phi q, f2 = sum_ij
+    # r_ij q_i q_j: 1/2 int (C : B_ij) : grad du + 1/2 (G_i phi_j + G_j phi_i)
+    lin = skfem.LinearForm(lambda v, w: w["s0"] * v.grad[0] + w["s1"] * v.grad[1] + w["s2"] * v.grad[2])
+    r = np.zeros((3 * nn, n * n))
+    for i in range(n):
+        for j in range(i, n):
+            bij = b[i * n + j].reshape(3, 3, *shape)
+            sij = 2.0 * solid.mu * bij + solid.lam * (bij[0, 0] + bij[1, 1] + bij[2, 2]) * np.eye(3).reshape(3, 3, 1, 1)
+            for a in range(3):
+                col = 0.5 * skfem.asm(lin, solid.basis, s0=sij[a, 0], s1=sij[a, 1], s2=sij[a, 2])
+                r[a::3, i * n + j] = col + 0.5 * (gs[i] @ modes[a][:, j] + gs[j] @ modes[a][:, i])
+            r[:, j * n + i] = r[:, i * n + j]
+    # the complement's compliance: R^T K^-1 R - (Phi^T R)^T K_r^-1 (Phi^T R)
+    free = np.nonzero(~held)[0]
+    lu = spla.splu(solid.k[free][:, free].tocsc())
+    c = r[free].T @ lu.solve(r[free])
+    pr = basis.T @ r
+    kr = basis.T @ (solid.k @ basis)
+    c -= pr.T @ np.linalg.solve(0.5 * (kr + kr.T), pr)
+    h = h - 4.0 * c
+    return g, 0.5 * (h + h.T)
 
 
 def held_mask(sets: Any, reference: str, n3: int) -> np.ndarray:
@@ -115,4 +179,4 @@ def held_mask(sets: Any, reference: str, n3: int) -> np.ndarray:
     return held
 
 
-__all__ = ["LOAD_CASES", "STRESS_COMPONENTS", "geometric_stiffness", "held_mask", "stress", "stress_modes"]
+__all__ = ["LOAD_CASES", "STRESS_COMPONENTS", "geometric_stiffness", "held_mask", "quadratic_strain", "stress", "stress_modes"]

@@ -208,23 +208,26 @@ def spin_up(omega: float, duration: float) -> str:
 
 @functools.lru_cache(maxsize=4)
 def _rod_data_cached(length: float, mesh: Tuple[int, int, int], modes: int, section: Tuple[float, float, float, float],
-                     stress_stiffening: bool) -> Any:
+                     stress_stiffening: bool, quadratic_strain: bool = False) -> Any:
     from . import fe3
 
     side, rho, e, nu = section
     bar = fe3.bar_mesh(length, side, side, mesh)
     return fe3.from_mesh(bar, density=rho, youngs_modulus=e, poisson_ratio=nu, modes=modes,
                          interfaces={"A": lambda x: x[:, 0] < 1e-9 * length, "B": lambda x: x[:, 0] > length * (1 - 1e-9)},
-                         frame=("clamped", "A"), reduction="craig-bampton", stress_stiffening=stress_stiffening)
+                         frame=("clamped", "A"), reduction="craig-bampton", stress_stiffening=stress_stiffening,
+                         quadratic_strain=quadratic_strain)
 
 
 def slider_crank_rod_data(mesh: Sequence[int] = (16, 1, 1), modes: int = 4, rod: float = 0.3,
-                          section: Tuple[float, float, float, float] = ROD_SECTION, stress_stiffening: bool = False) -> Any:
+                          section: Tuple[float, float, float, float] = ROD_SECTION, stress_stiffening: bool = False,
+                          quadratic_strain: bool = False) -> Any:
     """The modal data (:func:`ukflex.fe3.from_mesh`) of :func:`flexible_slider_crank`'s rod:
     the square bar (``section = (side, density, E, nu)``) of length ``rod`` along its ``x``,
     meshed with ``mesh`` boxes of P2 tetrahedra, the frame clamped at the crank end's face
     (interface ``A``), Craig-Bampton with the slider end's face (interface ``B``): six static
-    constraint modes and ``modes`` fixed-interface normal modes. Cached (the same arguments give
+    constraint modes and ``modes`` fixed-interface normal modes; ``stress_stiffening`` and
+    ``quadratic_strain`` those of :func:`ukflex.fe3.from_mesh`. Cached (the same arguments give
     the same object)."""
     mesh_t = tuple(count("mesh", c) for c in mesh)
     if len(mesh_t) != 3:
@@ -232,13 +235,17 @@ def slider_crank_rod_data(mesh: Sequence[int] = (16, 1, 1), modes: int = 4, rod:
     sec = tuple(positive("section", v) for v in section)
     if len(sec) != 4 or sec[3] >= 0.5:
         raise InvalidArgumentError("section", f"expected (side, density, E, nu) with nu < 0.5, got {section!r}")
-    return _rod_data_cached(positive("rod", rod), mesh_t, count("modes", modes), sec, bool(stress_stiffening))
+    for name, flag in (("stress_stiffening", stress_stiffening), ("quadratic_strain", quadratic_strain)):
+        if not isinstance(flag, bool):
+            raise InvalidArgumentError(name, f"expected True or False, got {flag!r}")
+    return _rod_data_cached(positive("rod", rod), mesh_t, count("modes", modes), sec, stress_stiffening, quadratic_strain)
 
 
 def flexible_slider_crank(rod_model: str = "beam", *, elements: int = 8, data: Any = None, omega: float = 150.0,
                           spin_up_time: float = 0.05, crank: float = 0.08, rod: float = 0.3,
                           pivot: Tuple[float, float, float] = (0.0, 0.1, 0.12), section: Tuple[float, float, float, float] = ROD_SECTION,
-                          masses: Tuple[float, float] = (0.12, 0.1), gravity: float = 0.0) -> SpatialScene:
+                          masses: Tuple[float, float] = (0.12, 0.1), gravity: float = 0.0,
+                          quadratic_strain: bool = False) -> SpatialScene:
     """Haug's spatial slider-crank (:func:`slider_crank`'s geometry) with a flexible connecting
     rod: a square steel bar (``section = (side, density, E, nu)``, default 8 mm, first pinned
     bending frequency about 1310 rad/s), the crank driven from rest to ``omega`` (150 rad/s)
@@ -247,7 +254,8 @@ def flexible_slider_crank(rod_model: str = "beam", *, elements: int = 8, data: A
     ``x`` on the slider, the rod's ``y``), as in the rigid scene: the rod's spin about its axis is
     held by the universal joint alone, no row is redundant. ``rod_model``: ``"beam"`` (a
     ``beam3`` of ``elements`` elements, an even number so that the midpoint is a node) or
-    ``"modal"`` (a ``flexible3`` body from ``data``, default :func:`slider_crank_rod_data`).
+    ``"modal"`` (a ``flexible3`` body from ``data``, default :func:`slider_crank_rod_data`, with
+    the Green-Lagrange strain's cubic energy if ``quadratic_strain``: docs/spatial-flexible.md).
     Crank and slider masses ``masses`` (the crank's inertia that of the rigid scene, the
     slider's ``1e-6 I``). Everything starts at rest, undeformed, gravity ``-z`` (default 0).
     Bodies ``crank``, ``rod`` (the beam's nodes ``rod[0] .. rod[N]``), ``slider``."""
@@ -276,7 +284,10 @@ def flexible_slider_crank(rod_model: str = "beam", *, elements: int = 8, data: A
         end_b, end_c = beam.node(0), beam.node(-1)
     else:
         if data is None:
-            data = slider_crank_rod_data(rod=rod, section=section)
+            data = slider_crank_rod_data(rod=rod, section=section, quadratic_strain=quadratic_strain)
+        elif quadratic_strain:
+            raise InvalidArgumentError("quadratic_strain", "given with data: build the data with "
+                                       "slider_crank_rod_data(..., quadratic_strain=True) instead")
         if not {"A", "B"} <= set(getattr(data, "interfaces", {})):
             raise InvalidArgumentError("data", "the rod's modal data need interfaces 'A' (crank end) and 'B' (slider end)")
         body = s.flexible_body("rod", data, position=B, orientation=Rr)
