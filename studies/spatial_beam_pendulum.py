@@ -26,11 +26,13 @@ RHO, E, NU, SIDE = 7850.0, 2.1e9, 0.3, 0.02
 RUN = dict(method="DOPRI5", rtol=1e-10, atol=1e-12)
 
 
-def modal(mesh: Tuple[int, int, int], modes: int, stress_stiffening: bool = False) -> fe3.FlexibleData3:
+def modal(mesh: Tuple[int, int, int], modes: int, stress_stiffening: bool = False,
+          quadratic_strain: bool = False) -> fe3.FlexibleData3:
     m = fe3.bar_mesh(LENGTH, SIDE, SIDE, mesh)
     return fe3.from_mesh(m, density=RHO, youngs_modulus=E, poisson_ratio=NU,
                          interfaces={"A": lambda x: x[:, 0] < 1e-9, "B": lambda x: x[:, 0] > LENGTH - 1e-9},
-                         modes=modes, frame=("clamped", "A"), stress_stiffening=stress_stiffening)
+                         modes=modes, frame=("clamped", "A"), stress_stiffening=stress_stiffening,
+                         quadratic_strain=quadratic_strain)
 
 
 def beam_tip(elements: int, t: np.ndarray, **run: Any) -> Tuple[np.ndarray, float]:
@@ -82,6 +84,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     rows.append(("flexible3 (40, 2, 2), 8 modes (ref)", ref, dt_ref))
     tip, dt = ukflex_tip(modal((20, 2, 2), 8, stress_stiffening=True), t, **RUN)
     rows.append(("flexible3 (20, 2, 2), 8, stiffened", tip, dt))
+    for mesh, modes in (((40, 2, 2), 16), ((40, 2, 2), 8)):
+        tip, dt = ukflex_tip(modal(mesh, modes), t, **RUN)
+        rows.append((f"flexible3 {mesh}, {modes} modes", tip, dt))
+        tip, dt = ukflex_tip(modal(mesh, modes, quadratic_strain=True), t, **RUN)
+        rows.append((f"flexible3 {mesh}, {modes}, quadratic strain", tip, dt))
     for n in (5, 10, 20, 40):
         tip, dt = beam_tip(n, t)
         rows.append((f"beam3 {n} elements", tip, dt))
