@@ -90,6 +90,9 @@ pub struct BuildContext<'a> {
     pub q0: &'a [f64],
     /// `body.coordinate` names, in `q`'s order (what loads' expressions may read).
     pub coordinate_names: &'a [String],
+    /// The joints built so far, with their resolved markers (what `angle(J)`, `s(J)` in a
+    /// load's expression read: `force::value_joint`; forces are built after the joints).
+    pub joints: &'a [Constraint],
 }
 
 impl BuildContext<'_> {

@@ -17,6 +17,7 @@ pub mod rotational_spring;
 pub mod value;
 pub mod value3;
 pub mod value_beam;
+pub mod value_joint;
 
 pub mod spatial;
 pub mod spatial_load;

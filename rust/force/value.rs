@@ -15,6 +15,7 @@ use std::sync::Arc;
 
 use super::value3::Spatial;
 use super::value_beam::BeamQuantity;
+use super::value_joint::JointQuantity;
 use crate::body::marker3::{add_jacobian, Marker3};
 use crate::body::{Body, Marker};
 use crate::constraint::BuildContext;
@@ -41,6 +42,8 @@ pub enum Input {
     Point3 { k: usize, axis: usize, rate: bool },
     /// The value's beam quantity `k` (`Expr::beams`, `value_beam.rs`): `u`, `v`, `psi` or a rate.
     Beam(usize),
+    /// The value's joint quantity `k` (`Expr::joints`, `value_joint.rs`): `angle`, `s` or a rate.
+    Joint(usize),
 }
 
 /// The state a value is evaluated at.
@@ -55,7 +58,7 @@ pub struct Env<'a> {
 
 impl Env<'_> {
     #[inline]
-    fn get(&self, i: Input, points: &[Marker], points3: &[Marker3], beams: &[BeamQuantity]) -> f64 {
+    fn get(&self, i: Input, points: &[Marker], points3: &[Marker3], beams: &[BeamQuantity], joints: &[JointQuantity]) -> f64 {
         match i {
             Input::Time => self.t,
             Input::Coord(k) => self.q[k],
@@ -70,6 +73,7 @@ impl Env<'_> {
                 if rate { s.vd[axis] } else { s.v[axis] }
             }
             Input::Beam(k) => beams[k].value(self.q, self.qd),
+            Input::Joint(k) => joints[k].value(self.bodies, self.q, self.qd),
         }
     }
 }
@@ -100,7 +104,7 @@ fn point_quantity(s: &str) -> Option<(usize, bool, String, f64, usize)> {
 
 /// An expression's text with its point quantities replaced: the text, the placeholders with
 /// their inputs, the planar and the spatial points' markers.
-type Substituted = (String, Vec<(String, Input)>, Vec<Marker>, Vec<Marker3>, Vec<BeamQuantity>);
+type Substituted = (String, Vec<(String, Input)>, Vec<Marker>, Vec<Marker3>, Vec<BeamQuantity>, Vec<JointQuantity>);
 
 impl Scope<'_> {
     /// `text` with each point quantity replaced by a placeholder variable of the same length
@@ -110,6 +114,7 @@ impl Scope<'_> {
         let (mut found, mut markers): (Vec<(String, Input)>, Vec<Marker>) = (Vec::new(), Vec::new());
         let mut markers3: Vec<Marker3> = Vec::new();
         let mut beams: Vec<BeamQuantity> = Vec::new();
+        let mut joints: Vec<JointQuantity> = Vec::new();
         let mut i = 0;
         let bytes = text.as_bytes();
         while i < text.len() {
@@ -133,6 +138,12 @@ impl Scope<'_> {
                     i += len;
                     continue;
                 }
+                if let Some(len) = self.joint_quantity(item, text, i, found.len(), &mut joints)? {
+                    found.push((format!("{:_<len$}", format!("_p{}", found.len())), Input::Joint(joints.len() - 1)));
+                    out.push_str(&found.last().expect("just pushed").0);
+                    i += len;
+                    continue;
+                }
                 if let Some((axis, rate, body, xi, len)) = point_quantity(&text[i..]) {
                     let placeholder = format!("_p{}", found.len());
                     if let (Some(ctx), true) = (self.ctx, placeholder.len() <= len) {
@@ -151,7 +162,19 @@ impl Scope<'_> {
             out.push(c);
             i += c.len_utf8();
         }
-        Ok((out, found, markers, markers3, beams))
+        Ok((out, found, markers, markers3, beams, joints))
+    }
+
+    /// A joint quantity `angle(J)`, `s(J)` (or its rate) at `text[i..]`, pushed on `joints`:
+    /// the length of its text; `None` if there is none (or no room for the placeholder `k`).
+    fn joint_quantity(&self, item: &str, text: &str, i: usize, k: usize, joints: &mut Vec<JointQuantity>) -> Result<Option<usize>> {
+        let (Some(ctx), Some((what, rate, joint, len))) = (self.ctx, super::value_joint::parse(&text[i..])) else { return Ok(None) };
+        if format!("_p{k}").len() > len {
+            return Ok(None);
+        }
+        let err = |message: String| Error::Expression { item: item.to_string(), text: text.to_string(), message, position: i };
+        joints.push(JointQuantity::new(ctx, what, rate, joint, &err)?);
+        Ok(Some(len))
     }
 
     /// A beam quantity `u/v/psi(B, XI)` (or its rate) at `text[i..]`, pushed on `beams`: the
@@ -196,6 +219,7 @@ impl Scope<'_> {
         if self.ctx.is_some() {
             s += ", x(BODY, XI), y(BODY, XI) or their rates d:x(...)";
             s += super::value_beam::HELP;
+            s += super::value_joint::HELP;
         }
         if self.spatial.is_some() {
             s += super::value3::HELP;
@@ -217,6 +241,8 @@ pub struct Expr {
     points3: Vec<Marker3>,
     /// The beam quantities it reads.
     beams: Vec<BeamQuantity>,
+    /// The joint quantities it reads.
+    joints: Vec<JointQuantity>,
 }
 
 /// The natural cubic spline of `constraint::motion` (a driver's tabulated motion) through
@@ -309,7 +335,7 @@ impl Value {
                 Ok(Value::Const(*v))
             }
             LoadValueDesc::Expression(text) => {
-                let (parsed, points, markers, markers3, beams) = scope.substitute_points(item, text)?;
+                let (parsed, points, markers, markers3, beams, joints) = scope.substitute_points(item, text)?;
                 let mut names: Vec<String> = vec!["t".into()];
                 names.extend(scope.local.iter().map(|s| s.to_string()));
                 names.extend(scope.coordinate_names.iter().cloned());
@@ -324,7 +350,7 @@ impl Value {
                     .iter()
                     .map(|v| points.iter().find(|(p, _)| p == v).map(|(_, i)| *i).or_else(|| scope.resolve(v)).expect("a candidate name"))
                     .collect();
-                Ok(Value::Expr(Box::new(Expr { f, inputs, points: markers, points3: markers3, beams })))
+                Ok(Value::Expr(Box::new(Expr { f, inputs, points: markers, points3: markers3, beams, joints })))
             }
             LoadValueDesc::Table(t) => Ok(Value::Table(Box::new(Table::new(item, scope, t)?))),
             LoadValueDesc::Callable(c) => Ok(Value::Callable(Box::new(Callable::new(item, scope, c)?))),
@@ -354,7 +380,7 @@ impl Value {
     /// a planar point's `d:x(BODY, XI)` does too, and that is left out).
     pub fn add_position_gradient(&self, env: &Env, scratch: &mut [f64], row: &mut [f64]) -> [f64; 2] {
         let mut local = [0.0; 2];
-        let mut put = |i: Input, g: f64, points: &[Marker], points3: &[Marker3], beams: &[BeamQuantity], row: &mut [f64]| match i {
+        let mut put = |i: Input, g: f64, points: &[Marker], points3: &[Marker3], beams: &[BeamQuantity], joints: &[JointQuantity], row: &mut [f64]| match i {
             Input::Coord(j) => row[j] += g,
             Input::Point { k, axis, rate: false } => {
                 let s = points[k].state(env.bodies, env.q, env.qd);
@@ -372,6 +398,7 @@ impl Value {
             }
             Input::Local(k) => local[k] += g,
             Input::Beam(k) => beams[k].add_gradient(env.q, env.qd, g, row),
+            Input::Joint(k) => joints[k].add_gradient(env.bodies, env.q, env.qd, g, row),
             _ => {}
         };
         match self {
@@ -380,16 +407,16 @@ impl Value {
                 let (x, rest) = scratch.split_at_mut(k);
                 let (grad, buf) = rest.split_at_mut(k);
                 for (xi, &i) in x.iter_mut().zip(&e.inputs) {
-                    *xi = env.get(i, &e.points, &e.points3, &e.beams);
+                    *xi = env.get(i, &e.points, &e.points3, &e.beams, &e.joints);
                 }
                 e.f.eval_gradient(x, buf, grad);
                 for (&i, &g) in e.inputs.iter().zip(grad.iter()) {
-                    put(i, g, &e.points, &e.points3, &e.beams, row);
+                    put(i, g, &e.points, &e.points3, &e.beams, &e.joints, row);
                 }
             }
             Value::Table(t) => {
-                let (_, slope) = t.eval(env.get(t.input, &[], &[], &[]));
-                put(t.input, slope, &[], &[], &[], row);
+                let (_, slope) = t.eval(env.get(t.input, &[], &[], &[], &[]));
+                put(t.input, slope, &[], &[], &[], &[], row);
             }
             _ => {}
         }
@@ -419,7 +446,7 @@ impl Value {
     /// The markers of the point quantities the value reads (a spatial point's: its `base`).
     pub fn points(&self) -> Vec<&Marker> {
         match self {
-            Value::Expr(e) => e.points.iter().chain(e.points3.iter().map(|m| &m.base)).collect(),
+            Value::Expr(e) => e.points.iter().chain(e.points3.iter().map(|m| &m.base)).chain(e.joints.iter().flat_map(JointQuantity::markers)).collect(),
             _ => Vec::new(),
         }
     }
@@ -437,15 +464,15 @@ impl Value {
             Value::Expr(e) => {
                 let (x, buf) = scratch.split_at_mut(e.inputs.len());
                 for (xi, &i) in x.iter_mut().zip(&e.inputs) {
-                    *xi = env.get(i, &e.points, &e.points3, &e.beams);
+                    *xi = env.get(i, &e.points, &e.points3, &e.beams, &e.joints);
                 }
                 e.f.eval(x, buf)
             }
-            Value::Table(tb) => tb.eval(env.get(tb.input, &[], &[], &[])).0,
+            Value::Table(tb) => tb.eval(env.get(tb.input, &[], &[], &[], &[])).0,
             Value::Callable(c) => {
                 let x = &mut scratch[..c.inputs.len()];
                 for (xi, &i) in x.iter_mut().zip(&c.inputs) {
-                    *xi = env.get(i, &[], &[], &[]);
+                    *xi = env.get(i, &[], &[], &[], &[]);
                 }
                 c.f.as_ref().map_or(f64::NAN, |f| f.call(env.t, x))
             }

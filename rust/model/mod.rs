@@ -437,7 +437,7 @@ impl ModelBuilder {
     }
 
     fn context(&self) -> BuildContext<'_> {
-        BuildContext { bodies: &self.bodies, index: &self.index, q0: &self.q0, coordinate_names: &self.coordinate_names }
+        BuildContext { bodies: &self.bodies, index: &self.index, q0: &self.q0, coordinate_names: &self.coordinate_names, joints: &self.joints }
     }
 
     pub fn add_joint(&mut self, d: &JointDesc) -> Result<&Constraint> {
