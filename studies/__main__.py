@@ -15,6 +15,7 @@ or their output folder:
   python -m studies spatial-flexible-exudyn
   python -m studies spatial-beam-pendulum
   python -m studies spatial-beam-spin-up
+  python -m studies spatial-beam-spin-up-exudyn [--meshes 8,12,16,24] [--rtols 1e-3,1e-5] [--exudyn-meshes 8,12,16,24] [--steps 1000,2000,4000] [--repeat 3] [--exudyn-repeat 1] [--no-fe]
   python -m studies right-angle-cantilever [--quick] [--meshes 5,10,20,40] [--exudyn-meshes 10,20,40,80] [--steps 500,1000,3000] [--repeat 3] [--exudyn-repeat 1]
   python -m studies spatial-flexible-crank [--quick]
   python -m studies sweeps --out results/sweeps [--small]
@@ -198,6 +199,8 @@ def _build_parser() -> argparse.ArgumentParser:
     _passthrough(sub, "spatial-flexible-exudyn", "spatial_flexible_exudyn", "the 3D flexible pendulum against Exudyn's ObjectFFRFreducedOrder (docs/spatial-flexible.md)")
     _passthrough(sub, "spatial-beam-pendulum", "spatial_beam_pendulum", "the 3D flexible pendulum: geometrically exact beam against the modal body (docs/spatial-flexible.md)")
     _passthrough(sub, "spatial-beam-spin-up", "spatial_beam_spin_up", "Kane's spin-up beam: the 3D beam against the planar ANCF cable (docs/spatial-flexible.md)")
+    _passthrough(sub, "spatial-beam-spin-up-exudyn", "spatial_beam_spin_up_exudyn",
+                 "Kane's spin-up beam in 3D: the modal body against the beam, and against Exudyn (docs/spatial-flexible.md)")
     _passthrough(sub, "right-angle-cantilever", "right_angle_cantilever", "Simo and Vu-Quoc's right-angle cantilever: beam3 against Exudyn (docs/spatial-flexible.md)")
     _passthrough(sub, "spatial-flexible-crank", "spatial_flexible_crank",
                  "the spatial slider-crank with a flexible rod: beam3 against flexible3 and against Exudyn (docs/spatial-flexible.md)")
