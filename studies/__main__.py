@@ -109,7 +109,7 @@ def _cmd_geometric(args: argparse.Namespace) -> int:
 #: arguments that start with ``-``, so ``flexible-coupler --nonlinear`` was refused).
 _PASSTHROUGH = {"flexible-coupler": "flexible_coupler", "simeon-crank": "simeon_crank", "sweeps": "sweeps",
                 "clearance": "clearance", "engine": "engine", "spatial-flexible-crank": "spatial_flexible_crank",
-                "right-angle-cantilever": "right_angle_cantilever"}
+                "right-angle-cantilever": "right_angle_cantilever", "spatial-beam-spin-up-exudyn": "spatial_beam_spin_up_exudyn"}
 
 
 def _passthrough(sub, name: str, module: str, help: str) -> None:

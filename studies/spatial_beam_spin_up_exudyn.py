@@ -13,7 +13,8 @@
 
 Output: the tip's deflection in the hub frame, ``v`` (across, in the plane of the spin) and
 ``u`` (along), at 0.1 s intervals; gaps in units of the dip (the largest ``|v|``); wall times of
-the whole solve call on a fresh system, medians of interleaved repetitions.
+the whole solve call on a fresh system, medians of interleaved repetitions. The whole study took
+3 min 34 s on the shared machine (load 4-5); the tables are in docs/spatial-flexible.md.
 """
 
 from __future__ import annotations
