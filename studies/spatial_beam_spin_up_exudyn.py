@@ -14,7 +14,7 @@
 Output: the tip's deflection in the hub frame, ``v`` (across, in the plane of the spin) and
 ``u`` (along), at 0.1 s intervals; gaps in units of the dip (the largest ``|v|``); wall times of
 the whole solve call on a fresh system, medians of interleaved repetitions. The whole study took
-3 min 34 s on the shared machine (load 4-5); the tables are in docs/spatial-flexible.md.
+6 min 14 s on the shared machine (load 5-6); the tables are in docs/spatial-flexible.md.
 """
 
 from __future__ import annotations
@@ -255,7 +255,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         return tuple(int(x) for x in text.split(","))
 
     ap = argparse.ArgumentParser(prog="python -m studies spatial-beam-spin-up-exudyn")
-    ap.add_argument("--meshes", default="8,12,16,24", help="the elements of ukflex's timed default runs")
+    ap.add_argument("--meshes", default="8,12,16,20,24", help="the elements of ukflex's timed default runs")
     ap.add_argument("--rtols", default="1e-3,1e-5", help="their rtol")
     ap.add_argument("--exudyn-meshes", default="8,12,16,24", help="the elements of Exudyn's timed runs")
     ap.add_argument("--steps", default="1000,2000,4000", help="Exudyn's step counts over 20 s")
