@@ -9,7 +9,7 @@ import pytest
 import ukflex
 from ukflex import scenes, simulate
 from ukflex.run import choice
-from ukflex.run.choice import choose_method, elastic_shares
+from ukflex.run.choice import DOPRI5_RTOL_PER_RTOL, choose_method, elastic_shares
 
 
 def test_rigid_scenes_go_explicit():
@@ -97,7 +97,7 @@ def test_user_settings_win_and_scipy_options_map_to_scipy():
     res = simulate(sys_, 0.01, formulation="uk-numpy")
     assert res.method == "Radau"
     res = simulate(scenes.pendulum(), 0.1, step=1e-3)  # a fixed step on a scene auto runs with DOPRI5
-    assert res.method == "RADAU5M" and res.extra["naccept"] == 100
+    assert res.method == "RADAU5M" and res.extra["naccept"] == 100 and res.rtol == 1e-6  # not DOPRI5's rtol
 
 
 def test_auto_on_the_papers_linear_scene_against_a_tight_explicit_run():
@@ -241,8 +241,15 @@ def test_the_cores_decision_is_the_former_python_ones():
             methods.add((new.method, new.step is not None))
             where = (label, rtol, new, old)
             assert new.method == old.method and new.options.keys() == old.options.keys(), where
-            assert numbers.sub("#", new.reason) == numbers.sub("#", old.reason), where
-            for key in ("step", "omega_elastic", "omega_max", "rtol"):
+            reason, keys = new.reason, ("step", "omega_elastic", "omega_max", "rtol")
+            if new.method == "DOPRI5":
+                # new in the core (not a former decision): DOPRI5 runs at DOPRI5_RTOL_PER_RTOL rtol
+                assert old.rtol is None and new.rtol == pytest.approx(DOPRI5_RTOL_PER_RTOL * rtol, rel=1e-12), where
+                reason, tight = reason.split("; DOPRI5 at rtol ")
+                assert tight.startswith(f"{new.rtol:.3g} "), where
+                keys = keys[:3]
+            assert numbers.sub("#", reason) == numbers.sub("#", old.reason), where
+            for key in keys:
                 a, b = getattr(new, key), getattr(old, key)
                 assert (a is None) == (b is None) and (a is None or a == pytest.approx(b, rel=1e-6)), (key, where)
             assert (new.floor is None) == (old.floor is None), where

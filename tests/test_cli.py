@@ -187,7 +187,7 @@ def test_export_then_run(tmp_path):
     assert "\nauto: RADAU5M, fixed step" in r.stdout  # the exported file runs the default chooser
     r = ukflex_cli("run", "pendulum", "--t-end", "0.1", "--out", tmp_path / "p", "--no-plot")
     assert r.returncode == 0, r.stderr
-    assert "\nauto: DOPRI5 (no elastic mode" in r.stdout
+    assert "\nauto: DOPRI5, rtol 3e-07 (no elastic mode" in r.stdout
 
 
 def test_help_of_every_command():

@@ -231,15 +231,13 @@ def lattice_reference(system, columns: int, rows: int, cell: float, mass: float,
     return sol.y[:h]
 
 
-@pytest.mark.parametrize("rows", [1, pytest.param(2, marks=pytest.mark.xfail(strict=True, reason=(
-    "passed only while the core read the description's numbers up to an ulp off (serde_json's fast float "
-    "parser, issue 28): with the numbers exactly as written, two levels of continuous beams at exactly 12 rad/s "
-    "pass the horizontal so exactly that a DOPRI5 stage meets accelerations beyond the double range at "
-    "t = 1.98 s (non-finite acceleration, a named stop with the partial result); any relative change of 1e-15 "
-    "in the speed passes (docs/robustness.md, left alone)")))])
+@pytest.mark.parametrize("rows", [1, 2])
 def test_lattice_hangers_pass_the_horizontal_on_their_branch(rows):
     """Continuous beams (redundant rows) at a speed that takes the hangers over the top: every
-    passage of the horizontal drops the rank further; the default follows the reduced model."""
+    passage of the horizontal drops the rank further; the default follows the reduced model.
+    (rows = 2 was an expected failure while auto ran DOPRI5 at the user's rtol: a stage met the
+    horizontal so exactly that its accelerations left the double range at t = 1.98 s; at
+    auto's 0.3 rtol the steps fall elsewhere. The fragility is not gone: docs/robustness.md.)"""
     columns, cell, mass = 3, 0.25, 0.1
     system = scenes.lattice(columns=columns, rows=rows, cell=cell, mass=mass, beams="continuous", speed=12.0).build()
     t = np.linspace(0.0, 2.0, 201)

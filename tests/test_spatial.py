@@ -239,9 +239,10 @@ def test_projection_keeps_the_angular_velocity_of_scaled_euler_parameters():
 
 def test_heavy_top_at_the_default_rtol():
     """The heavy top (30 rad/s, 10 s) with defaults (auto: DOPRI5, rtol 1e-6): energy, L_z and
-    L.e3 within 15 rtol (docs/spatial.md, "The heavy top at the default rtol": 1.3e-5, 1.1e-5,
-    4.3e-6; 3.0e-5, 1.8e-5, 1.6e-5 before the Euler parameters' rates were normalized with them;
-    the issue's 10 rtol is not met: what is left is DOPRI5's own dissipation)."""
+    L.e3 within the issue's 10 rtol (docs/spatial.md, "The heavy top at the default rtol": 2.7e-6,
+    2.8e-6, 7.7e-7 now that auto runs DOPRI5 at 0.3 rtol; 1.3e-5, 1.1e-5, 4.3e-6 when it ran
+    DOPRI5 at the user's rtol, whose global error over the top's 10 s is 13 rtol; 3.0e-5, 1.8e-5,
+    1.6e-5 before the Euler parameters' rates were normalized with them)."""
     model, system = _top_system()
     t = np.linspace(0.0, 10.0, 2001)
     res = ukflex.simulate(system, 10.0, t_eval=t)
@@ -251,7 +252,7 @@ def test_heavy_top_at_the_default_rtol():
     L3 = np.einsum("ij,ij->i", L, out["bodies"]["top"]["rotation"][:, :, 2])
     rel = lambda x: np.abs(x - x[0]).max() / abs(x[0])  # noqa: E731
     figures = rel(out["energy"]), rel(L[:, 2]), rel(L3)
-    assert max(figures) < 1.5e-5, figures
+    assert max(figures) < 10 * 1e-6, figures
 
 
 def test_double_pendulum_run_matches_the_reference_run():

@@ -48,7 +48,9 @@ DATA = os.path.normpath(os.path.join(HERE, "..", "data"))
 #: scene -> (duration s, Exudyn linear solver)
 SCENES = {"bricard": (10.0, "EigenDense"), "flyball_governor": (2.0, "EigenSparse"), "slider_crank": (2.0, "EigenSparse")}
 LEVELS = (1e-3, 1e-4)
-RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+#: auto's rtols (3e-3: auto runs DOPRI5 at 0.3 rtol, so its rtol 3e-3 is the DOPRI5 run at ~1e-3
+#: that auto's rtol 1e-3 was until issue 26's round on DOPRI5's rtol)
+RTOLS = (3e-3, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 STEPS = (1e-2, 5e-3, 2.5e-3, 1e-3, 5e-4)
 DT = 0.01
 

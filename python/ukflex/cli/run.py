@@ -136,12 +136,13 @@ def _settings_line(solver: Dict[str, Any]) -> str:
 
 def _auto_line(auto: Dict[str, Any]) -> str:
     """What ``method="auto"`` derived from the settings (``res.extra["auto"]``), named as such:
-    ``auto: RADAU5M, fixed step 8.2e-05 s, Newton tol 1e-05 (reason ...)``."""
+    ``auto: RADAU5M, fixed step 8.2e-05 s, Newton tol 1e-05 (reason ...)``, ``auto: DOPRI5, rtol
+    3e-07 (reason ...)``."""
     derived = [str(auto["method"])]
     if auto.get("step") is not None:
         derived.append(f"fixed step {auto['step']:.3g} s")
     if auto.get("rtol") is not None:
-        derived.append(f"Newton tol {auto['rtol']:g}")
+        derived.append(f"{'Newton tol' if auto.get('step') is not None else 'rtol'} {auto['rtol']:g}")
     return f"auto: {', '.join(derived)} ({auto['reason']})"
 
 

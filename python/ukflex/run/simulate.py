@@ -182,7 +182,10 @@ def simulate(
         see docs/integrators.md.
     rtol : float
         Relative tolerance (the paper used ``RelTol = 1e-6`` with ode15s); below 100 x machine
-        epsilon it is raised to that floor with a warning, as ``solve_ivp`` does.
+        epsilon it is raised to that floor with a warning, as ``solve_ivp`` does.  ``method="auto"``
+        runs its integrator at an rtol derived from it (DOPRI5 at
+        ``ukflex.run.choice.DOPRI5_RTOL_PER_RTOL`` x rtol, fixed-step RADAU5M with the Newton
+        tolerance ``min(100 rtol, 1e-3)``), stated in ``res.rtol`` and ``res.extra["auto"]["rtol"]``.
     atol : float or array of shape (2n,), optional
         Absolute tolerance; default ``1e-3 * rtol``.
     t_eval : array of shape (nt,), optional
@@ -1210,8 +1213,8 @@ def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options, deadline
         choice.method, choice.options, choice.rtol = "GENALPHA", {}, None
         choice.reason += f"; GENALPHA because of the option(s) {genalpha_only}"
     elif "step" in options and choice.method == "DOPRI5":
-        choice.method, choice.options = "RADAU5M", {}
-        choice.reason += "; RADAU5M because of the option step (DOPRI5 has no fixed step)"
+        choice.method, choice.options, choice.rtol = "RADAU5M", {}, None
+        choice.reason += "; RADAU5M because of the option step (DOPRI5 has no fixed step), at the user's rtol"
     merged = dict(choice.options)
     merged.update(options)  # the user's own settings win (e.g. step=...)
     return choice.method, merged, choice

@@ -11,9 +11,9 @@ use crate::error::Error;
 use crate::integrate::choice::{self, AutoChoice, Spectrum};
 
 /// The decision as a dict: verdict, method (None when more modes are needed), omega_elastic,
-/// omega_max, step, newton_rtol, phase, floor, floor_modes, overdamped (None or a dict omega,
+/// omega_max, step, newton_rtol, rtol (the integrator's, `choice::integrator_rtol`), phase, floor, floor_modes, overdamped (None or a dict omega,
 /// zeta, fast, h_explicit).
-fn choice_dict<'py>(py: Python<'py>, c: &AutoChoice) -> PyResult<Bound<'py, PyDict>> {
+fn choice_dict<'py>(py: Python<'py>, c: &AutoChoice, rtol: f64) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("verdict", c.verdict.name())?;
     d.set_item("method", if c.method.is_empty() { None } else { Some(c.method) })?;
@@ -21,6 +21,7 @@ fn choice_dict<'py>(py: Python<'py>, c: &AutoChoice) -> PyResult<Bound<'py, PyDi
     d.set_item("omega_max", c.omega_max)?;
     d.set_item("step", c.step)?;
     d.set_item("newton_rtol", c.newton_rtol)?;
+    d.set_item("rtol", choice::integrator_rtol(c, rtol))?;
     d.set_item("phase", c.phase)?;
     d.set_item("floor", c.floor)?;
     let modes: Vec<(f64, f64, f64)> = c.floor_modes.iter().map(|m| (m[0], m[1], m[2])).collect();
@@ -49,7 +50,7 @@ impl PySystem {
     /// `n_dof` alone the answer needs no spectrum (no degree of freedom, no elastic potential)
     /// or has `method` None (ask with a spectrum), and with a spectrum `verdict`
     /// "need_more_modes" asks for more modes. Returns a dict (verdict, method, omega_elastic,
-    /// omega_max, step, newton_rtol, phase, floor, floor_modes, overdamped).
+    /// omega_max, step, newton_rtol, rtol (the integrator's, `choice::integrator_rtol`), phase, floor, floor_modes, overdamped).
     #[pyo3(signature = (t0, q, qd, t_end, rtol, n_dof=None, omega=None, shapes=None, omega_max=None))]
     #[allow(clippy::too_many_arguments)]
     fn auto_choice<'py>(&self, py: Python<'py>, t0: Real, q: Vector<'py>, qd: Vector<'py>, t_end: Real, rtol: f64, n_dof: Option<usize>, omega: Option<Vector<'py>>, shapes: Option<PyReadonlyArray2<'py, f64>>, omega_max: Option<f64>) -> PyResult<Bound<'py, PyDict>> {
@@ -97,6 +98,6 @@ impl PySystem {
                 }
             })
         })?;
-        choice_dict(py, &out)
+        choice_dict(py, &out, rtol)
     }
 }
