@@ -25,7 +25,7 @@
 //! velocity terms; gravity is a constant generalized force.
 
 use super::ffrf_beam::{material_section, BeamSection};
-use super::marker::axis_marker_xi;
+use super::marker::{axis_element, axis_marker_xi};
 use super::{finite_vec2, InitialState, MarkerState};
 use super::inspect::Array;
 use serde_json::{Map, Value};
@@ -56,7 +56,7 @@ enum Part {
 }
 
 mod element;
-pub use element::hermite;
+pub use element::{hermite, hermite_third};
 use element::{cross, dot2, map, Axial, Bending};
 
 /// Shape data of one quadrature point, the same for every element (equal element lengths).
@@ -415,11 +415,9 @@ impl AncfCable {
     /// (signs as `ffrf_beam::Beam::internal_forces`). Elastic parts only (no strain-rate
     /// damping); `x` is the undeformed arc length.
     pub fn internal_forces(&self, xi: f64, q: &[f64]) -> [f64; 5] {
-        let t = xi * self.elements as f64;
-        let el = (t.floor() as usize).min(self.elements - 1);
-        let (s, l) = (t - el as f64, self.element_length);
+        let ((el, s), l) = (axis_element(xi, self.elements), self.element_length);
         let (_, d, dd) = hermite(s, l);
-        let ddd = [12.0 / (l * l * l), 6.0 / (l * l), -12.0 / (l * l * l), 6.0 / (l * l)];
+        let ddd = hermite_third(l);
         let e = &q[4 * el..4 * el + 8];
         let (rx, rxx, rxxx) = (map(&d, e), map(&dd, e), map(&ddd, e));
         let g = dot2(rx, rx);
@@ -441,9 +439,8 @@ impl AncfCable {
 
     /// Shape of the axis point at `xi` in [0, 1].
     pub fn point(&self, xi: f64) -> CablePoint {
-        let t = xi * self.elements as f64;
-        let el = (t.floor() as usize).min(self.elements - 1);
-        let (s, d, _) = hermite(t - el as f64, self.element_length);
+        let (el, s) = axis_element(xi, self.elements);
+        let (s, d, _) = hermite(s, self.element_length);
         let (sn, cs) = self.angle0.sin_cos();
         CablePoint { xi, first: 4 * el, s, d, phi_ref: self.angle0, t_ref: [cs, sn] }
     }

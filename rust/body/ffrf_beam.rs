@@ -8,7 +8,7 @@
 //! internal forces, and the shape of its axis points.
 
 use super::ffrf::{Ffrf, FfrfData, PointShape};
-use super::marker::axis_marker_xi;
+use super::marker::{axis_element, axis_marker_xi};
 use super::InitialState;
 use super::inspect::{spelled, Array};
 use serde_json::{Map, Value};
@@ -382,10 +382,7 @@ impl Beam {
 
     /// Shape of the axis point at `xi` in [0, 1]: `u_f = S q_f`, `psi = N_psi q_f`.
     pub fn point_shape(&self, xi: f64) -> PointShape {
-        let n = self.elements;
-        let t = xi * n as f64;
-        let el = (t.floor() as usize).min(n - 1);
-        let s = t - el as f64;
+        let (el, s) = axis_element(xi, self.elements);
         let sh = element_shape(s, self.element_length, self.phi);
         let mut entries = Vec::with_capacity(6);
         for a in 0..6 {
@@ -627,11 +624,9 @@ impl Beam {
     /// element; for the Davis element it equals `k G a (v' - psi)`, the element being exact
     /// in statics). Elastic parts only (no strain-rate damping).
     pub fn internal_forces(&self, xi: f64, q: &[f64]) -> [f64; 5] {
-        let n = self.elements;
-        let t = xi * n as f64;
-        let el = (t.floor() as usize).min(n - 1);
+        let (el, s) = axis_element(xi, self.elements);
         let l = self.element_length;
-        let sh = element_shape(t - el as f64, l, self.phi);
+        let sh = element_shape(s, l, self.phi);
         let d = self.element_dofs(el, &q[3..]);
         let (eps_lin, gamma, _) = self.element_strain(&d);
         let eps = if self.strain == Strain::Nonlinear { eps_lin + gamma } else { eps_lin };

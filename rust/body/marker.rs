@@ -154,6 +154,15 @@ fn body_slice<'r>(bodies: &[Body], bi: usize, row: &'r mut [f64], layout: Option
     &mut row[start..start + body.n_coords]
 }
 
+/// The element of a beam of `n` equal elements that holds the axis point `xi` in [0, 1], and
+/// the local abscissa `s` in [0, 1] there: the right element at a node, the last at `xi = 1`
+/// (both beam formulations: shapes, outputs, load inputs).
+pub fn axis_element(xi: f64, n: usize) -> (usize, f64) {
+    let t = xi * n as f64;
+    let el = (t.floor() as usize).min(n - 1);
+    (el, t - el as f64)
+}
+
 /// The abscissa `xi` in [0, 1] of a marker on a beam axis (both beam formulations).
 pub(crate) fn axis_marker_xi(md: &MarkerDesc, body: &str, item: &str) -> Result<f64> {
     if md.point.is_some() {

@@ -18,6 +18,7 @@ pub mod value;
 pub mod value3;
 pub mod value_beam;
 pub mod value_joint;
+pub mod value_strain;
 
 pub mod spatial;
 pub mod spatial_load;

@@ -11,16 +11,24 @@
 //! positions. On an ANCF cable they are functions of the point's element vector and the two end
 //! positions (12 numbers): value and gradient analytic; a rate is `grad . qd`, whose change with
 //! the positions is taken by central differences of that analytic gradient (on the stack).
+//!
+//! The strains and internal forces `N`, `V`, `M`, `eps`, `kappa(B, XI)` (the outputs of the same
+//! spelling) and their rates are read the same way; their shapes are `value_strain.rs`'.
 
+use super::value_strain::{self, Section};
 use crate::body::BodyKind;
 use crate::constraint::BuildContext;
 use crate::error::{Error, Result};
 
-/// What the quantity is: `u`, `v` or `psi`.
-const NAMES: [&str; 3] = ["u", "v", "psi"];
+/// What the quantity is: `u`, `v` or `psi`; then the sections' `N`, `V`, `M`, `eps`, `kappa`
+/// (`value_strain::NAMES`).
+const NAMES: [&str; 8] = ["u", "v", "psi", "N", "V", "M", "eps", "kappa"];
+
+/// The first section quantity in [`NAMES`].
+const SECTION: usize = 3;
 
 /// What the beam quantities look like, for messages.
-pub const HELP: &str = ", u(BEAM, XI), v(BEAM, XI), psi(BEAM, XI) (a beam's displacement in its frame) or their rates d:u(...)";
+pub const HELP: &str = ", u(BEAM, XI), v(BEAM, XI), psi(BEAM, XI) (a beam's displacement in its frame), N(BEAM, XI), V(...), M(...), eps(...), kappa(...) (its internal forces and strains) or their rates d:u(...), d:M(...)";
 
 #[derive(Debug, Clone)]
 enum Shape {
@@ -29,12 +37,14 @@ enum Shape {
     /// ANCF cable: the global indices of `[r(0), r(L), e]` (2 + 2 + 8), the point's shape
     /// values `s`, slopes `d` and its undeformed axial place `xi L`.
     Cable { idx: [usize; 12], s: [f64; 4], d: [f64; 4], x0: f64 },
+    /// A strain or internal force (`value_strain.rs`).
+    Section(Section),
 }
 
 /// One beam quantity a value reads.
 #[derive(Debug, Clone)]
 pub struct BeamQuantity {
-    /// 0: u, 1: v, 2: psi.
+    /// 0: u, 1: v, 2: psi; from `SECTION` on a section quantity (its `Shape` knows which).
     what: usize,
     pub rate: bool,
     shape: Shape,
@@ -47,7 +57,7 @@ pub fn parse(s: &str) -> Option<(usize, bool, &str, &str, usize)> {
         Some(r) => (true, r),
         None => (false, s),
     };
-    // `psi` before `v`/`u`: no name is a prefix of another
+    // no name is a prefix of another
     let what = NAMES.iter().position(|n| rest.starts_with(n))?;
     let inner = rest[NAMES[what].len()..].trim_start().strip_prefix('(')?;
     let close = inner.find(')')?;
@@ -60,15 +70,10 @@ pub fn parse(s: &str) -> Option<(usize, bool, &str, &str, usize)> {
 }
 
 /// The refusal of a sensor at the start of `s` that a load cannot read: a joint's reaction
-/// depends on the accelerations, which depend on the load (an algebraic loop); a beam's strains
-/// and internal forces are not inputs yet (docs/loads.md, "Not done").
+/// depends on the accelerations, which depend on the load (an algebraic loop).
 pub fn refused_sensor(s: &str) -> Option<String> {
-    let head = |name: &str| s.strip_prefix(name).is_some_and(|r| r.trim_start().starts_with('('));
-    if head("reaction") {
-        return Some("a joint's reaction is not a load input: it depends on the accelerations, which depend on the load (an algebraic loop); a friction force that follows the reaction is joint_friction, which closes that loop in each acceleration call".into());
-    }
-    let sensor = ["eps", "kappa", "N", "M", "V"].into_iter().find(|n| head(n))?;
-    Some(format!("the beam sensor {sensor}(BEAM, XI) is not a load input (docs/loads.md, Not done); the displacements u, v, psi(BEAM, XI) are"))
+    let reaction = s.strip_prefix("reaction").is_some_and(|r| r.trim_start().starts_with('('));
+    reaction.then(|| "a joint's reaction is not a load input: it depends on the accelerations, which depend on the load (an algebraic loop); a friction force that follows the reaction is joint_friction, which closes that loop in each acceleration call".into())
 }
 
 impl BeamQuantity {
@@ -85,6 +90,8 @@ impl BeamQuantity {
         };
         let b = &ctx.bodies[bi];
         let shape = match &b.kind {
+            BodyKind::Beam(k) if what >= SECTION => Shape::Section(Section::ffrf(k, b.offset, what - SECTION, xi)),
+            BodyKind::Cable(k) if what >= SECTION => Shape::Section(Section::cable(k, b.offset, what - SECTION, xi)),
             BodyKind::Beam(k) => {
                 let ps = k.point_shape(xi);
                 Shape::Linear(ps.entries.iter().map(|&(i, su, sv, sp)| (b.offset + 3 + i, [su, sv, sp][what])).collect())
@@ -97,6 +104,13 @@ impl BeamQuantity {
                     idx[j] = b.offset + l;
                 }
                 Shape::Cable { idx, s: p.s, d: p.d, x0: xi * k.length }
+            }
+            _ if what >= SECTION => {
+                return Err(err(format!(
+                    "{name}({body}, ...): body '{body}' ({}) has no beam axis; {} are a beam's (FFRF or ANCF) internal forces and strains",
+                    b.kind_name(),
+                    value_strain::NAMES.join(", ")
+                )))
             }
             _ => {
                 return Err(err(format!(
@@ -113,6 +127,7 @@ impl BeamQuantity {
         match &self.shape {
             Shape::Linear(c) => c.iter().map(|&(i, _)| i).collect(),
             Shape::Cable { idx, .. } => idx.to_vec(),
+            Shape::Section(s) => s.coords(),
         }
     }
 
@@ -133,6 +148,7 @@ impl BeamQuantity {
                     f[self.what]
                 }
             }
+            Shape::Section(sec) => sec.value(self.rate, q, qd),
         }
     }
 
@@ -155,19 +171,10 @@ impl BeamQuantity {
                     }
                     return;
                 }
-                // d(grad . qd)/dq by central differences of the analytic gradient
                 let xd = idx.map(|i| qd[i]);
-                let rate_at = |x: &[f64; 12]| -> f64 { cable(x, s, d, *x0).1[self.what].iter().zip(&xd).map(|(g, v)| g * v).sum() };
-                for j in 0..12 {
-                    let (xj, h) = (x[j], 1e-6 * (1.0 + x[j].abs()));
-                    x[j] = xj + h;
-                    let fp = rate_at(&x);
-                    x[j] = xj - h;
-                    let fm = rate_at(&x);
-                    x[j] = xj;
-                    row[idx[j]] += w * (fp - fm) / (2.0 * h);
-                }
+                value_strain::rate_position_gradient(&mut x, idx, |x| cable(x, s, d, *x0).1[self.what].iter().zip(&xd).map(|(g, v)| g * v).sum(), w, row);
             }
+            Shape::Section(sec) => sec.add_gradient(self.rate, q, qd, w, row),
         }
     }
 }
@@ -219,42 +226,23 @@ mod tests {
     use super::*;
     use crate::dynamics;
     use crate::force::tests::{moving, stiffness_rows_against_differences};
+    use crate::force::value_strain::tests::{along, scene};
 
-    /// A linear Euler-Bernoulli FFRF beam `a`, a nonlinear Timoshenko beam `b` (clamped frame)
-    /// and an ANCF cable `c`, each 3 elements, and one point mass per quantity `quantities`
-    /// loaded by `fx` = that quantity of each beam.
-    fn scene(quantities: &[&str]) -> (String, Vec<(String, usize, f64, bool)>) {
-        let mut bodies = vec![
-            r#"{"kind": "beam", "name": "a", "length": 1.2, "elements": 3, "theory": "euler-bernoulli", "strain": "linear", "density": 7800, "youngs_modulus": 2e11, "section": {"rectangular": {"width": 0.02, "height": 0.01}}, "angle": 0.4}"#.to_string(),
-            r#"{"kind": "beam", "name": "b", "length": 0.8, "elements": 3, "poisson_ratio": 0.3, "shear_factor": 0.9, "frame": "clamped", "density": 7800, "youngs_modulus": 2e11, "section": {"circular": {"diameter": 0.01}}, "position": [0.3, 0.1]}"#.to_string(),
-            r#"{"kind": "cable", "name": "c", "length": 1.0, "elements": 3, "density": 7800, "youngs_modulus": 2e11, "section": {"circular": {"diameter": 0.01}}, "angle": -0.3}"#.to_string(),
-        ];
-        let (mut forces, mut cases) = (Vec::new(), Vec::new());
-        for (bi, beam) in ["a", "b", "c"].iter().enumerate() {
-            for (k, qty) in quantities.iter().enumerate() {
-                let xi = [0.3, 0.65, 0.9, 0.5, 0.85, 0.15][(k + bi) % 6];
-                let name = format!("m{bi}_{k}");
-                bodies.push(format!(r#"{{"kind": "point_mass", "name": "{name}", "mass": 1.0}}"#));
-                let what = qty.trim_start_matches("d:");
-                forces.push(format!(r#"{{"kind": "point_load", "point": {{"body": "{name}"}}, "fx": "{qty}({beam}, {xi})", "fy": 0}}"#));
-                cases.push((format!("{qty}({beam}, {xi})"), NAMES.iter().position(|n| *n == what).unwrap(), xi, qty.starts_with("d:")));
-            }
-        }
-        (format!(r#"{{"bodies": [{}], "forces": [{}]}}"#, bodies.join(", "), forces.join(", ")), cases)
-    }
+    /// Where the displacement tests read.
+    const DISPLACEMENT_XI: [f64; 6] = [0.3, 0.65, 0.9, 0.5, 0.85, 0.15];
 
     #[test]
     fn beam_quantities_are_the_outputs() {
         // the load's input against `Body::beam_point` (the outputs' u, v, psi) at a deformed,
         // moving state; a rate against central differences of beam_point along qd
-        let (text, cases) = scene(&["u", "v", "psi", "d:u", "d:v", "d:psi"]);
+        let (text, cases) = scene(3, &["u", "v", "psi", "d:u", "d:v", "d:psi"], &DISPLACEMENT_XI);
         let (model, mut data, q, qd) = moving(&text, 0.01, 0.5);
         dynamics::mass_and_forces(&model, &mut data, 0.0, &q, &qd);
         let h = 1e-6;
-        let qp: Vec<f64> = q.iter().zip(&qd).map(|(x, v)| x + h * v).collect();
-        let qm: Vec<f64> = q.iter().zip(&qd).map(|(x, v)| x - h * v).collect();
-        for (k, (label, what, xi, rate)) in cases.iter().enumerate() {
-            let beam = &model.bodies[k / 6];
+        let (qp, qm) = along(&q, &qd, h);
+        for (k, (label, bi, name, xi, rate)) in cases.iter().enumerate() {
+            let what = NAMES.iter().position(|n| n == name).unwrap();
+            let beam = &model.bodies[*bi];
             let m = &model.bodies[3 + k];
             let expected = if *rate {
                 (beam.beam_point(*xi, &qp).unwrap()[2 + what] - beam.beam_point(*xi, &qm).unwrap()[2 + what]) / (2.0 * h)
@@ -271,7 +259,7 @@ mod tests {
     fn beam_quantity_stiffness_matches_differences() {
         // the point masses' rows of K = -dQ/dq (constant Jacobians: exactly -dF/dq; the beams'
         // own rows hold their inertia forces, which K leaves out) against central differences
-        let (text, _) = scene(&["u", "v", "psi", "d:u", "d:v", "d:psi"]);
+        let (text, _) = scene(3, &["u", "v", "psi", "d:u", "d:v", "d:psi"], &DISPLACEMENT_XI);
         let k = stiffness_rows_against_differences(&text, 0.01, 0.5, |m, i| i >= m.bodies[3].offset);
         // the rows of the point masses (2 coordinates each, after the beams' 3 x 3 elements)
         let n = (k.len() as f64).sqrt() as usize;

@@ -12,6 +12,11 @@ pub fn hermite(s: f64, l: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
     )
 }
 
+/// The third derivatives (in x) of the Hermite shapes of an element of length `l`: constant.
+pub fn hermite_third(l: f64) -> [f64; 4] {
+    [12.0 / (l * l * l), 6.0 / (l * l), -12.0 / (l * l * l), 6.0 / (l * l)]
+}
+
 /// `sum_a c[a] e_a` for the element vector `e` (8 numbers, `e_a = (e[2a], e[2a + 1])`).
 #[inline]
 pub(super) fn map(c: &[f64; 4], e: &[f64]) -> [f64; 2] {
