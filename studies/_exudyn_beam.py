@@ -12,7 +12,7 @@ of the rigid segment around each node. Both converge to the same continuum.
 from __future__ import annotations
 
 import time
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -85,8 +85,8 @@ def settings(t_end: float, steps: int, spectral_radius: float = 1.0, newton_rtol
     ss.timeIntegration.endTime = t_end
     ss.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
     ss.timeIntegration.verboseMode = 0
-    ss.solutionSettings.writeSolutionToFile = False
-    ss.solutionSettings.sensorsWritePeriod = t_end / steps
+    ss.solution.file.write = False  # solutionSettings.writeSolutionToFile before Exudyn 1.13
+    ss.solution.sensors.writePeriod = t_end / steps
     if newton_rtol is not None:
         ss.timeIntegration.newton.relativeTolerance = newton_rtol
     if newton_atol is not None:
@@ -113,3 +113,17 @@ def history(mbs: Any, sensor: int, t: np.ndarray) -> np.ndarray:
     """A 3-vector sensor's stored history interpolated at ``t``: ``(nt, 3)``."""
     d = np.asarray(mbs.GetSensorStoredData(sensor))
     return np.column_stack([np.interp(t, d[:, 0], d[:, c]) for c in (1, 2, 3)])
+
+
+def run_grid(runs: Dict[Tuple[str, int, int], List[Any]], failed: List[str], meshes: Sequence[int], steps: Sequence[int],
+             run: Callable[[int, int], Any], log: Callable[[str], None], prefix: str = "", unit: str = "elements") -> None:
+    """Exudyn's runs of a study on each mesh at each step count, ``run(mesh, steps)`` appended
+    to ``runs[("Exudyn", mesh, steps)]``; a run that Exudyn stops (its Newton failing at too
+    large a step) is reported in ``failed``."""
+    for n in meshes:
+        for st in steps:
+            log(f"{prefix}Exudyn {n} {unit}, {st} steps")
+            try:
+                runs.setdefault(("Exudyn", n, st), []).append(run(n, st))
+            except Exception as exc:
+                failed.append(f"Exudyn {n} {unit}, {st} steps failed: {type(exc).__name__}: {str(exc)[:60]}")

@@ -211,13 +211,9 @@ def main(argv: Optional[List[str]] = None) -> int:
         for n in uk_meshes:
             _log(f"repetition {k + 1}/{repeat}: ukflex {n} el./member, default simulate()")
             runs.setdefault(("ukflex default simulate()", n, 0), []).append(ukflex_run(n, t))
-        for n in ex_meshes if k < args.exudyn_repeat else ():
-            for st in steps:
-                _log(f"repetition {k + 1}/{repeat}: Exudyn {n} el./member, {st} steps")
-                try:
-                    runs.setdefault(("Exudyn", n, st), []).append(exudyn_run(n, t, st))
-                except Exception as exc:  # Exudyn's Newton failing at too large a step: reported
-                    failed.append(f"Exudyn {n} el./member, {st} steps failed: {type(exc).__name__}: {str(exc)[:60]}")
+        if k < args.exudyn_repeat:
+            xb.run_grid(runs, failed, ex_meshes, steps, lambda n, st: exudyn_run(n, t, st), _log,
+                        prefix=f"repetition {k + 1}/{repeat}: ", unit="el./member")
     ref_u, ref_x, lines, lim = _converged(t, uk_meshes, ex_meshes, runs)
     lines += failed + ["", "| code | el./member | steps | error (to the mesh limit) | to its own time-converged run | wall time [s], median |",
               "|---|---:|---:|---:|---:|---:|"]
