@@ -14,6 +14,7 @@ or their output folder:
   python -m studies spatial-fe-bar
   python -m studies spatial-flexible-exudyn
   python -m studies spatial-beam-pendulum
+  python -m studies spatial-beam-pendulum-exudyn [--quick] [--repeat 3]
   python -m studies spatial-beam-spin-up
   python -m studies spatial-beam-spin-up-exudyn [--meshes 8,12,16,20,24] [--rtols 1e-3,1e-5] [--exudyn-meshes 8,12,16,24] [--steps 1000,2000,4000] [--repeat 3] [--exudyn-repeat 1] [--no-fe]
   python -m studies right-angle-cantilever [--quick] [--meshes 5,10,20,40] [--exudyn-meshes 10,20,40,80] [--steps 500,1000,3000] [--repeat 3] [--exudyn-repeat 1]
@@ -109,7 +110,8 @@ def _cmd_geometric(args: argparse.Namespace) -> int:
 #: arguments that start with ``-``, so ``flexible-coupler --nonlinear`` was refused).
 _PASSTHROUGH = {"flexible-coupler": "flexible_coupler", "simeon-crank": "simeon_crank", "sweeps": "sweeps",
                 "clearance": "clearance", "engine": "engine", "spatial-flexible-crank": "spatial_flexible_crank",
-                "right-angle-cantilever": "right_angle_cantilever", "spatial-beam-spin-up-exudyn": "spatial_beam_spin_up_exudyn"}
+                "right-angle-cantilever": "right_angle_cantilever", "spatial-beam-spin-up-exudyn": "spatial_beam_spin_up_exudyn",
+                "spatial-beam-pendulum-exudyn": "spatial_beam_pendulum_exudyn"}
 
 
 def _passthrough(sub, name: str, module: str, help: str) -> None:
@@ -198,6 +200,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _passthrough(sub, "spatial-fe-bar", "spatial_fe_bar", "the modes of a 3D FE bar against closed forms (docs/spatial-flexible.md)")
     _passthrough(sub, "spatial-flexible-exudyn", "spatial_flexible_exudyn", "the 3D flexible pendulum against Exudyn's ObjectFFRFreducedOrder (docs/spatial-flexible.md)")
     _passthrough(sub, "spatial-beam-pendulum", "spatial_beam_pendulum", "the 3D flexible pendulum: geometrically exact beam against the modal body (docs/spatial-flexible.md)")
+    _passthrough(sub, "spatial-beam-pendulum-exudyn", "spatial_beam_pendulum_exudyn", "the 3D flexible pendulum's beam against Exudyn's ObjectBeamGeometricallyExact (docs/spatial-flexible.md)")
     _passthrough(sub, "spatial-beam-spin-up", "spatial_beam_spin_up", "Kane's spin-up beam: the 3D beam against the planar ANCF cable (docs/spatial-flexible.md)")
     _passthrough(sub, "spatial-beam-spin-up-exudyn", "spatial_beam_spin_up_exudyn",
                  "Kane's spin-up beam in 3D: the modal body against the beam, and against Exudyn (docs/spatial-flexible.md)")

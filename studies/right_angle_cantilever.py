@@ -26,6 +26,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 import ukflex
+from studies import _exudyn_beam as xb
 
 L, EA, GA, GJ, EI, RHO_A, RHO_J = 10.0, 1e6, 1e6, 1e3, 1e3, 1.0, (20.0, 10.0, 10.0)
 T_END = 30.0
@@ -103,28 +104,15 @@ def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float 
     ``steps`` steps over ``[0, t[-1]]`` (generalized-alpha at ``spectral_radius``), and the wall
     time of ``mbs.SolveDynamic``."""
     import exudyn as exu
-    from exudyn.itemInterface import (Force, GenericJoint, MarkerNodeRigid, NodeRigidBodyEP, ObjectBeamGeometricallyExact,
-                                      ObjectGround, MarkerBodyRigid, SensorNode)
-    from exudyn.rigidBodyUtilities import RotationMatrix2EulerParameters, RotationMatrixZ
+    from exudyn.itemInterface import Force, GenericJoint, MarkerBodyRigid, MarkerNodeRigid, ObjectGround, SensorNode
+    from exudyn.rigidBodyUtilities import RotationMatrixZ
 
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
-    sec = exu.BeamSection()
-    sec.stiffnessMatrix = np.diag([EA, GA, GA, GJ, EI, EI])
-    sec.massPerLength = RHO_A
-    sec.inertia = np.diag(RHO_J)
-    le = L / elements
+    sec = xb.beam_section(EA, GA, GA, GJ, EI, EI, RHO_A, RHO_J)
     rot_b = RotationMatrixZ(np.pi / 2)
-    ep_a, ep_b = [1.0, 0.0, 0.0, 0.0], list(RotationMatrix2EulerParameters(rot_b))
-
-    def member(start: np.ndarray, axis: np.ndarray, ep: List[float]) -> List[int]:
-        nodes = [mbs.AddNode(NodeRigidBodyEP(referenceCoordinates=list(start + k * le * axis) + ep)) for k in range(elements + 1)]
-        for n0, n1 in zip(nodes[:-1], nodes[1:]):
-            mbs.AddObject(ObjectBeamGeometricallyExact(nodeNumbers=[n0, n1], physicsLength=le, sectionData=sec))
-        return nodes
-
-    na = member(np.zeros(3), np.array([1.0, 0, 0]), ep_a)
-    nb = member(np.array([L, 0, 0]), np.array([0, 1.0, 0]), ep_b)
+    na = xb.add_member(mbs, (0.0, 0.0, 0.0), np.eye(3), L, elements, sec)
+    nb = xb.add_member(mbs, (L, 0.0, 0.0), rot_b, L, elements, sec)
     ground = mbs.AddObject(ObjectGround())
     mg = mbs.AddMarker(MarkerBodyRigid(bodyNumber=ground, localPosition=[0, 0, 0]))
     mbs.AddObject(GenericJoint(markerNumbers=[mg, mbs.AddMarker(MarkerNodeRigid(nodeNumber=na[0]))], constrainedAxes=[1] * 6))
@@ -136,32 +124,11 @@ def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float 
     s_elbow = mbs.AddSensor(SensorNode(nodeNumber=na[-1], outputVariableType=exu.OutputVariableType.Displacement, storeInternal=True))
     s_tip = mbs.AddSensor(SensorNode(nodeNumber=nb[-1], outputVariableType=exu.OutputVariableType.Displacement, storeInternal=True))
     mbs.Assemble()
-    ss = exu.SimulationSettings()
-    t_end = float(t[-1])
-    ss.timeIntegration.numberOfSteps = steps
-    ss.timeIntegration.endTime = t_end
-    ss.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
-    ss.timeIntegration.verboseMode = 0
-    ss.solutionSettings.writeSolutionToFile = False
-    ss.solutionSettings.sensorsWritePeriod = t_end / steps
-    ss.timeIntegration.newton.relativeTolerance = exudyn_newton_rtol(elements)
     # its sparse solver: the dense default factors the whole (n + m) matrix (at 40 elements per
     # member and 3000 steps 59 s against 13 s, the same answer to 1e-9; one run each)
-    ss.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-    for key, value in (settings or {}).items():  # e.g. "timeIntegration.verboseMode": 1
-        *path, last = key.split(".")
-        obj = ss
-        for p in path:
-            obj = getattr(obj, p)
-        setattr(obj, last, value)
-    t0 = time.perf_counter()
-    mbs.SolveDynamic(ss)
-    dt = time.perf_counter() - t0
-    out = []
-    for s in (s_elbow, s_tip):
-        d = np.asarray(mbs.GetSensorStoredData(s))
-        out.append(np.column_stack([np.interp(t, d[:, 0], d[:, c]) for c in (1, 2, 3)]))
-    return out[0], out[1], dt
+    ss = xb.settings(float(t[-1]), steps, spectral_radius, newton_rtol=exudyn_newton_rtol(elements), sparse=True, overrides=settings)
+    dt = xb.solve(mbs, ss)
+    return xb.history(mbs, s_elbow, t), xb.history(mbs, s_tip, t), dt
 
 
 def gap(a: Tuple[np.ndarray, np.ndarray], b: Tuple[np.ndarray, np.ndarray]) -> float:
@@ -244,13 +211,9 @@ def main(argv: Optional[List[str]] = None) -> int:
         for n in uk_meshes:
             _log(f"repetition {k + 1}/{repeat}: ukflex {n} el./member, default simulate()")
             runs.setdefault(("ukflex default simulate()", n, 0), []).append(ukflex_run(n, t))
-        for n in ex_meshes if k < args.exudyn_repeat else ():
-            for st in steps:
-                _log(f"repetition {k + 1}/{repeat}: Exudyn {n} el./member, {st} steps")
-                try:
-                    runs.setdefault(("Exudyn", n, st), []).append(exudyn_run(n, t, st))
-                except Exception as exc:  # Exudyn's Newton failing at too large a step: reported
-                    failed.append(f"Exudyn {n} el./member, {st} steps failed: {type(exc).__name__}: {str(exc)[:60]}")
+        if k < args.exudyn_repeat:
+            xb.run_grid(runs, failed, ex_meshes, steps, lambda n, st: exudyn_run(n, t, st), _log,
+                        prefix=f"repetition {k + 1}/{repeat}: ", unit="el./member")
     ref_u, ref_x, lines, lim = _converged(t, uk_meshes, ex_meshes, runs)
     lines += failed + ["", "| code | el./member | steps | error (to the mesh limit) | to its own time-converged run | wall time [s], median |",
               "|---|---:|---:|---:|---:|---:|"]

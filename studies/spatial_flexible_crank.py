@@ -23,6 +23,7 @@ from typing import Any, Dict, List, Optional, Tuple
 import numpy as np
 
 import ukflex
+from studies import _exudyn_beam as xb
 from ukflex import spatial_scenes as sps
 from ukflex.results.fields import modal_fields
 
@@ -81,36 +82,15 @@ def ukflex_run(rod_model: str, t: np.ndarray, elements: int = 8, data: Any = Non
     return outputs(system, res, data), dt
 
 
-def _section() -> Dict[str, float]:
-    """The rod's section data as ``beam3`` derives them (Cowper's shear factor, Saint-Venant's
-    torsion constant of the square), for Exudyn."""
-    a, rho, e, nu = sps.ROD_SECTION
-    g = e / (2 * (1 + nu))
-    n = np.arange(1, 200, 2)
-    j = a ** 4 * (1 / 3 - 64 / np.pi ** 5 * np.sum(np.tanh(n * np.pi / 2) / n ** 5))
-    i = a ** 4 / 12
-    k = 10 * (1 + nu) / (12 + 11 * nu)
-    return {"EA": e * a * a, "kGA": k * g * a * a, "GJ": g * j, "EI": e * i, "rhoA": rho * a * a, "rhoI": rho * i}
-
-
 def _exudyn_beam(mbs: Any, elements: int, B: np.ndarray, Rr: np.ndarray) -> Tuple[int, int, List[int]]:
-    """The rod as ``elements`` ``ObjectBeamGeometricallyExact`` on ``NodeRigidBodyEP`` nodes:
-    the markers of its two ends (position, rigid) and the position sensors of its ends and
-    middle node."""
+    """The rod as ``elements`` ``ObjectBeamGeometricallyExact`` on ``NodeRigidBodyEP`` nodes
+    (the section data as ``beam3`` derives them): the markers of its two ends (position, rigid)
+    and the position sensors of its ends and middle node."""
     import exudyn as exu
-    from exudyn.itemInterface import MarkerNodePosition, MarkerNodeRigid, NodeRigidBodyEP, ObjectBeamGeometricallyExact, SensorNode
-    from exudyn.rigidBodyUtilities import RotationMatrix2EulerParameters
+    from exudyn.itemInterface import MarkerNodePosition, MarkerNodeRigid, SensorNode
 
-    sec = _section()
-    ep = list(RotationMatrix2EulerParameters(Rr))
-    le = ROD / elements
-    nodes = [mbs.AddNode(NodeRigidBodyEP(referenceCoordinates=list(B + k * le * Rr[:, 0]) + ep)) for k in range(elements + 1)]
-    bs = exu.BeamSection()
-    bs.stiffnessMatrix = np.diag([sec["EA"], sec["kGA"], sec["kGA"], sec["GJ"], sec["EI"], sec["EI"]])
-    bs.massPerLength = sec["rhoA"]
-    bs.inertia = np.diag([2 * sec["rhoI"], sec["rhoI"], sec["rhoI"]])
-    for n0, n1 in zip(nodes[:-1], nodes[1:]):
-        mbs.AddObject(ObjectBeamGeometricallyExact(nodeNumbers=[n0, n1], physicsLength=le, sectionData=bs))
+    a, rho, e, nu = sps.ROD_SECTION
+    nodes = xb.add_member(mbs, B, Rr, ROD, elements, xb.beam_section(**xb.rectangle_section(a, a, rho, e, nu)))
     sensors = [mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=exu.OutputVariableType.Position, storeInternal=True))
                for n in (nodes[0], nodes[elements // 2], nodes[-1])]
     return mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[0])), mbs.AddMarker(MarkerNodeRigid(nodeNumber=nodes[-1])), sensors
@@ -198,22 +178,10 @@ def exudyn_run(t: np.ndarray, steps: int, elements: int = 8, spectral_radius: fl
                                               mbs.AddMarker(MarkerBodyRigid(bodyNumber=slider_b))], constrainedAxes=[0, 1, 1, 1, 1, 1]))
     sensors.append(mbs.AddSensor(SensorNode(nodeNumber=sn, outputVariableType=exu.OutputVariableType.Position, storeInternal=True)))
     mbs.Assemble()
-    ss = exu.SimulationSettings()
-    t_end = float(t[-1])
-    ss.timeIntegration.numberOfSteps = steps
-    ss.timeIntegration.endTime = t_end
-    ss.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
-    ss.timeIntegration.verboseMode = 0
     # Newton's absolute goal in N: its default 1e-10 lies below the residual's round-off here
     # (EA = 1.3e7 N; the residual stalls at 2e-8 and the solver stops at the first step)
-    ss.timeIntegration.newton.absoluteTolerance = NEWTON_ABS
-    ss.solutionSettings.writeSolutionToFile = False
-    ss.solutionSettings.sensorsWritePeriod = t_end / steps
-    t0 = time.perf_counter()
-    mbs.SolveDynamic(ss)
-    dt = time.perf_counter() - t0
-    a, m, b, sl = (np.column_stack([np.interp(t, d[:, 0], d[:, c]) for c in (1, 2, 3)])
-                   for d in (np.asarray(mbs.GetSensorStoredData(s)) for s in sensors))
+    dt = xb.solve(mbs, xb.settings(float(t[-1]), steps, spectral_radius, newton_atol=NEWTON_ABS))
+    a, m, b, sl = (xb.history(mbs, s, t) for s in sensors)
     return {"slider": sl[:, 0], "deflection": _chord(a, b, m), "ends": np.stack([a, b])}, dt
 
 
