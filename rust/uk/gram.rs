@@ -248,9 +248,11 @@ impl GramUk {
     /// is certified (ready for `correct`), `None` otherwise.
     pub fn factor(&mut self, model: &Model, bodies: &[BodyData], ajac: &SegJac, rcond: f64, atol: f64) -> Option<RankInfo> {
         debug_assert_eq!(self.vals.len(), ajac.vals.len());
-        self.vals.copy_from_slice(&ajac.vals);
+        // B^T = F^-1 A^T, segment by segment (the segments tile the values)
         for s in &self.segs {
-            model.bodies[s.body].finv(&bodies[s.body], &mut self.vals[s.val..s.val + s.len]);
+            let v = &mut self.vals[s.val..s.val + s.len];
+            v.copy_from_slice(&ajac.vals[s.val..s.val + s.len]);
+            model.bodies[s.body].finv(&bodies[s.body], v);
         }
         let mut trace_s = 0.0;
         for (d, u) in self.d.iter_mut().zip(&self.units) {
@@ -281,12 +283,16 @@ impl GramUk {
             return None;
         }
         let mut trace_sinv = self.env.selected_inverse_trace(&mut self.z);
-        // one accumulator per unit (a sum through memory would wait on each store)
+        // four partial sums per unit in registers (a sum through memory waits on each store,
+        // one register on each addition)
         for (b, d) in self.d.iter().enumerate() {
-            let mut zu = 1.0;
-            for &(e, s, t, w) in &self.quad[self.quad_ptr[b]..self.quad_ptr[b + 1]] {
-                zu += w * self.z[e] * self.xval[s] * self.xval[t];
+            let mut acc = [0.0f64; 4];
+            for chunk in self.quad[self.quad_ptr[b]..self.quad_ptr[b + 1]].chunks(4) {
+                for (a, &(e, s, t, w)) in acc.iter_mut().zip(chunk) {
+                    *a += w * self.z[e] * self.xval[s] * self.xval[t];
+                }
             }
+            let zu = 1.0 + ((acc[0] + acc[2]) + (acc[1] + acc[3]));
             trace_sinv += zu / (d * d);
         }
         self.trace_sinv = trace_sinv;
