@@ -32,7 +32,7 @@ pub(crate) fn lu_cm(a: &mut [f64], piv: &mut [usize], n: usize) -> bool {
         let (left, right) = a.split_at_mut((k + 1) * n);
         let lk = &left[k * n + k + 1..(k + 1) * n];
         // the column's nonzeros lie within [lo, hi) (`nonzero_span`): the axpys run there only
-        let (lo, hi) = nonzero_span(lk);
+        let (lo, hi) = if n >= SPARSE_UPDATE_MIN { nonzero_span(lk) } else { (0, lk.len()) };
         let lk = &lk[lo..hi];
         for colj in right.chunks_exact_mut(n) {
             let u = colj[k];
@@ -47,6 +47,9 @@ pub(crate) fn lu_cm(a: &mut [f64], piv: &mut [usize], n: usize) -> bool {
 /// Up to this size the complex LU keeps the nonzeros of each pivot row in a stack buffer and
 /// updates through them when they are sparse (`nonzeros`).
 const SPARSE_UPDATE_MAX: usize = 256;
+/// From this size on the LU kernels look for the zeros (below it the scans cost what they save:
+/// Simeon's crank and the paper scene, 15 x 15 matrices, were 1-3 % slower with them).
+const SPARSE_UPDATE_MIN: usize = 32;
 
 /// The saddle-point matrices of the implicit methods (`[M + g C + g^2 K, A^T; A - g Bv, 0]`)
 /// are sparse and stay so through their elimination (the zero block; a body's coordinates
@@ -70,7 +73,7 @@ fn nonzero_span(x: &[f64]) -> (usize, usize) {
 #[inline(always)]
 fn nonzeros<'b>(re: &[f64], im: &[f64], buf: &'b mut [u16; SPARSE_UPDATE_MAX]) -> Option<&'b [u16]> {
     let len = re.len();
-    if len > SPARSE_UPDATE_MAX || len < 8 {
+    if len > SPARSE_UPDATE_MAX {
         return None;
     }
     let mut cnt = 0;
@@ -201,7 +204,7 @@ pub(crate) fn lu_cplx(ar: &mut [f64], ai: &mut [f64], piv: &mut [usize], n: usiz
         let (ar_top, ar_bot) = ar.split_at_mut((k + 1) * n);
         let (ai_top, ai_bot) = ai.split_at_mut((k + 1) * n);
         let (ur, ui) = (&ar_top[k * n + k + 1..], &ai_top[k * n + k + 1..]);
-        let nz = nonzeros(ur, ui, &mut buf);
+        let nz = if n >= SPARSE_UPDATE_MIN { nonzeros(ur, ui, &mut buf) } else { None };
         for (rr, ri) in ar_bot.chunks_exact_mut(n).zip(ai_bot.chunks_exact_mut(n)) {
             let (xr, xi) = (rr[k], ri[k]);
             let (lr, li) = (xr * ir - xi * ii, xr * ii + xi * ir);
