@@ -309,4 +309,70 @@ mod tests {
             }
         }
     }
+
+    /// A saddle-point matrix `[H, A^T; A, 0]` (column-major, `n + m` square) with `H` block
+    /// diagonal (blocks of 5, a coupling between neighbours) and `A` two entries a row: sparse
+    /// enough that both kernels take their sparse updates (from `SPARSE_UPDATE_MIN` on).
+    fn saddle(n: usize, m: usize) -> Vec<f64> {
+        let nm = n + m;
+        let mut a = vec![0.0; nm * nm];
+        let r = matrix(nm);
+        for j in 0..n {
+            for i in 0..n {
+                if i / 5 == j / 5 || i.abs_diff(j) == 5 {
+                    a[i + j * nm] = r[i + j * nm] + if i == j { 2.0 } else { 0.0 };
+                }
+            }
+        }
+        for k in 0..m {
+            for j in [k % n, (3 * k + 7) % n] {
+                a[(n + k) + j * nm] = 1.0 + r[k + j * nm];
+                a[j + (n + k) * nm] = 1.0 + r[k + j * nm];
+            }
+        }
+        a
+    }
+
+    #[test]
+    fn the_sparse_updates_solve_saddle_point_systems() {
+        let (n, m) = (34, 12);
+        let nm = n + m;
+        assert!(nm >= SPARSE_UPDATE_MIN);
+        let a0 = saddle(n, m);
+        let b: Vec<f64> = (0..nm).map(|i| (i as f64 + 1.0).cos()).collect();
+        let residual = |x: &[f64], im: Option<&[f64]>| -> f64 {
+            // |A x - b| for the real system, |(A + i 0.3 A_H) x - b| for the complex one
+            (0..nm)
+                .map(|i| {
+                    let (mut sr, mut si) = (-b[i], 0.0);
+                    for j in 0..nm {
+                        let re = a0[i + j * nm];
+                        let ai = if im.is_some() && i < n && j < n { 0.3 * re } else { 0.0 };
+                        let (xr, xi) = (x[j], im.map_or(0.0, |v| v[j]));
+                        sr += re * xr - ai * xi;
+                        si += re * xi + ai * xr;
+                    }
+                    sr.hypot(si)
+                })
+                .fold(0.0, f64::max)
+        };
+        let mut lu = a0.clone();
+        let mut piv = vec![0; nm];
+        assert!(lu_cm(&mut lu, &mut piv, nm));
+        let mut x = b.clone();
+        lu_cm_solve(&lu, &piv, nm, &mut x);
+        assert!(residual(&x, None) < 1e-12, "real: {}", residual(&x, None));
+        // the complex matrix A + i 0.3 H, row-major
+        let (mut ar, mut ai) = (vec![0.0; nm * nm], vec![0.0; nm * nm]);
+        for i in 0..nm {
+            for j in 0..nm {
+                ar[i * nm + j] = a0[i + j * nm];
+                ai[i * nm + j] = if i < n && j < n { 0.3 * a0[i + j * nm] } else { 0.0 };
+            }
+        }
+        assert!(lu_cplx(&mut ar, &mut ai, &mut piv, nm));
+        let (mut xr, mut xi) = (b.clone(), vec![0.0; nm]);
+        lu_cplx_solve(&ar, &ai, &piv, nm, &mut xr, &mut xi);
+        assert!(residual(&xr, Some(&xi)) < 1e-12, "complex: {}", residual(&xr, Some(&xi)));
+    }
 }
