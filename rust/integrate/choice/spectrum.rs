@@ -1,13 +1,16 @@
 //! The constrained modal analysis of a small system at a state, and what the chooser reads
 //! from its modes: which are elastic, and each flexible body's lowest elastic mode.
 //!
-//! The UK accelerations are linearized in `q` by central differences (the core's
+//! The UK accelerations are linearized in `q` by central differences (as the core's
 //! `System.jac`: elastic and spring stiffness, gravity, the constraint forces through the
-//! multipliers); the motion is restricted to an orthonormal basis `N` of the null space of
-//! `A(q)` (SVD, singular values above `max(m, n) eps sigma_max` kept: `scipy.linalg.null_space`)
-//! and the symmetric part of `K_r = -N^T M (dqdd/dq) N` is solved against `M_r = N^T M N`
-//! (Cholesky of `M_r`, then the symmetric eigenproblem: `scipy.linalg.eigh`). The same
-//! analysis as `System.frequencies(modes=True)` below `System.SPARSE_MODES_MIN`.
+//! multipliers) along the columns of an orthonormal basis `N` of the null space of `A(q)` (SVD,
+//! singular values above `max(m, n) eps sigma_max` kept: `scipy.linalg.null_space`), two UK
+//! evaluations per degree of freedom (`jacobian::position_directional`; before, two per
+//! coordinate and then `Jq N`: on A05 8 evaluations instead of 68, auto's analysis 0.31 ms CPU
+//! instead of 1.05, its frequencies the same to 1e-11), and the symmetric part of
+//! `K_r = -N^T M (dqdd/dq) N` is solved against `M_r = N^T M N` (Cholesky of `M_r`, then the
+//! symmetric eigenproblem: `scipy.linalg.eigh`). The same analysis as
+//! `System.frequencies(modes=True)` below `System.SPARSE_MODES_MIN`.
 
 use faer::{Mat, Side};
 
@@ -91,19 +94,17 @@ pub fn dense_spectrum(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
     let n = model.n;
     let NullSpace(rank, basis) = ns;
     let k = n - rank;
-    let mut jq = vec![0.0; n * n];
-    jacobian::position_jacobian(model, data, t, q, qd, &mut jq)?;
+    // Jq N by differences along the null space's k directions (not Jq's n columns, then N)
+    let mut jqn = vec![0.0; n * k];
+    jacobian::position_directional(model, data, t, q, qd, &basis, k, &mut jqn)?;
     dynamics::mass_and_forces(model, data, t, q, qd);
     let mass = dynamics::dense_mass(model, data);
     // MN = M N, KN = M Jq N (n x k, column-major)
     let mut mn = vec![0.0; n * k];
-    let mut jn = vec![0.0; n];
     let mut kn = vec![0.0; n * k];
     for c in 0..k {
         let col = &basis[c * n..(c + 1) * n];
-        for i in 0..n {
-            jn[i] = (0..n).map(|j| jq[i * n + j] * col[j]).sum();
-        }
+        let jn = &jqn[c * n..(c + 1) * n];
         for i in 0..n {
             let row = &mass[i * n..(i + 1) * n];
             mn[c * n + i] = (0..n).map(|j| row[j] * col[j]).sum();
