@@ -2,15 +2,16 @@
 (J. C. Simo and L. Vu-Quoc 1988, "On the dynamics in space of rods undergoing large motions - a
 geometrically exact approach", Computer Methods in Applied Mechanics and Engineering 66, 125-161:
 the figure of the elbow's and the tip's out-of-plane displacement over 0-30 s of their
-right-angle cantilever example). The paper gives the histories as curves only, no table: the
-points below were read from that figure by others (digitized), not tabulated by the authors.
+right-angle cantilever example). The histories are published as curves (no table of them was
+found): the points below were read from that figure by others (digitized), not tabulated by the
+authors.
 
 ``ELBOW`` and ``TIP``: one reading of both curves, the reference data of the AeroBeams.jl test
 suite (its right-angled "elbow frame" case, labelled there Simo and Vu-Quoc). ``TIP_SECOND_READING``:
 an independent reading of the tip curve, in the FinEtoolsFlexStructures.jl examples (P. Krysl).
-The two readings of the tip agree on the extreme values (8.30 / 8.32 and -9.67 / -9.21) but not
-on their times (7.67 s / 6.58 s, 15.99 s / 14.43 s): the reading error of a time axis is of the
-order of a second in the second one, which is therefore only shown as the spread of the readings.
+The two readings of the tip agree on its first maximum (8.30 / 8.32), less on its minimum
+(-9.67 / -9.21), and not on their times (7.67 s / 6.58 s, 15.99 s / 14.7 s): the second one's time
+axis is off by up to a second, so it only shows the spread of the readings.
 
 Pairs ``(t [s], u_z)``; the force ``F_z`` at the elbow is positive (``+z``), and both curves start
 upwards.
