@@ -17,7 +17,7 @@ or their output folder:
   python -m studies spatial-beam-pendulum-exudyn [--quick] [--repeat 3]
   python -m studies spatial-beam-spin-up
   python -m studies spatial-beam-spin-up-exudyn [--meshes 8,12,16,20,24] [--rtols 1e-3,1e-5] [--exudyn-meshes 8,12,16,24] [--steps 1000,2000,4000] [--repeat 3] [--exudyn-repeat 1] [--no-fe]
-  python -m studies right-angle-cantilever [--quick] [--meshes 5,10,20,40] [--exudyn-meshes 10,20,40,80] [--steps 500,1000,3000] [--repeat 3] [--exudyn-repeat 1]
+  python -m studies right-angle-cantilever [--quick] [--meshes 5,10,20,40] [--exudyn-meshes 10,20,40,80] [--steps 500,1000,3000] [--repeat 3] [--exudyn-repeat 1] [--published [20]]
   python -m studies spatial-flexible-crank [--quick]
   python -m studies sweeps --out results/sweeps [--small]
   python -m studies clearance [flores]

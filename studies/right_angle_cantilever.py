@@ -180,6 +180,21 @@ def _converged(t: np.ndarray, uk_meshes: Sequence[int], ex_meshes: Sequence[int]
     return ref_u, ref_x, lines + ["", f"reference: ukflex's mesh limit; elbow max u_z {np.max(np.abs(lim_u[0][:, 2])):.4f}"], lim_u
 
 
+def published(elements: int) -> int:
+    """ukflex's time-converged run (RADAU5 at rtol 1e-9, outputs every 0.01 s) on ``elements``
+    per member against the extrema of Simo and Vu-Quoc's published curves, as read from their
+    figure (``studies/_rac_published.py``)."""
+    from studies import _rac_published as pub
+
+    t = np.linspace(0.0, T_END, 3001)
+    _log(f"ukflex {elements} el./member, RADAU5 rtol 1e-9")
+    elbow, tip, _ = ukflex_run(elements, t, method="RADAU5", rtol=1e-9, atol=1e-10)
+    scale = max(np.max(np.abs(elbow[:, 2])), np.max(np.abs(tip[:, 2])))
+    print(f"ukflex {elements} el./member against the published curves (read from the figure); max |u_z| {scale:.4f}")
+    print("\n".join(pub.compare(t, elbow[:, 2], tip[:, 2], scale)))
+    return 0
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     """The converged comparison (each code's time-converged runs on its meshes, the mesh limits by
     Richardson extrapolation of the two finest) and the speed at equal accuracy: ukflex's default
@@ -196,7 +211,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--repeat", type=int, default=3, help="interleaved repetitions of ukflex's timed runs")
     ap.add_argument("--exudyn-repeat", type=int, default=1, help="... of Exudyn's (a minute and more each on the fine meshes)")
     ap.add_argument("--quick", action="store_true", help="meshes 5, 10, 20 (Exudyn 10, 20, 40), one repetition")
+    ap.add_argument("--published", type=int, nargs="?", const=20, metavar="ELEMENTS",
+                    help="only ukflex (ELEMENTS per member, 20 if not given) against Simo and Vu-Quoc's published curves")
     args = ap.parse_args(argv)
+    if args.published:
+        return published(args.published)
 
     def ints(text: str) -> Tuple[int, ...]:
         return tuple(int(x) for x in text.split(","))
