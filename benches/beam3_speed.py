@@ -2,12 +2,15 @@
 interleaved repetitions on freshly built Systems (docs/spatial-flexible.md, "Speed of the
 default on the beam"): Kane's spin-up beam at 8 and 20 elements (rtol 1e-5, the study's
 fastest runs within 0.5 % and 0.1 %) and the right-angle cantilever at 20 elements per member
-(the default, its 0.5 % run). Prints the medians, the solver's counts (steps, ``nfev``,
-``njev``, ``nlu``) of the last repetition, and with ``--save``/``--compare`` the answers'
+(the default, its 0.5 % run). Prints the medians, the solver's counts (``nfev``, ``njev``,
+``nlu``) of one more run, and with ``--save``/``--compare`` the answers'
 largest change against a saved run (a build before a change), in units of each scene's output
 scale (the spin-up's 0.57 m dip, the frame's largest tip displacement).
 
     PYTHONPATH=. python benches/beam3_speed.py [--repeat 3] [--save before.npz] [--compare before.npz]
+
+Before / after a change of the extension: run it once per build, alternating, with
+``PYTHONPATH=<a copy of python/ with the other build's _core>:.`` for the other build.
 """
 
 from __future__ import annotations
@@ -52,7 +55,7 @@ SCENES: Dict[str, Tuple[str, Callable[[], Callable[[], Tuple[np.ndarray, float, 
 
 
 def counts(key: str) -> str:
-    """Steps, nfev, njev and nlu of one default run (simulate's result)."""
+    """The method, nfev, njev and nlu of one default run (simulate's result)."""
     seen: Dict[str, Any] = {}
     orig = ukflex.simulate
 
@@ -66,8 +69,7 @@ def counts(key: str) -> str:
     finally:
         ukflex.simulate = orig
     r = seen["res"]
-    steps = r.extra.get("steps", "?") if isinstance(getattr(r, "extra", None), dict) else "?"
-    return f"method {r.method}, steps {steps}, nfev {r.nfev}, njev {r.njev}, nlu {r.nlu}"
+    return f"method {r.method}, nfev {r.nfev}, njev {r.njev}, nlu {r.nlu}"
 
 
 def main() -> None:
