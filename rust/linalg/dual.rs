@@ -1,6 +1,6 @@
 //! Forward-mode automatic differentiation for small generic energies: a scalar trait [`Real`]
 //! implemented by `f64`, by [`Dual<N>`] (value and gradient in `N` seeded directions) and by
-//! [`HyperDual<N>`] (value, gradient and Hessian). A function written once over `T: Real`
+//! [`HyperDual<N, M>`] (value, gradient and the Hessian's `M = N (N + 1) / 2` packed entries). A function written once over `T: Real`
 //! gives its value, its exact gradient (to rounding) and its exact Hessian; everything lives on
 //! the stack (no allocation per call). Only the operations the elements need: `+ - * /`, and
 //! unary functions given with their first two derivatives (`Real::unary`; `sqrt` is one).
@@ -61,8 +61,8 @@ impl Real for f64 {
 
 /// `-a` and `a / b` from `scale` and `recip` (the same for both dual types).
 macro_rules! neg_and_div {
-    ($t:ident) => {
-        impl<const N: usize> Neg for $t<N> {
+    ($t:ident < $($n:ident),+ >) => {
+        impl<$(const $n: usize),+> Neg for $t<$($n),+> {
             type Output = Self;
             #[inline]
             fn neg(self) -> Self {
@@ -70,7 +70,7 @@ macro_rules! neg_and_div {
             }
         }
 
-        impl<const N: usize> Div for $t<N> {
+        impl<$(const $n: usize),+> Div for $t<$($n),+> {
             type Output = Self;
             #[inline]
             #[allow(clippy::suspicious_arithmetic_impl)] // a / b = a * (1 / b), the chain rule of 1 / b
@@ -81,8 +81,8 @@ macro_rules! neg_and_div {
     };
 }
 
-neg_and_div!(Dual);
-neg_and_div!(HyperDual);
+neg_and_div!(Dual<N>);
+neg_and_div!(HyperDual<N, M>);
 
 /// Value and gradient in `N` directions.
 #[derive(Debug, Clone, Copy)]
@@ -155,65 +155,105 @@ impl<const N: usize> Real for Dual<N> {
     }
 }
 
-/// Value, gradient and Hessian (full, symmetric) in `N` directions.
+/// Value, gradient and Hessian in `N` directions. The Hessian is symmetric and stored packed:
+/// its upper triangle row by row (`M = N (N + 1) / 2` entries, checked at compile time), so a
+/// product costs half the work and half the copies of a full square.
 #[derive(Debug, Clone, Copy)]
-pub struct HyperDual<const N: usize> {
+pub struct HyperDual<const N: usize, const M: usize> {
     pub v: f64,
     pub g: [f64; N],
-    pub h: [[f64; N]; N],
+    /// `H[i][j]` for `j >= i`, row by row (`HyperDual::hessian` unpacks it).
+    pub h: [f64; M],
 }
 
-impl<const N: usize> HyperDual<N> {
+impl<const N: usize, const M: usize> HyperDual<N, M> {
+    const PACKED: () = assert!(M == N * (N + 1) / 2, "HyperDual<N, M> needs M = N (N + 1) / 2");
+
     /// The `i`-th independent variable at `x`.
     pub fn var(x: f64, i: usize) -> Self {
         let mut g = [0.0; N];
         g[i] = 1.0;
-        HyperDual { v: x, g, h: [[0.0; N]; N] }
+        Self::with(x, g, [0.0; M])
+    }
+
+    #[inline]
+    fn with(v: f64, g: [f64; N], h: [f64; M]) -> Self {
+        #[allow(clippy::let_unit_value)]
+        let _ = Self::PACKED;
+        HyperDual { v, g, h }
+    }
+
+    /// The full symmetric Hessian.
+    pub fn hessian(&self) -> [[f64; N]; N] {
+        let mut out = [[0.0; N]; N];
+        let mut k = 0;
+        for i in 0..N {
+            for j in i..N {
+                out[i][j] = self.h[k];
+                out[j][i] = self.h[k];
+                k += 1;
+            }
+        }
+        out
     }
 }
 
-impl<const N: usize> Add for HyperDual<N> {
+impl<const N: usize, const M: usize> Add for HyperDual<N, M> {
     type Output = Self;
     #[inline]
     fn add(mut self, o: Self) -> Self {
         self.v += o.v;
         for i in 0..N {
             self.g[i] += o.g[i];
-            for j in 0..N {
-                self.h[i][j] += o.h[i][j];
-            }
+        }
+        for k in 0..M {
+            self.h[k] += o.h[k];
         }
         self
     }
 }
 
-impl<const N: usize> Sub for HyperDual<N> {
+impl<const N: usize, const M: usize> Sub for HyperDual<N, M> {
     type Output = Self;
     #[inline]
-    fn sub(self, o: Self) -> Self {
-        self + o.scale(-1.0)
+    fn sub(mut self, o: Self) -> Self {
+        self.v -= o.v;
+        for i in 0..N {
+            self.g[i] -= o.g[i];
+        }
+        for k in 0..M {
+            self.h[k] -= o.h[k];
+        }
+        self
     }
 }
 
-impl<const N: usize> Mul for HyperDual<N> {
+impl<const N: usize, const M: usize> Mul for HyperDual<N, M> {
     type Output = Self;
     #[inline]
     fn mul(self, o: Self) -> Self {
-        let mut r = HyperDual { v: self.v * o.v, g: [0.0; N], h: [[0.0; N]; N] };
+        let (a, b) = (self.v, o.v);
+        let g = std::array::from_fn(|i| a * o.g[i] + b * self.g[i]);
+        let mut h = [0.0; M];
+        // row by row as slices (one bounds check a row, the inner loop vectorizes)
+        let mut k = 0;
         for i in 0..N {
-            r.g[i] = self.v * o.g[i] + o.v * self.g[i];
-            for j in 0..N {
-                r.h[i][j] = self.v * o.h[i][j] + o.v * self.h[i][j] + self.g[i] * o.g[j] + o.g[i] * self.g[j];
+            let (ga, gb) = (self.g[i], o.g[i]);
+            let end = k + N - i;
+            let rows = h[k..end].iter_mut().zip(&self.h[k..end]).zip(&o.h[k..end]);
+            for (((hv, &ha), &hb), (&gaj, &gbj)) in rows.zip(self.g[i..].iter().zip(&o.g[i..])) {
+                *hv = a * hb + b * ha + ga * gbj + gb * gaj;
             }
+            k = end;
         }
-        r
+        Self::with(a * b, g, h)
     }
 }
 
-impl<const N: usize> Real for HyperDual<N> {
+impl<const N: usize, const M: usize> Real for HyperDual<N, M> {
     #[inline]
     fn cst(x: f64) -> Self {
-        HyperDual { v: x, g: [0.0; N], h: [[0.0; N]; N] }
+        Self::with(x, [0.0; N], [0.0; M])
     }
     #[inline]
     fn val(&self) -> f64 {
@@ -221,17 +261,21 @@ impl<const N: usize> Real for HyperDual<N> {
     }
     #[inline]
     fn unary(self, f: f64, df: f64, d2f: f64) -> Self {
-        let mut r = HyperDual { v: f, g: self.g.map(|x| df * x), h: [[0.0; N]; N] };
+        let mut h = [0.0; M];
+        let mut k = 0;
         for i in 0..N {
-            for j in 0..N {
-                r.h[i][j] = df * self.h[i][j] + d2f * self.g[i] * self.g[j];
+            let gi = d2f * self.g[i];
+            let end = k + N - i;
+            for ((hv, &hs), &gj) in h[k..end].iter_mut().zip(&self.h[k..end]).zip(&self.g[i..]) {
+                *hv = df * hs + gi * gj;
             }
+            k = end;
         }
-        r
+        Self::with(f, self.g.map(|x| df * x), h)
     }
     #[inline]
     fn scale(self, s: f64) -> Self {
-        HyperDual { v: self.v * s, g: self.g.map(|x| s * x), h: self.h.map(|row| row.map(|x| s * x)) }
+        Self::with(self.v * s, self.g.map(|x| s * x), self.h.map(|x| s * x))
     }
 }
 
@@ -247,7 +291,8 @@ mod tests {
     #[test]
     fn gradient_and_hessian_match_differences() {
         let (x, y) = (0.7, 1.3);
-        let hd = f(HyperDual::<2>::var(x, 0), HyperDual::<2>::var(y, 1));
+        let hd = f(HyperDual::<2, 3>::var(x, 0), HyperDual::<2, 3>::var(y, 1));
+        let hh = hd.hessian();
         let d = f(Dual::<2>::var(x, 0), Dual::<2>::var(y, 1));
         let h = 1e-5;
         let fx = (f(x + h, y) - f(x - h, y)) / (2.0 * h);
@@ -261,7 +306,7 @@ mod tests {
             b[j] -= h;
             let (ga, gb) = (gx(a[0], a[1]), gx(b[0], b[1]));
             for i in 0..2 {
-                assert!((hd.h[i][j] - (ga[i] - gb[i]) / (2.0 * h)).abs() < 1e-8, "H[{i}][{j}]");
+                assert!((hh[i][j] - (ga[i] - gb[i]) / (2.0 * h)).abs() < 1e-8, "H[{i}][{j}]");
             }
         }
     }
