@@ -27,6 +27,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 import ukflex
+from studies._exudyn_beam import add_member, beam_section, history, settings, solve
 from studies.right_angle_cantilever import richardson
 from studies.spatial_beam_spin_up import EA, EI, GA, L, MU, OMEGA, T_END, T_SPIN, _in_hub_frame, beam3, cable, hub_angle
 
@@ -103,20 +104,13 @@ def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float 
     (docs/spatial-flexible.md)."""
     import exudyn as exu
     from exudyn.itemInterface import (CoordinateConstraint, GenericJoint, MarkerNodeCoordinate, MarkerNodeRigid, NodePointGround,
-                                      NodeRigidBodyEP, NodeRigidBodyRxyz, ObjectBeamGeometricallyExact, ObjectRigidBody,
-                                      SensorNode)
+                                      NodeRigidBodyRxyz, ObjectRigidBody, SensorNode)
 
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
-    sec = exu.BeamSection()
-    sec.stiffnessMatrix = np.diag([EA, GA, GA, EI, 3 * EI, EI])
-    sec.massPerLength = MU
     rho_i = MU / 4e-4 * EI / 7e10  # rho I, as in the ukflex beam (spatial_beam_spin_up.beam3)
-    sec.inertia = np.diag([4 * rho_i, 3 * rho_i, rho_i])
-    le = L / elements
-    nodes = [mbs.AddNode(NodeRigidBodyEP(referenceCoordinates=[k * le, 0, 0, 1.0, 0, 0, 0])) for k in range(elements + 1)]
-    for n0, n1 in zip(nodes[:-1], nodes[1:]):
-        mbs.AddObject(ObjectBeamGeometricallyExact(nodeNumbers=[n0, n1], length=le, sectionData=sec))
+    sec = beam_section(EA, GA, GA, EI, 3 * EI, EI, MU, (4 * rho_i, 3 * rho_i, rho_i))
+    nodes = add_member(mbs, (0.0, 0.0, 0.0), np.eye(3), L, elements, sec)
     hub = mbs.AddNode(NodeRigidBodyRxyz(referenceCoordinates=[0.0] * 6))
     mbs.AddObject(ObjectRigidBody(nodeNumber=hub, mass=1.0, inertia=[1.0, 1.0, 1.0, 0, 0, 0]))
     m_ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
@@ -129,20 +123,9 @@ def exudyn_run(elements: int, t: np.ndarray, steps: int, spectral_radius: float 
                                constrainedAxes=[1] * 6))
     s_tip = mbs.AddSensor(SensorNode(nodeNumber=nodes[-1], outputVariableType=exu.OutputVariableType.Position, storeInternal=True))
     mbs.Assemble()
-    ss = exu.SimulationSettings()
-    ti = ss.timeIntegration
-    ti.numberOfSteps, ti.endTime, ti.verboseMode = steps, T_END, 0
-    ti.generalizedAlpha.spectralRadius = spectral_radius
-    ti.newton.absoluteTolerance = absolute_tolerance
-    ss.solution.file.write = False
-    ss.solution.sensors.writePeriod = T_END / steps
-    ss.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-    t0 = time.perf_counter()
-    mbs.SolveDynamic(ss)
-    dt = time.perf_counter() - t0
-    d = np.asarray(mbs.GetSensorStoredData(s_tip))
-    x, y = np.interp(t, d[:, 0], d[:, 1]), np.interp(t, d[:, 0], d[:, 2])
-    u, v = _in_hub_frame(t, x, y)
+    dt = solve(mbs, settings(T_END, steps, spectral_radius, newton_atol=absolute_tolerance, sparse=True))
+    tip = history(mbs, s_tip, t)
+    u, v = _in_hub_frame(t, tip[:, 0], tip[:, 1])
     return u, v, dt
 
 
