@@ -12,7 +12,11 @@ its physical error (docs/integrators.md, "auto on scenes nobody tuned it for").
   RADAU5M at fixed steps ``h = angle / omega`` (the hub's turn per step) for hub speeds 3, 6 and
   12 rad/s, cables of 4 and 8 elements: accepted steps and Newton failures (rejections).  ~20 s.
 
-    python benches/auto_speed_checks.py models|coarse|spin
+* ``overhead``: what auto adds to the run it picks on the shortest scene (the pinned beam, 0.02 s):
+  its whole call, ``choose_method`` alone and RADAU5M at auto's step and Newton tolerance, CPU
+  medians of 300 interleaved calls on one System.  ~3 s.
+
+    python benches/auto_speed_checks.py models|coarse|spin|overhead
 """
 
 from __future__ import annotations
@@ -88,9 +92,31 @@ def spin():
                           flush=True)
 
 
+def overhead(repeat=300):
+    from ukflex.run.choice import choose_method
+
+    te = np.linspace(0.0, 0.02, A.NOUT)
+    for f in ("ffrf", "ancf"):
+        system = scenes.pinned_beam(elements=A.N_MODEL, formulation=f, gravity=True).build()
+        h = ukflex.simulate(system, 0.02).extra["auto"]["step"]
+        runs = {"auto": lambda: ukflex.simulate(system, 0.02, t_eval=te),
+                "choose_method": lambda: choose_method(system, 0.0, 0.02, 1e-6),
+                "RADAU5M at h_auto": lambda: ukflex.simulate(system, 0.02, method="RADAU5M", step=h, rtol=1e-4, t_eval=te)}
+        cpu = {k: [] for k in runs}
+        for _ in range(repeat):
+            for label, run in runs.items():
+                tic = time.process_time()
+                run()
+                cpu[label].append(time.process_time() - tic)
+        ms = {k: 1e3 * statistics.median(v) for k, v in cpu.items()}
+        rest = ms["auto"] - ms["choose_method"] - ms["RADAU5M at h_auto"]
+        print(f"pinned beam {f}: " + ", ".join(f"{k} {v:.3f} ms" for k, v in ms.items()) + f", the rest {rest:.3f} ms CPU",
+              flush=True)
+
+
 if __name__ == "__main__":
     warnings.simplefilter("ignore")
     part = sys.argv[1] if len(sys.argv) > 1 else ""
-    if part not in ("models", "coarse", "spin"):
+    if part not in ("models", "coarse", "spin", "overhead"):
         sys.exit(__doc__.rstrip().splitlines()[-1].strip())
-    {"models": models, "coarse": coarse, "spin": spin}[part]()
+    {"models": models, "coarse": coarse, "spin": spin, "overhead": overhead}[part]()
