@@ -261,7 +261,7 @@ def main() -> None:
             auto = next(x for x in table if x[1] == "auto (default)")
             best, by_physical = fastest_at(table, auto, own=True), fastest_at(table, auto, own=False)
             summary.append((kind, f, auto, best, by_physical))
-            print(f"{kind:18} {f:5} auto {1e3 * auto[2]:8.2f} ms  err {auto[3][1]:.2e} (integration {auto[3][2]:.1e}, "
+            print(f"{kind:18} {f:5} auto {1e3 * auto[2]:8.2f} ms CPU  err {auto[3][1]:.2e} (integration {auto[3][2]:.1e}, "
                   f"{auto[3][3]}, {auto[3][6]} steps, {auto[3][7]} rejected)  fastest at that error: {best[1]} "
                   f"{1e3 * best[2]:.2f} ms ({best[3][1]:.2e}, integration {best[3][2]:.1e})  ratio {auto[2] / best[2]:.2f}"
                   f" (wall {wall_ratio(walls, auto, best):.2f})"
@@ -272,7 +272,7 @@ def main() -> None:
                     "integration error", "notes"])
         w.writerows(rows)
     print()
-    print("| scene | model | auto: ms, physical error (integration) | fastest at auto's error (integration) | ratio "
+    print("| scene | model | auto: CPU ms, physical error (integration) | fastest at auto's error (integration) | ratio "
           "| by the physical error alone: fastest, ratio |")
     print("|---|---|---|---|---|---|")
     for kind, f, auto, best, phys in summary:
