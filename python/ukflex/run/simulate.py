@@ -339,6 +339,7 @@ def simulate(
         raise InvalidArgumentError(
             "formulation", f"events, dense_output and args need formulation='uk' (the NumPy reference {formulation!r} "
             "runs its own solve_ivp call)")
+    auto_extra = None
     if method == "auto":
         from ..analysis.modes import BudgetExceeded
 
@@ -356,16 +357,13 @@ def simulate(
             if choice is not None:
                 res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
             return res
-        run_rtol = choice.rtol if choice is not None and choice.rtol is not None else rtol
-        res = simulate(system, None, method, run_rtol, atol, t_eval_v, formulation, t_span=(t0, t_end_f), q0=q_init,
-                       qd0=qd_init, partition=partition, progress=progress, events=ev_list or None,
-                       dense_output=dense_output, max_steps=budget.max_steps, max_nfev=budget.max_nfev,
-                       max_wall_time=budget.remaining(), min_step=budget.min_step, on_drift=on_drift,
-                       stabilization=stabilization, rank_tolerance=rank_tolerance, pseudoinverse=pseudoinverse,
-                       raise_on_failure=raise_on_failure, **options)
         if choice is not None:
-            res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
-        return res
+            auto_extra = dict(choice.as_dict(), time=choice_time)
+            if choice.rtol is not None:  # the rtol the chosen integrator runs at, atol defaulted from it
+                rtol, atol_v = _checked_tolerances(choice.rtol, atol, n)
+        # the chosen method runs below with the arguments checked once above; its own options checked here
+        _check_options(method, formulation, options)
+        options = _checked_steps(options, budget, t0, t_end_f)
     y0 = np.concatenate([q_init, qd_init])
     guard = _Guard(drift_limit(system, rtol, atol_v), on_drift == "stop")
     if method in NATIVE_METHODS:
@@ -398,6 +396,8 @@ def simulate(
     _report(system, res, guard, method, options)
     if label is not None:
         res.extra["stabilization"] = label
+    if auto_extra is not None:
+        res.extra["auto"] = auto_extra
     if raise_on_failure and res.status < 0:
         t_fail = float(res.t[-1]) if res.t.size else t0
         kind = label["kind"] if isinstance(label, dict) else (label or "default")
