@@ -66,6 +66,16 @@ TIP_SECOND_READING = (
     (27.792, 2.8419), (28.423, 1.2648), (29.409, 0.81423), (29.961, 0.73913),
 )
 
+#: The extrema (``|u_z| > 0.5``; t [s], u_z, +1 at a maximum / -1 at a minimum) of a third code's
+#: computed histories, not a reading: AeroBeams.jl's own solution of the same frame (its test's stored output,
+#: ``test/newTestDataGenerators/elbowFrame/u3_elbow.txt`` and ``u3_tip.txt``, commit 04634043b917;
+#: 20 elements per member, time step 0.05 s, the data above; sampled every 0.05 s, so its
+#: times are good to 0.025 s). A geometrically exact beam of another formulation (Hodges'
+#: mixed one), against which its own figure plots the readings above.
+AEROBEAMS_ELBOW = ((3.10, 5.5099, 1), (6.60, 2.4627, -1), (6.90, 2.4685, 1), (10.85, -4.0609, -1), (13.80, 0.9297, 1),
+                   (17.40, -1.8773, -1), (18.55, -1.7137, 1), (20.95, -3.2896, -1), (25.25, 6.1061, 1))
+AEROBEAMS_TIP = ((7.45, 8.2513, 1), (15.85, -9.7340, -1), (22.65, 6.5650, 1), (23.55, 6.4002, -1), (26.15, 7.2092, 1))
+
 #: how far apart in time [s] a published extremum and ukflex's are still matched
 WINDOW = 1.5
 
@@ -84,6 +94,27 @@ def extrema(t: np.ndarray, u: np.ndarray) -> List[Tuple[float, float, int]]:
             out.append((float(0.5 * (t[i] + t[j])), float(u[i]), 1 if d[j] < 0 else -1))
         i = j + 1
     return out
+
+
+def compare_computed(t: np.ndarray, elbow: np.ndarray, tip: np.ndarray, scale: float) -> List[str]:
+    """Markdown rows: each extremum of AeroBeams' computed histories (``AEROBEAMS_ELBOW``,
+    ``AEROBEAMS_TIP``) against the extremum of the same kind nearest in time of the sampled
+    histories ``elbow``, ``tip``, and against the published (read) extremum of the same kind
+    within ``WINDOW`` (the elbow and the first reading of the tip): the differences in ``u_z``
+    over ``scale``."""
+    rows = ["| point | AeroBeams (computed): t [s], u_z | ukflex - AeroBeams: u_z (/ max abs u_z), t [s] | "
+            "published (read) - AeroBeams: u_z (/ max abs u_z) |", "|---|---|---|---|"]
+    for name, theirs, pub, u in (("elbow", AEROBEAMS_ELBOW, ELBOW, elbow), ("tip", AEROBEAMS_TIP, TIP, tip)):
+        mine = extrema(t, u)
+        p = np.asarray(pub, dtype=float).T
+        read = extrema(p[0], p[1])
+        for ta, ua, kind in theirs:
+            tm, um, _ = min((m for m in mine if m[2] == kind), key=lambda m: abs(m[0] - ta))
+            near = [r for r in read if r[2] == kind and abs(r[0] - ta) <= WINDOW]
+            pr = min(near, key=lambda r: abs(r[0] - ta)) if near else None
+            cell = f"{pr[1] - ua:+.3f} ({(pr[1] - ua) / scale:+.1%})" if pr else "none"
+            rows.append(f"| {name} | {ta:.2f}, {ua:+.3f} | {um - ua:+.3f} ({(um - ua) / scale:+.2%}), {tm - ta:+.2f} | {cell} |")
+    return rows
 
 
 def compare(t: np.ndarray, elbow: np.ndarray, tip: np.ndarray, scale: float) -> List[str]:

@@ -180,18 +180,25 @@ def _converged(t: np.ndarray, uk_meshes: Sequence[int], ex_meshes: Sequence[int]
     return ref_u, ref_x, lines + ["", f"reference: ukflex's mesh limit; elbow max u_z {np.max(np.abs(lim_u[0][:, 2])):.4f}"], lim_u
 
 
-def published(elements: int) -> int:
+def published(elements: int, step: Optional[float] = None) -> int:
     """ukflex's time-converged run (RADAU5 at rtol 1e-9, outputs every 0.01 s) on ``elements``
     per member against the extrema of Simo and Vu-Quoc's published curves, as read from their
-    figure (``studies/_rac_published.py``)."""
+    figure, and against those of a third code's computed histories (AeroBeams.jl's,
+    ``studies/_rac_published.py``). ``step``: instead, generalized-alpha without numerical
+    damping (``rho_inf = 1``: Newmark's average acceleration, as Simo and Vu-Quoc's scheme) at
+    that fixed step, e.g. 0.25 s (what a large step of the original computation would do)."""
     from studies import _rac_published as pub
 
     t = np.linspace(0.0, T_END, 3001)
-    _log(f"ukflex {elements} el./member, RADAU5 rtol 1e-9")
-    elbow, tip, _ = ukflex_run(elements, t, method="RADAU5", rtol=1e-9, atol=1e-10)
+    run = dict(method="RADAU5", rtol=1e-9, atol=1e-10) if step is None else dict(method="GENALPHA", step=step, rho_inf=1.0, rtol=1e-8)
+    how = "RADAU5 rtol 1e-9" if step is None else f"generalized-alpha rho_inf 1, fixed step {step} s"
+    _log(f"ukflex {elements} el./member, {how}")
+    elbow, tip, _ = ukflex_run(elements, t, **run)
     scale = max(np.max(np.abs(elbow[:, 2])), np.max(np.abs(tip[:, 2])))
-    print(f"ukflex {elements} el./member against the published curves (read from the figure); max |u_z| {scale:.4f}")
+    print(f"ukflex {elements} el./member, {how}, against the published curves (read from the figure); max |u_z| {scale:.4f}")
     print("\n".join(pub.compare(t, elbow[:, 2], tip[:, 2], scale)))
+    print(f"\nukflex and the published readings against AeroBeams.jl's computed histories (20 el./member, step 0.05 s)")
+    print("\n".join(pub.compare_computed(t, elbow[:, 2], tip[:, 2], scale)))
     return 0
 
 
@@ -213,9 +220,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--quick", action="store_true", help="meshes 5, 10, 20 (Exudyn 10, 20, 40), one repetition")
     ap.add_argument("--published", type=int, nargs="?", const=20, metavar="ELEMENTS",
                     help="only ukflex (ELEMENTS per member, 20 if not given) against Simo and Vu-Quoc's published curves")
+    ap.add_argument("--step", type=float, default=None,
+                    help="with --published: generalized-alpha (rho_inf 1, Newmark's average acceleration) at this fixed step [s]")
     args = ap.parse_args(argv)
     if args.published:
-        return published(args.published)
+        return published(args.published, args.step)
 
     def ints(text: str) -> Tuple[int, ...]:
         return tuple(int(x) for x in text.split(","))

@@ -71,7 +71,10 @@ def outputs(system: ukflex.System, res: Any, data: Any = None) -> Dict[str, np.n
 
 
 def ukflex_run(rod_model: str, t: np.ndarray, elements: int = 8, data: Any = None, **run: Any) -> Tuple[Dict[str, np.ndarray], float]:
-    """One run on a freshly built System: outputs at ``t`` and the wall time of ``simulate``."""
+    """One run on a freshly built System: outputs at ``t`` and the wall time of ``simulate``; the
+    modal rod's ``data`` default to the builder's default rod (:data:`ukflex.spatial_scenes.ROD_DEFAULTS`)."""
+    if rod_model == "modal" and data is None:
+        data = sps.slider_crank_rod_data()
     system = ukflex.System(sps.flexible_slider_crank(rod_model, elements=elements, data=data, omega=OMEGA,
                                                      spin_up_time=SPIN_UP, crank=CRANK, rod=ROD))
     t0 = time.perf_counter()
@@ -214,24 +217,29 @@ def main(argv: Optional[List[str]] = None) -> int:
     """Three tables: the two ukflex models converged and compared; the beam-modal gap against the
     crank speed; ukflex against Exudyn, error against wall time (medians of 3 interleaved
     repetitions). ``--quick``: fewer meshes, no speed table, one repetition; ``--gap``: the
-    beam-modal gap against the crank speed alone."""
+    beam-modal gap against the crank speed alone; ``--default-rod``: the builder's default modal
+    rod before and after its rule (:func:`default_rod_table`)."""
     args = list(argv or [])
     if "-h" in args or "--help" in args:
         print(__doc__)
         return 0
-    unknown = [a for a in args if a not in ("--quick", "--gap")]
+    unknown = [a for a in args if a not in ("--quick", "--gap", "--default-rod")]
     if unknown:
-        print(f"python -m studies spatial-flexible-crank: unknown arguments {unknown} (options: --quick, --gap)", file=sys.stderr)
+        print(f"python -m studies spatial-flexible-crank: unknown arguments {unknown} (options: --quick, --gap, --default-rod)",
+              file=sys.stderr)
         return 2
     if "--gap" in args:
         print("\n".join(gap_table()))
+        return 0
+    if "--default-rod" in args:
+        print("\n".join(default_rod_table()))
         return 0
     quick = "--quick" in args
     reps = 1 if quick else 3
     t = times()
     _log("ukflex beam3 32 elements, RADAU5 rtol 1e-9 (the reference)")
     ref, _ = ukflex_run("beam", t, elements=32, **TIGHT)
-    modal_ref_data = sps.slider_crank_rod_data((32, 2, 2), 8)
+    modal_ref_data = sps.slider_crank_rod_data((32, 2, 2), 8, quadratic_strain=False)
     _log("ukflex flexible3 (32, 2, 2), 8 modes, RADAU5 rtol 1e-9 (the modal reference)")
     mref, _ = ukflex_run("modal", t, data=modal_ref_data, **TIGHT)
     refs = {"beam3 32": ref, "flexible3 (32,2,2) 8": mref}
@@ -243,12 +251,14 @@ def main(argv: Optional[List[str]] = None) -> int:
     for mesh, modes in (((16, 1, 1), 4),) if quick else (((16, 1, 1), 4), ((16, 1, 1), 8), ((32, 2, 2), 4)):
         _log(f"ukflex flexible3 {mesh}, {modes} modes")
         rows.append((f"flexible3 {mesh}, {modes} modes | RADAU5 rtol 1e-9",
-                     *ukflex_run("modal", t, data=sps.slider_crank_rod_data(mesh, modes), **TIGHT)))
+                     *ukflex_run("modal", t, data=sps.slider_crank_rod_data(mesh, modes, quadratic_strain=False), **TIGHT)))
     rows.append(("flexible3 (32, 2, 2), 8 modes | RADAU5 rtol 1e-9", mref, float("nan")))
     for mesh, modes in (((16, 1, 1), 4),) if quick else (((16, 1, 1), 4), ((32, 2, 2), 8)):
         _log(f"ukflex flexible3 {mesh}, {modes} modes, quadratic strain")
         rows.append((f"flexible3 {mesh}, {modes} modes, quadratic strain | RADAU5 rtol 1e-9",
                      *ukflex_run("modal", t, data=sps.slider_crank_rod_data(mesh, modes, quadratic_strain=True), **TIGHT)))
+    _log("ukflex flexible3, the builder's default rod (sps.ROD_DEFAULTS)")
+    rows.append(("flexible3, the builder's default rod | RADAU5 rtol 1e-9", *ukflex_run("modal", t, **TIGHT)))
     print(f"crank {OMEGA} rad/s after a {SPIN_UP} s spin-up, {t[-1]:.4f} s; rod clamped-clamped modes (Hz): "
           f"{np.round(modal_ref_data.info['frequencies'][:4], 1).tolist()}")
     print("error = max |x - x_ref| / max |x_ref - x_ref(0)| (slider), max |d - d_ref| / max |d_ref| (deflection)\n")
@@ -260,7 +270,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     runs += [(f"ukflex beam3 {n}, RADAU5M rtol 1e-6", (lambda n=n: ukflex_run("beam", t, elements=n, method="RADAU5M", rtol=1e-6)))
              for n in meshes]
     runs += [("ukflex flexible3 (16, 1, 1), 4 modes, default simulate()",
-              lambda: ukflex_run("modal", t, data=sps.slider_crank_rod_data((16, 1, 1), 4)))]
+              lambda: ukflex_run("modal", t, data=sps.slider_crank_rod_data((16, 1, 1), 4, quadratic_strain=False))),
+             ("ukflex flexible3, the builder's default rod, default simulate()", lambda: ukflex_run("modal", t))]
     runs += [(f"Exudyn {n} elements, {k} steps", (lambda n=n, k=k: exudyn_run(t, k, n)))
              for n, k in (((8, 1000), (32, 1000)) if quick else ((8, 1000), (16, 1000), (32, 500), (32, 1000), (32, 2000), (64, 2000)))]
     timed: Dict[str, List[Tuple[Dict[str, np.ndarray], float]]] = {name: [] for name, _ in runs}
@@ -293,7 +304,7 @@ def gap_table(modal_ref_data: Any = None) -> List[str]:
     1e-9)."""
     global OMEGA
     if modal_ref_data is None:
-        modal_ref_data = sps.slider_crank_rod_data((32, 2, 2), 8)
+        modal_ref_data = sps.slider_crank_rod_data((32, 2, 2), 8, quadratic_strain=False)
     models = [("8 modes", modal_ref_data), ("8 modes, quadratic strain", sps.slider_crank_rod_data((32, 2, 2), 8, quadratic_strain=True)),
               ("16 modes, quadratic strain", sps.slider_crank_rod_data((32, 2, 2), 16, quadratic_strain=True))]
     out = ["\nbeam3 16 elements against flexible3 (32, 2, 2), linear and with the quadratic strain, by crank speed (RADAU5 rtol "
@@ -314,6 +325,40 @@ def gap_table(modal_ref_data: Any = None) -> List[str]:
     return out
 
 
+def default_rod_table(reps: int = 3) -> List[str]:
+    """The builder's default modal rod before (the (16, 1, 1) mesh, the 4 lowest modes, linear)
+    and after its rule (``sps.ROD_DEFAULTS``: (32, 2, 2), the 8 lowest modes and the first axial
+    one, the quadratic strain): errors against the converged beam (beam3 32 elements, RADAU5
+    rtol 1e-9) and the cost, the modal data built from scratch (the cache cleared) and the whole
+    default ``simulate()`` on a fresh System, medians of ``reps`` interleaved repetitions."""
+    t = times()
+    _log("ukflex beam3 32 elements, RADAU5 rtol 1e-9 (the reference)")
+    ref, _ = ukflex_run("beam", t, elements=32, **TIGHT)
+    cases = {"before: (16, 1, 1), the 4 lowest modes, linear": lambda: sps.slider_crank_rod_data((16, 1, 1), 4, quadratic_strain=False),
+             "after: the default, (32, 2, 2), the 8 lowest and the first axial mode, quadratic strain": sps.slider_crank_rod_data}
+    runs: Dict[str, List[Tuple[Dict[str, np.ndarray], Any, float, float]]] = {name: [] for name in cases}
+    for r in range(reps):
+        for name, make in cases.items():
+            _log(f"repetition {r + 1}/{reps}: {name}")
+            sps.clear_rod_data_cache()
+            t0 = time.perf_counter()
+            data = make()
+            build = time.perf_counter() - t0
+            o, wall = ukflex_run("modal", t, data=data)
+            runs[name].append((o, data, build, wall))
+    out = [f"\nthe builder's default modal rod against beam3 32 elements (RADAU5 rtol 1e-9); cost: medians of {reps} interleaved "
+           "runs of the data build (from scratch) and of the default simulate():\n",
+           "| modal rod | fixed-interface modes kept | slider error | deflection error | max \\|d\\| [mm] | data build [s] | "
+           "simulate() [s] | together [s] |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for name, rs in runs.items():
+        o, data = rs[-1][0], rs[-1][1]
+        e_s, e_d = errors(o, ref)
+        build, wall = float(np.median([x[2] for x in rs])), float(np.median([x[3] for x in rs]))
+        out.append(f"| {name} | {data.info['mode_numbers']} | {e_s:.2e} | {e_d:.2e} | "
+                   f"{1e3 * np.max(np.linalg.norm(o['deflection'], axis=1)):.4f} | {build:.2f} | {wall:.2f} | {build + wall:.2f} |")
+    return out
+
+
 #: Exudyn's spectral radius for the modal rod: at 1 (no numerical damping) its answer wanders
 #: with the step count (6e-3, 1.2e-2 at 1000, 2000 steps) and 4000 steps fail
 FFRF_SPECTRAL_RADIUS = 0.8
@@ -323,7 +368,7 @@ def modal_table(t: np.ndarray, reps: int = 3, mesh: Tuple[int, int, int] = (16, 
     """The modal rod in ukflex (``flexible3``) and in Exudyn (``ObjectFFRFreducedOrder`` of the
     same FE model and mode basis): errors against ukflex RADAU5 at rtol 1e-10, wall times
     (medians of ``reps`` interleaved runs)."""
-    data = sps.slider_crank_rod_data(mesh, modes)
+    data = sps.slider_crank_rod_data(mesh, modes, quadratic_strain=False)  # linear, as Exudyn's ObjectFFRFreducedOrder
     _log(f"modal rod {mesh}, {modes} modes: ukflex RADAU5 rtol 1e-10 (the reference)")
     ref, _ = ukflex_run("modal", t, data=data, method="RADAU5", rtol=1e-10, atol=1e-12)
     runs = [("ukflex flexible3, default simulate()", lambda: ukflex_run("modal", t, data=data)),

@@ -246,3 +246,41 @@ def test_spin_up_beam_stiffens_like_the_planar_ancf_cable():
     _, v, _ = sbs.beam3(t, 6)  # asserts the tip stays in its plane
     assert v_cable.min() < -0.5
     assert np.max(np.abs(v - v_cable)) < 6e-3, np.max(np.abs(v - v_cable))
+
+
+def test_marker_at_a_material_point_between_nodes():
+    # SpatialBeamRef.point(s): a marker on the node whose rigid segment holds the point, at its
+    # offset along the axis. A force F (y) at a = 0.43 L (between nodes for N = 5 .. 40) of a
+    # cantilever: the tip deflects by Timoshenko's F a^2 (3 L - a) / (6 EI) + F a / (kGA), the
+    # point by F a^3 / (3 EI) + F a / (kGA). The point moves with its node's section, so it misses
+    # the shear angle times its offset (this section is shear-flexible: F a / (kGA) is 40 % of the
+    # point's deflection) and the curvature times the offset squared: measured -5.8 %, -3.6 %,
+    # +1.7 %, -0.52 % at the point and -2.9 %, -1.9 %, +0.65 %, -0.25 % at the tip (N = 5, 10, 20,
+    # 40; the offsets 0.03, 0.03, -0.02, 0.005; with a shear-rigid section second order: -0.084 %
+    # at the point at N = 40)
+    a, f = 0.43, 1e-4 * 3 * 2500.0
+    errs = []
+    for n in (5, 10, 20, 40):
+        s = ukflex.SpatialScene()
+        b = s.beam("b", (0, 0, 0), (1.0, 0, 0), SEC, elements=n)
+        s.fixed(s.ground.marker((0, 0, 0)), b.node(0), name="clamp")
+        m = b.point(a)
+        k, off = int(m.body[2:-1]), m.point[0]
+        assert abs(k / n + off - a) < 1e-12 and 0 < abs(off) <= 0.5 / n + 1e-12
+        s.point_force(m, (0.0, f, 0.0))
+        sys, q = _static(s)
+        tip, _ = _tip(sys, q, b)
+        r, p = _node(sys, q, b, k)
+        point = r + off * ref.rotation(p)[:, 0]
+        exact_tip = f * a * a * (3 - a) / (6 * EIZ) + f * a / GAY
+        exact_point = f * a**3 / (3 * EIZ) + f * a / GAY
+        errs.append((tip[1] / exact_tip - 1, point[1] / exact_point - 1))
+    assert all(abs(et) < 0.04 and abs(ep) < 0.07 for et, ep in errs), errs
+    assert abs(errs[-1][0]) < 4e-3 and abs(errs[-1][1]) < 8e-3, errs
+    # on the beam only, named
+    b = ukflex.SpatialScene().beam("b", (0, 0, 0), (2.0, 0, 0), SEC, elements=4)
+    assert b.point(2.0).body == "b[4]" and b.point(0.0).point == (0.0, 0.0, 0.0)
+    for bad in (-0.1, 2.1, float("nan")):
+        with pytest.raises(ukflex.InvalidArgumentError) as e:
+            b.point(bad)
+        assert e.value.argument == "s"

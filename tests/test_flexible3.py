@@ -71,6 +71,20 @@ def test_reduced_frequencies_match_full_fe():
     assert np.all(errs[1] < errs[0])
 
 
+def test_mode_numbers_select_modes_of_the_spectrum():
+    # modes=(0, 2, 5): those normal modes of the spectrum, as the lowest six give them (free-free
+    # after the rigid ones, and fixed-interface)
+    mesh = fe3.bar_mesh(0.5, 0.02, 0.02, (6, 1, 1))
+    ok = dict(density=RHO, youngs_modulus=E, poisson_ratio=NU)
+    for kw in (dict(interfaces={"A": _face(0.0)}), dict(interfaces={"A": _face(0.0), "B": _face(0.5)}, frame=("clamped", "A"),
+                                                        reduction="craig-bampton")):
+        all6 = fe3.from_mesh(mesh, modes=6, **kw, **ok)
+        some = fe3.from_mesh(mesh, modes=(0, 2, 5), **kw, **ok)
+        assert some.info["mode_numbers"] == [0, 2, 5] and all6.info["mode_numbers"] == list(range(6))
+        np.testing.assert_allclose(some.info["frequencies"], all6.info["frequencies"][[0, 2, 5]], rtol=1e-9)
+        assert some.n_modes == all6.n_modes - 3
+
+
 def test_free_body_frequencies_are_the_free_free_modes():
     d = febar.bar((20, 2, 2), modes=6)
     s = ukflex.SpatialScene()
@@ -141,6 +155,9 @@ def test_bad_input_named_errors():
             fe3.from_mesh(mesh, interfaces={"A": _face(0.0)}, **{**ok, key: bad})
     with pytest.raises(InvalidArgumentError, match="modes"):
         fe3.from_mesh(mesh, interfaces={"A": _face(0.0)}, modes=10 ** 6, **ok)
+    for bad in ((), (2, 1), (0, 0), (-1, 2), (0, 1.5), (True,)):  # mode numbers: integers >= 0, ascending
+        with pytest.raises(InvalidArgumentError, match="modes"):
+            fe3.from_mesh(mesh, interfaces={"A": _face(0.0)}, modes=bad, **ok)
     with pytest.raises(InvalidArgumentError, match="selects no node"):
         fe3.from_mesh(mesh, interfaces={"A": _face(7.0)}, **ok)
     # the frame words are every FFRF body's: a 3D body takes mean-axis or clamped

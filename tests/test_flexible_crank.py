@@ -20,13 +20,15 @@ T = np.linspace(0.0, 0.03, 31)
 @pytest.fixture(scope="module")
 def runs():
     beam, _ = sfc.ukflex_run("beam", T, elements=4)
-    modal, _ = sfc.ukflex_run("modal", T, data=sps.slider_crank_rod_data((16, 1, 1), 4))
+    # the linear modal rod (the builder's default rod is not linear: test_default_modal_rod_*)
+    modal, _ = sfc.ukflex_run("modal", T, data=sps.slider_crank_rod_data((16, 1, 1), 4, quadratic_strain=False))
     return beam, modal
 
 
 def test_scene_builds_consistent_and_not_over_constrained():
     for rod in ("beam", "modal"):
-        system = ukflex.System(sps.flexible_slider_crank(rod, elements=4))
+        data = sps.slider_crank_rod_data((16, 1, 1), 4, quadratic_strain=False) if rod == "modal" else None
+        system = ukflex.System(sps.flexible_slider_crank(rod, elements=4, data=data))
         names = system.body_names
         assert {"crank", "slider"} <= set(names)
         assert (names.count("rod") == 1) if rod == "modal" else all(f"rod[{i}]" in names for i in range(5))
@@ -87,12 +89,34 @@ def test_beam_against_exudyn_on_the_same_mesh(runs):
 
 def test_modal_rod_against_exudyn_ffrf_on_the_same_fe_model(runs):
     pytest.importorskip("exudyn")
-    ex, _ = sfc.exudyn_run(T, 300, data=sps.slider_crank_rod_data((16, 1, 1), 4), mesh=(16, 1, 1),
+    ex, _ = sfc.exudyn_run(T, 300, data=sps.slider_crank_rod_data((16, 1, 1), 4, quadratic_strain=False), mesh=(16, 1, 1),
                            spectral_radius=sfc.FFRF_SPECTRAL_RADIUS)
     e_s, e_d = sfc.errors(ex, runs[1])
     # measured: 8.0e-9 and 1.6e-4 (6.2e-4 at 150 steps, 4.0e-5 at 600: Exudyn's second order)
     assert e_s < 1e-7, e_s
     assert e_d < 5e-4, e_d
+
+
+def test_default_modal_rod_keeps_the_lowest_modes_and_the_first_axial_one():
+    # the builder's rule (sps.ROD_DEFAULTS, docs/spatial-flexible.md "The builder's default modal
+    # rod"): the quadratic strain and the eight lowest fixed-interface modes plus the rod's first
+    # axial mode, the 12th on the (16, 1, 1) mesh (8664 Hz, c / 2L = 8620 Hz), the 14th on the
+    # default (32, 2, 2) mesh (8646 Hz; measured, not built here: 5 to 15 s)
+    assert sps.ROD_DEFAULTS["mesh"] == (32, 2, 2) and sps.ROD_DEFAULTS["quadratic_strain"] is True
+    numbers = sps.rod_modes((16, 1, 1))
+    assert numbers == tuple(range(8)) + (11,), numbers
+    d = sps.slider_crank_rod_data((16, 1, 1))
+    assert d.info["mode_numbers"] == list(numbers) and d.n_modes == 6 + 9
+    assert d.quadratic_strain is not None and d.quadratic_strain_quartic is not None
+    f = d.info["frequencies"]
+    assert np.all(np.diff(f) > 0) and abs(f[-1] / 8620.3 - 1) < 0.01, f  # the axial mode, c / 2L = sqrt(E / rho) / 2L
+    normal = np.asarray(d.info["modes"])[:, 6:]
+    share = np.sum(normal[0::3] ** 2, axis=0) / np.sum(normal ** 2, axis=0)
+    assert share[-1] > 0.99 and np.all(share[:-1] < 0.1), share
+    # the same numbers as a count and a selection give the same modes; a linear rod on request
+    lin = sps.slider_crank_rod_data((16, 1, 1), 12, quadratic_strain=False)
+    np.testing.assert_allclose(lin.info["frequencies"][list(numbers)], f, rtol=1e-9)
+    assert lin.quadratic_strain is None
 
 
 @pytest.mark.parametrize("kwargs, argument", [
@@ -114,7 +138,8 @@ def test_builder_names_its_bad_arguments(kwargs, argument):
 
 def test_rod_data_names_its_bad_arguments():
     for kwargs, argument in ((dict(mesh=(16, 1)), "mesh"), (dict(modes=0), "modes"), (dict(section=(0.008, 7850.0, 2.1e11, 0.6)), "section"),
-                             (dict(quadratic_strain=1), "quadratic_strain")):
+                             (dict(quadratic_strain=1), "quadratic_strain"), (dict(mesh=(4, 1, 1), modes=(3, 1)), "modes"),
+                             (dict(mesh=(4, 1, 1), modes=(0, 2.5)), "modes")):
         with pytest.raises(ukflex.InvalidArgumentError) as e:
             sps.slider_crank_rod_data(**kwargs)
         assert e.value.argument == argument

@@ -18,6 +18,7 @@ __all__ = [
     "item_name",
     "beam_elastic_dofs",
     "beam3_default_elements",
+    "beam3_material_point",
     "frame_options",
     "motion_values",
     "dense_eval",
@@ -280,6 +281,10 @@ def motion_values(motion_json: str, t: _F64) -> _F64:
     ...
 def beam3_default_elements() -> int:
     """Number of elements of a 3D beam whose description gives none."""
+    ...
+def beam3_material_point(elements: int, length: float, s: float) -> Tuple[int, float]:
+    """The node of a 3D beam whose rigid segment holds the material point at arc length s, and the
+    point's offset from it along the axis."""
     ...
 def beam_elastic_dofs(elements: int, frame: str) -> int:
     """Number of elastic coordinates of a beam."""

@@ -18,7 +18,7 @@ use pyo3::types::PyType;
 use pyo3::Borrowed;
 
 use crate::error::Error;
-use scene::{beam3_default_elements, beam_elastic_dofs, frame_options, item_name, PySceneChecker};
+use scene::{beam3_default_elements, beam3_material_point, beam_elastic_dofs, frame_options, item_name, PySceneChecker};
 use system::PySystem;
 
 create_exception!(ukflex, UkflexError, PyException, "Base class of every ukflex error.");
@@ -300,6 +300,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(item_name, m)?)?;
     m.add_function(wrap_pyfunction!(beam_elastic_dofs, m)?)?;
     m.add_function(wrap_pyfunction!(beam3_default_elements, m)?)?;
+    m.add_function(wrap_pyfunction!(beam3_material_point, m)?)?;
     m.add_function(wrap_pyfunction!(frame_options, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::motion_values, m)?)?;
     m.add_function(wrap_pyfunction!(dense_eval, m)?)?;

@@ -109,6 +109,13 @@ pub fn beam3_default_elements() -> usize {
     crate::body::beam3::DEFAULT_ELEMENTS
 }
 
+/// The node of a 3D beam (`elements`, `length`) whose rigid segment holds the material point at
+/// arc length `s`, and the point's offset from it along the axis (`body::beam3::material_point`).
+#[pyfunction]
+pub fn beam3_material_point(elements: usize, length: f64, s: f64) -> PyResult<(usize, f64)> {
+    crate::body::beam3::material_point(elements, length, s).map_err(super::to_py)
+}
+
 /// Number of elastic coordinates of a beam with `elements` elements and reference `frame`.
 #[pyfunction]
 pub fn beam_elastic_dofs(elements: usize, frame: &str) -> PyResult<usize> {

@@ -127,6 +127,32 @@ pub fn section_frame(item: &str, t: &V3, y_hint: Option<&V3>) -> Result<M3> {
     Ok([[t[0], y[0], z[0]], [t[1], y[1], z[1]], [t[2], y[2], z[2]]])
 }
 
+/// The tributary segment of node `i` of `ne` elements of length `le`, `[x_i - L_e / 2, x_i + L_e /
+/// 2]` cut at the beam's ends: its length and its centre's offset from the node along the axis.
+/// The node's body is this rigid segment (module docs).
+fn tributary(i: usize, ne: usize, le: f64) -> (f64, f64) {
+    let lo = if i == 0 { 0.0 } else { -0.5 * le };
+    let hi = if i == ne { 0.0 } else { 0.5 * le };
+    (hi - lo, 0.5 * (lo + hi))
+}
+
+/// The node whose rigid segment holds the material point at arc length `s` from the start of a
+/// beam of `ne` elements and `length` (the nearer node; halfway between two, the later one), and
+/// the point's offset from that node along the section axis: a marker there moves with the
+/// segment (the beam's mass model), exact at the nodes and off the element's own centreline by
+/// the curvature times the offset squared in between.
+pub fn material_point(ne: usize, length: f64, s: f64) -> Result<(usize, f64)> {
+    if ne == 0 || ne > MAX_ELEMENTS || !(length.is_finite() && length > 0.0) {
+        return Err(Error::argument("elements", format!("a beam of 1 to {MAX_ELEMENTS} elements and a positive length, got {ne} and {length}")));
+    }
+    if !(s.is_finite() && (-1e-12 * length..=length * (1.0 + 1e-12)).contains(&s)) {
+        return Err(Error::argument("s", format!("the arc length must lie on the beam, 0 to {length}, got {s}")));
+    }
+    let le = length / ne as f64;
+    let i = ((s / le + 0.5).floor().max(0.0) as usize).min(ne);
+    Ok((i, s - i as f64 * le))
+}
+
 /// A beam description's node bodies (`name[i]`, kind `rigid3`, in order from `start`) and the
 /// constants of its elements (element `j` between nodes `j` and `j + 1`).
 pub fn expand(item: &str, d: &Beam3Desc) -> Result<(Vec<Rigid3Desc>, Vec<ElementConsts>)> {
@@ -147,12 +173,7 @@ pub fn expand(item: &str, d: &Beam3Desc) -> Result<(Vec<Rigid3Desc>, Vec<Element
     let sec = section3(item, d)?;
     let le = length / ne as f64;
     let w = d.angular_velocity;
-    // the tributary segment of node i, [x_i - L_e / 2, x_i + L_e / 2] within [0, L], from the node
-    let segment = |i: usize| -> (f64, f64) {
-        let lo = if i == 0 { 0.0 } else { -0.5 * le };
-        let hi = if i == ne { 0.0 } else { 0.5 * le };
-        (hi - lo, 0.5 * (lo + hi))
-    };
+    let segment = |i: usize| tributary(i, ne, le);
     let nodes = (0..=ne)
         .map(|i| {
             let (l, c) = segment(i);
@@ -179,6 +200,20 @@ pub fn expand(item: &str, d: &Beam3Desc) -> Result<(Vec<Rigid3Desc>, Vec<Element
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn material_points_go_to_the_segment_that_holds_them() {
+        // 4 elements of 0.25: node i holds [0.25 i - 0.125, 0.25 i + 0.125] within [0, 1]
+        for (s, i, off) in [(0.0, 0, 0.0), (0.1, 0, 0.1), (0.13, 1, -0.12), (0.5, 2, 0.0), (0.6, 2, 0.1), (1.0, 4, 0.0), (0.9, 4, -0.1)] {
+            let (k, o) = material_point(4, 1.0, s).unwrap();
+            assert_eq!(k, i, "{s}");
+            assert!((o - off).abs() < 1e-12, "{s}: {o}");
+        }
+        for bad in [-0.01, 1.01, f64::NAN] {
+            assert!(matches!(material_point(4, 1.0, bad), Err(Error::Argument { .. })), "{bad}");
+        }
+        assert!(material_point(0, 1.0, 0.5).is_err() && material_point(4, 0.0, 0.0).is_err());
+    }
 
     #[test]
     fn torsion_constant_of_a_square_and_a_thin_strip() {

@@ -335,6 +335,20 @@ def _eigs(k: sp.spmatrix, m: sp.spmatrix, count_: int) -> Tuple[np.ndarray, np.n
     return lam, x
 
 
+def _mode_numbers(modes: Any) -> Tuple[int, np.ndarray]:
+    """``from_mesh``'s ``modes``: how many of the lowest normal modes to compute, and the numbers
+    of those kept (a count: all of them; a sequence: its numbers, 0-based and ascending)."""
+    if not isinstance(modes, (Sequence, np.ndarray)) or isinstance(modes, (str, bytes)):
+        n = count("modes", modes)
+        return n, np.arange(n)
+    items = list(np.asarray(modes, dtype=object).ravel())
+    whole = all(isinstance(m, (int, np.integer)) and not isinstance(m, (bool, np.bool_)) and m >= 0 for m in items)
+    numbers = [int(m) for m in items] if whole else []
+    if not numbers or any(b <= a for a, b in zip(numbers, numbers[1:])):
+        raise InvalidArgumentError("modes", f"expected a count or mode numbers (integers >= 0, ascending), got {modes!r}")
+    return numbers[-1] + 1, np.asarray(numbers)
+
+
 def _held(frame: Any, names: List[str]) -> Optional[str]:
     """The interface a frame holds (``None``: the mean axes), its words those of every FFRF body."""
     words = frame_interfaces(frame, names, accepted=("mean-axis", "clamped"))
@@ -345,11 +359,13 @@ def _held(frame: Any, names: List[str]) -> Optional[str]:
 
 
 def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio: float,
-              interfaces: Mapping[str, InterfaceSpec], modes: int = 8, frame: Any = "mean-axis",
+              interfaces: Mapping[str, InterfaceSpec], modes: Union[int, Sequence[int]] = 8, frame: Any = "mean-axis",
               reduction: str = "modes", order: int = 2, damping_ratio: float = 0.0,
               stress_stiffening: bool = False, quadratic_strain: bool = False) -> FlexibleData3:
-    """The ``flexible3`` body of an FE solid reduced to ``modes`` normal modes (module docs).
-    ``interfaces``: name -> node index, indices, mask, ``select(nodes) -> mask`` or
+    """The ``flexible3`` body of an FE solid reduced to ``modes`` normal modes (module docs):
+    the lowest ``modes``, or, a sequence, the normal modes of those numbers (0-based, ascending,
+    in the spectrum of the free-free modes after the six rigid ones, or of the fixed-interface
+    modes; ``info["mode_numbers"]``), e.g. the lowest few and an axial mode. ``interfaces``: name -> node index, indices, mask, ``select(nodes) -> mask`` or
     ``{"point": (x, y, z)}`` (a node must sit there). ``frame``: ``"mean-axis"`` or
     ``"clamped"`` (``("clamped", NAME)``: that interface held); ``reduction``: ``"modes"`` or
     ``"craig-bampton"`` (module docs). ``damping_ratio``: modal damping of the kept modes.
@@ -359,7 +375,7 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
     the Green-Lagrange strain's cubic and quartic energy, stored as ``quadratic_strain``
     (n, n, n) and ``quadratic_strain_quartic`` (n^2, n^2) (module docs); not with ``stress_stiffening`` (both would count the stress the modes carry)."""
     zeta = non_negative("damping_ratio", damping_ratio)
-    nmodes = count("modes", modes)
+    nmodes, keep = _mode_numbers(modes)
     for name, flag in (("stress_stiffening", stress_stiffening), ("quadratic_strain", quadratic_strain)):
         if not isinstance(flag, bool):
             raise InvalidArgumentError(name, f"expected True or False, got {flag!r}")
@@ -391,7 +407,7 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
         lam, x = _eigs(k, mfull, nmodes + 6)
         if lam[5] > 1e-6 * lam[6]:
             raise InvalidArgumentError("mesh", f"the free part does not have six rigid-body modes (eigenvalues {lam[:7].tolist()}): is the mesh connected?")
-        basis, normal = x[:, 6:], lam[6:]
+        basis, normal = x[:, 6:][:, keep], lam[6:][keep]
     else:
         held = held_mask(sets, reference, n3)
         boundary = []
@@ -411,7 +427,8 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
             raise InvalidArgumentError("modes", f"{nmodes} modes do not fit: only {free.size} free dofs")
         kff, mff = k[free][:, free], mfull[free][:, free]
         lam, xf = _eigs(kff, mff, nmodes)
-        normal_x = np.zeros((n3, nmodes))
+        lam, xf = lam[keep], xf[:, keep]
+        normal_x = np.zeros((n3, keep.size))
         normal_x[free] = xf
         static = []
         if boundary:
@@ -432,6 +449,7 @@ def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio
         basis = np.column_stack(static + [normal_x]) if static else normal_x
         normal = lam
     data = _reduced(nodes, k, ms, basis, rows, sets, normal, zeta)
+    data.info["mode_numbers"] = keep.tolist()
     data.info["cells"] = _vtk_cells(solid.mesh)
     data.info["stress_modes"] = stress_modes(solid, basis)
     if stress_stiffening:

@@ -37,6 +37,7 @@ from typing import Any, Dict, List, Optional, Sequence
 import numpy as np
 
 from .. import _core
+from ..arguments import real
 from ..errors import InvalidArgumentError, InvalidSceneError
 
 __all__ = ["SpatialScene", "SpatialMarker", "SpatialBodyRef", "SpatialFlexibleRef", "SpatialBeamRef", "CustomSection3", "outputs", "normalize_spatial", "NATIVE_METHODS_3D"]
@@ -130,10 +131,11 @@ class CustomSection3:
 @dataclass(frozen=True)
 class SpatialBeamRef:
     """A handle on a 3D beam (:meth:`SpatialScene.beam`): its node bodies ``name[i]`` (``i = 0``
-    at ``start``, ``elements`` at ``end``) and elements ``name[e j]``."""
+    at ``start``, ``elements`` at ``end``), elements ``name[e j]`` and ``length``."""
 
     name: str
     elements: int
+    length: float = float("nan")
 
     def node_name(self, i: int) -> str:
         """The body name of node ``i`` (negative counts from the end)."""
@@ -146,6 +148,15 @@ class SpatialBeamRef:
         """A marker at node ``i`` (axes ``z``, ``x`` in the section frame ``[axis, y, z]``; default the
         section frame itself): usable by every spatial joint, driver and force."""
         return SpatialMarker(self.node_name(i), (0.0, 0.0, 0.0), None if z is None else tuple(z), None if x is None else tuple(x))
+
+    def point(self, s: float, z: Optional[Sequence[float]] = None, x: Optional[Sequence[float]] = None) -> SpatialMarker:
+        """A marker at the material point at arc length ``s`` from ``start`` (axes as for
+        :meth:`node`), between the nodes too: on the node whose rigid segment holds it (the
+        beam's mass model, docs/spatial-flexible.md), at its offset along the section axis. It
+        moves with that segment: exact at the nodes, off the elements' centreline in between by
+        about the curvature times the offset squared (converging with the mesh)."""
+        node, offset = _core.beam3_material_point(self.elements, float(self.length), real("s", s))
+        return SpatialMarker(self.node_name(node), (offset, 0.0, 0.0), None if z is None else tuple(z), None if x is None else tuple(x))
 
     @property
     def element_names(self) -> List[str]:
@@ -250,7 +261,7 @@ class SpatialScene:
             b["y_axis"] = _vec("y_axis", y_axis)
         self._d["bodies"].append(b)
         n = int(elements) if elements is not None else int(_core.beam3_default_elements())
-        return SpatialBeamRef(name, n)
+        return SpatialBeamRef(name, n, float(np.linalg.norm(np.subtract(b["end"], b["start"]))))
 
     def point_mass(self, name: str, mass: float, *, position: Sequence[float] = (0, 0, 0),
                    velocity: Sequence[float] = (0, 0, 0)) -> SpatialBodyRef:
