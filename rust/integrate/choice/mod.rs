@@ -46,13 +46,14 @@ pub const RADAU_MAX_STEP_OMEGA: f64 = 1.0;
 pub const NEWTON_PER_RTOL: f64 = 100.0;
 /// ... and at most this.
 pub const NEWTON_MAX_RTOL: f64 = 1e-3;
-/// ... per rtol on a scene with a geometrically exact beam (`beam3`): Newton's norm weighs each
-/// coordinate's correction against how far the step moves it, and the beam's node bodies carry
-/// its rigid motion in their absolute coordinates, of which the deformation is a small part. On
-/// Kane's spin-up (8 elements, rtol 1e-5, the fixed step 0.12 s) Newton at 100 rtol left the
-/// history 3.7e-3 of the dip off (370 rtol), at 1 rtol 2.1e-5, at about the same cost
-/// (docs/spatial-flexible.md, "The Newton matrices co-rotated").
-pub const NEWTON_PER_RTOL_BEAM: f64 = 1.0;
+/// ... and at most this on a scene with a geometrically exact beam (`beam3`): Newton's norm weighs
+/// each coordinate's correction against how far the step moves it, and the beam's node bodies
+/// carry its rigid motion in their absolute coordinates, of which the deformation is a small
+/// part. On Kane's spin-up (8 elements, the fixed step 0.12 s of rtol 1e-5) Newton at 1e-3 left
+/// the history 3.7e-3 of the dip off, at 1e-4 9.9e-5, at 1e-5 2.1e-5, at about the same cost; at
+/// rtol 1e-3 .. 1e-6 auto's runs are 1.0e-4 .. 1.6e-4 off with this cap (docs/spatial-flexible.md,
+/// "The Newton matrices co-rotated"). At the default rtol the cap changes nothing.
+pub const NEWTON_MAX_RTOL_BEAM: f64 = 1e-4;
 /// DOPRI5's average `h omega_max` on stiff flexible scenes, and a RADAU5M step's cost in DOPRI5
 /// steps (nonlinear FFRF coupler N = 4: 17 us against 6 UK calls of ~1.7 us).
 pub const EXPLICIT_STEP_OMEGA: f64 = 0.5;
@@ -94,7 +95,7 @@ pub fn constants() -> Vec<(&'static str, f64)> {
         ("RADAU_MAX_STEP_OMEGA", RADAU_MAX_STEP_OMEGA),
         ("NEWTON_PER_RTOL", NEWTON_PER_RTOL),
         ("NEWTON_MAX_RTOL", NEWTON_MAX_RTOL),
-        ("NEWTON_PER_RTOL_BEAM", NEWTON_PER_RTOL_BEAM),
+        ("NEWTON_MAX_RTOL_BEAM", NEWTON_MAX_RTOL_BEAM),
         ("EXPLICIT_STEP_OMEGA", EXPLICIT_STEP_OMEGA),
         ("RADAU_COST_RATIO", RADAU_COST_RATIO),
         ("DOPRI5_REAL_STABILITY", DOPRI5_REAL_STABILITY),
@@ -118,7 +119,7 @@ pub struct SceneTraits {
     /// Contacts (revolute joints with clearance): forces that switch on and off during the run,
     /// which the spectrum at the start does not see.
     pub contact: bool,
-    /// A geometrically exact beam (`beam3_element`s): RADAU5M's Newton at `NEWTON_PER_RTOL_BEAM`.
+    /// A geometrically exact beam (`beam3_element`s): RADAU5M's Newton at most `NEWTON_MAX_RTOL_BEAM`.
     pub beam: bool,
 }
 
@@ -252,8 +253,7 @@ pub fn integrator_rtol(c: &AutoChoice, rtol: f64) -> Option<f64> {
 
 /// RADAU5M's Newton tolerance with auto's fixed step for the user's `rtol`.
 pub fn newton_rtol(traits: SceneTraits, rtol: f64) -> f64 {
-    let per = if traits.beam { NEWTON_PER_RTOL_BEAM } else { NEWTON_PER_RTOL };
-    (per * rtol).min(NEWTON_MAX_RTOL)
+    (NEWTON_PER_RTOL * rtol).min(if traits.beam { NEWTON_MAX_RTOL_BEAM } else { NEWTON_MAX_RTOL })
 }
 
 /// The step that resolves `omega_c` to the amplitude budget `phase` over `span`: `(y, h)`.
