@@ -368,4 +368,14 @@ mod tests {
         assert_eq!(integrator_rtol(&stiff, 1e-6), Some(1e-4));
         assert_eq!(integrator_rtol(&AutoChoice::plain(Verdict::Overdamped, "RADAU5M", 1e4), 1e-6), None);
     }
+
+    #[test]
+    fn a_beams_newton_tolerance_is_capped_lower() {
+        let (plain, beam) = (SceneTraits::default(), SceneTraits { beam: true, ..SceneTraits::default() });
+        assert_eq!(newton_rtol(plain, 1e-3), NEWTON_MAX_RTOL);
+        assert_eq!(newton_rtol(beam, 1e-3), NEWTON_MAX_RTOL_BEAM);
+        // at the default rtol the cap changes nothing
+        assert_eq!(newton_rtol(beam, 1e-6), newton_rtol(plain, 1e-6));
+        assert!((newton_rtol(beam, 1e-8) - NEWTON_PER_RTOL * 1e-8).abs() < 1e-20);
+    }
 }
