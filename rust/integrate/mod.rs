@@ -120,6 +120,9 @@ pub trait SecondOrderSystem {
     fn conditioning_ratio(&self) -> f64 {
         1.0
     }
+    /// The coordinate offsets of the bodies `[r (3), p (4)]` whose elastic forces only turn with
+    /// them (a beam's nodes): RADAU5M co-rotates its Newton matrices with them (`radau_m/corotate.rs`).
+    fn corotated_bodies(&self, _offsets: &mut Vec<usize>) {}
     /// The numerical rank of the constraints at the last factorization (0 without constraints):
     /// `n` minus it is the number of degrees of freedom there.
     fn conditioning_rank(&self) -> usize {

@@ -48,6 +48,7 @@
 //! **Dense output.** The quintic Hermite interpolant of `q` from `q`, `qd`, `qdd` at both ends
 //! (error O(h^6)); `qd` its derivative.
 
+mod corotate;
 mod iteration;
 
 use super::newton::NewtonMatrices;
@@ -138,6 +139,10 @@ pub struct RadauM {
     tmp: Vec<f64>,
     eq: Vec<f64>,
     ev: Vec<f64>,
+    /// Newton's corrections of the stages ((n+m) each) and the co-rotation of the matrices
+    /// with a beam's nodes (`radau_m/corotate.rs`; empty without beams).
+    dw: [Vec<f64>; 3],
+    corot: corotate::Corotation,
     /// The structure (`M`, `K`, `C`, `A`, `db/dqd`) and the real and complex iteration
     /// matrices, dense or sparse (`newton.rs`; made in `init`, when the system is known).
     newton: Option<NewtonMatrices>,
@@ -260,6 +265,8 @@ impl RadauM {
             tmp: z(nm),
             eq: z(n),
             ev: z(n),
+            dw: z3(nm),
+            corot: corotate::Corotation::new(Vec::new(), &a2),
             newton: None,
             lu_h: 0.0,
             reuse: false,
@@ -297,6 +304,7 @@ impl RadauM {
         if !self.newton.as_mut().expect("RADAU5M: init first").read_stiff(sys, q, qd)? {
             return Err(Error::argument("method", "RADAU5M needs a system with a structured Jacobian (mass, stiffness, constraints)"));
         }
+        self.corot.set_reference(&self.qs[2]);
         self.factor(h)
     }
 
@@ -393,6 +401,9 @@ impl Stepper for RadauM {
         self.theta = 1.0;
         let (q, qd) = y0.split_at(n);
         self.newton = Some(NewtonMatrices::for_system(sys, self.opts.linear_solver, true, false, "RADAU5M")?);
+        let mut nodes = Vec::new();
+        sys.corotated_bodies(&mut nodes);
+        self.corot = corotate::Corotation::new(nodes, &self.a2);
         sys.acc(t0, q, qd, &mut self.qdd)?;
         self.st.stats.nfev += 1;
         sys.multipliers(&mut self.lam);

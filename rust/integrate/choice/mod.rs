@@ -46,6 +46,14 @@ pub const RADAU_MAX_STEP_OMEGA: f64 = 1.0;
 pub const NEWTON_PER_RTOL: f64 = 100.0;
 /// ... and at most this.
 pub const NEWTON_MAX_RTOL: f64 = 1e-3;
+/// ... and at most this on a scene with a geometrically exact beam (`beam3`): Newton's norm weighs
+/// each coordinate's correction against how far the step moves it, and the beam's node bodies
+/// carry its rigid motion in their absolute coordinates, of which the deformation is a small
+/// part. On Kane's spin-up (8 elements, the fixed step 0.12 s of rtol 1e-5) Newton at 1e-3 left
+/// the history 3.7e-3 of the dip off, at 1e-4 9.9e-5, at 1e-5 2.1e-5, at about the same cost; at
+/// rtol 1e-3 .. 1e-6 auto's runs are 1.0e-4 .. 1.6e-4 off with this cap (docs/spatial-flexible.md,
+/// "The Newton matrices co-rotated"). At the default rtol the cap changes nothing.
+pub const NEWTON_MAX_RTOL_BEAM: f64 = 1e-4;
 /// DOPRI5's average `h omega_max` on stiff flexible scenes, and a RADAU5M step's cost in DOPRI5
 /// steps (nonlinear FFRF coupler N = 4: 17 us against 6 UK calls of ~1.7 us).
 pub const EXPLICIT_STEP_OMEGA: f64 = 0.5;
@@ -87,6 +95,7 @@ pub fn constants() -> Vec<(&'static str, f64)> {
         ("RADAU_MAX_STEP_OMEGA", RADAU_MAX_STEP_OMEGA),
         ("NEWTON_PER_RTOL", NEWTON_PER_RTOL),
         ("NEWTON_MAX_RTOL", NEWTON_MAX_RTOL),
+        ("NEWTON_MAX_RTOL_BEAM", NEWTON_MAX_RTOL_BEAM),
         ("EXPLICIT_STEP_OMEGA", EXPLICIT_STEP_OMEGA),
         ("RADAU_COST_RATIO", RADAU_COST_RATIO),
         ("DOPRI5_REAL_STABILITY", DOPRI5_REAL_STABILITY),
@@ -110,6 +119,8 @@ pub struct SceneTraits {
     /// Contacts (revolute joints with clearance): forces that switch on and off during the run,
     /// which the spectrum at the start does not see.
     pub contact: bool,
+    /// A geometrically exact beam (`beam3_element`s): RADAU5M's Newton at most `NEWTON_MAX_RTOL_BEAM`.
+    pub beam: bool,
 }
 
 impl SceneTraits {
@@ -133,7 +144,7 @@ impl SceneTraits {
         let beam = model.forces.iter().any(|f| matches!(&f.kind, ForceKind::Spatial(s) if s.kind() == "beam3_element"));
         let flexible = beam || model.bodies.iter().any(|b| b.capabilities().elastic);
         let contact = forces.iter().any(|f| f.get("kind").and_then(Value::as_str) == Some("revolute_clearance"));
-        SceneTraits { damped, elastic_potential: flexible || spring, contact }
+        SceneTraits { damped, elastic_potential: flexible || spring, contact, beam }
     }
 }
 
@@ -240,6 +251,11 @@ pub fn integrator_rtol(c: &AutoChoice, rtol: f64) -> Option<f64> {
     }
 }
 
+/// RADAU5M's Newton tolerance with auto's fixed step for the user's `rtol`.
+pub fn newton_rtol(traits: SceneTraits, rtol: f64) -> f64 {
+    (NEWTON_PER_RTOL * rtol).min(if traits.beam { NEWTON_MAX_RTOL_BEAM } else { NEWTON_MAX_RTOL })
+}
+
 /// The step that resolves `omega_c` to the amplitude budget `phase` over `span`: `(y, h)`.
 pub fn resolving_step(omega_c: f64, phase: f64, span: f64) -> f64 {
     let y = RADAU_MAX_STEP_OMEGA.min((phase / (RADAU_DECAY * omega_c * span)).powf(0.2));
@@ -300,7 +316,7 @@ pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &
         }
         c.verdict = Verdict::Stiff;
         c.method = "RADAU5M";
-        c.newton_rtol = Some((NEWTON_PER_RTOL * rtol).min(NEWTON_MAX_RTOL));
+        c.newton_rtol = Some(newton_rtol(traits, rtol));
         if sp.complete() {
             let (total, top) = floor::transient_floor(model, data, traits, t0, q, qd, sp, omega_c, h, span)?;
             c.floor = Some(total);
@@ -335,10 +351,10 @@ mod tests {
 
     #[test]
     fn the_prelude_needs_no_spectrum_for_prescribed_or_rigid_scenes() {
-        let rigid = SceneTraits { damped: false, elastic_potential: false, contact: false };
+        let rigid = SceneTraits { damped: false, elastic_potential: false, contact: false, beam: false };
         assert_eq!(prelude(rigid, 0).unwrap().verdict, Verdict::NoDof);
         assert_eq!(prelude(rigid, 3).unwrap().verdict, Verdict::NoElasticPotential);
-        assert!(prelude(SceneTraits { damped: false, elastic_potential: true, contact: false }, 3).is_none());
+        assert!(prelude(SceneTraits { damped: false, elastic_potential: true, contact: false, beam: false }, 3).is_none());
     }
 
     #[test]
@@ -351,5 +367,15 @@ mod tests {
         stiff.newton_rtol = Some(1e-4);
         assert_eq!(integrator_rtol(&stiff, 1e-6), Some(1e-4));
         assert_eq!(integrator_rtol(&AutoChoice::plain(Verdict::Overdamped, "RADAU5M", 1e4), 1e-6), None);
+    }
+
+    #[test]
+    fn a_beams_newton_tolerance_is_capped_lower() {
+        let (plain, beam) = (SceneTraits::default(), SceneTraits { beam: true, ..SceneTraits::default() });
+        assert_eq!(newton_rtol(plain, 1e-3), NEWTON_MAX_RTOL);
+        assert_eq!(newton_rtol(beam, 1e-3), NEWTON_MAX_RTOL_BEAM);
+        // at the default rtol the cap changes nothing
+        assert_eq!(newton_rtol(beam, 1e-6), newton_rtol(plain, 1e-6));
+        assert!((newton_rtol(beam, 1e-8) - NEWTON_PER_RTOL * 1e-8).abs() < 1e-20);
     }
 }

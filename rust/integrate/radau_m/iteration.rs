@@ -36,6 +36,10 @@ impl RadauM {
             if k == 1 && !(self.reuse && h == self.lu_h) {
                 self.refresh_matrices(sys, h)?;
             }
+            if !self.corot.is_empty() {
+                self.corot.follow(&self.qs);
+                self.corot.to_reference(&mut self.res);
+            }
             // transformed right-hand sides: -(T^-1 (x) I) R
             for k2 in 0..nm {
                 let (r0, r1, r2) = (self.res[0][k2], self.res[1][k2], self.res[2][k2]);
@@ -47,22 +51,29 @@ impl RadauM {
             nw.solve_real(&mut self.xr);
             nw.solve_complex(&mut self.xc, &mut self.xi);
             self.st.stats.newton += 1;
-            // back: (T (x) I) X; the norm of the position and velocity corrections of all stages
+            // back: (T (x) I) X (turned to the stages: co-rotation); the norm of the position and
+            // velocity corrections of all stages
             let mut dyno = 0.0;
             for k2 in 0..nm {
                 let (x0, x1, x2) = (self.xr[k2], self.xc[k2], self.xi[k2]);
                 for i in 0..3 {
-                    let d = self.t[i][0] * x0 + self.t[i][1] * x1 + self.t[i][2] * x2;
+                    self.dw[i][k2] = self.t[i][0] * x0 + self.t[i][1] * x1 + self.t[i][2] * x2;
+                }
+            }
+            if !self.corot.is_empty() {
+                self.corot.from_reference(&mut self.dw);
+            }
+            for i in 0..3 {
+                for k2 in 0..nm {
                     if k2 < n {
-                        self.w[i][k2] += d;
+                        self.w[i][k2] += self.dw[i][k2];
                     } else {
-                        self.ls[i][k2 - n] += d;
+                        self.ls[i][k2 - n] += self.dw[i][k2];
                     }
                 }
             }
             for k2 in 0..n {
-                let (x0, x1, x2) = (self.xr[k2], self.xc[k2], self.xi[k2]);
-                let d: [f64; 3] = std::array::from_fn(|i| self.t[i][0] * x0 + self.t[i][1] * x1 + self.t[i][2] * x2);
+                let d: [f64; 3] = std::array::from_fn(|i| self.dw[i][k2]);
                 let s = self.newton_scal(k2);
                 for i in 0..3 {
                     let dq = h * h * (self.a2[i][0] * d[0] + self.a2[i][1] * d[1] + self.a2[i][2] * d[2]);
@@ -145,8 +156,22 @@ impl RadauM {
         let n = self.n;
         let g = h * self.lambda;
         let nw = self.newton.as_mut().expect("RADAU5M: init first");
-        nw.filtered_rhs(g, &self.eq, &self.ev, &mut self.tmp);
-        nw.solve_real(&mut self.tmp);
+        if self.corot.is_empty() {
+            nw.filtered_rhs(g, &self.eq, &self.ev, &mut self.tmp);
+            nw.solve_real(&mut self.tmp);
+        } else {
+            // co-rotated: the bracket turned back to the reference, where the matrices were read,
+            // and the filtered estimate forward to the step's end
+            let [d0, d1, _] = &mut self.dw;
+            let (eq, ev) = (&mut d0[..n], &mut d1[..n]);
+            eq.copy_from_slice(&self.eq);
+            ev.copy_from_slice(&self.ev);
+            self.corot.turn_end(eq, false);
+            self.corot.turn_end(ev, false);
+            nw.filtered_rhs(g, eq, ev, &mut self.tmp);
+            nw.solve_real(&mut self.tmp);
+            self.corot.turn_end(&mut self.tmp[..n], true);
+        }
         if tangent {
             weigh_error(sys, &mut self.tmp[..n], n, self.kappa_ref);
         }
