@@ -12,7 +12,9 @@ on the path (the extension has one ABI), e.g.
       python benches/default_wait.py --repeat 20 --label new
     done
 
-(~2 s per call of the script), and take the medians of the medians.
+(~2 s per call of the script), and take the medians of the medians. ``--outputs 1001`` times the
+side-by-side's default (1,001 dense outputs); CPU is the calling thread's time (``time.thread_time``),
+less sensitive than the wall time to the other processes of a loaded machine.
 """
 
 from __future__ import annotations
@@ -36,20 +38,24 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeat", type=int, default=20)
     ap.add_argument("--label", default="")
+    ap.add_argument("--outputs", type=int, default=0,
+                    help="t_eval of this many equally spaced times (the side-by-side's default: 1001); 0: the steps")
     args = ap.parse_args(argv)
+    t_eval = np.linspace(0.0, 0.1, args.outputs) if args.outputs else None
     for name, make in CASES.items():
-        total, auto, run = [], [], []
+        total, auto, run, cpu = [], [], [], []
         for _ in range(args.repeat):
             system = make().build()  # fresh; the build is not timed
-            tic = time.perf_counter()
-            res = simulate(system, 0.1)
+            tic, cpu0 = time.perf_counter(), time.thread_time()
+            res = simulate(system, 0.1, t_eval=t_eval)
             total.append(time.perf_counter() - tic)
+            cpu.append(time.thread_time() - cpu0)
             auto.append(res.extra["auto"].get("time", 0.0))
             run.append(res.wall_time)
         med = lambda v: 1e3 * statistics.median(v)  # noqa: E731
         rest = [t - a - r for t, a, r in zip(total, auto, run)]
         print(f"{args.label:5s} {name:28s} whole {med(total):6.3f} ms (min {1e3 * min(total):6.3f}); auto "
-              f"{med(auto):6.3f}, run {med(run):6.3f}, rest {med(rest):6.3f}; {res.method} {res.extra['naccept']} steps; "
+              f"{med(auto):6.3f}, run {med(run):6.3f}, rest {med(rest):6.3f}; CPU {med(cpu):6.3f}; {res.method} {res.extra['naccept']} steps; "
               f"load {np.round(__import__('os').getloadavg()[0], 2)}; {ukflex.__file__.rsplit('/python/', 1)[0]}")
     return 0
 

@@ -126,12 +126,11 @@ pub struct RadauM {
     ls_old: [Vec<f64>; 3],
     h_old: f64,
     have_old: bool,
-    /// Stage states and residuals `[r1; r2]` ((n+m) each).
+    /// Stage states and residuals ((n+m) each; the error estimate's scratch `r1`, n).
     qs: [Vec<f64>; 3],
     vs: [Vec<f64>; 3],
     res: [Vec<f64>; 3],
     r1: Vec<f64>,
-    r2: Vec<f64>,
     /// Transformed right-hand sides / solutions: real, complex (re, im); (n+m) each.
     xr: Vec<f64>,
     xc: Vec<f64>,
@@ -258,7 +257,6 @@ impl RadauM {
             vs: z3(n),
             res: z3(nm),
             r1: z(n),
-            r2: z(m),
             xr: z(nm),
             xc: z(nm),
             xi: z(nm),

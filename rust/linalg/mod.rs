@@ -23,6 +23,7 @@ pub mod dense;
 pub mod dual;
 pub mod envelope;
 pub mod lu;
+pub mod lu_rows;
 pub mod quadrature;
 pub mod rcm;
 pub mod rot3;

@@ -17,13 +17,12 @@ impl RadauM {
         for k in 1..=NIT {
             self.stages(h);
             for i in 0..3 {
-                let ok = sys.augmented_residual(t0 + self.c[i] * h, &self.qs[i], &self.vs[i], &self.w[i], &self.ls[i], &mut self.r1, &mut self.r2)?;
+                let (r1, r2) = self.res[i].split_at_mut(n);
+                let ok = sys.augmented_residual(t0 + self.c[i] * h, &self.qs[i], &self.vs[i], &self.w[i], &self.ls[i], r1, r2)?;
                 if !ok {
                     return Err(Error::argument("method", "RADAU5M needs a system with the acceleration-level residual"));
                 }
                 self.st.stats.nfev += 1;
-                self.res[i][..n].copy_from_slice(&self.r1);
-                self.res[i][n..].copy_from_slice(&self.r2);
             }
             if !self.res.iter().all(|r| r.iter().all(|x| x.is_finite())) {
                 let (q, qd) = (&self.qs, &self.vs);
@@ -48,11 +47,11 @@ impl RadauM {
                 self.xi[k2] = -(self.ti[2][0] * r0 + self.ti[2][1] * r1 + self.ti[2][2] * r2);
             }
             let nw = self.newton.as_mut().expect("RADAU5M: init first");
-            nw.solve_real(&mut self.xr);
-            nw.solve_complex(&mut self.xc, &mut self.xi);
+            nw.solve_pair(&mut self.xr, &mut self.xc, &mut self.xi);
             self.st.stats.newton += 1;
             // back: (T (x) I) X (turned to the stages: co-rotation); the norm of the position and
-            // velocity corrections of all stages
+            // velocity corrections of all stages (one division per coordinate: six in the chain
+            // of the sum cost their latency)
             let mut dyno = 0.0;
             for k2 in 0..nm {
                 let (x0, x1, x2) = (self.xr[k2], self.xc[k2], self.xi[k2]);
@@ -74,11 +73,11 @@ impl RadauM {
             }
             for k2 in 0..n {
                 let d: [f64; 3] = std::array::from_fn(|i| self.dw[i][k2]);
-                let s = self.newton_scal(k2);
+                let s = 1.0 / self.newton_scal(k2);
                 for i in 0..3 {
-                    let dq = h * h * (self.a2[i][0] * d[0] + self.a2[i][1] * d[1] + self.a2[i][2] * d[2]);
-                    let dv = h * (self.a[i][0] * d[0] + self.a[i][1] * d[1] + self.a[i][2] * d[2]);
-                    dyno += (dq / s) * (dq / s) + (h * dv / s) * (h * dv / s);
+                    let dq = h * h * (self.a2[i][0] * d[0] + self.a2[i][1] * d[1] + self.a2[i][2] * d[2]) * s;
+                    let dv = h * h * (self.a[i][0] * d[0] + self.a[i][1] * d[1] + self.a[i][2] * d[2]) * s;
+                    dyno += dq * dq + dv * dv;
                 }
             }
             let dyno = (dyno / (6 * n) as f64).sqrt();
