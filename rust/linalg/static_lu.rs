@@ -110,6 +110,20 @@ fn minimum_degree(n: usize, s: &[bool]) -> Vec<usize> {
     order
 }
 
+/// The structural pattern (`n x n`, row-major) with rows `rows[i]` and columns `cols[j]` at
+/// `(i, j)`, into the bitset `s`.
+fn permuted_pattern(pattern: &[bool], rows: &[usize], cols: &[usize], s: &mut Bits) {
+    let n = rows.len();
+    s.b.fill(0);
+    for i in 0..n {
+        for j in 0..n {
+            if pattern[rows[i] * n + cols[j]] {
+                s.set(i, j);
+            }
+        }
+    }
+}
+
 /// An `n x n` matrix and, after `factor`, its LU factors in a kept pivot sequence.
 #[derive(Debug, Clone)]
 pub struct StaticLu<T: Scalar> {
@@ -137,8 +151,12 @@ pub struct StaticLu<T: Scalar> {
     dinv: Vec<T>,
     ucache: Vec<T>,
     work: Vec<T>,
-    /// The analysis' dense copy and its bitset scratch.
+    /// The analysis' dense copy, its row ids and the bitset of the fill (all sized at
+    /// construction, the lists reserved for a full triangle: a new choice of pivots during a
+    /// run allocates nothing).
     scratch: Vec<T>,
+    rowid: Vec<usize>,
+    bits: Bits,
 }
 
 impl<T: Scalar> StaticLu<T> {
@@ -150,6 +168,7 @@ impl<T: Scalar> StaticLu<T> {
         }
         let md = minimum_degree(n, &pattern);
         let z = |k: usize| vec![T::default(); k];
+        let tri = n * n.saturating_sub(1) / 2;
         StaticLu {
             n,
             pattern,
@@ -159,16 +178,18 @@ impl<T: Scalar> StaticLu<T> {
             rows: vec![0; n],
             cols: vec![0; n],
             l_ptr: vec![0; n + 1],
-            l_pos: Vec::new(),
-            l_base: Vec::new(),
+            l_pos: Vec::with_capacity(tri),
+            l_base: Vec::with_capacity(tri),
             u_ptr: vec![0; n + 1],
-            u_pos: Vec::new(),
-            u_col: Vec::new(),
-            fill: Vec::new(),
+            u_pos: Vec::with_capacity(tri),
+            u_col: Vec::with_capacity(tri),
+            fill: Vec::with_capacity(n * n),
             dinv: z(n),
             ucache: z(n),
             work: z(n),
-            scratch: Vec::new(),
+            scratch: z(n * n),
+            rowid: vec![0; n],
+            bits: Bits::new(n),
         }
     }
 
@@ -176,14 +197,16 @@ impl<T: Scalar> StaticLu<T> {
     /// the same again).
     pub fn bytes(n: usize) -> u64 {
         let n = n as u64;
-        (3 * std::mem::size_of::<T>() as u64 + 9) * n * n
+        // values and the analysis' copy; the pattern; the four lists (half each) and the fill
+        (2 * std::mem::size_of::<T>() as u64 + 1 + 12) * n * n
     }
 
     /// Multiply-adds of a factorization with diagonal pivots in the minimum degree order (the
     /// structural estimate the choice of the linear solver reads).
     pub fn estimated_flops(&self) -> u64 {
         let n = self.n;
-        let mut s = self.permuted_pattern(&self.md, &self.md);
+        let mut s = Bits::new(n);
+        permuted_pattern(&self.pattern, &self.md, &self.md, &mut s);
         let mut flops = 0u64;
         for k in 0..n {
             let nu = (k + 1..n).filter(|&j| s.get(k, j)).count() as u64;
@@ -295,8 +318,6 @@ impl<T: Scalar> StaticLu<T> {
     /// every pivot. `false`: a zero column (singular to working precision) or a non-finite value.
     fn choose_pivots(&mut self) -> bool {
         let n = self.n;
-        self.scratch.clear();
-        self.scratch.resize(n * n, T::default());
         // b[i][k] = a[md[i]][md[k]]; `rowid[i]`: the caller's row now at place i
         for i in 0..n {
             for k in 0..n {
@@ -304,7 +325,8 @@ impl<T: Scalar> StaticLu<T> {
             }
         }
         let b = &mut self.scratch;
-        let mut rowid: Vec<usize> = self.md.clone();
+        let rowid = &mut self.rowid;
+        rowid.copy_from_slice(&self.md);
         for k in 0..n {
             let (mut p, mut best) = (k, 0.0f64);
             for i in k..n {
@@ -340,29 +362,16 @@ impl<T: Scalar> StaticLu<T> {
                 }
             }
         }
-        self.rows.copy_from_slice(&rowid);
+        self.rows.copy_from_slice(rowid);
         self.cols.copy_from_slice(&self.md);
         true
-    }
-
-    /// The structural pattern with rows `rows[i]` and columns `cols[j]` at `(i, j)`, as bitsets.
-    fn permuted_pattern(&self, rows: &[usize], cols: &[usize]) -> Bits {
-        let n = self.n;
-        let mut s = Bits::new(n);
-        for i in 0..n {
-            for j in 0..n {
-                if self.pattern[rows[i] * n + cols[j]] {
-                    s.set(i, j);
-                }
-            }
-        }
-        s
     }
 
     /// The fill of the pivot sequence from the structural pattern: the lists.
     fn symbolic(&mut self) {
         let n = self.n;
-        let mut s = self.permuted_pattern(&self.rows, &self.cols);
+        let s = &mut self.bits;
+        permuted_pattern(&self.pattern, &self.rows, &self.cols, s);
         for v in [&mut self.l_pos, &mut self.l_base, &mut self.u_pos, &mut self.u_col, &mut self.fill] {
             v.clear();
         }
