@@ -21,21 +21,26 @@
 //! * `Structure`: the values of `M`, `K`, `C`, `A`, `db/dqd` in the pattern (`fill_*`).
 //! * `BandNewton`: a reverse Cuthill-McKee order of `H`'s graph (once), the band positions of
 //!   every entry, and the real and complex band LU (`band_lu`) refilled and refactored in place:
-//!   a chain, a rope or an ANCF cable has a band of a few coordinates whatever its length.
+//!   a chain, a rope or an ANCF cable has a band of a few coordinates whatever its length. Where
+//!   the band is wide but the elimination stays sparse (`Factorization::Static`, chosen by
+//!   `integrate::newton::factorization`), the sparse LU with kept pivots (`static_lu`) instead.
 //! * `fill_linearized_stiffness`: the stiffness of the constrained linearization
 //!   `K_eff = -d/dq (Q - M qdd - A^T lambda)` at fixed `qdd`, `lambda` (what
 //!   `System.frequencies` needs, the constraint forces included), by coloured central
 //!   differences in the positions.
 
 use crate::linalg::band_lu::{BandLu, C64};
-use crate::linalg::rcm::rcm;
+use crate::linalg::static_lu::{Factored, StaticLu};
 use crate::constraint::jac::SegJac;
 use crate::data::Data;
 use crate::dynamics::{constraints, mass_and_forces, mass_times};
 use crate::error::{Error, Result};
 use crate::model::Model;
 
+mod factor;
 mod velocity;
+use factor::Lu;
+pub use factor::{newton_entries, BandLayout, Factorization};
 pub use velocity::{fill_velocity_terms, velocity_differences};
 
 /// Symbolic analysis of the structure (once per model).
@@ -55,7 +60,14 @@ pub struct Pattern {
     /// Columns by colour: colour `c` is `color_cols[color_ptr[c]..color_ptr[c + 1]]`.
     pub color_ptr: Vec<usize>,
     pub color_cols: Vec<usize>,
+    /// On small systems (`n^2 <= DENSE_INDEX_MAX`) the value index of every coordinate entry
+    /// `(i, j)` at `i n + j` (`u32::MAX` outside the pattern): `find` without a search (the
+    /// stiffness of A05's two spring-dampers writes ~2 500 entries per read).
+    index: Vec<u32>,
 }
+
+/// Largest `n^2` for which `Pattern` keeps the dense index of its entries.
+const DENSE_INDEX_MAX: usize = 1 << 16;
 
 /// Structural coordinates of each constraint row: `(global column, index in SegJac::vals)`,
 /// sorted by column.
@@ -227,7 +239,16 @@ impl Pattern {
             color_cols[next[c]] = j;
             next[c] += 1;
         }
-        Ok(Pattern { n, m, col_ptr, row, acol_ptr, arow, aseg, color_ptr, color_cols })
+        let mut index = Vec::new();
+        if n * n <= DENSE_INDEX_MAX {
+            index = vec![u32::MAX; n * n];
+            for j in 0..n {
+                for e in col_ptr[j]..col_ptr[j + 1] {
+                    index[row[e] * n + j] = e as u32;
+                }
+            }
+        }
+        Ok(Pattern { n, m, col_ptr, row, acol_ptr, arow, aseg, color_ptr, color_cols, index })
     }
 
     /// Entries of the coordinate block.
@@ -248,6 +269,12 @@ impl Pattern {
     /// that misses an entry the kernels write is a bug, caught by the tests' dense comparison).
     #[inline]
     pub fn find(&self, i: usize, j: usize) -> usize {
+        if !self.index.is_empty() {
+            let e = self.index[i * self.n + j];
+            if e != u32::MAX {
+                return e as usize;
+            }
+        }
         let (a, b) = (self.col_ptr[j], self.col_ptr[j + 1]);
         a + self.row[a..b].binary_search(&i).unwrap_or_else(|_| panic!("entry ({i}, {j}) outside the sparse pattern"))
     }
@@ -422,52 +449,10 @@ pub fn fill_linearized_stiffness(model: &Model, data: &mut Data, t: f64, q: &[f6
     }
 }
 
-/// The ordering and band positions of `H = [M + g_c C + g_k K, A^T; A - g_c db/dqd, reg I]`
-/// (size `n + m`) for a `Pattern`: symmetric half-bandwidth `hb` after RCM.
-#[derive(Debug, Clone)]
-pub struct BandLayout {
-    pub size: usize,
-    pub hb: usize,
-    /// `perm[i]`: band position of unknown `i` (coordinates, then multipliers).
-    pub perm: Vec<usize>,
-}
 
-impl BandLayout {
-    pub fn new(p: &Pattern) -> BandLayout {
-        let (n, m) = (p.n, p.m);
-        let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n + m];
-        for (i, j) in p.entries() {
-            if i != j {
-                adj[i].push(j);
-                adj[j].push(i);
-            }
-        }
-        for (r, j) in p.a_entries() {
-            adj[n + r].push(j);
-            adj[j].push(n + r);
-        }
-        for a in adj.iter_mut() {
-            a.sort_unstable();
-            a.dedup();
-        }
-        let perm = rcm(&adj);
-        let mut hb = 0;
-        for (v, a) in adj.iter().enumerate() {
-            for &u in a {
-                hb = hb.max(perm[v].abs_diff(perm[u]));
-            }
-        }
-        BandLayout { size: n + m, hb, perm }
-    }
-
-    /// Multiply-adds of one real band factorization (at most).
-    pub fn factor_flops(&self) -> f64 {
-        BandLu::<f64>::factor_flops(self.size, self.hb, self.hb)
-    }
-}
-
-/// The sparse Newton matrices of an implicit method: `Structure`, band positions of every
-/// entry, the real band LU and, for Radau IIA, the complex one; all sized once.
+/// The sparse Newton matrices of an implicit method: `Structure`, the positions of every entry
+/// (in band order), the real LU (band or static, `Factorization`) and, for Radau IIA, the
+/// complex one; all sized once.
 #[derive(Debug, Clone)]
 pub struct BandNewton {
     pub s: Structure,
@@ -478,8 +463,8 @@ pub struct BandNewton {
     ar: Vec<usize>,
     at: Vec<usize>,
     diag: Vec<usize>,
-    real: BandLu<f64>,
-    cplx: Option<BandLu<C64>>,
+    real: Lu<f64>,
+    cplx: Option<Lu<C64>>,
     xr: Vec<f64>,
     xc: Vec<C64>,
     /// Right-hand sides of the first-order solves (`solve_first_order_*`): real and imaginary
@@ -491,60 +476,85 @@ pub struct BandNewton {
 }
 
 impl BandNewton {
-    /// Bytes of the band storage (real, and complex when `complex`) for a layout.
-    pub fn bytes(layout: &BandLayout, complex: bool) -> u64 {
+    /// Bytes of the factorization's storage (real, and complex when `complex`) for a layout.
+    pub fn bytes(layout: &BandLayout, complex: bool, kind: Factorization) -> u64 {
         let (n, hb) = (layout.size, layout.hb);
-        BandLu::<f64>::bytes(n, hb, hb) + if complex { BandLu::<C64>::bytes(n, hb, hb) } else { 0 } + 24 * n as u64
+        let lu = match kind {
+            Factorization::Band => BandLu::<f64>::bytes(n, hb, hb) + if complex { BandLu::<C64>::bytes(n, hb, hb) } else { 0 },
+            Factorization::Static => StaticLu::<f64>::bytes(n) + if complex { StaticLu::<C64>::bytes(n) } else { 0 },
+        };
+        lu + 24 * n as u64
     }
 
-    pub fn new(s: Structure, layout: BandLayout, complex: bool) -> BandNewton {
-        let (n, size, hb) = (s.pattern.n, layout.size, layout.hb);
-        let real = BandLu::<f64>::new(size, hb, hb);
+    pub fn new(s: Structure, layout: BandLayout, complex: bool, kind: Factorization) -> BandNewton {
+        let (n, size) = (s.pattern.n, layout.size);
+        let entries = if kind == Factorization::Static { newton_entries(&s.pattern, &layout) } else { Vec::new() };
+        let real = Lu::<f64>::new(kind, &layout, &entries);
         let perm = &layout.perm;
         let cc = s.pattern.entries().map(|(i, j)| real.index(perm[i], perm[j])).collect();
         let ar = s.pattern.a_entries().map(|(r, j)| real.index(perm[n + r], perm[j])).collect();
         let at = s.pattern.a_entries().map(|(r, j)| real.index(perm[j], perm[n + r])).collect();
         let diag = (0..s.pattern.m).map(|r| real.index(perm[n + r], perm[n + r])).collect();
-        let cplx = complex.then(|| BandLu::<C64>::new(size, hb, hb));
+        let cplx = complex.then(|| Lu::<C64>::new(kind, &layout, &entries));
         let z = |k: usize| vec![0.0; k];
         BandNewton { s, layout, cc, ar, at, diag, real, cplx, xr: z(size), xc: vec![C64::default(); if complex { size } else { 0 }], fr: z(size), fi: z(size), vr: z(n), vi: z(n) }
     }
 
+    /// Whether the factorization is the static sparse LU.
+    pub fn is_static(&self) -> bool {
+        matches!(self.real, Lu::Static(_))
+    }
+
     /// Assemble `[M + gc C + gk K, A^T; A - gc db/dqd, reg I]` and factor it. `false`: singular.
     pub fn factor_real(&mut self, gk: f64, gc: f64, reg: f64) -> bool {
-        let s = &self.s;
-        self.real.clear();
-        let ab = self.real.values_mut();
-        for (e, &pos) in self.cc.iter().enumerate() {
-            ab[pos] = s.m[e] + gc * s.c[e] + gk * s.k[e];
+        // a kept pivot sequence that fails its check asks for one more assembly (`static_lu`)
+        for _ in 0..2 {
+            let s = &self.s;
+            self.real.clear();
+            let ab = self.real.values_mut();
+            for (e, &pos) in self.cc.iter().enumerate() {
+                ab[pos] = s.m[e] + gc * s.c[e] + gk * s.k[e];
+            }
+            for (e, (&pr, &pt)) in self.ar.iter().zip(&self.at).enumerate() {
+                ab[pr] = s.a[e] - gc * s.bv[e];
+                ab[pt] = s.a[e] + s.af[e];
+            }
+            for &pos in &self.diag {
+                ab[pos] = reg;
+            }
+            match self.real.factor() {
+                Factored::Ok => return true,
+                Factored::Singular => return false,
+                Factored::Reorder => {}
+            }
         }
-        for (e, (&pr, &pt)) in self.ar.iter().zip(&self.at).enumerate() {
-            ab[pr] = s.a[e] - gc * s.bv[e];
-            ab[pt] = s.a[e] + s.af[e];
-        }
-        for &pos in &self.diag {
-            ab[pos] = reg;
-        }
-        self.real.factor()
+        false
     }
 
     /// The same with complex coefficients `gk`, `gc` (Radau IIA's complex eigenvalue).
     pub fn factor_complex(&mut self, gk: C64, gc: C64, reg: f64) -> bool {
-        let s = &self.s;
-        let lu = self.cplx.as_mut().expect("a complex factorization was asked for at construction");
-        lu.clear();
-        let ab = lu.values_mut();
-        for (e, &pos) in self.cc.iter().enumerate() {
-            ab[pos] = C64::new(s.m[e] + gc.re * s.c[e] + gk.re * s.k[e], gc.im * s.c[e] + gk.im * s.k[e]);
+        for _ in 0..2 {
+            let s = &self.s;
+            let lu = self.cplx.as_mut().expect("a complex factorization was asked for at construction");
+            lu.clear();
+            let ab = lu.values_mut();
+            for (e, &pos) in self.cc.iter().enumerate() {
+                ab[pos] = C64::new(s.m[e] + gc.re * s.c[e] + gk.re * s.k[e], gc.im * s.c[e] + gk.im * s.k[e]);
+            }
+            for (e, (&pr, &pt)) in self.ar.iter().zip(&self.at).enumerate() {
+                ab[pr] = C64::new(s.a[e] - gc.re * s.bv[e], -gc.im * s.bv[e]);
+                ab[pt] = C64::new(s.a[e] + s.af[e], 0.0);
+            }
+            for &pos in &self.diag {
+                ab[pos] = C64::new(reg, 0.0);
+            }
+            match lu.factor() {
+                Factored::Ok => return true,
+                Factored::Singular => return false,
+                Factored::Reorder => {}
+            }
         }
-        for (e, (&pr, &pt)) in self.ar.iter().zip(&self.at).enumerate() {
-            ab[pr] = C64::new(s.a[e] - gc.re * s.bv[e], -gc.im * s.bv[e]);
-            ab[pt] = C64::new(s.a[e] + s.af[e], 0.0);
-        }
-        for &pos in &self.diag {
-            ab[pos] = C64::new(reg, 0.0);
-        }
-        lu.factor()
+        false
     }
 
     /// `x <- H^-1 x` with the real factors (`x`: n + m, coordinates then multipliers).
@@ -653,7 +663,7 @@ impl BandNewton {
         for (i, &p) in perm.iter().enumerate() {
             self.xc[p] = C64::new(xr[i], xi[i]);
         }
-        self.cplx.as_ref().expect("complex factors").solve(&mut self.xc);
+        self.cplx.as_mut().expect("complex factors").solve(&mut self.xc);
         for (i, &p) in perm.iter().enumerate() {
             xr[i] = self.xc[p].re;
             xi[i] = self.xc[p].im;

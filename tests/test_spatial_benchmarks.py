@@ -162,6 +162,27 @@ def test_a05_radau5m_steps_follow_rtol():
     assert steps[1e-3] < 0.85 * steps[1e-5], steps
 
 
+def test_a05_sparse_lu_with_kept_pivots_matches_the_dense_lu():
+    """A05's Newton matrices (64 x 64, a band as wide as the matrix) take the sparse LU with a
+    minimum degree order and kept pivots (``rust/linalg/static_lu.rs``) under ``auto`` and under
+    explicit ``sparse``; ``dense`` is the dense LU. The same steps, factorizations and Newton
+    iterations, and the slider within rounding of Newton's corrections (docs/spatial.md, round
+    i30-a05c: 4.8e-10 m over 2 s at rtol 1e-3)."""
+    t = np.linspace(0.0, 0.5, 51)
+    runs = {}
+    for solver in ("dense", "auto", "sparse"):
+        system = ukflex.System(spatial_scenes.flyball_governor())
+        res = ukflex.simulate(system, 0.5, t_eval=t, rtol=1e-4, linear_solver=solver)
+        assert res.status == 0 and res.method == "RADAU5M", (solver, res.message)
+        z = ukflex.spatial_outputs(system, res)["bodies"]["slider"]["position"][:, 2]
+        runs[solver] = (z, res.extra["naccept"], res.extra["newton_iterations"], res.nlu)
+    for solver in ("auto", "sparse"):
+        assert runs[solver][1:] == runs["dense"][1:], (solver, runs[solver][1:], runs["dense"][1:])
+        assert np.abs(runs[solver][0] - runs["dense"][0]).max() < 1e-8, solver
+    # not the dense LU itself: its rounding differs
+    assert np.abs(runs["auto"][0] - runs["dense"][0]).max() > 0.0
+
+
 def test_bricard_cod_backend_matches_the_svd_on_the_manifold():
     """``set_pseudoinverse("cod")``: A04's rank-deficient B by the certified complete orthogonal
     decomposition (rust/linalg/small_svd/cod.rs) gives the SVD's rank and, on the manifold, its

@@ -8,7 +8,9 @@
 //!   small systems.
 //! * **Sparse**: the same matrices from `structure_sparse` in the pattern of `sparse_newton`,
 //!   ordered once (RCM) and factored in band storage (`band_lu`): O(n) per read, factorization
-//!   and solve for chains, ropes, cables.
+//!   and solve for chains, ropes, cables. Where the band is wide but the elimination stays
+//!   sparse (`factorization`: Radau IIA's two matrices, a hub such as A05's shaft and slider),
+//!   the sparse LU with a minimum degree order and kept pivots (`static_lu`) instead.
 //!
 //! `LinearSolver::Auto` takes the sparse form where it is measured to win
 //! (`prefer_sparse`, docs/scale.md). Both give the same matrices to the bit; their solutions
@@ -21,7 +23,8 @@ use crate::band_lu::C64;
 use crate::error::{Error, Result};
 use crate::data::Data;
 use crate::model::Model;
-use crate::sparse_newton::{BandLayout, BandNewton, Pattern, Structure};
+use crate::linalg::static_lu::StaticLu;
+use crate::sparse_newton::{newton_entries, BandLayout, BandNewton, Factorization, Pattern, Structure};
 
 /// How an implicit method factors its Newton matrices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -66,13 +69,40 @@ pub const SPARSE_NEWTON_MIN_COMPLEX: usize = 50;
 /// dense FFRF blocks, or a hub that couples everything, has a band as wide as the matrix: the
 /// band LU would do the dense work with more bookkeeping).
 pub fn prefer_sparse(layout: &BandLayout, complex: bool) -> bool {
-    layout.size >= sparse_min(complex) && 2 * (2 * layout.hb + 1) <= layout.size
+    layout.size >= sparse_min(complex) && narrow(layout)
 }
 
 /// The smallest `n + m` at which `Auto` may take the sparse form: below it the pattern and its
 /// ordering are not built (the same choice, without their cost on every run of a small scene).
 fn sparse_min(complex: bool) -> usize {
     if complex { SPARSE_NEWTON_MIN_COMPLEX } else { SPARSE_NEWTON_MIN }
+}
+
+/// The band after RCM covers at most half of the matrix.
+fn narrow(layout: &BandLayout) -> bool {
+    2 * (2 * layout.hb + 1) <= layout.size
+}
+
+/// Up to this size the sparse LU with kept pivots (`static_lu`) may replace the dense one (its
+/// order is chosen on bitset rows: O(n^3 / 64) once).
+pub const STATIC_LU_MAX: usize = 256;
+
+/// How the sparse form factors (`pattern` in `layout`): the band LU where the band is narrow;
+/// with Radau IIA's complex matrix (RADAU5M, RADAU5), from `SPARSE_NEWTON_MIN_COMPLEX` to
+/// `STATIC_LU_MAX`, a wide band, and a minimum degree elimination of at most a quarter of the
+/// dense one's multiply-adds, the sparse LU with kept pivots (A05, 64 x 64: ~5 000 against
+/// ~87 000; a flexible body's dense FFRF block fills in and stays dense or banded).
+pub fn factorization(pattern: &Pattern, layout: &BandLayout, complex: bool) -> Factorization {
+    let size = layout.size;
+    if !complex || narrow(layout) || !(SPARSE_NEWTON_MIN_COMPLEX..=STATIC_LU_MAX).contains(&size) {
+        return Factorization::Band;
+    }
+    let lu = StaticLu::<f64>::new(size, newton_entries(pattern, layout).into_iter());
+    if 4 * lu.estimated_flops() <= (size * size * size / 3) as u64 {
+        Factorization::Static
+    } else {
+        Factorization::Band
+    }
 }
 
 /// The solve with a factorization at which GENALPHA forms its inverse (dense, small only).
@@ -167,7 +197,7 @@ impl NewtonMatrices {
 
     pub fn sparse(structure: Structure, complex: bool) -> Self {
         let layout = BandLayout::new(&structure.pattern);
-        NewtonMatrices { inner: Inner::Sparse(Box::new(BandNewton::new(structure, layout, complex))) }
+        NewtonMatrices { inner: Inner::Sparse(Box::new(BandNewton::new(structure, layout, complex, Factorization::Band))) }
     }
 
     /// The Newton matrices `method` runs on with `system` (n coordinates, m rows), for the
@@ -197,9 +227,10 @@ impl NewtonMatrices {
         match structure {
             Some(s) => {
                 let layout = BandLayout::new(&s.pattern);
-                if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) {
-                    sys.check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex))?;
-                    return Ok(Some(BandNewton::new(s, layout, complex)));
+                let kind = factorization(&s.pattern, &layout, complex);
+                if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) || kind == Factorization::Static {
+                    sys.check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex, kind))?;
+                    return Ok(Some(BandNewton::new(s, layout, complex, kind)));
                 }
                 Ok(None)
             }
@@ -219,8 +250,9 @@ impl NewtonMatrices {
             r => r?,
         };
         let layout = BandLayout::new(&p);
-        if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) {
-            Error::check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex), data.memory_limit, "raise memory_limit")?;
+        let kind = factorization(&p, &layout, complex);
+        if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) || kind == Factorization::Static {
+            Error::check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex, kind), data.memory_limit, "raise memory_limit")?;
             return Ok(LinearSolver::Sparse);
         }
         Ok(LinearSolver::Dense)

@@ -7,7 +7,8 @@
 //! * `envelope`: envelope (profile) storage, its Cholesky factor and selected inverse (the
 //!   Gram matrix of the spatial UK path);
 //! * `band_lu`: the band LU with partial pivoting of the implicit methods' sparse Newton
-//!   matrices, real and complex; `lu`: their dense LU;
+//!   matrices, real and complex; `static_lu`: their sparse LU with a fill-reducing order and
+//!   kept pivots (a wide band whose elimination stays sparse); `lu`: their dense LU;
 //! * `small_svd`: the QR + one-sided Jacobi SVD of the UK pseudoinverse;
 //! * `rcm`: the reverse Cuthill-McKee order that makes the sparse matrices banded;
 //! * `quadrature`: the Gauss rule of the element integrals;
@@ -28,6 +29,7 @@ pub mod quadrature;
 pub mod rcm;
 pub mod rot3;
 pub mod small_svd;
+pub mod static_lu;
 
 pub use banded::{Banded, BandedCholesky};
 pub use dense::{cholesky3, dot4, solve_lower3, solve_upper3};

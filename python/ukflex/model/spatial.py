@@ -455,6 +455,12 @@ class SpatialScene:
         """Build the description in the core (every rule is the core's; named errors)."""
         normalize_spatial(self._d, self.callables, copy_back=False)
 
+    def core_text(self) -> str:
+        """The description as the core reads it (JSON; a NaN or infinity refused by name):
+        :class:`ukflex.System` builds its core from it once, and that build is the validation
+        (the same named errors as :meth:`validate`, without a second build)."""
+        return _core_text(self._d)
+
 
 def _check_transportable(v: Any, path: str) -> None:
     """JSON carries no NaN or infinity: name where one stands (every other rule is the core's)."""
@@ -468,17 +474,21 @@ def _check_transportable(v: Any, path: str) -> None:
             _check_transportable(x, f"{path}[{i}]")
 
 
-def normalize_spatial(description: Dict[str, Any], callables: Optional[Dict[str, Any]] = None,
-                      copy_back: bool = True):
-    """Validate a spatial description dict in the core (with the loads' Python ``callables`` by
-    name); returns ``(None, dict)`` like :func:`ukflex.description.normalize` (spatial scenes
-    have no item-by-item checker; ``copy_back=False``: ``(None, None)``, no copy)."""
+def _core_text(description: Dict[str, Any]) -> str:
+    """The description's JSON text for the core; a NaN or infinity named where it stands."""
     try:
-        text = json.dumps(description, allow_nan=False)
+        return json.dumps(description, allow_nan=False)
     except (TypeError, ValueError) as exc:
         # name where a NaN or infinity stands (the walk only when the fast encoder refused:
         # 0.2 of A05's 2 ms build otherwise)
         _check_transportable(description, "")
         raise InvalidSceneError(f"scene: not a JSON-compatible description ({exc})") from exc
-    _core.System(text, callables=callables)
+
+
+def normalize_spatial(description: Dict[str, Any], callables: Optional[Dict[str, Any]] = None,
+                      copy_back: bool = True):
+    """Validate a spatial description dict in the core (with the loads' Python ``callables`` by
+    name); returns ``(None, dict)`` like :func:`ukflex.description.normalize` (spatial scenes
+    have no item-by-item checker; ``copy_back=False``: ``(None, None)``, no copy)."""
+    _core.System(_core_text(description), callables=callables)
     return None, copy.deepcopy(dict(description)) if copy_back else None
