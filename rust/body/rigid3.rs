@@ -304,6 +304,26 @@ impl Rigid3 {
         v[6] = s * y4 * self.inv_sqrt_k;
     }
 
+    /// `F^-1` of the body as `(1 / sqrt m, T)`: `(F^-1 v)_r = v_r / sqrt m`, `(F^-1 v)_p = T v_p`
+    /// (`T = [L_J^-1 G; p^T / sqrt k] / (2 |p|^2)`, the rows of `finv`), for a caller that maps
+    /// many vectors with one factor (`uk::gram`: each constraint row's segment of `B^T`).
+    #[inline]
+    pub fn finv_matrix(&self, bd: &Rigid3Data) -> (f64, [[f64; 4]; 4]) {
+        let p = &bd.p;
+        let g = rot_g(p);
+        let s = 0.5 / bd.p2;
+        let mut t = [[0.0; 4]; 4];
+        for i in 0..3 {
+            for l in 0..4 {
+                t[i][l] = s * (self.l_inv[i][0] * g[0][l] + self.l_inv[i][1] * g[1][l] + self.l_inv[i][2] * g[2][l]);
+            }
+        }
+        for l in 0..4 {
+            t[3][l] = s * self.inv_sqrt_k * p[l];
+        }
+        (self.inv_sqrt_m, t)
+    }
+
     /// `v <- F^-T v`: `v_r / sqrt m`; `N^T diag(L_J^-T, 1/sqrt k) v_p / (2 |p|^2)`.
     #[inline]
     pub fn finvt(&self, bd: &Rigid3Data, v: &mut [f64]) {

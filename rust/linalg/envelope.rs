@@ -4,8 +4,11 @@
 //! Row `i` stores the columns `first[i]..=i` of the lower triangle contiguously. The Cholesky
 //! factor `L` (`S = L L^T`) has its nonzeros inside the same envelope (George and Liu, *Computer
 //! Solution of Large Sparse Positive Definite Systems*, 1981, ch. 4), so it is computed in place,
-//! row by row, each entry one contiguous dot product of two rows; the triangular solves run over
-//! the same contiguous rows. For a matrix whose rows couple only within a few blocks (the Gram
+//! column by column (right-looking: each column's outer product is subtracted from the later
+//! columns, updates independent of one another; the row-by-row form, one dot product per entry,
+//! chains each entry on the ones before it in its row and was slower on the Gram matrices of
+//! `uk::gram`); the triangular solves run over the contiguous rows. The rounding bound of the
+//! factor (Higham, *Accuracy and Stability*, Thm 10.3) does not depend on the order of the sums. For a matrix whose rows couple only within a few blocks (the Gram
 //! matrix of the spatial UK path, `uk::gram`) the envelope is much smaller than a band of the
 //! same rows: the work is `sum_i (i - first[i])^2 / 2` instead of `n hb^2 / 2`.
 //!
@@ -38,6 +41,8 @@ pub struct EnvelopeCholesky {
     pair: Vec<usize>,
     /// Most entries in one row (`max (i - first[i] + 1)`).
     pub width: usize,
+    /// Scratch of `selected_inverse_trace`: one column of `L` (the longest column's length).
+    lcol: Vec<f64>,
 }
 
 impl EnvelopeCholesky {
@@ -68,7 +73,8 @@ impl EnvelopeCholesky {
             pair_ptr.push(pair.len());
         }
         let len = ptr[n];
-        EnvelopeCholesky { n, first, ptr, data: vec![0.0; len], inv_diag: vec![0.0; n], col_ptr, col, pair_ptr, pair, width }
+        let lcol = vec![0.0; (0..n).map(|j| col_ptr[j + 1] - col_ptr[j]).max().unwrap_or(0)];
+        EnvelopeCholesky { n, first, ptr, data: vec![0.0; len], inv_diag: vec![0.0; n], col_ptr, col, pair_ptr, pair, width, lcol }
     }
 
     /// Position of entry `(i, j)`, `first[i] <= j <= i`, in `data` (and in a selected inverse).
@@ -100,26 +106,34 @@ impl EnvelopeCholesky {
     }
 
     /// Cholesky `S = L L^T` in place. `false` at a pivot that is not positive and finite (the
-    /// factor is then unusable).
+    /// factor is then unusable). Right-looking, column by column: column `j` is scaled by its
+    /// pivot and its outer product subtracted from the later columns (`pair`, the lookups of the
+    /// selected inverse): the updates of one column are independent of one another, where the
+    /// row-by-row form chains each entry of a row on the ones before it.
     pub fn factor_in_place(&mut self) -> bool {
-        for i in 0..self.n {
-            let (fi, pi) = (self.first[i], self.ptr[i]);
-            let (head, tail) = self.data.split_at_mut(pi);
-            for j in fi..i {
-                let fj = self.first[j];
-                let k0 = fi.max(fj);
-                let rj = &head[self.ptr[j] + k0 - fj..self.ptr[j] + j - fj];
-                let s = tail[j - fi] - dot4(&tail[k0 - fi..j - fi], rj);
-                tail[j - fi] = s * self.inv_diag[j];
-            }
-            let row = &tail[..i - fi];
-            let d = tail[i - fi] - dot4(row, row);
+        let data = &mut self.data;
+        for j in 0..self.n {
+            let dj = self.ptr[j + 1] - 1;
+            let d = data[dj];
             if !(d > 0.0 && d.is_finite()) {
                 return false;
             }
             let l = d.sqrt();
-            tail[i - fi] = l;
-            self.inv_diag[i] = 1.0 / l;
+            let inv = 1.0 / l;
+            data[dj] = l;
+            self.inv_diag[j] = inv;
+            let c = &self.col[self.col_ptr[j]..self.col_ptr[j + 1]];
+            for &(_, kj) in c {
+                data[kj] *= inv;
+            }
+            let p = &self.pair[self.pair_ptr[j]..self.pair_ptr[j + 1]];
+            for (a, &(_, aj)) in c.iter().enumerate() {
+                let la = data[aj];
+                // (k_a, k_b) for b <= a: the lower triangle of the pairs
+                for (&(_, bj), &ab) in c[..=a].iter().zip(&p[a * c.len()..]) {
+                    data[ab] -= la * data[bj];
+                }
+            }
         }
         true
     }
@@ -144,20 +158,25 @@ impl EnvelopeCholesky {
 
     /// The selected inverse `Z = S^-1` inside the envelope into `z` (the layout of `data`, at
     /// least `len()` long), from the factor of `factor_in_place`; returns `trace(S^-1)`.
-    pub fn selected_inverse_trace(&self, z: &mut [f64]) -> f64 {
+    pub fn selected_inverse_trace(&mut self, z: &mut [f64]) -> f64 {
         let l = &self.data;
         let mut trace = 0.0;
         for j in (0..self.n).rev() {
             let c = &self.col[self.col_ptr[j]..self.col_ptr[j + 1]];
             let p = &self.pair[self.pair_ptr[j]..self.pair_ptr[j + 1]];
             let inv = self.inv_diag[j];
+            // column j of L gathered once (each of its entries is read by every row of the column)
+            let lc = &mut self.lcol[..c.len()];
+            for (x, &(_, kj)) in lc.iter_mut().zip(c) {
+                *x = l[kj];
+            }
             // Z_ij for the rows i of column j: only entries of columns > j are read
             for (a, &(_, ij)) in c.iter().enumerate() {
                 let zrow = &p[a * c.len()..(a + 1) * c.len()];
-                let s: f64 = c.iter().zip(zrow).map(|(&(_, kj), &ik)| l[kj] * z[ik]).sum();
+                let s: f64 = lc.iter().zip(zrow).map(|(&lk, &ik)| lk * z[ik]).sum();
                 z[ij] = -s * inv;
             }
-            let s: f64 = c.iter().map(|&(_, kj)| l[kj] * z[kj]).sum();
+            let s: f64 = lc.iter().zip(c).map(|(&lk, &(_, kj))| lk * z[kj]).sum();
             let d = (inv - s) * inv;
             z[self.ptr[j + 1] - 1] = d;
             trace += d;

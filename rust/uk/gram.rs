@@ -48,7 +48,7 @@
 //! estimate is 1.9e6).
 
 use super::settings::RankInfo;
-use crate::body::BodyData;
+use crate::body::{BodyData, BodyKind};
 use crate::constraint::jac::{Seg, SegJac};
 use crate::linalg::envelope::EnvelopeCholesky;
 use crate::model::Model;
@@ -99,6 +99,8 @@ pub struct GramUk {
     quad_ptr: Vec<usize>,
     /// `S_22[entry] += vals_a . vals_b` over `(entry, a, b, len)`.
     pairs: Vec<(usize, usize, usize, usize)>,
+    /// Per body: a rigid3 body's `F^-1` as `(1 / sqrt m, T)` (`Rigid3::finv_matrix`), this call's.
+    finv: Vec<Option<(f64, [[f64; 4]; 4])>>,
     /// Longest dot product that makes one entry of `S_22`.
     max_dot: usize,
     env: EnvelopeCholesky,
@@ -121,6 +123,21 @@ pub struct GramUk {
     pub trace_sinv: f64,
     /// Factorizations left to the dense QR after the last refusal (`GRAM_RETRY`).
     pub skip: u32,
+}
+
+/// `dot4(x, y)` to the bit, with the six- and seven-entry cases (a rigid3 body off its unit
+/// coordinate: most products of `S_22`; a rigid3 body's segment) written out so that they have
+/// no loop and no remainder branches.
+#[inline(always)]
+fn seg_dot(x: &[f64], y: &[f64]) -> f64 {
+    let head = |x: &[f64], y: &[f64]| (x[0] * y[0] + x[2] * y[2]) + (x[1] * y[1] + x[3] * y[3]);
+    if let (Ok(x), Ok(y)) = (<&[f64; 6]>::try_from(x), <&[f64; 6]>::try_from(y)) {
+        head(x, y) + x[4] * y[4] + x[5] * y[5]
+    } else if let (Ok(x), Ok(y)) = (<&[f64; 7]>::try_from(x), <&[f64; 7]>::try_from(y)) {
+        head(x, y) + x[4] * y[4] + x[5] * y[5] + x[6] * y[6]
+    } else {
+        crate::linalg::dot4(x, y)
+    }
 }
 
 impl GramUk {
@@ -218,6 +235,7 @@ impl GramUk {
             quad,
             quad_ptr,
             pairs,
+            finv: vec![None; model.bodies.len()],
             max_dot: dots.into_iter().max().unwrap_or(0),
             env,
             z: vec![0.0; len],
@@ -248,11 +266,29 @@ impl GramUk {
     /// is certified (ready for `correct`), `None` otherwise.
     pub fn factor(&mut self, model: &Model, bodies: &[BodyData], ajac: &SegJac, rcond: f64, atol: f64) -> Option<RankInfo> {
         debug_assert_eq!(self.vals.len(), ajac.vals.len());
-        // B^T = F^-1 A^T, segment by segment (the segments tile the values)
+        // B^T = F^-1 A^T, segment by segment (the segments tile the values); a rigid3 body's
+        // factor once as a matrix, its segments read from `A` and written in one pass
+        for (f, (body, bd)) in self.finv.iter_mut().zip(model.bodies.iter().zip(bodies)) {
+            if let (BodyKind::Rigid3(k), BodyData::Rigid3(d)) = (&body.kind, bd) {
+                *f = Some(k.finv_matrix(d));
+            }
+        }
         for s in &self.segs {
-            let v = &mut self.vals[s.val..s.val + s.len];
-            v.copy_from_slice(&ajac.vals[s.val..s.val + s.len]);
-            model.bodies[s.body].finv(&bodies[s.body], v);
+            let (a, v) = (&ajac.vals[s.val..s.val + s.len], &mut self.vals[s.val..s.val + s.len]);
+            match &self.finv[s.body] {
+                Some((im, t)) if s.len == 7 => {
+                    for c in 0..3 {
+                        v[c] = a[c] * im;
+                    }
+                    for (o, row) in v[3..7].iter_mut().zip(t) {
+                        *o = row[0] * a[3] + row[1] * a[4] + row[2] * a[5] + row[3] * a[6];
+                    }
+                }
+                _ => {
+                    v.copy_from_slice(a);
+                    model.bodies[s.body].finv(&bodies[s.body], v);
+                }
+            }
         }
         let mut trace_s = 0.0;
         for (d, u) in self.d.iter_mut().zip(&self.units) {
@@ -265,10 +301,18 @@ impl GramUk {
             self.vals[e] = 0.0;
             trace_s += *x * *x;
         }
+        // each entry's products summed in a register, then stored once (the pairs are sorted
+        // by entry: a sum through memory waits on the previous store)
         let data = &mut self.env.data;
         data.fill(0.0);
-        for &(e, a, b, len) in &self.pairs {
-            data[e] += crate::linalg::dot4(&self.vals[a..a + len], &self.vals[b..b + len]);
+        let vals = &self.vals;
+        let mut pairs = self.pairs.iter().peekable();
+        while let Some(&(e, a, b, len)) = pairs.next() {
+            let mut s = seg_dot(&vals[a..a + len], &vals[b..b + len]);
+            while let Some(&(_, a, b, len)) = pairs.next_if(|p| p.0 == e) {
+                s += seg_dot(&vals[a..a + len], &vals[b..b + len]);
+            }
+            data[e] = s;
         }
         let mut max_d = 0.0f64;
         for p in 0..self.rows.len() {
@@ -286,13 +330,18 @@ impl GramUk {
         // four partial sums per unit in registers (a sum through memory waits on each store,
         // one register on each addition)
         for (b, d) in self.d.iter().enumerate() {
-            let mut acc = [0.0f64; 4];
-            for chunk in self.quad[self.quad_ptr[b]..self.quad_ptr[b + 1]].chunks(4) {
-                for (a, &(e, s, t, w)) in acc.iter_mut().zip(chunk) {
-                    *a += w * self.z[e] * self.xval[s] * self.xval[t];
-                }
+            let term = |&(e, s, t, w): &(usize, usize, usize, f64)| w * self.z[e] * self.xval[s] * self.xval[t];
+            let quad = self.quad[self.quad_ptr[b]..self.quad_ptr[b + 1]].chunks_exact(4);
+            let rest = quad.remainder();
+            let (mut a0, mut a1, mut a2, mut a3) = (0.0, 0.0, 0.0, 0.0);
+            for c in quad {
+                (a0, a1, a2, a3) = (a0 + term(&c[0]), a1 + term(&c[1]), a2 + term(&c[2]), a3 + term(&c[3]));
             }
-            let zu = 1.0 + ((acc[0] + acc[2]) + (acc[1] + acc[3]));
+            // the last partial chunk on the first sums, as before
+            for (a, c) in [&mut a0, &mut a1, &mut a2].into_iter().zip(rest) {
+                *a += term(c);
+            }
+            let zu = 1.0 + ((a0 + a2) + (a1 + a3));
             trace_sinv += zu / (d * d);
         }
         self.trace_sinv = trace_sinv;
@@ -323,7 +372,7 @@ impl GramUk {
         let i = self.rows[p];
         let mut s = 0.0;
         for sg in &self.segs[self.seg_ptr[i]..self.seg_ptr[i + 1]] {
-            s += crate::linalg::dot4(&self.vals[sg.val..sg.val + sg.len], &v[sg.col..sg.col + sg.len]);
+            s += seg_dot(&self.vals[sg.val..sg.val + sg.len], &v[sg.col..sg.col + sg.len]);
         }
         s
     }
@@ -332,8 +381,15 @@ impl GramUk {
     fn add_yt_times(&self, x: &[f64], out: &mut [f64]) {
         for (&i, &xi) in self.rows.iter().zip(x) {
             for sg in &self.segs[self.seg_ptr[i]..self.seg_ptr[i + 1]] {
-                for (o, b) in out[sg.col..sg.col + sg.len].iter_mut().zip(&self.vals[sg.val..sg.val + sg.len]) {
-                    *o += b * xi;
+                let (o, b) = (&mut out[sg.col..sg.col + sg.len], &self.vals[sg.val..sg.val + sg.len]);
+                if let (Ok(o), Ok(b)) = (<&mut [f64; 7]>::try_from(&mut *o), <&[f64; 7]>::try_from(b)) {
+                    for k in 0..7 {
+                        o[k] += b[k] * xi;
+                    }
+                } else {
+                    for (o, b) in o.iter_mut().zip(b) {
+                        *o += b * xi;
+                    }
                 }
             }
         }
