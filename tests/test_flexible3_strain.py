@@ -140,3 +140,23 @@ def test_cubic_terms_agree_with_the_assembled_geometric_stiffness():
     v4 = np.einsum("p,abp,abp->", dx, solid.mu * enl, enl) + 0.5 * solid.lam * np.einsum("p,p->", dx, np.einsum("aap->p", enl) ** 2)
     v4c = 0.125 * np.einsum("ijkl,i,j,k,l->", h.reshape(n, n, n, n), q, q, q, q)
     assert 0.0 < v4c < v4
+
+
+def test_condensation_compliance_every_path_against_a_dense_solve():
+    """``R^T K^-1 R`` of the condensation (issue 31): the banded Cholesky of a narrow band (a
+    chain), SuperLU for a wide band (random couplings) and for an indefinite ``K`` (the Cholesky
+    fails), each against the dense solve."""
+    import scipy.sparse as sp
+
+    from ukflex.model.fe3_stiffening import _compliance
+
+    rng = np.random.default_rng(3)
+    n = 400
+    chain = sp.diags([-np.ones(n - 1), 4.0 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+    wide = sp.random(n, n, density=0.02, random_state=4)
+    wide = wide + wide.T + 10.0 * sp.eye(n)
+    indefinite = chain - 3.0 * sp.eye(n)  # eigenvalues 1 - 2 cos(.) in (-1, 3)
+    r = rng.standard_normal((n, 7))
+    for k in (chain, wide, indefinite):
+        dense = r.T @ np.linalg.solve(k.toarray(), r)
+        assert np.allclose(_compliance(k, r), dense, rtol=1e-9, atol=1e-9 * np.abs(dense).max())

@@ -131,6 +131,8 @@ ROOM_EXCEPTIONS = {
     # the method lists a scene file's [solver] table is checked against; they move into the core
     # with the run-option rules (issue 29 item 3, the Rust side)
     ("ukflex.model.scenefile", "ukflex.run.simulate"): "method names",
+    # the FE build runs with one BLAS thread (the one thread-limit helper, threadpoolctl optional)
+    ("ukflex.model.fe3", "ukflex.reference._blas"): "BLAS threads",
 }
 BASE = {"ukflex.errors", "ukflex.arguments", "ukflex._core"}
 

@@ -57,6 +57,7 @@ import scipy.sparse.linalg as spla
 
 from ..arguments import count, non_negative, positive, real
 from ..errors import InvalidArgumentError, require
+from ..reference._blas import single_blas_thread
 from .fe import REDUCTIONS, frame_interfaces
 from .fe3_stiffening import geometric_stiffness, held_mask, quadratic_strain as _quadratic_strain, stress_modes
 
@@ -358,6 +359,9 @@ def _held(frame: Any, names: List[str]) -> Optional[str]:
     return words[1][0] if words[0] == "clamped" else None
 
 
+# one BLAS thread: the build's many small dense blocks (SuperLU's supernodes, ARPACK's steps) ran
+# 2-15x slower with two threads on a loaded 2-core machine (docs/spatial-flexible.md, the default rod)
+@single_blas_thread()
 def from_mesh(mesh: Any, *, density: float, youngs_modulus: float, poisson_ratio: float,
               interfaces: Mapping[str, InterfaceSpec], modes: Union[int, Sequence[int]] = 8, frame: Any = "mean-axis",
               reduction: str = "modes", order: int = 2, damping_ratio: float = 0.0,
