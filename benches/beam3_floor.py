@@ -9,6 +9,7 @@ motion), and RADAU5M at rtol 1e-9 with its own step control.
 
     PYTHONPATH=. python benches/beam3_floor.py                    # minutes
     PYTHONPATH=. python benches/beam3_floor.py --scenes pendulum4 --refs DOPRI5
+    PYTHONPATH=. python benches/beam3_floor.py --sweep spin_up8 --refs RADAU5M   # 10-30 s: where the error comes from
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from __future__ import annotations
 import argparse
 import math
 import time
-from typing import Callable, Dict, Tuple
+from typing import Any, Callable, Dict, Tuple
 
 import numpy as np
 
@@ -72,12 +73,42 @@ def node_positions(system: ukflex.System, q: np.ndarray) -> np.ndarray:
     return np.stack([q[7 * i:7 * i + 3] for i in idx])
 
 
+def sweep(key: str, ref: str, points: int) -> None:
+    """Where a scene's error comes from: auto at rtol 1e-4 .. 1e-8 (its step, its Newton
+    tolerance), and RADAU5M at auto's steps with Newton at 1e-9, and at 1/4 and 1/16 of the step
+    of rtol 1e-6."""
+    label, make, T = SCENES[key]
+    te = np.linspace(0.0, T, points)
+
+    def run(**kw: Any) -> Tuple[np.ndarray, Any]:
+        system = make()
+        r = ukflex.simulate(system, T, t_eval=te, **kw)
+        return node_positions(system, np.asarray(r.q)), r
+
+    base, _ = run(**REFS[ref])
+    steps = {}
+    print(f"{label}, against {ref} at rtol {REFS[ref]['rtol']:g}")
+    for rtol in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
+        x, r = run(rtol=rtol)
+        a = r.extra["auto"]
+        steps[rtol] = a["step"]
+        print(f"auto rtol {rtol:g}: step {a['step']:.3g} s, stated floor {a.get('floor')}, "
+              f"error {np.linalg.norm(x - base, axis=1).max():.2e} m", flush=True)
+    for h in (steps[1e-6], steps[1e-7], steps[1e-8], steps[1e-6] / 4, steps[1e-6] / 16):
+        x, _ = run(method="RADAU5M", step=h, rtol=1e-9)
+        print(f"RADAU5M step {h:.3g} s, Newton 1e-9: error {np.linalg.norm(x - base, axis=1).max():.2e} m", flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
+    ap.add_argument("--sweep", default="")
     ap.add_argument("--scenes", default="pendulum4,pendulum10,spin_up8,rac5")
     ap.add_argument("--refs", default="DOPRI5,RADAU5M")
     ap.add_argument("--points", type=int, default=2001)
     args = ap.parse_args()
+    if args.sweep:
+        sweep(args.sweep, args.refs.split(",")[0], args.points)
+        return
     print("| scene | coordinates | stated floor [m] | reference | measured [m] | floor / measured | auto [s] | reference [s] |")
     print("|---|---:|---:|---|---:|---:|---:|---:|")
     for key in args.scenes.split(","):

@@ -85,8 +85,9 @@ pub const FIRST_MODES: usize = 8;
 pub const DOPRI5_RTOL_PER_RTOL: f64 = 0.3;
 /// Large systems up to this many coordinates get their floor from the whole dense spectrum,
 /// computed for it alone (the sparse analysis finds the lowest modes, the floor sums over the
-/// fast ones): 4 ms on the 70-coordinate spin-up beam; beyond, the cubic cost of the dense
-/// eigenproblem outgrows the run's and no floor is stated.
+/// fast ones): at most the whole dense analysis' time, 8-10 ms at 70-84 coordinates, 17 ms at
+/// 126, 62 ms at 203 (3D spin-up beams; benches/beam3_floor.py's scenes); beyond, the cubic
+/// cost of the dense eigenproblem grows on and no floor is stated.
 pub const FLOOR_DENSE_MAX: usize = 200;
 /// The body points at which the floor's displacements are read (fractions of a beam's length).
 pub const FLOOR_POINTS: [f64; 4] = [0.25, 0.5, 0.75, 1.0];
