@@ -79,6 +79,8 @@ LOCAL_NEWTON_MIN_STEP_OMEGA = _core.AUTO["LOCAL_NEWTON_MIN_STEP_OMEGA"]
 ELASTIC_SHARE = _core.AUTO["ELASTIC_SHARE"]
 BODY_SHARE = _core.AUTO["BODY_SHARE"]
 FIRST_MODES = int(_core.AUTO["FIRST_MODES"])
+#: large systems up to this many coordinates get their floor from the whole dense spectrum
+FLOOR_DENSE_MAX = int(_core.AUTO["FLOOR_DENSE_MAX"])
 DOPRI5_RTOL_PER_RTOL = _core.AUTO["DOPRI5_RTOL_PER_RTOL"]
 FLOOR_POINTS = tuple(_core.AUTO["FLOOR_POINTS"])
 

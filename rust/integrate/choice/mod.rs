@@ -15,6 +15,7 @@
 //! here in one call ([`spectrum::dense_spectrum`], [`choose`]); a large system's lowest modes
 //! come from the sparse Lanczos of `ukflex.analysis.modes` and are handed to [`choose`].
 
+mod chains;
 mod floor;
 mod overdamped;
 pub mod spectrum;
@@ -82,6 +83,12 @@ pub const FIRST_MODES: usize = 8;
 /// for auto's DOPRI5"); at 0.3 rtol it is at most 5.6 rtol from rtol 1e-5 to 1e-9, for ~30 %
 /// more steps.
 pub const DOPRI5_RTOL_PER_RTOL: f64 = 0.3;
+/// Large systems up to this many coordinates get their floor from the whole dense spectrum,
+/// computed for it alone (the sparse analysis finds the lowest modes, the floor sums over the
+/// fast ones): at most the whole dense analysis' time, 8-10 ms at 70-84 coordinates, 17 ms at
+/// 126, 62 ms at 203 (3D spin-up beams; benches/beam3_floor.py's scenes); beyond, the cubic
+/// cost of the dense eigenproblem grows on and no floor is stated.
+pub const FLOOR_DENSE_MAX: usize = 200;
 /// The body points at which the floor's displacements are read (fractions of a beam's length).
 pub const FLOOR_POINTS: [f64; 4] = [0.25, 0.5, 0.75, 1.0];
 
@@ -104,6 +111,7 @@ pub fn constants() -> Vec<(&'static str, f64)> {
         ("ELASTIC_SHARE", ELASTIC_SHARE),
         ("BODY_SHARE", BODY_SHARE),
         ("FIRST_MODES", FIRST_MODES as f64),
+        ("FLOOR_DENSE_MAX", FLOOR_DENSE_MAX as f64),
         ("DOPRI5_RTOL_PER_RTOL", DOPRI5_RTOL_PER_RTOL),
     ]
 }
@@ -317,8 +325,18 @@ pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &
         c.verdict = Verdict::Stiff;
         c.method = "RADAU5M";
         c.newton_rtol = Some(newton_rtol(traits, rtol));
-        if sp.complete() {
-            let (total, top) = floor::transient_floor(model, data, traits, t0, q, qd, sp, omega_c, h, span)?;
+        let dense;
+        let full = if sp.complete() {
+            Some(sp)
+        } else if model.n <= FLOOR_DENSE_MAX {
+            let rank = spectrum::constraint_rank(model, data, q)?;
+            dense = spectrum::dense_spectrum(model, data, t0, q, qd, rank)?;
+            Some(&dense)
+        } else {
+            None
+        };
+        if let Some(full) = full {
+            let (total, top) = floor::transient_floor(model, data, traits, t0, q, qd, full, omega_c, h, span)?;
             c.floor = Some(total);
             c.floor_modes = top;
         }
