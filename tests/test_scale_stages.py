@@ -192,6 +192,19 @@ def test_redundant_rows_on_the_sparse_newton_path(method):
     assert np.max(np.abs(s.phi(0.05, ys[: s.n_coords, -1]))) <= 1e-10
 
 
+def test_the_sparse_lu_with_kept_pivots_is_radau5ms_only():
+    """The continuous-beam lattice 8 x 2 (132 unknowns, a wide band, little fill): RADAU5M's
+    default takes the sparse LU with kept pivots (another pivot order: not the dense run to the
+    bit, but its answer), RADAU5's keeps the dense LU (`STATIC_LU_METHODS`: measured slower)."""
+    t = np.linspace(0.0, 0.02, 5)
+    run = {(m, ls): ukflex.simulate(scenes.lattice(8, 2, beams="continuous").build(), 0.02, method=m,
+                                    linear_solver=ls, t_eval=t).q
+           for m in ("RADAU5M", "RADAU5") for ls in ("dense", "auto")}
+    assert np.array_equal(run["RADAU5", "auto"], run["RADAU5", "dense"])
+    d = np.max(np.abs(run["RADAU5M", "auto"] - run["RADAU5M", "dense"]))
+    assert 0.0 < d <= 1e-10
+
+
 def test_a_budget_spent_before_a_native_runs_first_step_names_it():
     s = wire(64).build()
     res = ukflex.simulate(s, 0.05, method="RADAU5M", step=1e-4, max_wall_time=1e-9)

@@ -173,7 +173,8 @@ impl Marker3 {
             }
             let ck = col(&self.c, k);
             let jp = rot_b(p, &ck);
-            st.axes[k] = Kin3 { v: mat_vec(&a, &ck), vd: m34_vec(&jp, pd), h: quad_term(pd, &ck), jr: 0.0, jp, ..Default::default() };
+            // `quad_term(pd, ck)` with `A(pd)` computed once per marker
+            st.axes[k] = Kin3 { v: mat_vec(&a, &ck), vd: m34_vec(&jp, pd), h: scale(2.0, &mat_vec(&ad, &ck)), jr: 0.0, jp, ..Default::default() };
         }
         st
     }

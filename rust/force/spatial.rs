@@ -92,7 +92,8 @@ impl SpatialForce {
 
     /// Spring length and its rate, with the unit direction `u = d / L` (`None` at `L = 0`).
     fn spring(a: &Marker3, b: &Marker3, bodies: &[Body], q: &[f64], qd: &[f64]) -> (f64, f64, Option<V3>, [crate::body::marker3::Marker3State; 2]) {
-        let (sa, sb) = (a.state(bodies, q, qd), b.state(bodies, q, qd));
+        // the points alone: a spring reads no axis
+        let (sa, sb) = (a.state_axes(bodies, q, qd, 0), b.state_axes(bodies, q, qd, 0));
         let (d, dd, _) = prim::separation(&sa, &sb);
         let l = norm(&d);
         if l == 0.0 {
@@ -140,7 +141,7 @@ impl SpatialForce {
                 }
             }
             SpatialForce::PointForce { point, force, frame } => {
-                let st = point.state(bodies, q, qd);
+                let st = point.state_axes(bodies, q, qd, 0);
                 add_jacobian(bodies, &st, &st.point, &world_force(point, *frame, bodies, q, force), qv, None);
             }
             SpatialForce::Torque { body, torque, frame, .. } => add_torque(bodies, *body, *frame, q, torque, qv),

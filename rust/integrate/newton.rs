@@ -87,14 +87,21 @@ fn narrow(layout: &BandLayout) -> bool {
 /// order is chosen on bitset rows: O(n^3 / 64) once).
 pub const STATIC_LU_MAX: usize = 256;
 
-/// How the sparse form factors (`pattern` in `layout`): the band LU where the band is narrow;
-/// with Radau IIA's complex matrix (RADAU5M, RADAU5), from `SPARSE_NEWTON_MIN_COMPLEX` to
+/// The methods whose Newton matrices may take the sparse LU with kept pivots: RADAU5M. RADAU5
+/// (the same two matrices, far fewer factorizations per run: its Jacobian is kept over steps)
+/// measured slower with it on the one planar scene that takes it, the continuous-beam lattice
+/// 8 x 2 (132 unknowns: 1.07-1.08x the dense path's whole call, two runs;
+/// `benches/planar_static_lu.py`, docs/spatial.md "A05 this round (i30-a05d)").
+pub const STATIC_LU_METHODS: &[&str] = &["RADAU5M"];
+
+/// How the sparse form factors (`pattern` in `layout`) for `method`: the band LU where the band
+/// is narrow; with Radau IIA's complex matrix and a method of `STATIC_LU_METHODS`, from `SPARSE_NEWTON_MIN_COMPLEX` to
 /// `STATIC_LU_MAX`, a wide band, and a minimum degree elimination of at most a quarter of the
 /// dense one's multiply-adds, the sparse LU with kept pivots (A05, 64 x 64: ~5 000 against
 /// ~87 000; a flexible body's dense FFRF block fills in and stays dense or banded).
-pub fn factorization(pattern: &Pattern, layout: &BandLayout, complex: bool) -> Factorization {
+pub fn factorization(pattern: &Pattern, layout: &BandLayout, complex: bool, method: &str) -> Factorization {
     let size = layout.size;
-    if !complex || narrow(layout) || !(SPARSE_NEWTON_MIN_COMPLEX..=STATIC_LU_MAX).contains(&size) {
+    if !complex || !STATIC_LU_METHODS.contains(&method) || narrow(layout) || !(SPARSE_NEWTON_MIN_COMPLEX..=STATIC_LU_MAX).contains(&size) {
         return Factorization::Band;
     }
     let lu = StaticLu::<f64>::new(size, newton_entries(pattern, layout).into_iter());
@@ -227,7 +234,7 @@ impl NewtonMatrices {
         match structure {
             Some(s) => {
                 let layout = BandLayout::new(&s.pattern);
-                let kind = factorization(&s.pattern, &layout, complex);
+                let kind = factorization(&s.pattern, &layout, complex, method);
                 if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) || kind == Factorization::Static {
                     sys.check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex, kind))?;
                     return Ok(Some(BandNewton::new(s, layout, complex, kind)));
@@ -241,7 +248,7 @@ impl NewtonMatrices {
 
     /// What `for_system` will take for the UK system of `model` (its workspace `data`):
     /// `Sparse` or `Dense` (checks the sparse form's memory; the caller checks the dense one's).
-    pub fn resolve(model: &Model, data: &Data, asked: LinearSolver, complex: bool) -> Result<LinearSolver> {
+    pub fn resolve(model: &Model, data: &Data, asked: LinearSolver, complex: bool, method: &str) -> Result<LinearSolver> {
         if asked == LinearSolver::Dense || (asked == LinearSolver::Auto && model.n + model.m < sparse_min(complex)) {
             return Ok(LinearSolver::Dense);
         }
@@ -250,7 +257,7 @@ impl NewtonMatrices {
             r => r?,
         };
         let layout = BandLayout::new(&p);
-        let kind = factorization(&p, &layout, complex);
+        let kind = factorization(&p, &layout, complex, method);
         if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) || kind == Factorization::Static {
             Error::check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex, kind), data.memory_limit, "raise memory_limit")?;
             return Ok(LinearSolver::Sparse);

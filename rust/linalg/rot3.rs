@@ -105,27 +105,22 @@ pub fn rot_e(p: &[f64]) -> M34 {
     [[-e1, e0, -e3, e2], [-e2, e3, e0, -e1], [-e3, -e2, e1, e0]]
 }
 
-/// `B(p, a) = d(A(p) a)/dp`.
+/// `B(p, a) = d(A(p) a)/dp = 2 [S a, e a^T - S ~a]` with `S = e0 I + ~e`; as
+/// `~e ~a = a e^T - (e . a) I`, column `k` of the second block is
+/// `2 (e a_k - a e_k + (e . a) e_k - e0 ~a e_k)`.
 #[inline]
 pub fn rot_b(p: &[f64], a: &V3) -> M34 {
     let (e0, e) = (p[0], [p[1], p[2], p[3]]);
-    // S = e0 I + ~e; S a = e0 a + e x a
     let ea = cross(&e, a);
-    let sa = [e0 * a[0] + ea[0], e0 * a[1] + ea[1], e0 * a[2] + ea[2]];
-    // S ~a: columns S (e_k x a)... compute (e a^T - S ~a) column by column: col k = e a_k - S (a x? )
-    // ~a column k = a x e_k  (since ~a e_k = a x e_k)
+    let ed = e[0] * a[0] + e[1] * a[1] + e[2] * a[2];
+    // e0 ~a, row-major
+    let t = [[0.0, -e0 * a[2], e0 * a[1]], [e0 * a[2], 0.0, -e0 * a[0]], [-e0 * a[1], e0 * a[0], 0.0]];
     let mut out = [[0.0; 4]; 3];
     for i in 0..3 {
-        out[i][0] = 2.0 * sa[i];
-    }
-    for k in 0..3 {
-        let mut ek = [0.0; 3];
-        ek[k] = 1.0;
-        let c = cross(a, &ek); // ~a e_k
-        let ec = cross(&e, &c);
-        for i in 0..3 {
-            let s_c = e0 * c[i] + ec[i];
-            out[i][k + 1] = 2.0 * (e[i] * a[k] - s_c);
+        out[i][0] = 2.0 * (e0 * a[i] + ea[i]);
+        for k in 0..3 {
+            let d = if i == k { ed } else { 0.0 };
+            out[i][k + 1] = 2.0 * (e[i] * a[k] - a[i] * e[k] + d - t[i][k]);
         }
     }
     out

@@ -163,12 +163,12 @@ impl PySystem {
         // decided here so that the dense ones are refused before the run when too large
         let mut opts = opts;
         if let Method::GenAlpha(_) | Method::RadauM(_) = method {
-            opts.linear_solver = NewtonMatrices::resolve(model, &data, linear_solver, matches!(method, Method::RadauM(_))).map_err(to_py)?;
+            opts.linear_solver = NewtonMatrices::resolve(model, &data, linear_solver, matches!(method, Method::RadauM(_)), method.name()).map_err(to_py)?;
         }
         if method == Method::Radau5 {
             // with the structured Jacobian RADAU5 solves its iteration matrices as saddle points
             opts.linear_solver = match jacobian {
-                Differences::Structured => NewtonMatrices::resolve(model, &data, linear_solver, true).map_err(to_py)?,
+                Differences::Structured => NewtonMatrices::resolve(model, &data, linear_solver, true, method.name()).map_err(to_py)?,
                 _ => LinearSolver::Dense,
             };
         }
