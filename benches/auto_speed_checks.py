@@ -16,7 +16,12 @@ its physical error (docs/integrators.md, "auto on scenes nobody tuned it for").
   its whole call, ``choose_method`` alone and RADAU5M at auto's step and Newton tolerance, CPU
   medians of 300 interleaved calls on one System.  ~3 s.
 
-    python benches/auto_speed_checks.py models|coarse|spin|overhead
+* ``tolerance``: does auto's step on the four-bar (4 elements) ask more than rtol and atol do?  Each
+  position's error against the same model at h_auto / 16, in units of ``rtol max|q_i| + atol``,
+  for auto, RADAU5M at 4 .. 1/2 h_auto (Newton at 1e-4, and at 4 and 1 h_auto at 1e-8) and
+  error-controlled RADAU5M at the same rtol.  ~45 s.
+
+    python benches/auto_speed_checks.py models|coarse|spin|overhead|tolerance
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ import numpy as np
 import auto_speed as A
 import ukflex
 from ukflex import scenes
+from ukflex.run.simulate import RUN_OPTIONS
 
 
 def _h_auto(kind, f, n):
@@ -114,9 +120,51 @@ def overhead(repeat=300):
               flush=True)
 
 
+def tolerance(rtol=1e-6):
+    """The four-bar (4 elements) at the user's ``rtol`` (atol defaulted from it): each run's error
+    against the same model at h_auto / 16 (rtol 1e-10), per coordinate, in units of the tolerance
+    ``rtol max|q_i| + atol`` that rtol and atol set on it (the largest over the outputs and the
+    positions, the FFRF model's rigid and elastic coordinates apart), and the coupler's
+    deflection error in m.  auto's step against what rtol and atol ask; error-controlled RADAU5M
+    at the same rtol is what they ask step by step (solve_ivp's meaning); RADAU5M at 4 and 1
+    h_auto with Newton at 1e-8 separates the step's error from Newton's; the reference's own error
+    against DOPRI5 at rtol 1e-10 (FFRF).  ~45 s."""
+    atol = RUN_OPTIONS["defaults"]["atol_per_rtol"] * rtol
+    for f in ("ffrf", "ancf"):
+        scene, T, out = A._scene("four_bar", f, A.N_MODEL)
+        system = scene.build()
+        te = np.linspace(0.0, T, A.NOUT)
+        h = ukflex.simulate(system, T).extra["auto"]["step"]
+        ref = ukflex.simulate(scene.build(), T, method="RADAU5M", step=h / 16, rtol=1e-10, t_eval=te)
+        yref, vref = ref.y, out(system, ref)
+        elastic = system.elastic_mask() if f == "ffrf" else None
+        tol = rtol * np.abs(yref).max(axis=1) + atol  # per coordinate, at its largest |y| (the loosest reading)
+        n = system.n_coords
+        if f == "ffrf":  # the reference's own error: DOPRI5 keeps every mode (FFRF only: ~15 s)
+            tight = ukflex.simulate(scene.build(), T, method="DOPRI5", rtol=1e-10, t_eval=te, max_wall_time=120.0)
+            e = np.abs(yref[:n] - tight.y[:n]).max(axis=1) / tol[:n]
+            print(f"four_bar ffrf N = {A.N_MODEL}  the reference (h_auto / 16) against DOPRI5 rtol 1e-10 "
+                  f"({tight.extra['naccept']} steps): deflection {np.abs(vref - out(system, tight)).max() * 0.3:.1e} m, "
+                  f"position error / (rtol |q| + atol): rigid {e[~elastic].max():.2g}, elastic {e[elastic].max():.2g}", flush=True)
+        cfg = [("auto", "auto", {"rtol": rtol})] + [(f"RADAU5M {k:g} h_auto", "RADAU5M", {"step": k * h, "rtol": 1e-4})
+                                                   for k in (4, 2, 1, 0.5)]
+        # the step's own error: Newton converged far below auto's 1e-4
+        cfg += [(f"RADAU5M {k:g} h_auto, Newton 1e-8", "RADAU5M", {"step": k * h, "rtol": 1e-8}) for k in (4, 1)]
+        cfg.append((f"RADAU5M rtol {rtol:g}", "RADAU5M", {"rtol": rtol}))  # error-controlled: solve_ivp's meaning
+        for label, method, kw in cfg:
+            (cpu, _), v, res = A._run("four_bar", f, A.N_MODEL, method, budget=60.0, **kw)
+            e = np.abs(res.y[:n] - yref[:n]).max(axis=1) / tol[:n]
+            parts = {"positions": e} if elastic is None else {"rigid": e[~elastic], "elastic": e[elastic]}
+            dv = np.abs(v - vref).max() * 0.3  # the deflection is read per coupler length (0.3 m)
+            print(f"four_bar {f} N = {A.N_MODEL}  {label:32} {1e3 * cpu:6.1f} ms CPU  {res.extra['naccept']:5} steps  "
+                  f"deflection error {dv:.1e} m = {dv / atol:6.1f} atol;  position error / (rtol |q| + atol): "
+                  + ", ".join(f"{k} {x.max():.2g}" for k, x in parts.items())
+                  + (f";  stated floor {res.extra['auto']['floor']:.1e} m" if method == "auto" else ""), flush=True)
+
+
 if __name__ == "__main__":
     warnings.simplefilter("ignore")
     part = sys.argv[1] if len(sys.argv) > 1 else ""
-    if part not in ("models", "coarse", "spin", "overhead"):
+    if part not in ("models", "coarse", "spin", "overhead", "tolerance"):
         sys.exit(__doc__.rstrip().splitlines()[-1].strip())
-    {"models": models, "coarse": coarse, "spin": spin, "overhead": overhead}[part]()
+    {"models": models, "coarse": coarse, "spin": spin, "overhead": overhead, "tolerance": tolerance}[part]()
