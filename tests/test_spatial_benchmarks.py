@@ -162,6 +162,27 @@ def test_a05_radau5m_steps_follow_rtol():
     assert steps[1e-3] < 0.85 * steps[1e-5], steps
 
 
+def test_a05_newton_matrices_turn_with_the_governor():
+    """RADAU5M co-rotates its Newton matrices with the spinning governor (the whole mechanism
+    turned about gravity's axis, by the shaft's rotation: ``rust/integrate/corotation.rs``).
+    Gravity tilted by 1e-9 rad off the shaft breaks the symmetry the rule needs (the motion is
+    the same to ~1e-9): the plain iteration, whose matrices go stale as the dampers turn.
+    Measured at rtol 1e-3 over 2 s: 141 Newton iterations in 107 attempts against 180 in 104;
+    at rtol 1e-2, 61 steps against 98 (Newton held the step before, not the error)."""
+    def run(tilt, rtol):
+        d = spatial_scenes.flyball_governor().to_dict()
+        g = d["gravity"][2]
+        d["gravity"] = [0.0, -g * tilt, g]
+        res = ukflex.simulate(ukflex.System(ukflex.SpatialScene.from_dict(d)), 2.0, method="RADAU5M", rtol=rtol)
+        assert res.status == 0, res.message
+        return res.extra["naccept"], res.extra["newton_iterations"] / (res.extra["naccept"] + res.extra["nreject"])
+
+    (steps_turned, per_turned), (steps_plain, per_plain) = run(0.0, 1e-3), run(1e-9, 1e-3)
+    assert per_turned < 1.45 < 1.6 < per_plain, (per_turned, per_plain)
+    assert abs(steps_turned - steps_plain) < 0.1 * steps_plain, (steps_turned, steps_plain)
+    assert run(0.0, 1e-2)[0] < 0.75 * run(1e-9, 1e-2)[0]
+
+
 def test_a05_sparse_lu_with_kept_pivots_matches_the_dense_lu():
     """A05's Newton matrices (64 x 64, a band as wide as the matrix) take the sparse LU with a
     minimum degree order and kept pivots (``rust/linalg/static_lu.rs``) under ``auto`` and under

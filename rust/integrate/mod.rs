@@ -29,6 +29,7 @@ pub(crate) use crate::linalg::lu;
 pub mod newton;
 mod radau5;
 mod radau_m;
+pub mod corotation;
 pub mod singular;
 mod dense;
 mod options;
@@ -45,8 +46,7 @@ pub use options::{check_tolerances, default_projection, options_of, Method, Opti
 pub use uk_system::{Conditioning, UkSystem};
 
 use crate::correct::{self, ProjectOutcome, ProjectWorkspace, ProjectionTolerance};
-use crate::data::RankInfo;
-use crate::data::Data;
+use crate::data::{Data, RankInfo};
 use crate::dynamics;
 use crate::error::{check_finite, Error, Result};
 use crate::jacobian::{uk_jacobian, Differences, JacobianWorkspace};
@@ -120,9 +120,10 @@ pub trait SecondOrderSystem {
     fn conditioning_ratio(&self) -> f64 {
         1.0
     }
-    /// The coordinate offsets of the bodies `[r (3), p (4)]` whose elastic forces only turn with
-    /// them (a beam's nodes): RADAU5M co-rotates its Newton matrices with them (`radau_m/corotate.rs`).
-    fn corotated_bodies(&self, _offsets: &mut Vec<usize>) {}
+    /// What RADAU5M's Newton matrices turn with (`corotation.rs`, `radau_m/corotate.rs`).
+    fn corotated_bodies(&self) -> corotation::Corotated {
+        Default::default()
+    }
     /// The numerical rank of the constraints at the last factorization (0 without constraints):
     /// `n` minus it is the number of degrees of freedom there.
     fn conditioning_rank(&self) -> usize {
@@ -696,4 +697,3 @@ pub fn integrate_uk_observed(model: &Model, data: Data, method: Method, opts: Op
     };
     Ok((sol, sys.jac_full_evals, sys.jac_cheap_evals))
 }
-

@@ -139,7 +139,7 @@ pub struct RadauM {
     eq: Vec<f64>,
     ev: Vec<f64>,
     /// Newton's corrections of the stages ((n+m) each) and the co-rotation of the matrices
-    /// with a beam's nodes (`radau_m/corotate.rs`; empty without beams).
+    /// (`radau_m/corotate.rs`: a beam's nodes, a mechanism spinning about gravity's axis).
     dw: [Vec<f64>; 3],
     corot: corotate::Corotation,
     /// The structure (`M`, `K`, `C`, `A`, `db/dqd`) and the real and complex iteration
@@ -264,7 +264,7 @@ impl RadauM {
             eq: z(n),
             ev: z(n),
             dw: z3(nm),
-            corot: corotate::Corotation::new(Vec::new(), &a2),
+            corot: corotate::Corotation::new(Default::default(), &a2),
             newton: None,
             lu_h: 0.0,
             reuse: false,
@@ -399,9 +399,7 @@ impl Stepper for RadauM {
         self.theta = 1.0;
         let (q, qd) = y0.split_at(n);
         self.newton = Some(NewtonMatrices::for_system(sys, self.opts.linear_solver, true, false, "RADAU5M")?);
-        let mut nodes = Vec::new();
-        sys.corotated_bodies(&mut nodes);
-        self.corot = corotate::Corotation::new(nodes, &self.a2);
+        self.corot = corotate::Corotation::new(sys.corotated_bodies(), &self.a2);
         sys.acc(t0, q, qd, &mut self.qdd)?;
         self.st.stats.nfev += 1;
         sys.multipliers(&mut self.lam);

@@ -242,18 +242,8 @@ impl SecondOrderSystem for UkSystem<'_> {
     fn conditioning_rank(&self) -> usize {
         if self.model.m == 0 { 0 } else { self.data.rank_info.rank }
     }
-    fn corotated_bodies(&self, offsets: &mut Vec<usize>) {
-        // the node bodies of geometrically exact beam elements: an element's energy is invariant
-        // under a rotation of both its nodes, so its stiffness turns with them
-        for f in &self.model.forces {
-            if let crate::force::ForceKind::Spatial(crate::force::spatial::SpatialForce::Beam3 { nodes, .. }) = &f.kind {
-                for &b in nodes {
-                    offsets.push(self.model.bodies[b].offset);
-                }
-            }
-        }
-        offsets.sort_unstable();
-        offsets.dedup();
+    fn corotated_bodies(&self) -> corotation::Corotated {
+        corotation::Corotated::of_model(self.model)
     }
     fn conditioning(&mut self, t: f64, q: &[f64]) -> Result<Option<Conditioning>> {
         if self.model.m == 0 {

@@ -20,7 +20,15 @@
 //! with the factored matrices as before, and turn the corrections' position increments forward
 //! (`from_reference`: `W = (a^2)^-1 G (a^2) W~`). The multipliers and every other body's
 //! coordinates are untouched (with no beam the iteration is the plain one, to the bit).
+//!
+//! The same holds for a whole mechanism turned by one rotation about gravity's axis (A05, the
+//! flyball governor spinning on its shaft; `integrate/corotation.rs` says when): `G` turns
+//! every body (rigid bodies' `[r, p]`, point masses' `r`) by the rotation of the body on the
+//! ground revolute since the reference. The joints between bodies turn their rows with them
+//! (`A(G q) = H A(q) G^T`, `H` orthogonal on each joint's rows); the multipliers left
+//! unturned leave the position corrections exact up to the turn times the constraint residual.
 
+use crate::integrate::corotation::Corotated;
 use crate::linalg::rot3::{cross, V3};
 
 /// `a (x) b`, Euler parameters scalar first.
@@ -59,13 +67,27 @@ fn unit(p: &[f64]) -> [f64; 4] {
     if s > 0.0 && s.is_finite() { [p[0] / s, p[1] / s, p[2] / s, p[3] / s] } else { [1.0, 0.0, 0.0, 0.0] }
 }
 
-/// The co-rotation of RADAU5M's Newton matrices (module docs); empty without beams.
+/// Turn a block of coordinates by `r`: `[r, p]` (7) or a point's `r` (3).
+fn turn_block(r: &[f64; 4], x: &mut [f64], rigid: bool) {
+    if rigid {
+        let v: [f64; 7] = std::array::from_fn(|k| x[k]);
+        x[..7].copy_from_slice(&turn7(r, &v));
+    } else {
+        let v = turn_vec(r, &[x[0], x[1], x[2]]);
+        x[..3].copy_from_slice(&v);
+    }
+}
+
+/// The co-rotation of RADAU5M's Newton matrices (module docs); empty without beams or a
+/// mechanism spinning about gravity's axis (`integrate/corotation.rs`).
 pub(super) struct Corotation {
-    /// Coordinate offsets of the co-rotated node bodies (`[r (3), p (4)]` each).
-    offsets: Vec<usize>,
-    /// Their Euler parameters where the matrices were read.
+    /// Coordinate offsets of the bodies whose rotations turn the matrices (`[r (3), p (4)]`).
+    sources: Vec<usize>,
+    /// The turned blocks: offset, `[r, p]` (else a point's `r`), the source turning it.
+    blocks: Vec<(usize, bool, usize)>,
+    /// The sources' Euler parameters where the matrices were read.
     p_ref: Vec<[f64; 4]>,
-    /// Per stage, per node: its rotation from the reference.
+    /// Per stage, per source: its rotation from the reference.
     rot: [Vec<[f64; 4]>; 3],
     /// `a^2` of Radau IIA and its inverse.
     s: [[f64; 3]; 3],
@@ -73,65 +95,66 @@ pub(super) struct Corotation {
 }
 
 impl Corotation {
-    pub(super) fn new(offsets: Vec<usize>, a2: &[[f64; 3]; 3]) -> Self {
-        let k = offsets.len();
-        Corotation { p_ref: vec![[1.0, 0.0, 0.0, 0.0]; k], rot: std::array::from_fn(|_| vec![[1.0, 0.0, 0.0, 0.0]; k]), offsets, s: *a2, si: inverse3(a2) }
+    pub(super) fn new(c: Corotated, a2: &[[f64; 3]; 3]) -> Self {
+        let k = c.sources.len();
+        let one = [1.0, 0.0, 0.0, 0.0];
+        Corotation { p_ref: vec![one; k], rot: std::array::from_fn(|_| vec![one; k]), sources: c.sources, blocks: c.blocks, s: *a2, si: inverse3(a2) }
     }
 
     pub(super) fn is_empty(&self) -> bool {
-        self.offsets.is_empty()
+        self.blocks.is_empty()
     }
 
     /// The matrices were read at `q`: it is the reference.
     pub(super) fn set_reference(&mut self, q: &[f64]) {
-        for (p, &o) in self.p_ref.iter_mut().zip(&self.offsets) {
+        for (p, &o) in self.p_ref.iter_mut().zip(&self.sources) {
             *p = unit(&q[o + 3..o + 7]);
         }
     }
 
-    /// Each node's rotation from the reference at the stages `qs`.
+    /// Each source's rotation from the reference at the stages `qs`.
     pub(super) fn follow(&mut self, qs: &[Vec<f64>; 3]) {
         for (rot, q) in self.rot.iter_mut().zip(qs) {
-            for ((r, p), &o) in rot.iter_mut().zip(&self.p_ref).zip(&self.offsets) {
+            for ((r, p), &o) in rot.iter_mut().zip(&self.p_ref).zip(&self.sources) {
                 *r = unit(&qmul(&unit(&q[o + 3..o + 7]), &conj(p)));
             }
         }
     }
 
-    /// Turn the nodes' part of each stage's force residual (the first `n` entries) back to the
+    /// Turn the blocks' part of each stage's force residual (the first `n` entries) back to the
     /// reference: `G_i^T r_i`.
     pub(super) fn to_reference(&self, res: &mut [Vec<f64>; 3]) {
         for (rot, r) in self.rot.iter().zip(res.iter_mut()) {
-            for (g, &o) in rot.iter().zip(&self.offsets) {
-                let x: [f64; 7] = std::array::from_fn(|k| r[o + k]);
-                r[o..o + 7].copy_from_slice(&turn7(&conj(g), &x));
+            for &(o, rigid, g) in &self.blocks {
+                turn_block(&conj(&rot[g]), &mut r[o..], rigid);
             }
         }
     }
 
-    /// The stages' corrections `d` (accelerations, the nodes' entries) solved in the reference
+    /// The stages' corrections `d` (accelerations, the blocks' entries) solved in the reference
     /// turned to their stages: `d <- (a^2)^-1 G (a^2) d` (their position increments turned).
     pub(super) fn from_reference(&self, d: &mut [Vec<f64>; 3]) {
-        for (b, &o) in self.offsets.iter().enumerate() {
+        for &(o, rigid, g) in &self.blocks {
+            let len = if rigid { 7 } else { 3 };
             let z: [[f64; 7]; 3] = std::array::from_fn(|i| {
-                let x: [f64; 7] = std::array::from_fn(|k| (0..3).map(|j| self.s[i][j] * d[j][o + k]).sum());
-                turn7(&self.rot[i][b], &x)
+                let mut x: [f64; 7] = std::array::from_fn(|k| if k < len { (0..3).map(|j| self.s[i][j] * d[j][o + k]).sum() } else { 0.0 });
+                turn_block(&self.rot[i][g], &mut x, rigid);
+                x
             });
             for (i, di) in d.iter_mut().enumerate() {
-                for k in 0..7 {
+                for k in 0..len {
                     di[o + k] = (0..3).map(|j| self.si[i][j] * z[j][k]).sum();
                 }
             }
         }
     }
 
-    /// `x <- G_3^T x` (`back`: `G_3 x`) on the nodes' entries: the step's end against the
+    /// `x <- G_3^T x` (`back`: `G_3 x`) on the blocks' entries: the step's end against the
     /// reference (the error estimate's filter, which solves with the reference's matrices).
     pub(super) fn turn_end(&self, x: &mut [f64], back: bool) {
-        for (g, &o) in self.rot[2].iter().zip(&self.offsets) {
-            let v: [f64; 7] = std::array::from_fn(|k| x[o + k]);
-            let g = if back { *g } else { conj(g) };
-            x[o..o + 7].copy_from_slice(&turn7(&g, &v));
+        for &(o, rigid, g) in &self.blocks {
+            let r = if back { self.rot[2][g] } else { conj(&self.rot[2][g]) };
+            turn_block(&r, &mut x[o..], rigid);
         }
     }
 }
