@@ -292,3 +292,32 @@ def test_auto_states_a_beam3_floor_within_3x_of_the_error_it_reaches():
     sparse = choose_method(system, 0.0, 0.3, 1e-6)
     dense = system.core.auto_choice(0.0, system.q0, system.qd0, 0.3, 1e-6)
     assert sparse.floor == pytest.approx(dense["floor"], rel=1e-6) and sparse.floor > 1e-6, (sparse, dense["floor"])
+
+
+def test_the_floor_is_stated_when_read_and_is_the_choosers():
+    """``simulate`` leaves auto's floor (which decides nothing) to the reader: ``extra["auto"]``
+    computes ``floor``, ``floor_modes`` and the reason's floor clause on their first read, the
+    same as ``choose_method``'s, through every way of reading the dict; a scipy mapping's own
+    clause stays after it."""
+    import copy
+    import json
+    import pickle
+
+    system = scenes.pinned_beam(elements=4, formulation="ancf", gravity=True).build()
+    full = choose_method(system, 0.0, 0.02, 1e-6)
+    bare = choose_method(system, 0.0, 0.02, 1e-6, floor=False)
+    assert full.floor > 0.0 and bare.floor is None and "whatever rtol" not in bare.reason
+    assert (bare.method, bare.step, bare.omega_elastic, bare.omega_max) == (full.method, full.step, full.omega_elastic,
+                                                                             full.omega_max)
+    want = dict(full.as_dict(), time=0.0)
+    for read in (lambda d: d["floor"], lambda d: d.get("reason"), dict, lambda d: json.loads(json.dumps(d)),
+                 lambda d: pickle.loads(pickle.dumps(d)), copy.deepcopy, lambda d: dict(d.items()), repr,
+                 lambda d: d == want):
+        auto = simulate(system, 0.02).extra["auto"]
+        assert isinstance(auto, choice.AutoReport) and dict.__getitem__(auto, "floor") is None
+        read(auto)
+        auto["time"] = 0.0
+        assert dict(auto) == want and dict.__getitem__(auto, "floor") == full.floor
+    auto = simulate(system, 0.02, jac=system.jac, max_steps=3).extra["auto"]  # scipy's Radau
+    assert auto["reason"] == full.reason + auto["reason"][len(full.reason):] and "; scipy Radau" in auto["reason"]
+    assert auto["floor"] == full.floor and auto["floor_modes"] == full.floor_modes
