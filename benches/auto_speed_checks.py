@@ -106,7 +106,7 @@ def overhead(repeat=300):
         system = scenes.pinned_beam(elements=A.N_MODEL, formulation=f, gravity=True).build()
         h = ukflex.simulate(system, 0.02).extra["auto"]["step"]
         runs = {"auto": lambda: ukflex.simulate(system, 0.02, t_eval=te),
-                "choose_method": lambda: choose_method(system, 0.0, 0.02, 1e-6),
+                "choose_method": lambda: choose_method(system, 0.0, 0.02, 1e-6, floor=False),
                 "RADAU5M at h_auto": lambda: ukflex.simulate(system, 0.02, method="RADAU5M", step=h, rtol=1e-4, t_eval=te)}
         cpu = {k: [] for k in runs}
         for _ in range(repeat):

@@ -268,6 +268,16 @@ def test_the_cores_decision_is_the_former_python_ones():
     assert methods >= {("DOPRI5", False), ("RADAU5M", True), ("RADAU5M", False)}, methods
 
 
+def _spun_bar():
+    """A geometrically exact bar of 10 elements on a spherical joint, spun and falling: 77
+    coordinates, the sparse analysis."""
+    s = ukflex.SpatialScene(gravity=(0, 0, -9.81))
+    bar = s.beam("bar", (0, 0, 0), (0.5, 0, 0), ukflex.Rectangular(0.02, 0.02), elements=10, density=7850,
+                 youngs_modulus=2.1e9, poisson_ratio=0.3, angular_velocity=(0, 0, 3))
+    s.spherical(s.ground.marker((0, 0, 0)), bar.node(0))
+    return s
+
+
 def test_auto_states_a_beam3_floor_within_3x_of_the_error_it_reaches():
     """A geometrically exact beam's rigid motion is its node chain's as one body, and its floor is
     read at the nodes (rust/integrate/choice/chains.rs): the spun falling pendulum on 4 elements
@@ -283,12 +293,43 @@ def test_auto_states_a_beam3_floor_within_3x_of_the_error_it_reaches():
     assert err / 3 < floor < 3 * err, (floor, err)
     assert "whatever rtol" in runs[0].extra["auto"]["reason"]
 
-    s = ukflex.SpatialScene(gravity=(0, 0, -9.81))
-    bar = s.beam("bar", (0, 0, 0), (0.5, 0, 0), ukflex.Rectangular(0.02, 0.02), elements=10, density=7850,
-                 youngs_modulus=2.1e9, poisson_ratio=0.3, angular_velocity=(0, 0, 3))
-    s.spherical(s.ground.marker((0, 0, 0)), bar.node(0))
-    system = ukflex.System(s)
+    system = ukflex.System(_spun_bar())
     assert system.n_coords >= system.SPARSE_MODES_MIN
     sparse = choose_method(system, 0.0, 0.3, 1e-6)
     dense = system.core.auto_choice(0.0, system.q0, system.qd0, 0.3, 1e-6)
     assert sparse.floor == pytest.approx(dense["floor"], rel=1e-6) and sparse.floor > 1e-6, (sparse, dense["floor"])
+
+
+def test_the_floor_is_stated_when_read_and_is_the_choosers():
+    """``simulate`` leaves auto's floor (which decides nothing) to the reader: ``extra["auto"]``
+    computes ``floor``, ``floor_modes`` and the reason's floor clause on their first read, the
+    same as ``choose_method``'s, through every way of reading the dict; a scipy mapping's own
+    clause stays after it."""
+    import copy
+    import json
+    import pickle
+
+    system = scenes.pinned_beam(elements=4, formulation="ancf", gravity=True).build()
+    full = choose_method(system, 0.0, 0.02, 1e-6)
+    bare = choose_method(system, 0.0, 0.02, 1e-6, floor=False)
+    assert full.floor > 0.0 and bare.floor is None and "whatever rtol" not in bare.reason
+    assert (bare.method, bare.step, bare.omega_elastic, bare.omega_max) == (full.method, full.step, full.omega_elastic,
+                                                                             full.omega_max)
+    want = dict(full.as_dict(), time=0.0)
+    for read in (lambda d: d["floor"], lambda d: d.get("reason"), dict, lambda d: json.loads(json.dumps(d)),
+                 lambda d: pickle.loads(pickle.dumps(d)), copy.deepcopy, lambda d: dict(d.items()), repr,
+                 lambda d: d == want):
+        auto = simulate(system, 0.02).extra["auto"]
+        assert isinstance(auto, choice.AutoReport) and dict.__getitem__(auto, "floor") is None
+        read(auto)
+        auto["time"] = 0.0
+        assert dict(auto) == want and dict.__getitem__(auto, "floor") == full.floor
+    auto = simulate(system, 0.02, jac=system.jac, max_steps=3).extra["auto"]  # scipy's Radau
+    assert auto["reason"] == full.reason + auto["reason"][len(full.reason):] and "; scipy Radau" in auto["reason"]
+    assert auto["floor"] == full.floor and auto["floor_modes"] == full.floor_modes
+    # a large system: the sparse analysis' modes, and the floor's dense spectrum when read
+    system = ukflex.System(_spun_bar())
+    auto = simulate(system, 0.3).extra["auto"]
+    assert dict.__getitem__(auto, "floor") is None
+    full = choose_method(system, 0.0, 0.3, 1e-6)
+    assert auto["floor"] == full.floor > 0.0 and auto["reason"] == full.reason

@@ -188,10 +188,10 @@ class System:
         and sigma_min / sigma_max of A M^-1/2 there."""
     def auto_choice(self, t0: float, q: _F64, qd: _F64, t_end: float, rtol: float, n_dof: Optional[int] = None,
                     omega: Optional[_F64] = None, shapes: Optional[_F64] = None,
-                    omega_max: Optional[float] = None) -> Dict[str, Any]:
+                    omega_max: Optional[float] = None, floor: bool = True) -> Dict[str, Any]:
         """method="auto"'s decision (rust/integrate/choice/): verdict, method, omega_elastic, omega_max, step,
         newton_rtol, rtol (the integrator's), phase, floor, floor_modes, overdamped; a large system gives n_dof
-        and its lowest modes."""
+        and its lowest modes; floor=False leaves the floor out (None)."""
     def material_energies(self, q: _F64, shapes: _F64) -> _F64:
         """1/2 v^T K_m v per column v of shapes (n, k): the bodies' material stiffness and the springs."""
     def rigid_motions(self, q: _F64, qd: _F64) -> Tuple[_F64, _F64]:

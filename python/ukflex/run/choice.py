@@ -48,11 +48,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
-from typing import Any, Dict, Optional
+from typing import Any, Callable, Dict, Optional, Tuple
 
 import numpy as np
 
 from .. import _core
+from ..errors import SolverError
 
 #: the chooser's constants, read from the core (``rust/integrate/choice/mod.rs``, the one place):
 #: amplitude budget per rtol and its cap, fewest steps per run; RADAU5M's amplitude loss per
@@ -102,12 +103,93 @@ class MethodChoice:
     floor: Optional[float] = None
     #: the largest contributions to it: ``(omega, amplitude at a body point [m], error [m])``
     floor_modes: list = field(default_factory=list)
+    #: ``choose_method(..., floor=False)`` on a fixed-step RADAU5M choice: what computes the
+    #: whole choice (``floor``, ``floor_modes``, the reason with its floor clause), and the
+    #: reason as the core's decision stated it
+    _floor_later: Optional[Tuple[Callable[[], "MethodChoice"], str]] = field(default=None, repr=False, compare=False)
 
     def as_dict(self) -> Dict[str, Any]:
         """The fields as a plain dict (the options dict and the floor's list copied)."""
-        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        d = {name: getattr(self, name) for name in _STATED}
         d["options"], d["floor_modes"] = dict(self.options), list(self.floor_modes)
         return d
+
+    def report(self, **more: Any) -> Dict[str, Any]:
+        """``res.extra["auto"]``: :meth:`as_dict` with ``more``; a floor left out
+        (``floor=False``) is an :class:`AutoReport` that computes it when read."""
+        d = dict(self.as_dict(), **more)
+        return d if self._floor_later is None else AutoReport(d, *self._floor_later)
+
+
+#: the fields :meth:`MethodChoice.as_dict` states (read once: ``dataclasses.fields`` on every call
+#: was ~2 us of auto's Python)
+_STATED = tuple(f.name for f in fields(MethodChoice) if not f.name.startswith("_"))
+
+
+class AutoReport(dict):
+    """``res.extra["auto"]`` of a fixed-step RADAU5M run: a dict whose ``floor``, ``floor_modes``
+    and ``reason`` (the floor's clause) are computed on their first read, and kept.
+
+    The floor decides nothing (it is what the run's history error cannot go below,
+    ``rust/integrate/choice/floor.rs``), and its analysis was ~40 % of auto's on small systems
+    (the excitation of every fast mode and its history over the run), up to 62 ms on large ones
+    (a dense spectrum of its own): ``simulate`` leaves it to the reader, as it leaves the
+    residual norms (``SimulationResult.residuals``).  Every read of the whole dict (iteration,
+    ``items``, ``dict(...)``, ``repr``, ``==``, pickling) computes it first."""
+
+    _LATE = ("floor", "floor_modes", "reason")
+
+    def __init__(self, values: Dict[str, Any], later: Callable[[], MethodChoice], bare_reason: str):
+        super().__init__(values)
+        self._later: Optional[Tuple[Callable[[], MethodChoice], str]] = (later, bare_reason)
+
+    def _fill(self) -> None:
+        if self._later is None:
+            return
+        later, bare = self._later
+        self._later = None
+        full = later()
+        # the reason as stated now, with the floor's clause where the bare reason ended (a
+        # scipy or GENALPHA mapping appended its own after it)
+        said = dict.__getitem__(self, "reason")
+        dict.update(self, floor=full.floor, floor_modes=list(full.floor_modes),
+                    reason=full.reason + said[len(bare):] if said.startswith(bare) else said)
+
+    def __getitem__(self, key: Any) -> Any:
+        if key in self._LATE:
+            self._fill()
+        return dict.__getitem__(self, key)
+
+    def get(self, key: Any, default: Any = None) -> Any:
+        if key in self._LATE:
+            self._fill()
+        return dict.get(self, key, default)
+
+
+def _filled_first(name: str) -> Callable:
+    method = getattr(dict, name)
+
+    def filled(self: AutoReport, *args: Any, **kwargs: Any) -> Any:
+        self._fill()
+        return method(self, *args, **kwargs)
+
+    filled.__name__ = filled.__qualname__ = name
+    filled.__doc__ = method.__doc__
+    return filled
+
+
+for _name in ("__iter__", "items", "values", "copy", "__repr__", "__eq__", "__ne__", "pop", "popitem", "setdefault",
+              "update", "__setitem__", "__delitem__", "__or__", "__ror__", "__ior__"):
+    setattr(AutoReport, _name, _filled_first(_name))
+AutoReport.__hash__ = None  # type: ignore[assignment]
+
+
+def _as_plain_dict(self: AutoReport) -> Tuple[Any, ...]:
+    """Pickling and copying: a plain dict of the filled values."""
+    return (dict, (dict(self),))
+
+
+AutoReport.__reduce__ = _as_plain_dict  # type: ignore[assignment]
 
 
 def elastic_shares(system, omega: np.ndarray, shapes: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -133,24 +215,24 @@ def local_newton_ok(h: float, omega_max: float) -> bool:
     return h * omega_max >= LOCAL_NEWTON_MIN_STEP_OMEGA
 
 
-def _sparse_decision(system, t0, q, qd, t_end, rtol, deadline) -> Dict[str, Any]:
+def _sparse_decision(system, t0, q, qd, t_end, rtol, deadline, floor=True) -> Tuple[Dict[str, Any], Dict[str, Any]]:
     """The core's decision for a large system (``System.SPARSE_MODES_MIN`` coordinates and more):
     ``omega_max`` from ``System.max_frequency`` and the lowest modes by shift-invert Lanczos,
     ``FIRST_MODES`` then four times more until the core has every flexible body's lowest elastic
-    mode among them."""
+    mode among them.  Returns the decision and the spectrum it was made on (the core's keywords)."""
     n_dof = system.n_dof
     d = system.core.auto_choice(t0, q, qd, t_end, rtol, n_dof=n_dof)
     if d["method"] is not None:  # no degree of freedom or no elastic potential: no spectrum needed
-        return d
+        return d, {"n_dof": n_dof}
     omega_max = system.max_frequency(t0, q, qd, deadline=deadline)
     k = FIRST_MODES
     while True:
         omega, shapes = system.frequencies(t0, q, qd, modes=True, count=min(k, n_dof), deadline=deadline)
-        d = system.core.auto_choice(t0, q, qd, t_end, rtol, n_dof=n_dof, omega=np.ascontiguousarray(omega),
-                                    shapes=np.ascontiguousarray(shapes),
-                                    omega_max=max(omega_max, float(np.abs(omega).max())))
+        spectrum = {"n_dof": n_dof, "omega": np.ascontiguousarray(omega), "shapes": np.ascontiguousarray(shapes),
+                    "omega_max": max(omega_max, float(np.abs(omega).max()))}
+        d = system.core.auto_choice(t0, q, qd, t_end, rtol, floor=floor, **spectrum)
         if d["verdict"] != "need_more_modes" or omega.size >= n_dof:
-            return d
+            return d, spectrum
         k *= 4
 
 
@@ -206,17 +288,35 @@ def _stated(d: Dict[str, Any], span: float) -> MethodChoice:
 
 
 def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.ndarray] = None,
-                  qd: Optional[np.ndarray] = None, deadline: Optional[float] = None) -> MethodChoice:
+                  qd: Optional[np.ndarray] = None, deadline: Optional[float] = None, floor: bool = True) -> MethodChoice:
     """The integrator ``method="auto"`` runs for ``system`` over ``[t0, t_end]`` at ``rtol``
     (``deadline``: a ``time.perf_counter()`` value; past it ``ukflex.analysis.modes.BudgetExceeded``;
-    a small system's analysis is one call of the core, checked after it)."""
-    span = float(t_end) - float(t0)
+    a small system's analysis is one call of the core, checked after it).
+
+    ``floor=False`` leaves out the error floor of a fixed-step RADAU5M choice (it decides
+    nothing): ``floor`` None and the reason without its clause, which :meth:`MethodChoice.report`
+    (``simulate``'s ``res.extra["auto"]``) computes when read, from the same state and spectrum."""
+    t0, t_end = float(t0), float(t_end)
+    span = t_end - t0
     if not (math.isfinite(span) and span > 0.0):
         raise ValueError(f"t_end must be finite and greater than t0 = {t0}, got {t_end!r}")
-    q = system.q0 if q is None else np.asarray(q, dtype=float)
-    qd = system.qd0 if qd is None else np.asarray(qd, dtype=float)
+    q = system.q0 if q is None else np.array(q, dtype=float)
+    qd = system.qd0 if qd is None else np.array(qd, dtype=float)
+    spectrum: Dict[str, Any] = {}
     if system.n_coords >= system.SPARSE_MODES_MIN:
-        d = _sparse_decision(system, float(t0), q, qd, float(t_end), rtol, deadline)
+        d, spectrum = _sparse_decision(system, t0, q, qd, t_end, rtol, deadline, floor)
     else:
-        d = system.core.auto_choice(float(t0), q, qd, float(t_end), rtol)
-    return _stated(d, span)
+        d = system.core.auto_choice(t0, q, qd, t_end, rtol, floor=floor)
+    choice = _stated(d, span)
+    if not floor and d["verdict"] == "stiff":
+        decided = (choice.method, choice.step)
+
+        def later() -> MethodChoice:
+            full = _stated(system.core.auto_choice(t0, q, qd, t_end, rtol, **spectrum), span)
+            if (full.method, full.step) != decided:  # the same analysis on the same state: never
+                raise SolverError(f"method='auto': the floor's analysis decided {full.method} at step {full.step}, "
+                                  f"the run's analysis {decided[0]} at {decided[1]}")
+            return full
+
+        choice._floor_later = (later, choice.reason)
+    return choice

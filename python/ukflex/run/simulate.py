@@ -355,10 +355,10 @@ def simulate(
             res = _spent_before_start(system, t0, q_init, qd_init, rtol, atol_v, budget,
                                       "method='auto''s modal analysis", choice_time)
             if choice is not None:
-                res.extra["auto"] = dict(choice.as_dict(), time=choice_time)
+                res.extra["auto"] = choice.report(time=choice_time)
             return res
         if choice is not None:
-            auto_extra = dict(choice.as_dict(), time=choice_time)
+            auto_extra = choice.report(time=choice_time)
             if choice.rtol is not None:  # the rtol the chosen integrator runs at, atol defaulted from it
                 rtol, atol_v = _checked_tolerances(choice.rtol, atol, n)
         # the chosen method runs below with the arguments checked once above; its own options checked here
@@ -1201,7 +1201,7 @@ def _resolve_auto(system, formulation, t0, t_end, rtol, q, qd, options, deadline
 
     if formulation != "uk":
         return "Radau", options, None
-    choice = choose_method(system, t0, t_end, rtol, q, qd, deadline=deadline)
+    choice = choose_method(system, t0, t_end, rtol, q, qd, deadline=deadline, floor=False)
     scipy_only = sorted(set(options) - set(_NATIVE_OPTIONS))
     if scipy_only:
         choice.method = "Radau" if choice.method == "RADAU5M" else "DOP853"

@@ -51,9 +51,11 @@ impl PySystem {
     /// or has `method` None (ask with a spectrum), and with a spectrum `verdict`
     /// "need_more_modes" asks for more modes. Returns a dict (verdict, method, omega_elastic,
     /// omega_max, step, newton_rtol, rtol (the integrator's, `choice::integrator_rtol`), phase, floor, floor_modes, overdamped).
-    #[pyo3(signature = (t0, q, qd, t_end, rtol, n_dof=None, omega=None, shapes=None, omega_max=None))]
+    /// `floor=False` leaves out the floor of a fixed-step RADAU5M choice (floor None, no
+    /// modes): it decides nothing, and `simulate` computes it when `res.extra["auto"]` is read.
+    #[pyo3(signature = (t0, q, qd, t_end, rtol, n_dof=None, omega=None, shapes=None, omega_max=None, floor=true))]
     #[allow(clippy::too_many_arguments)]
-    fn auto_choice<'py>(&self, py: Python<'py>, t0: Real, q: Vector<'py>, qd: Vector<'py>, t_end: Real, rtol: f64, n_dof: Option<usize>, omega: Option<Vector<'py>>, shapes: Option<PyReadonlyArray2<'py, f64>>, omega_max: Option<f64>) -> PyResult<Bound<'py, PyDict>> {
+    fn auto_choice<'py>(&self, py: Python<'py>, t0: Real, q: Vector<'py>, qd: Vector<'py>, t_end: Real, rtol: f64, n_dof: Option<usize>, omega: Option<Vector<'py>>, shapes: Option<PyReadonlyArray2<'py, f64>>, omega_max: Option<f64>, floor: bool) -> PyResult<Bound<'py, PyDict>> {
         let (t0, span) = (t0.0, t_end.0 - t0.0);
         if !(span.is_finite() && span > 0.0) {
             return Err(arg_err("t_end", format!("t_end must be finite and greater than t0 = {t0}, got {}", t_end.0)));
@@ -88,11 +90,11 @@ impl PySystem {
             self.with_ws(|model, ws| {
                 let data = &mut ws.data;
                 match (n_dof, given) {
-                    (None, None) => choice::choose_dense(model, data, traits, t0, &qv, &vv, span, rtol),
+                    (None, None) => choice::choose_dense(model, data, traits, t0, &qv, &vv, span, rtol, floor),
                     (Some(k), None) => Ok(choice::prelude(traits, k).unwrap_or_else(|| AutoChoice::needs_spectrum())),
                     (Some(k), Some((omega, shapes, omega_max))) => {
                         let sp = Spectrum { omega, shapes, n, omega_max, n_dof: k };
-                        choice::choose(model, data, traits, t0, &qv, &vv, span, rtol, &sp)
+                        choice::choose(model, data, traits, t0, &qv, &vv, span, rtol, &sp, floor)
                     }
                     (None, Some(_)) => Err(Error::argument("auto_choice", "a spectrum needs its n_dof")),
                 }

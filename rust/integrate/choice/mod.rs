@@ -276,31 +276,33 @@ pub fn local_newton_ok(h: f64, omega_max: f64) -> bool {
     h * omega_max >= LOCAL_NEWTON_MIN_STEP_OMEGA
 }
 
-/// The whole choice for a small system: the dense spectrum at `(t0, q, qd)` and the rule.
-pub fn choose_dense(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &[f64], qd: &[f64], span: f64, rtol: f64) -> Result<AutoChoice> {
+/// The whole choice for a small system: the dense spectrum at `(t0, q, qd)` and the rule;
+/// the floor only `with_floor` (it decides nothing: `simulate` states it when it is read).
+pub fn choose_dense(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &[f64], qd: &[f64], span: f64, rtol: f64, with_floor: bool) -> Result<AutoChoice> {
     let rank = spectrum::constraint_rank(model, data, q)?;
     if let Some(c) = prelude(traits, model.n - rank.0) {
         return Ok(c);
     }
     let sp = spectrum::dense_spectrum(model, data, t0, q, qd, rank)?;
-    choose(model, data, traits, t0, q, qd, span, rtol, &sp)
+    choose(model, data, traits, t0, q, qd, span, rtol, &sp, with_floor)
 }
 
-/// The rule on a spectrum (every mode of a small system, or a large one's lowest modes).
-pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &[f64], qd: &[f64], span: f64, rtol: f64, sp: &Spectrum) -> Result<AutoChoice> {
+/// The rule on a spectrum (every mode of a small system, or a large one's lowest modes); the
+/// floor of a fixed-step RADAU5M choice only `with_floor` (a large system's from a dense
+/// spectrum of its own: up to 62 ms, [`FLOOR_DENSE_MAX`]).
+pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &[f64], qd: &[f64], span: f64, rtol: f64, sp: &Spectrum, with_floor: bool) -> Result<AutoChoice> {
     if let Some(c) = prelude(traits, sp.n_dof) {
         return Ok(c);
     }
-    let shares = spectrum::elastic_shares(model, q, sp);
-    let per_body = spectrum::lowest_per_body(model, data, q, sp, &shares);
+    let mut shares = spectrum::Shares::new(model, q, sp);
+    let per_body = spectrum::lowest_per_body(model, data, q, sp, &mut shares);
     if !sp.complete() {
-        let elastic_any = (0..sp.len()).any(|k| sp.omega[k] > 0.0 && shares[k] > ELASTIC_SHARE);
-        let found = if per_body.is_empty() { elastic_any } else { per_body.iter().all(Option::is_some) };
+        let found = if per_body.is_empty() { (0..sp.len()).any(|k| shares.elastic(&sp.omega, k)) } else { per_body.iter().all(Option::is_some) };
         if !found {
             return Ok(AutoChoice::plain(Verdict::NeedMoreModes, "", sp.omega_max));
         }
     }
-    let Some(omega_c) = spectrum::lowest_elastic_frequency(sp, &shares, &per_body) else {
+    let Some(omega_c) = spectrum::lowest_elastic_frequency(sp, &mut shares, &per_body) else {
         return Ok(AutoChoice::plain(Verdict::NoElasticMode, "DOPRI5", sp.omega_max));
     };
     let phase = PHASE_CAP.min(PHASE_PER_RTOL * rtol);
@@ -318,7 +320,7 @@ pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &
         // a fixed step resolves the lowest elastic mode's oscillation: an overdamped one has
         // none (its slow decay is the motion), so the overdamped rule decides
         if sp.complete() && traits.damped && overdamped::decides(model, data, t0, q, qd, sp, omega_c)? {
-            if let Some(d) = overdamped::choice(model, data, t0, q, qd, sp, &shares, phase, span)? {
+            if let Some(d) = overdamped::choice(model, data, t0, q, qd, sp, &mut shares, phase, span)? {
                 return Ok(d);
             }
         }
@@ -326,7 +328,9 @@ pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &
         c.method = "RADAU5M";
         c.newton_rtol = Some(newton_rtol(traits, rtol));
         let dense;
-        let full = if sp.complete() {
+        let full = if !with_floor {
+            None
+        } else if sp.complete() {
             Some(sp)
         } else if model.n <= FLOOR_DENSE_MAX {
             let rank = spectrum::constraint_rank(model, data, q)?;
@@ -343,7 +347,7 @@ pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &
         return Ok(c);
     }
     if sp.complete() && traits.damped {
-        if let Some(d) = overdamped::choice(model, data, t0, q, qd, sp, &shares, phase, span)? {
+        if let Some(d) = overdamped::choice(model, data, t0, q, qd, sp, &mut shares, phase, span)? {
             return Ok(d);
         }
     }

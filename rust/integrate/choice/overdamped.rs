@@ -13,7 +13,7 @@ use crate::dynamics;
 use crate::error::Result;
 use crate::model::Model;
 
-use super::spectrum::{damping_ratios, lowest_elastic_of, lowest_per_body_of, Spectrum};
+use super::spectrum::{damping_ratios, lowest_elastic_of, lowest_per_body_of, Shares, Spectrum};
 use super::{resolving_step, AutoChoice, OverdampedMode, Verdict, DOPRI5_REAL_STABILITY, RADAU_COST_RATIO};
 
 /// Whether the mode at `omega_c` (the lowest elastic one, which the fixed-step rule would
@@ -31,7 +31,7 @@ pub fn decides(model: &Model, data: &mut Data, t0: f64, q: &[f64], qd: &[f64], s
 }
 
 /// `Some` adaptive RADAU5M choice when overdamped modes make the scene stiff.
-pub fn choice(model: &Model, data: &mut Data, t0: f64, q: &[f64], qd: &[f64], sp: &Spectrum, shares: &[f64], phase: f64, span: f64) -> Result<Option<AutoChoice>> {
+pub fn choice(model: &Model, data: &mut Data, t0: f64, q: &[f64], qd: &[f64], sp: &Spectrum, shares: &mut Shares, phase: f64, span: f64) -> Result<Option<AutoChoice>> {
     dynamics::mass_and_forces(model, data, t0, q, qd);
     let mass = dynamics::dense_mass(model, data);
     let zeta = damping_ratios(model, data, t0, q, qd, sp, &mass, &|_| true)?;

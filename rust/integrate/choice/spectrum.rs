@@ -202,34 +202,58 @@ fn generalized_eigen(mr: &mut [f64], kr: &[f64], k: usize) -> Result<(Vec<f64>, 
     Ok((omega, v))
 }
 
-/// Share of each mode's `omega^2` that is elastic: `2 E_m / omega^2`, `E_m` the strain energy
+/// Share of mode `k`'s `omega^2` that is elastic: `2 E_m / omega^2`, `E_m` the strain energy
 /// of the mode's first-order strains with the material stiffness alone, plus its springs'
 /// (`Body::material_energy`, `Force::material_energy`); zero for modes with `omega <= 0`.
-pub fn elastic_shares(model: &Model, q: &[f64], sp: &Spectrum) -> Vec<f64> {
-    (0..sp.len())
-        .map(|k| {
-            let w = sp.omega[k];
-            if !(w > 0.0) {
-                return 0.0;
-            }
-            let v = sp.mode(k);
-            let bodies: f64 = model.bodies.iter().map(|b| b.material_energy(q, v)).sum();
-            let springs: f64 = model.forces.iter().map(|f| f.material_energy(&model.bodies, q, v)).sum();
-            2.0 * (bodies + springs) / (w * w)
-        })
-        .collect()
+fn elastic_share(model: &Model, q: &[f64], sp: &Spectrum, k: usize) -> f64 {
+    let w = sp.omega[k];
+    if !(w > 0.0) {
+        return 0.0;
+    }
+    let v = sp.mode(k);
+    let bodies: f64 = model.bodies.iter().map(|b| b.material_energy(q, v)).sum();
+    let springs: f64 = model.forces.iter().map(|f| f.material_energy(&model.bodies, q, v)).sum();
+    2.0 * (bodies + springs) / (w * w)
+}
+
+/// The [`elastic_share`]s of a spectrum's modes, each computed when first asked for: the rule
+/// reads the lowest modes' only (their strain energies were ~10 % of a small system's analysis
+/// when computed for every mode), the overdamped rule all of them.
+pub struct Shares<'a> {
+    model: &'a Model,
+    q: &'a [f64],
+    sp: &'a Spectrum,
+    known: Vec<Option<f64>>,
+}
+
+impl<'a> Shares<'a> {
+    pub fn new(model: &'a Model, q: &'a [f64], sp: &'a Spectrum) -> Shares<'a> {
+        Shares { model, q, sp, known: vec![None; sp.len()] }
+    }
+
+    /// Mode `k`'s share.
+    pub fn get(&mut self, k: usize) -> f64 {
+        let (model, q, sp) = (self.model, self.q, self.sp);
+        *self.known[k].get_or_insert_with(|| elastic_share(model, q, sp, k))
+    }
+
+    /// Whether mode `k` at the rate `omega[k]` is elastic.
+    pub fn elastic(&mut self, omega: &[f64], k: usize) -> bool {
+        omega[k] > 0.0 && self.get(k) > ELASTIC_SHARE
+    }
 }
 
 /// Each flexible body's lowest elastic mode among the spectrum's (the lowest elastic mode with
 /// at least `BODY_SHARE` of its kinetic energy in that body; `None` if none is there), in the
 /// order of the bodies.
-pub fn lowest_per_body(model: &Model, data: &mut Data, q: &[f64], sp: &Spectrum, shares: &[f64]) -> Vec<Option<f64>> {
+pub fn lowest_per_body(model: &Model, data: &mut Data, q: &[f64], sp: &Spectrum, shares: &mut Shares) -> Vec<Option<f64>> {
     lowest_per_body_of(model, data, q, sp, &sp.omega, shares)
 }
 
 /// [`lowest_per_body`] on given rates `omega` of the spectrum's modes (the overdamped rule's
-/// slow rates).
-pub fn lowest_per_body_of(model: &Model, data: &mut Data, q: &[f64], sp: &Spectrum, omega: &[f64], shares: &[f64]) -> Vec<Option<f64>> {
+/// slow rates). A mode no lower than the body's lowest so far is not looked at (its share is
+/// not computed): the minimum is the same.
+pub fn lowest_per_body_of(model: &Model, data: &mut Data, q: &[f64], sp: &Spectrum, omega: &[f64], shares: &mut Shares) -> Vec<Option<f64>> {
     let n = model.n;
     dynamics::mass_and_forces(model, data, 0.0, q, &vec![0.0; n]);
     let mut out = Vec::new();
@@ -242,14 +266,14 @@ pub fn lowest_per_body_of(model: &Model, data: &mut Data, q: &[f64], sp: &Spectr
         let mut lowest: Option<f64> = None;
         for k in 0..sp.len() {
             let w = omega[k];
-            if !(w > 0.0 && shares[k] > ELASTIC_SHARE) {
+            if !(w > 0.0) || lowest.is_some_and(|l| w >= l) {
                 continue;
             }
             let v = &sp.mode(k)[o..o + nb];
             mv[..nb].fill(0.0);
             body.mass_times(bd, v, &mut mv[..nb]);
             let kinetic: f64 = (0..nb).map(|i| v[i] * mv[i]).sum();
-            if kinetic > BODY_SHARE {
+            if kinetic > BODY_SHARE && shares.elastic(omega, k) {
                 lowest = Some(lowest.map_or(w, |l| l.min(w)));
             }
         }
@@ -260,21 +284,26 @@ pub fn lowest_per_body_of(model: &Model, data: &mut Data, q: &[f64], sp: &Spectr
 
 /// The frequency the step must resolve: the highest of the flexible bodies' lowest elastic
 /// modes; without any, the lowest elastic (spring) mode; `None` if no mode is elastic.
-pub fn lowest_elastic_frequency(sp: &Spectrum, shares: &[f64], per_body: &[Option<f64>]) -> Option<f64> {
+pub fn lowest_elastic_frequency(sp: &Spectrum, shares: &mut Shares, per_body: &[Option<f64>]) -> Option<f64> {
     lowest_elastic_of(&sp.omega, shares, per_body)
 }
 
 /// [`lowest_elastic_frequency`] on given rates `omega` (the overdamped rule's slow rates).
-pub fn lowest_elastic_of(omega: &[f64], shares: &[f64], per_body: &[Option<f64>]) -> Option<f64> {
-    let elastic = |k: usize| omega[k] > 0.0 && shares[k] > ELASTIC_SHARE;
-    if !(0..omega.len()).any(elastic) {
+pub fn lowest_elastic_of(omega: &[f64], shares: &mut Shares, per_body: &[Option<f64>]) -> Option<f64> {
+    if !(0..omega.len()).any(|k| shares.elastic(omega, k)) {
         return None;
     }
     let found: Vec<f64> = per_body.iter().flatten().copied().collect();
     if !found.is_empty() {
         return Some(found.iter().fold(f64::NEG_INFINITY, |m, &w| m.max(w)));
     }
-    Some((0..omega.len()).filter(|&k| elastic(k)).map(|k| omega[k]).fold(f64::INFINITY, f64::min))
+    let mut lowest = f64::INFINITY;
+    for k in 0..omega.len() {
+        if omega[k] < lowest && shares.elastic(omega, k) {
+            lowest = lowest.min(omega[k]);
+        }
+    }
+    Some(lowest)
 }
 
 /// Each mode's damping ratio `zeta_k = -phi_k^T M dqdd/dqd phi_k / (2 omega_k)` by a central
