@@ -29,6 +29,7 @@ pub(crate) use crate::linalg::lu;
 pub mod newton;
 mod radau5;
 mod radau_m;
+mod switches;
 pub mod singular;
 mod dense;
 mod options;
@@ -45,8 +46,7 @@ pub use options::{check_tolerances, default_projection, options_of, Method, Opti
 pub use uk_system::{Conditioning, UkSystem};
 
 use crate::correct::{self, ProjectOutcome, ProjectWorkspace, ProjectionTolerance};
-use crate::data::RankInfo;
-use crate::data::Data;
+use crate::data::{Data, RankInfo};
 use crate::dynamics;
 use crate::error::{check_finite, Error, Result};
 use crate::jacobian::{uk_jacobian, Differences, JacobianWorkspace};
@@ -690,7 +690,7 @@ pub fn integrate_uk_observed(model: &Model, data: Data, method: Method, opts: Op
         }
         Method::RadauM(mut ro) => {
             ro.projection = sys.projection.take();
-            let mut st = RadauM::new(model.n, model.m, opts, ro)?;
+            let mut st = RadauM::new(model.n, model.m, opts, ro)?.with_stops(if ro.step.is_some() { switches::load_switches(model, t0, t_end) } else { Vec::new() });
             integrate_observed(&mut st, &mut sys, t0, y0, t_end, t_eval, dense, progress)?
         }
     };
