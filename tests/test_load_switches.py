@@ -44,3 +44,18 @@ def test_a_fixed_step_ends_at_the_kinks_of_an_expression_load():
     assert err["callable", 0.0826] > 30 * err["expression", 0.0826], err
     # a callable's aligned steps are the expression's: only the straddled kinks differ
     assert err["callable", 0.1] == pytest.approx(err["expression", 0.1], rel=1e-3), err
+
+
+def test_auto_follows_rtol_on_the_frame():
+    """auto on a geometrically exact beam runs RADAU5M's Newton at ``NEWTON_PER_RTOL_BEAM`` rtol
+    (``rust/integrate/choice/mod.rs``): on the frame (2 elements per member, 30 s) its tip is
+    1.1e-4 / 2.4e-5 / 5.4e-6 m off a tight run at rtol 1e-4 / 1e-6 / 1e-8. At 100 rtol (the
+    former rule) rtol 1e-6 was no closer than 1e-4 (1.1e-4 m both)."""
+    te = np.linspace(0.0, 30.0, 301)
+
+    def tip(**kw):
+        return np.asarray(ukflex.simulate(_frame(rac.PULSE), 30.0, t_eval=te, **kw).q)[-7:-4]
+
+    ref = tip(method="DOPRI5", rtol=1e-8, atol=1e-10)  # 1.6e-7 m off DOPRI5 at rtol 1e-10
+    err = {rtol: np.abs(tip(rtol=rtol) - ref).max() for rtol in (1e-4, 1e-6, 1e-8)}
+    assert err[1e-4] > 3 * err[1e-6] > 9 * err[1e-8], err

@@ -55,6 +55,12 @@ pub const NEWTON_MAX_RTOL: f64 = 1e-3;
 /// rtol 1e-3 .. 1e-6 auto's runs are 1.0e-4 .. 1.6e-4 off with this cap (docs/spatial-flexible.md,
 /// "The Newton matrices co-rotated"). At the default rtol the cap changes nothing.
 pub const NEWTON_MAX_RTOL_BEAM: f64 = 1e-4;
+/// ... and on such a scene `NEWTON_PER_RTOL_BEAM rtol` below the cap (for the same reason): on
+/// the right-angle cantilever (5 el./member) auto's history at 100 rtol stayed 1.5e-4 m off
+/// from rtol 1e-4 to 1e-6 and 3e-5 m from 1e-7 to 1e-9; at 10 rtol it falls with rtol, 1.5e-4
+/// to 7.5e-6 m, for 1.2x the time at the default rtol (benches/beam3_floor.py; docs/integrators.md,
+/// "Does auto honour rtol").
+pub const NEWTON_PER_RTOL_BEAM: f64 = 10.0;
 /// DOPRI5's average `h omega_max` on stiff flexible scenes, and a RADAU5M step's cost in DOPRI5
 /// steps (nonlinear FFRF coupler N = 4: 17 us against 6 UK calls of ~1.7 us).
 pub const EXPLICIT_STEP_OMEGA: f64 = 0.5;
@@ -103,6 +109,7 @@ pub fn constants() -> Vec<(&'static str, f64)> {
         ("NEWTON_PER_RTOL", NEWTON_PER_RTOL),
         ("NEWTON_MAX_RTOL", NEWTON_MAX_RTOL),
         ("NEWTON_MAX_RTOL_BEAM", NEWTON_MAX_RTOL_BEAM),
+        ("NEWTON_PER_RTOL_BEAM", NEWTON_PER_RTOL_BEAM),
         ("EXPLICIT_STEP_OMEGA", EXPLICIT_STEP_OMEGA),
         ("RADAU_COST_RATIO", RADAU_COST_RATIO),
         ("DOPRI5_REAL_STABILITY", DOPRI5_REAL_STABILITY),
@@ -127,7 +134,8 @@ pub struct SceneTraits {
     /// Contacts (revolute joints with clearance): forces that switch on and off during the run,
     /// which the spectrum at the start does not see.
     pub contact: bool,
-    /// A geometrically exact beam (`beam3_element`s): RADAU5M's Newton at most `NEWTON_MAX_RTOL_BEAM`.
+    /// A geometrically exact beam (`beam3_element`s): RADAU5M's Newton at `NEWTON_PER_RTOL_BEAM`
+    /// rtol, at most `NEWTON_MAX_RTOL_BEAM`.
     pub beam: bool,
 }
 
@@ -261,7 +269,7 @@ pub fn integrator_rtol(c: &AutoChoice, rtol: f64) -> Option<f64> {
 
 /// RADAU5M's Newton tolerance with auto's fixed step for the user's `rtol`.
 pub fn newton_rtol(traits: SceneTraits, rtol: f64) -> f64 {
-    (NEWTON_PER_RTOL * rtol).min(if traits.beam { NEWTON_MAX_RTOL_BEAM } else { NEWTON_MAX_RTOL })
+    if traits.beam { (NEWTON_PER_RTOL_BEAM * rtol).min(NEWTON_MAX_RTOL_BEAM) } else { (NEWTON_PER_RTOL * rtol).min(NEWTON_MAX_RTOL) }
 }
 
 /// The step that resolves `omega_c` to the amplitude budget `phase` over `span`: `(y, h)`.
@@ -392,8 +400,9 @@ mod tests {
         let (plain, beam) = (SceneTraits::default(), SceneTraits { beam: true, ..SceneTraits::default() });
         assert_eq!(newton_rtol(plain, 1e-3), NEWTON_MAX_RTOL);
         assert_eq!(newton_rtol(beam, 1e-3), NEWTON_MAX_RTOL_BEAM);
-        // at the default rtol the cap changes nothing
-        assert_eq!(newton_rtol(beam, 1e-6), newton_rtol(plain, 1e-6));
-        assert!((newton_rtol(beam, 1e-8) - NEWTON_PER_RTOL * 1e-8).abs() < 1e-20);
+        // below the cap, a beam's Newton is NEWTON_PER_RTOL_BEAM rtol
+        assert!((newton_rtol(plain, 1e-8) - NEWTON_PER_RTOL * 1e-8).abs() < 1e-20);
+        assert!((newton_rtol(beam, 1e-8) - NEWTON_PER_RTOL_BEAM * 1e-8).abs() < 1e-20);
+        assert!(newton_rtol(beam, 1e-6) < newton_rtol(plain, 1e-6));
     }
 }
