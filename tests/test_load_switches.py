@@ -47,15 +47,15 @@ def test_a_fixed_step_ends_at_the_kinks_of_an_expression_load():
 
 
 def test_auto_follows_rtol_on_the_frame():
-    """auto on a geometrically exact beam runs RADAU5M's Newton at ``NEWTON_PER_RTOL_BEAM`` rtol
-    (``rust/integrate/choice/mod.rs``): on the frame (2 elements per member, 30 s) its tip is
-    1.1e-4 / 2.4e-5 / 5.4e-6 m off a tight run at rtol 1e-4 / 1e-6 / 1e-8. At 100 rtol (the
-    former rule) rtol 1e-6 was no closer than 1e-4 (1.1e-4 m both)."""
+    """Below the default rtol auto runs a geometrically exact beam's Newton tighter than 100 rtol
+    (``newton_rtol`` in ``rust/integrate/choice/mod.rs``): on the frame (5 elements per member,
+    30 s) its tip is 1.4e-4 / 1.5e-5 / 4.3e-6 m off a tight run at rtol 1e-6 / 1e-7 / 1e-9; with
+    Newton at 100 rtol (the former rule) 1.4e-4 / 2.6e-5 / 1.7e-5."""
     te = np.linspace(0.0, 30.0, 301)
 
     def tip(**kw):
-        return np.asarray(ukflex.simulate(_frame(rac.PULSE), 30.0, t_eval=te, **kw).q)[-7:-4]
+        return np.asarray(ukflex.simulate(ukflex.System(rac.scene(5)), 30.0, t_eval=te, **kw).q)[-7:-4]
 
-    ref = tip(method="DOPRI5", rtol=1e-8, atol=1e-10)  # 1.6e-7 m off DOPRI5 at rtol 1e-10
-    err = {rtol: np.abs(tip(rtol=rtol) - ref).max() for rtol in (1e-4, 1e-6, 1e-8)}
-    assert err[1e-4] > 3 * err[1e-6] > 9 * err[1e-8], err
+    ref = tip(method="RADAU5M", step=0.005, rtol=1e-10)  # 1.1e-7 m off DOPRI5 at rtol 1e-10
+    err = {rtol: np.abs(tip(rtol=rtol) - ref).max() for rtol in (1e-6, 1e-7, 1e-9)}
+    assert err[1e-6] > 3 * err[1e-7] > 7.5 * err[1e-9], err
