@@ -10,6 +10,8 @@ motion), and RADAU5M at rtol 1e-9 with its own step control.
     PYTHONPATH=. python benches/beam3_floor.py                    # minutes
     PYTHONPATH=. python benches/beam3_floor.py --scenes pendulum4 --refs DOPRI5
     PYTHONPATH=. python benches/beam3_floor.py --sweep spin_up8 --refs RADAU5M   # 10-30 s: where the error comes from
+    PYTHONPATH=. python benches/beam3_floor.py --sweep rac5 --refs DOPRI5        # 10-30 s: the same on the frame
+    PYTHONPATH=. python benches/beam3_floor.py --sweep rac5 --refs DOPRI5 --steps 0.1,0.0826,0.07,0.06,0.05,0.04
 """
 
 from __future__ import annotations
@@ -74,9 +76,11 @@ def node_positions(system: ukflex.System, q: np.ndarray) -> np.ndarray:
 
 
 def sweep(key: str, ref: str, points: int) -> None:
-    """Where a scene's error comes from: auto at rtol 1e-4 .. 1e-8 (its step, its Newton
+    """Where a scene's error comes from: auto at rtol 1e-4 .. 1e-9 (its step, its Newton
     tolerance), and RADAU5M at auto's steps with Newton at 1e-9, and at 1/4 and 1/16 of the step
-    of rtol 1e-6."""
+    of rtol 1e-6. Each run's accepted and rejected steps beside the steps its fixed step makes:
+    where Newton cannot converge at the fixed step it cuts it (``radau_m.rs``, patience), and
+    the run is not at the step it was given (docs/spatial-flexible.md, "Limits")."""
     label, make, T = SCENES[key]
     te = np.linspace(0.0, T, points)
 
@@ -88,24 +92,50 @@ def sweep(key: str, ref: str, points: int) -> None:
     base, _ = run(**REFS[ref])
     steps = {}
     print(f"{label}, against {ref} at rtol {REFS[ref]['rtol']:g}")
-    for rtol in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
+    def counts(r: Any, h: float) -> str:
+        return f"{r.extra['naccept']} accepted + {r.extra['nreject']} rejected steps for {math.ceil(T / h)}"
+
+    for rtol in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9):
         x, r = run(rtol=rtol)
         a = r.extra["auto"]
         steps[rtol] = a["step"]
-        print(f"auto rtol {rtol:g}: step {a['step']:.3g} s, stated floor {a.get('floor')}, "
+        print(f"auto rtol {rtol:g}: step {a['step']:.3g} s ({counts(r, a['step'])}), stated floor {a.get('floor')}, "
               f"error {np.linalg.norm(x - base, axis=1).max():.2e} m", flush=True)
     for h in (steps[1e-6], steps[1e-7], steps[1e-8], steps[1e-6] / 4, steps[1e-6] / 16):
-        x, _ = run(method="RADAU5M", step=h, rtol=1e-9)
-        print(f"RADAU5M step {h:.3g} s, Newton 1e-9: error {np.linalg.norm(x - base, axis=1).max():.2e} m", flush=True)
+        for newton in (1e-6, 1e-9):
+            x, r = run(method="RADAU5M", step=h, rtol=newton)
+            print(f"RADAU5M step {h:.3g} s, Newton {newton:g} ({counts(r, h)}): "
+                  f"error {np.linalg.norm(x - base, axis=1).max():.2e} m", flush=True)
+
+
+def steps(key: str, ref: str, points: int, hs: str) -> None:
+    """RADAU5M at the fixed steps ``hs`` (Newton 1e-6), each run's steps and its error, also up to
+    1, 1.5 and 2 s (the right-angle cantilever's load has its kinks at 0, 1 and 2 s)."""
+    label, make, T = SCENES[key]
+    te = np.linspace(0.0, T, points)
+    ref_system = make()
+    base = node_positions(ref_system, np.asarray(ukflex.simulate(ref_system, T, t_eval=te, **REFS[ref]).q))
+    print(f"{label}, against {ref} at rtol {REFS[ref]['rtol']:g}")
+    for h in (float(x) for x in hs.split(",")):
+        system = make()
+        r = ukflex.simulate(system, T, t_eval=te, method="RADAU5M", step=h, rtol=1e-6)
+        e = np.linalg.norm(node_positions(system, np.asarray(r.q)) - base, axis=1).max(axis=0)
+        upto = ", ".join(f"to {t:g} s {e[te <= t].max():.1e}" for t in (1.0, 1.5, 2.0))
+        print(f"RADAU5M step {h:g} s ({r.extra['naccept']} accepted + {r.extra['nreject']} rejected steps for "
+              f"{math.ceil(T / h)}): error {e.max():.2e} m ({upto})", flush=True)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--sweep", default="")
+    ap.add_argument("--steps", default="", help="fixed steps for --sweep's scene, e.g. 0.1,0.0826,0.05")
     ap.add_argument("--scenes", default="pendulum4,pendulum10,spin_up8,rac5")
     ap.add_argument("--refs", default="DOPRI5,RADAU5M")
     ap.add_argument("--points", type=int, default=2001)
     args = ap.parse_args()
+    if args.sweep and args.steps:
+        steps(args.sweep, args.refs.split(",")[0], args.points, args.steps)
+        return
     if args.sweep:
         sweep(args.sweep, args.refs.split(",")[0], args.points)
         return

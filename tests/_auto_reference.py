@@ -33,6 +33,10 @@ NEWTON_MAX_RTOL = 1e-3
 #: core's co-rotated Newton matrices, issue 31: Newton's norm weighs corrections against each
 #: coordinate's move in the step, which for the beam's node bodies is mostly rigid motion)
 NEWTON_MAX_RTOL_BEAM = 1e-4
+#: a beam3 scene's Newton below NEWTON_BEAM_FULL_RTOL: at most NEWTON_MAX_RTOL_BEAM (rtol /
+#: NEWTON_BEAM_FULL_RTOL)^NEWTON_BEAM_EXPONENT; changed with the core's rule, issue 26
+#: (right-angle cantilever: at 100 rtol auto's error stopped following rtol; docs/integrators.md)
+NEWTON_BEAM_FULL_RTOL, NEWTON_BEAM_EXPONENT = 1e-6, 4.0 / 3.0
 #: DOPRI5's average h omega_max on stiff flexible scenes, and a RADAU5M step's cost in DOPRI5
 #: steps (nonlinear FFRF coupler N = 4: 17 us against 6 UK calls of ~1.7 us)
 EXPLICIT_STEP_OMEGA = 0.5
@@ -350,7 +354,9 @@ def choose_method(system, t0: float, t_end: float, rtol: float, q: Optional[np.n
                     "(method='DOPRI5' keeps them)")
         return MethodChoice(
             "RADAU5M", options={"step": h}, omega_elastic=omega_c, omega_max=omega_max, step=h,
-            rtol=min(NEWTON_PER_RTOL * rtol, NEWTON_MAX_RTOL_BEAM if _has_beam3(system) else NEWTON_MAX_RTOL), **floor,
+            rtol=min(NEWTON_PER_RTOL * rtol, NEWTON_MAX_RTOL_BEAM,
+                     NEWTON_MAX_RTOL_BEAM * (rtol / NEWTON_BEAM_FULL_RTOL) ** NEWTON_BEAM_EXPONENT)
+            if _has_beam3(system) else min(NEWTON_PER_RTOL * rtol, NEWTON_MAX_RTOL), **floor,
             reason=(f"stiff: the step {h:.3g} s ({omega_c * h:.2g} rad of the lowest elastic mode, {omega_c:.4g} rad/s, "
                     f"amplitude loss {RADAU_DECAY * (omega_c * h) ** 5 * omega_c * span:.1e} over the run) is "
                     f"{h * omega_max:.3g}/omega_max ({omega_max:.4g} rad/s), beyond what an explicit method may take "

@@ -125,6 +125,16 @@ impl Function {
         self.value.output(0, buf)
     }
 
+    /// A function of `t` alone: the times in `(lo, hi)` at which it has a kink or a jump (an
+    /// `abs` or `sign` of an argument that changes sign there; [`Tape::switches`]); none for a
+    /// function of anything else.
+    pub fn time_switches(&self, lo: f64, hi: f64, samples: usize) -> Vec<f64> {
+        if self.vars.len() != 1 || self.vars[0] != "t" {
+            return Vec::new();
+        }
+        self.value.switches(lo, hi, samples)
+    }
+
     /// The variables, in slot order.
     pub fn vars(&self) -> &[String] {
         &self.vars
@@ -149,6 +159,20 @@ impl Function {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_switches_of_a_function_of_t_are_its_kinks_and_jumps() {
+        // the right-angle cantilever's pulse: kinks at 0, 1 and 2 (0 is the interval's end)
+        let f = Function::parse_used("25 * (1 - abs(t - 1) + abs(1 - abs(t - 1)))", &["t", "x"]).unwrap();
+        let s = f.time_switches(0.0, 30.0, 4096);
+        assert_eq!(s.len(), 2, "{s:?}");
+        assert!((s[0] - 1.0).abs() < 1e-12 && (s[1] - 2.0).abs() < 1e-12, "{s:?}");
+        // a jump (sign), a kink on a sample, none in a smooth function or one of the state
+        let j = Function::parse("3 * sign(t - 0.3) + abs(t - 0.5)", &["t"]).unwrap().time_switches(0.0, 1.0, 8);
+        assert!(j.len() == 2 && (j[0] - 0.3).abs() < 1e-12 && j[1] == 0.5, "{j:?}");
+        assert!(Function::parse("sin(t) + t^2", &["t"]).unwrap().time_switches(0.0, 10.0, 64).is_empty());
+        assert!(Function::parse("abs(x - 1)", &["x"]).unwrap().time_switches(0.0, 10.0, 64).is_empty());
+    }
 
     fn ev(s: &str, t: f64) -> (f64, f64, f64) {
         let f = TimeFunction::parse("test", s).unwrap();

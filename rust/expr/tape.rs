@@ -87,4 +87,53 @@ impl Tape {
     pub fn output(&self, k: usize, buf: &[f64]) -> f64 {
         buf[self.outputs[k] as usize]
     }
+
+    /// The values of the variable in `(lo, hi)` at which the argument of an `abs` or `sign`
+    /// changes sign (a kink or a jump of a function of one variable): found on `samples`
+    /// equal intervals (two changes of one argument within an interval are not seen), each
+    /// bisected to the rounding of the variable; sorted, each once.
+    pub fn switches(&self, lo: f64, hi: f64, samples: usize) -> Vec<f64> {
+        let args: Vec<usize> = self.code.iter().filter_map(|c| match c {
+            Instr::Call(Func::Abs | Func::Sign, a) => Some(*a as usize),
+            _ => None,
+        }).collect();
+        let mut out = Vec::new();
+        if args.is_empty() || self.n_vars != 1 || !(hi > lo) || samples == 0 {
+            return out;
+        }
+        let mut buf = vec![0.0; self.code.len()];
+        let at = |x: f64, buf: &mut [f64]| -> Vec<f64> {
+            self.eval(&[x], buf);
+            args.iter().map(|&a| buf[a]).collect()
+        };
+        let (mut x_prev, mut prev) = (lo, at(lo, &mut buf));
+        for i in 1..=samples {
+            let x = if i == samples { hi } else { lo + (hi - lo) * i as f64 / samples as f64 };
+            let cur = at(x, &mut buf);
+            for (k, &a) in args.iter().enumerate() {
+                let (p, c) = (prev[k], cur[k]);
+                if !(p.is_finite() && c.is_finite()) || p == 0.0 || (p > 0.0) == (c > 0.0) && c != 0.0 {
+                    continue;
+                }
+                // p != 0 and c has the other sign or is 0: the change is in (x_prev, x]
+                let (mut x0, mut x1) = (x_prev, x);
+                loop {
+                    let xm = 0.5 * (x0 + x1);
+                    if xm <= x0 || xm >= x1 {
+                        break;
+                    }
+                    self.eval(&[xm], &mut buf);
+                    let v = buf[a];
+                    if v != 0.0 && (v > 0.0) == (p > 0.0) { x0 = xm } else { x1 = xm }
+                }
+                if x1 < hi {
+                    out.push(x1);
+                }
+            }
+            (x_prev, prev) = (x, cur);
+        }
+        out.sort_by(f64::total_cmp);
+        out.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * (hi - lo));
+        out
+    }
 }

@@ -157,7 +157,8 @@ impl Force {
         self.values().into_iter().flat_map(|v| v.points()).collect()
     }
 
-    fn values(&self) -> Vec<&value::Value> {
+    /// The values of this force (the loads' components, a motor's torque).
+    pub fn values(&self) -> Vec<&value::Value> {
         match &self.kind {
             ForceKind::Load(l) => match l.as_ref() {
                 load::Load::Force { f, .. } => f.iter().collect(),

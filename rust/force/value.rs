@@ -451,6 +451,15 @@ impl Value {
         }
     }
 
+    /// An expression of `t` alone: the times in `(lo, hi)` of its kinks and jumps
+    /// (`Function::time_switches`); none for any other value.
+    pub fn time_switches(&self, lo: f64, hi: f64, samples: usize) -> Vec<f64> {
+        match self {
+            Value::Expr(e) => e.f.time_switches(lo, hi, samples),
+            _ => Vec::new(),
+        }
+    }
+
     /// Whether the value is a constant.
     pub fn is_const(&self) -> bool {
         matches!(self, Value::Const(_))

@@ -30,6 +30,7 @@ pub mod newton;
 mod radau5;
 mod radau_m;
 pub mod corotation;
+mod switches;
 pub mod singular;
 mod dense;
 mod options;
@@ -691,7 +692,7 @@ pub fn integrate_uk_observed(model: &Model, data: Data, method: Method, opts: Op
         }
         Method::RadauM(mut ro) => {
             ro.projection = sys.projection.take();
-            let mut st = RadauM::new(model.n, model.m, opts, ro)?;
+            let mut st = RadauM::new(model.n, model.m, opts, ro)?.with_stops(if ro.step.is_some() { switches::load_switches(model, t0, t_end) } else { Vec::new() });
             integrate_observed(&mut st, &mut sys, t0, y0, t_end, t_eval, dense, progress)?
         }
     };

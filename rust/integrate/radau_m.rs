@@ -163,6 +163,8 @@ pub struct RadauM {
     short_steps: usize,
     patience: usize,
     doubled: bool,
+    /// Fixed step: the times a step ends at (the loads' kinks and jumps, `integrate::switches`).
+    stops: Vec<f64>,
 }
 
 /// 3 x 3 matrix product.
@@ -280,7 +282,15 @@ impl RadauM {
             short_steps: 0,
             patience: FIXED_STEP_PATIENCE,
             doubled: false,
+            stops: Vec::new(),
         })
+    }
+
+    /// With a fixed step, end a step at each of `stops` it would straddle (a load's kink inside
+    /// a step costs the collocation its order: `integrate::switches`).
+    pub fn with_stops(mut self, stops: Vec<f64>) -> Self {
+        self.stops = stops;
+        self
     }
 
     /// Re-read `M`, `K`, `C`, `A`, `db/dqd` at the step's start.
@@ -427,10 +437,16 @@ impl Stepper for RadauM {
         let mut fresh = false;
         loop {
             self.st.check_attempt("RADAU5M", &self.opts)?;
-            let mut h = self.st.h;
+            let (h_try, mut h) = (self.st.h, self.st.h);
             let last = self.st.t + 1.01 * h >= t_end;
             if last {
                 h = t_end - self.st.t;
+            }
+            // a fixed step ends at the next stop it would straddle (and takes up its size after)
+            let next = self.stops.iter().find(|&&s| s > self.st.t + 1e-9 * h_try).copied();
+            let clipped = fixed && !last && next.is_some_and(|s| self.st.t + h > s);
+            if clipped {
+                h = next.expect("clipped") - self.st.t;
             }
             if self.refresh || self.age >= VELOCITY_TERMS_AGE {
                 self.read_structure(sys)?;
@@ -544,6 +560,11 @@ impl Stepper for RadauM {
             // growth out of its stiff start, read them at every step: 14 of 36 passes)
             if !fixed && newt > 1 && self.theta > REFRESH_CONTRACTION {
                 self.refresh = true;
+            }
+            if fixed && clipped {
+                self.st.h = h_try;
+                self.reuse = false;
+                return Ok(());
             }
             if fixed {
                 // a step that Newton could not take at the fixed size is kept at the size it

@@ -58,8 +58,10 @@ from ..errors import SolverError
 #: the chooser's constants, read from the core (``rust/integrate/choice/mod.rs``, the one place):
 #: amplitude budget per rtol and its cap, fewest steps per run; RADAU5M's amplitude loss per
 #: step ``RADAU_DECAY (omega h)^6`` and its largest step ``RADAU_MAX_STEP_OMEGA`` rad of omega_c;
-#: its Newton tolerance ``min(NEWTON_PER_RTOL rtol, NEWTON_MAX_RTOL)`` (``NEWTON_MAX_RTOL_BEAM``
-#: instead of ``NEWTON_MAX_RTOL`` on a scene with a geometrically exact beam); DOPRI5's average
+#: its Newton tolerance ``min(NEWTON_PER_RTOL rtol, NEWTON_MAX_RTOL)`` (on a scene with a
+#: geometrically exact beam ``NEWTON_MAX_RTOL_BEAM`` instead of ``NEWTON_MAX_RTOL``, and below
+#: ``NEWTON_BEAM_FULL_RTOL`` at most ``NEWTON_MAX_RTOL_BEAM (rtol / NEWTON_BEAM_FULL_RTOL)^
+#: NEWTON_BEAM_EXPONENT``); DOPRI5's average
 #: ``h omega_max`` and a RADAU5M step's cost in DOPRI5 steps; DOPRI5's real stability interval;
 #: GENALPHA's looser Newton test and the coarsest ``h omega_max`` where it is safe; the elastic
 #: and body shares of a mode; the sparse analysis' first modes; the floor's body points; DOPRI5's
@@ -72,6 +74,8 @@ RADAU_MAX_STEP_OMEGA = _core.AUTO["RADAU_MAX_STEP_OMEGA"]
 NEWTON_PER_RTOL = _core.AUTO["NEWTON_PER_RTOL"]
 NEWTON_MAX_RTOL = _core.AUTO["NEWTON_MAX_RTOL"]
 NEWTON_MAX_RTOL_BEAM = _core.AUTO["NEWTON_MAX_RTOL_BEAM"]
+NEWTON_BEAM_FULL_RTOL = _core.AUTO["NEWTON_BEAM_FULL_RTOL"]
+NEWTON_BEAM_EXPONENT = _core.AUTO["NEWTON_BEAM_EXPONENT"]
 EXPLICIT_STEP_OMEGA = _core.AUTO["EXPLICIT_STEP_OMEGA"]
 RADAU_COST_RATIO = _core.AUTO["RADAU_COST_RATIO"]
 DOPRI5_REAL_STABILITY = _core.AUTO["DOPRI5_REAL_STABILITY"]

@@ -55,6 +55,15 @@ pub const NEWTON_MAX_RTOL: f64 = 1e-3;
 /// rtol 1e-3 .. 1e-6 auto's runs are 1.0e-4 .. 1.6e-4 off with this cap (docs/spatial-flexible.md,
 /// "The Newton matrices co-rotated"). At the default rtol the cap changes nothing.
 pub const NEWTON_MAX_RTOL_BEAM: f64 = 1e-4;
+/// ... and on such a scene, below `NEWTON_BEAM_FULL_RTOL`, the cap times `(rtol /
+/// NEWTON_BEAM_FULL_RTOL)^NEWTON_BEAM_EXPONENT` (10 rtol at rtol 1e-9, rtol at 1e-12): the
+/// default keeps its Newton (1e-4; the right-angle cantilever's default time against Exudyn),
+/// and below it Newton no longer sets the error. On that frame (5 el./member, with the load's
+/// kinks as step stops) auto's history at 100 rtol stayed 1.5e-4 m off down to rtol 1e-6 and
+/// 2.6-3.2e-5 m from 1e-7 to 1e-9 (Newton at 1e-9 at the same steps: 4-7e-6 m); docs/integrators.md,
+/// "Does auto honour rtol" (benches/beam3_floor.py).
+pub const NEWTON_BEAM_FULL_RTOL: f64 = 1e-6;
+pub const NEWTON_BEAM_EXPONENT: f64 = 4.0 / 3.0;
 /// DOPRI5's average `h omega_max` on stiff flexible scenes, and a RADAU5M step's cost in DOPRI5
 /// steps (nonlinear FFRF coupler N = 4: 17 us against 6 UK calls of ~1.7 us).
 pub const EXPLICIT_STEP_OMEGA: f64 = 0.5;
@@ -103,6 +112,8 @@ pub fn constants() -> Vec<(&'static str, f64)> {
         ("NEWTON_PER_RTOL", NEWTON_PER_RTOL),
         ("NEWTON_MAX_RTOL", NEWTON_MAX_RTOL),
         ("NEWTON_MAX_RTOL_BEAM", NEWTON_MAX_RTOL_BEAM),
+        ("NEWTON_BEAM_FULL_RTOL", NEWTON_BEAM_FULL_RTOL),
+        ("NEWTON_BEAM_EXPONENT", NEWTON_BEAM_EXPONENT),
         ("EXPLICIT_STEP_OMEGA", EXPLICIT_STEP_OMEGA),
         ("RADAU_COST_RATIO", RADAU_COST_RATIO),
         ("DOPRI5_REAL_STABILITY", DOPRI5_REAL_STABILITY),
@@ -127,7 +138,8 @@ pub struct SceneTraits {
     /// Contacts (revolute joints with clearance): forces that switch on and off during the run,
     /// which the spectrum at the start does not see.
     pub contact: bool,
-    /// A geometrically exact beam (`beam3_element`s): RADAU5M's Newton at most `NEWTON_MAX_RTOL_BEAM`.
+    /// A geometrically exact beam (`beam3_element`s): RADAU5M's Newton at most
+    /// `NEWTON_MAX_RTOL_BEAM`, tighter below `NEWTON_BEAM_FULL_RTOL` ([`newton_rtol`]).
     pub beam: bool,
 }
 
@@ -261,7 +273,11 @@ pub fn integrator_rtol(c: &AutoChoice, rtol: f64) -> Option<f64> {
 
 /// RADAU5M's Newton tolerance with auto's fixed step for the user's `rtol`.
 pub fn newton_rtol(traits: SceneTraits, rtol: f64) -> f64 {
-    (NEWTON_PER_RTOL * rtol).min(if traits.beam { NEWTON_MAX_RTOL_BEAM } else { NEWTON_MAX_RTOL })
+    if traits.beam {
+        ((NEWTON_PER_RTOL * rtol).min(NEWTON_MAX_RTOL_BEAM)).min(NEWTON_MAX_RTOL_BEAM * (rtol / NEWTON_BEAM_FULL_RTOL).powf(NEWTON_BEAM_EXPONENT))
+    } else {
+        (NEWTON_PER_RTOL * rtol).min(NEWTON_MAX_RTOL)
+    }
 }
 
 /// The step that resolves `omega_c` to the amplitude budget `phase` over `span`: `(y, h)`.
@@ -396,8 +412,11 @@ mod tests {
         let (plain, beam) = (SceneTraits::default(), SceneTraits { beam: true, ..SceneTraits::default() });
         assert_eq!(newton_rtol(plain, 1e-3), NEWTON_MAX_RTOL);
         assert_eq!(newton_rtol(beam, 1e-3), NEWTON_MAX_RTOL_BEAM);
-        // at the default rtol the cap changes nothing
+        // at the default rtol the cap changes nothing; below it a beam's Newton tightens
+        // faster than rtol: 10 rtol at 1e-9
         assert_eq!(newton_rtol(beam, 1e-6), newton_rtol(plain, 1e-6));
-        assert!((newton_rtol(beam, 1e-8) - NEWTON_PER_RTOL * 1e-8).abs() < 1e-20);
+        assert!((newton_rtol(plain, 1e-8) - NEWTON_PER_RTOL * 1e-8).abs() < 1e-20);
+        assert!((newton_rtol(beam, 1e-9) / 1e-8 - 1.0).abs() < 1e-12);
+        assert!(newton_rtol(beam, 1e-7) < newton_rtol(plain, 1e-7) / 2.0);
     }
 }
