@@ -65,12 +65,27 @@ pub struct Marker3State {
 }
 
 /// A spatial body's rotation at `(q, qd)`: `A(p)` and `A(pd)` (`rot3::rot_a`, not normalized),
-/// computed once per body for all its markers (`Data::frames3`, filled by
+/// computed once per body for all its markers (`Marker3Work::frames`, filled by
 /// `dynamics::constraints` before the joint rows read it).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Frame3 {
     pub a: M3,
     pub ad: M3,
+}
+
+/// The joint rows' marker workspace (`Data::marker3`): each body's `Frame3` at the state of the
+/// last `dynamics::constraints`, and the two states of the joint being evaluated
+/// (`Marker3::state_into` writes every field: nothing of a previous joint is read).
+#[derive(Debug, Clone)]
+pub struct Marker3Work {
+    pub frames: Vec<Frame3>,
+    pub states: [Marker3State; 2],
+}
+
+impl Marker3Work {
+    pub fn new(bodies: usize) -> Marker3Work {
+        Marker3Work { frames: vec![Frame3::default(); bodies], states: [Marker3State::default(); 2] }
+    }
 }
 
 impl Frame3 {

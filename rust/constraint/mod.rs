@@ -80,11 +80,9 @@ pub struct ConstraintOut<'a> {
     pub gamma: &'a mut [f64],
     /// Evaluation buffer of a driver's motion (`Data::motion_scratch`, `scratch_len()` long).
     pub scratch: &'a mut [f64],
-    /// The spatial bodies' rotations at `(q, qd)` (`Data::frames3`; empty for planar models).
-    pub frames: &'a [crate::body::marker3::Frame3],
-    /// The two marker states of a spatial joint (`Data::states3`, written in place by
-    /// `Marker3::state_into`; `None` for planar models).
-    pub states: Option<&'a mut [crate::body::marker3::Marker3State; 2]>,
+    /// Spatial models: the bodies' rotations at `(q, qd)` and the buffer of a joint's two
+    /// marker states (`Data::marker3`); `None` for planar models.
+    pub marker3: Option<&'a mut crate::body::marker3::Marker3Work>,
 }
 
 /// What a constraint needs from the model while it is built: the bodies, their names and the

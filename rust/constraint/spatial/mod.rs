@@ -74,18 +74,18 @@ impl Pair {
 }
 
 /// `f(si, sj, out)` with the pair's marker states (the axes in `axes`), written into the
-/// model's state buffer (`ConstraintOut::states`: no state zeroed or moved per call; by value
-/// without one).
+/// model's buffer with the bodies' cached rotations (`ConstraintOut::marker3`: no state zeroed
+/// or moved per call; by value without one).
 #[inline(always)]
 fn with_states(pair: &Pair, axes: [u8; 2], bodies: &[Body], q: &[f64], qd: &[f64], out: &mut ConstraintOut, f: impl FnOnce(&Marker3State, &Marker3State, &mut ConstraintOut)) {
-    match out.states.take() {
-        Some(st) => {
-            pair.states_into(st, bodies, out.frames, q, qd, axes);
-            f(&st[0], &st[1], out);
-            out.states = Some(st);
+    match out.marker3.take() {
+        Some(w) => {
+            pair.states_into(&mut w.states, bodies, &w.frames, q, qd, axes);
+            f(&w.states[0], &w.states[1], out);
+            out.marker3 = Some(w);
         }
         None => {
-            let (si, sj) = pair.states_axes(bodies, out.frames, q, qd, axes);
+            let (si, sj) = pair.states_axes(bodies, &[], q, qd, axes);
             f(&si, &sj, out);
         }
     }
