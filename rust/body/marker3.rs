@@ -95,7 +95,9 @@ impl Frame3 {
     }
 
     /// One per body: the rigid3 and flexible3 bodies' rotations at `(q, qd)` (the others are
-    /// left as they are: their markers read none).
+    /// left as they are: their markers read none). Out of line: the planar constraint loop
+    /// (`dynamics::constraints`) keeps its code.
+    #[inline(never)]
     pub fn fill(bodies: &[Body], q: &[f64], qd: &[f64], frames: &mut [Frame3]) {
         for (b, f) in bodies.iter().zip(frames.iter_mut()) {
             if matches!(b.kind, BodyKind::Rigid3(_) | BodyKind::Flexible3(_)) {
