@@ -6,6 +6,7 @@ use faer::linalg::svd::{svd_scratch, ComputeSvdVectors};
 use faer::diag::Diag;
 use faer::{Mat, Par};
 
+use crate::body::marker3::Marker3Work;
 use crate::body::BodyData;
 use crate::constraint::jac::SegJac;
 use crate::model::Model;
@@ -96,6 +97,9 @@ pub struct Data {
     /// Spatial models: `max |Phi_i|` at the last `dynamics::constraints` (the state's drift,
     /// which sets the default rank tolerance, `uk::dense`); `None` for planar models.
     pub spatial_drift: Option<f64>,
+    /// Spatial models: each body's rotations at the last `dynamics::constraints` and the
+    /// buffer of a joint's two marker states (`Marker3Work`); `None` for planar models.
+    pub marker3: Option<Box<Marker3Work>>,
     /// Spatial models: how many singular values of `B` the last rank decision at a nearly
     /// consistent state dropped (`RankTolerance::decides_redundancy`); far off the manifold
     /// they are dropped up to the drift (`RankTolerance::redundant_rcond`, `uk::dense`).
@@ -182,6 +186,7 @@ impl Data {
             factored_with: Factored::None,
             tolerance: RankTolerance::default(),
             spatial_drift: model.is_spatial().then_some(0.0),
+            marker3: model.is_spatial().then(|| Box::new(Marker3Work::new(model.bodies.len()))),
             redundant: 0,
             turns: vec![f64::NAN; model.forces.len()],
             stabilization: Stabilization::None,

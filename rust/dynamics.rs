@@ -86,6 +86,9 @@ pub fn apply_finv_sparse(model: &Model, bodies: &[BodyData], v: &mut [f64]) {
 pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], with_phi: bool) {
     // spatial rows compute their value anyway: keep it, it sets the rank tolerance (uk::dense)
     let with_phi = with_phi || data.spatial_drift.is_some();
+    if let Some(w) = data.marker3.as_deref_mut() {
+        crate::body::marker3::Frame3::fill(&model.bodies, q, qd, &mut w.frames);
+    }
     for (k, c) in model.constraints.iter().enumerate() {
         let rows = c.rows();
         let r0 = c.row;
@@ -98,6 +101,7 @@ pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]
             phi_t: &mut data.phi_t[r0..r0 + rows],
             gamma: &mut data.gamma[r0..r0 + rows],
             scratch: &mut data.motion_scratch,
+            marker3: data.marker3.as_deref_mut(),
         };
         c.eval(&model.bodies, t, q, qd, width, out);
     }

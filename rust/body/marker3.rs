@@ -17,7 +17,7 @@
 use super::{Body, BodyKind, Flexible3, Marker, MarkerShape};
 use crate::error::{check_finite_item, Error, Result};
 use crate::description::spatial::Marker3Desc;
-use crate::linalg::rot3::{add, col, cross, frame_from_z, m34_t_vec, m34_vec, mat_vec, norm, quad_term, rot_a, rot_b, scale, sub, M3, M34, V3};
+use crate::linalg::rot3::{add, col, cross, frame_from_z, m34_t_vec, m34_vec, mat_vec, norm, rot_a, rot_b, scale, sub, M3, M34, V3};
 
 /// Every axis (`Marker3::state_axes`).
 pub const ALL_AXES: u8 = 0b111;
@@ -62,6 +62,50 @@ pub struct Marker3State {
     /// `flexible3`: the interface node and `A(p)` (the elastic Jacobian's rotation).
     pub iface: Option<usize>,
     pub rot: M3,
+}
+
+/// A spatial body's rotation at `(q, qd)`: `A(p)` and `A(pd)` (`rot3::rot_a`, not normalized),
+/// computed once per body for all its markers (`Marker3Work::frames`, filled by
+/// `dynamics::constraints` before the joint rows read it).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Frame3 {
+    pub a: M3,
+    pub ad: M3,
+}
+
+/// The joint rows' marker workspace (`Data::marker3`): each body's `Frame3` at the state of the
+/// last `dynamics::constraints`, and the two states of the joint being evaluated
+/// (`Marker3::state_into` writes every field: nothing of a previous joint is read).
+#[derive(Debug, Clone)]
+pub struct Marker3Work {
+    pub frames: Vec<Frame3>,
+    pub states: [Marker3State; 2],
+}
+
+impl Marker3Work {
+    pub fn new(bodies: usize) -> Marker3Work {
+        Marker3Work { frames: vec![Frame3::default(); bodies], states: [Marker3State::default(); 2] }
+    }
+}
+
+impl Frame3 {
+    #[inline]
+    pub fn of(p: &[f64], pd: &[f64]) -> Frame3 {
+        Frame3 { a: rot_a(p), ad: rot_a(pd) }
+    }
+
+    /// One per body: the rigid3 and flexible3 bodies' rotations at `(q, qd)` (the others are
+    /// left as they are: their markers read none). Out of line: the planar constraint loop
+    /// (`dynamics::constraints`) keeps its code.
+    #[inline(never)]
+    pub fn fill(bodies: &[Body], q: &[f64], qd: &[f64], frames: &mut [Frame3]) {
+        for (b, f) in bodies.iter().zip(frames.iter_mut()) {
+            if matches!(b.kind, BodyKind::Rigid3(_) | BodyKind::Flexible3(_)) {
+                let o = b.offset;
+                *f = Frame3::of(&q[o + 3..o + 7], &qd[o + 3..o + 7]);
+            }
+        }
+    }
 }
 
 /// A frame's axes from a description: `z` (default `(0, 0, 1)`, normalized; zero or non-finite
@@ -140,57 +184,92 @@ impl Marker3 {
     /// spherical joint computes no axis at all.
     #[inline]
     pub fn state_axes(&self, bodies: &[Body], q: &[f64], qd: &[f64], axes: u8) -> Marker3State {
-        let mut st = Marker3State { body: self.body, rigid: self.rigid, iface: self.iface, ..Default::default() };
+        self.state_in(bodies, &[], q, qd, axes)
+    }
+
+    /// `state_axes` with the body's rotations read from `frames` (`Frame3::fill` at the same
+    /// `(q, qd)`, one per body); an empty `frames` computes them here. The same numbers bit for
+    /// bit: the cache only saves recomputing `A(p)` and `A(pd)` for every marker of a body.
+    #[inline]
+    pub fn state_in(&self, bodies: &[Body], frames: &[Frame3], q: &[f64], qd: &[f64], axes: u8) -> Marker3State {
+        let mut st = Marker3State::default();
+        self.state_into(&mut st, bodies, frames, q, qd, axes);
+        st
+    }
+
+    /// `state_in` written into `st`: every field of `st` is written (what it held before is
+    /// never read), so a caller's buffer is reused without being zeroed or moved.
+    #[inline]
+    pub fn state_into(&self, st: &mut Marker3State, bodies: &[Body], frames: &[Frame3], q: &[f64], qd: &[f64], axes: u8) {
+        st.body = self.body;
+        st.rigid = self.rigid;
+        st.iface = self.iface;
+        st.rot = [[0.0; 3]; 3];
         for k in 0..3 {
+            let ax = &mut st.axes[k];
+            *ax = Kin3::default();
             if axes & (1 << k) != 0 {
-                st.axes[k].v = col(&self.c, k);
+                ax.v = col(&self.c, k);
             }
         }
+        let pt = &mut st.point;
+        *pt = Kin3::default();
         let Some(bi) = self.body else {
-            st.point.v = self.s;
-            return st;
+            pt.v = self.s;
+            return;
         };
         let o = bodies[bi].offset;
         let r = [q[o], q[o + 1], q[o + 2]];
         let rd = [qd[o], qd[o + 1], qd[o + 2]];
-        st.point.jr = 1.0;
+        pt.jr = 1.0;
         if !self.rigid {
-            st.point.v = r;
-            st.point.vd = rd;
-            return st;
+            pt.v = r;
+            pt.vd = rd;
+            return;
         }
         let (p, pd) = (&q[o + 3..o + 7], &qd[o + 3..o + 7]);
+        let own;
+        let fr = match frames.get(bi) {
+            Some(f) => f,
+            None => {
+                own = Frame3::of(p, pd);
+                &own
+            }
+        };
         if let (Some(f), BodyKind::Flexible3(k)) = (self.iface, &bodies[bi].kind) {
-            return self.flexible_state(st, k, f, r, rd, q, qd, o, axes);
+            return self.flexible_state(st, k, f, fr, r, rd, q, qd, o, axes);
         }
-        let a = rot_a(p);
-        let ad = rot_a(pd);
-        let jp = rot_b(p, &self.s);
-        st.point = Kin3 { v: add(&r, &mat_vec(&a, &self.s)), vd: add(&rd, &m34_vec(&jp, pd)), h: scale(2.0, &mat_vec(&ad, &self.s)), jr: 1.0, jp, ..Default::default() };
+        let (a, ad) = (&fr.a, &fr.ad);
+        pt.jp = rot_b(p, &self.s);
+        pt.v = add(&r, &mat_vec(a, &self.s));
+        pt.vd = add(&rd, &m34_vec(&pt.jp, pd));
+        pt.h = scale(2.0, &mat_vec(ad, &self.s));
         for k in 0..3 {
             if axes & (1 << k) == 0 {
                 continue;
             }
             let ck = col(&self.c, k);
-            let jp = rot_b(p, &ck);
-            // `quad_term(pd, ck)` with `A(pd)` computed once per marker
-            st.axes[k] = Kin3 { v: mat_vec(&a, &ck), vd: m34_vec(&jp, pd), h: scale(2.0, &mat_vec(&ad, &ck)), jr: 0.0, jp, ..Default::default() };
+            // `quad_term(pd, ck)` with `A(pd)` computed once per body
+            let ax = &mut st.axes[k];
+            ax.jp = rot_b(p, &ck);
+            ax.v = mat_vec(a, &ck);
+            ax.vd = m34_vec(&ax.jp, pd);
+            ax.h = scale(2.0, &mat_vec(ad, &ck));
         }
-        st
     }
 
     /// `state_axes` of a marker on an interface node of a `flexible3` body (module docs).
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn flexible_state(&self, mut st: Marker3State, k: &Flexible3, f: usize, r: V3, rd: V3, q: &[f64], qd: &[f64], o: usize, axes: u8) -> Marker3State {
+    fn flexible_state(&self, st: &mut Marker3State, k: &Flexible3, f: usize, fr: &Frame3, r: V3, rd: V3, q: &[f64], qd: &[f64], o: usize, axes: u8) {
         let n = k.n;
         let (p, pd) = (&q[o + 3..o + 7], &qd[o + 3..o + 7]);
         let [s, sd, th, thd] = k.interface_state(f, &q[o + 7..o + 7 + n], &qd[o + 7..o + 7 + n]);
-        let a = rot_a(p);
+        let a = fr.a;
         st.rot = a;
         let jp = rot_b(p, &s);
         let vd = add(&add(&rd, &m34_vec(&jp, pd)), &mat_vec(&a, &sd));
-        let h = add(&quad_term(pd, &s), &scale(2.0, &m34_vec(&rot_b(p, &sd), pd)));
+        let h = add(&scale(2.0, &mat_vec(&fr.ad, &s)), &scale(2.0, &m34_vec(&rot_b(p, &sd), pd)));
         st.point = Kin3 { v: add(&r, &mat_vec(&a, &s)), vd, h, jr: 1.0, jp, flex: 1, c: [0.0; 3] };
         for kx in 0..3 {
             if axes & (1 << kx) == 0 {
@@ -201,10 +280,9 @@ impl Marker3 {
             let cc = add(&ck, &cross(&th, &ck));
             let jp = rot_b(p, &cc);
             let vd = add(&m34_vec(&jp, pd), &mat_vec(&a, &cd));
-            let h = add(&quad_term(pd, &cc), &scale(2.0, &m34_vec(&rot_b(p, &cd), pd)));
+            let h = add(&scale(2.0, &mat_vec(&fr.ad, &cc)), &scale(2.0, &m34_vec(&rot_b(p, &cd), pd)));
             st.axes[kx] = Kin3 { v: mat_vec(&a, &cc), vd, h, jr: 0.0, jp, flex: 2 + kx as u8, c: ck };
         }
-        st
     }
 }
 
@@ -231,6 +309,33 @@ pub fn add_jacobian(bodies: &[Body], ms: &Marker3State, k: &Kin3, w: &V3, row: &
     if k.flex != 0 {
         if let (Some(f), BodyKind::Flexible3(b)) = (ms.iface, &bodies[bi].kind) {
             b.add_marker_jacobian(f, k.flex, &k.c, &ms.rot, w, &mut row[start + 7..start + 7 + b.n]);
+        }
+    }
+}
+
+/// `rows[c] += sign e_c^T dP/dq`, `c = 0, 1, 2`: the marker's point Jacobian written row by
+/// row into three rows `n` apart (a point coincidence), its entries as they are instead of
+/// `e_c^T J_P` formed per row by `add_jacobian` (the same numbers: the other terms are zeros).
+#[inline]
+pub fn add_point_rows(bodies: &[Body], ms: &Marker3State, sign: f64, rows: &mut [f64], n: usize, layout: &[(usize, usize)]) {
+    let Some(bi) = ms.body else { return };
+    if ms.point.flex != 0 {
+        for c in 0..3 {
+            let mut e = [0.0; 3];
+            e[c] = sign;
+            add_jacobian(bodies, ms, &ms.point, &e, &mut rows[c * n..(c + 1) * n], Some(layout));
+        }
+        return;
+    }
+    let start = layout.iter().find(|e| e.0 == bi).expect("the marker's body is in the constraint's layout").1;
+    let k = &ms.point;
+    for c in 0..3 {
+        let row = &mut rows[c * n..(c + 1) * n];
+        row[start + c] += sign * k.jr;
+        if ms.rigid {
+            for l in 0..4 {
+                row[start + 3 + l] += sign * k.jp[c][l];
+            }
         }
     }
 }

@@ -80,6 +80,9 @@ pub struct ConstraintOut<'a> {
     pub gamma: &'a mut [f64],
     /// Evaluation buffer of a driver's motion (`Data::motion_scratch`, `scratch_len()` long).
     pub scratch: &'a mut [f64],
+    /// Spatial models: the bodies' rotations at `(q, qd)` and the buffer of a joint's two
+    /// marker states (`Data::marker3`); `None` for planar models.
+    pub marker3: Option<&'a mut crate::body::marker3::Marker3Work>,
 }
 
 /// What a constraint needs from the model while it is built: the bodies, their names and the

@@ -119,7 +119,7 @@ pub fn kinematics(c: Contact3, pair: &Pair, bodies: &[Body], q: &[f64], qd: &[f6
             dot(&sub(&omega(&pair.i, bodies, q, qd), &omega(&pair.j, bodies, q, qd)), &z)
         }
         Contact3::Slide => {
-            let (si, sj) = pair.states_axes(bodies, q, qd, [0, 0b100]);
+            let (si, sj) = pair.states_axes(bodies, &[], q, qd, [0, 0b100]);
             let z = sj.axes[2].v;
             *aux = z;
             add_jacobian(bodies, &si, &si.point, &z, g, None);

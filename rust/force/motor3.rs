@@ -118,7 +118,7 @@ impl Motor3 {
     fn read(&self, bodies: &[Body], q: &[f64], qd: &[f64], turn: &mut f64, count: bool) -> Reading {
         match self.drive {
             Drive::Rotation => {
-                let (sa, sb) = self.pair.states_axes(bodies, q, qd, [0b001, 0b011]);
+                let (sa, sb) = self.pair.states_axes(bodies, &[], q, qd, [0b001, 0b011]);
                 let (s, sd, _) = prim::dot_terms(&sa.axes[0], &sb.axes[1]);
                 let (c, cd, _) = prim::dot_terms(&sa.axes[0], &sb.axes[0]);
                 let r2 = s * s + c * c;
@@ -133,7 +133,7 @@ impl Motor3 {
                 Reading { x: th, xd: thd, sa, sb, scr: [s, c, r2] }
             }
             Drive::Slide => {
-                let (sa, sb) = self.pair.states_axes(bodies, q, qd, [0, 0b100]);
+                let (sa, sb) = self.pair.states_axes(bodies, &[], q, qd, [0, 0b100]);
                 let (x, xd, _) = prim::dot2_terms(&sb.axes[2], &sb, &sa);
                 Reading { x, xd, sa, sb, scr: [0.0; 3] }
             }

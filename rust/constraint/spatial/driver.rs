@@ -11,6 +11,7 @@
 //! * translation of `P_j` along `z_i`: `Phi = z_i . d - f`, `Phi_t = -f'`, `gamma = -h + f''`.
 
 use super::{prim, Pair};
+use crate::body::marker3::Marker3State;
 use crate::body::Body;
 use crate::constraint::{ConstraintOut, Motion};
 
@@ -25,8 +26,7 @@ impl RotationDriver {
     pub const AXES: [u8; 2] = [0b011, 0b001];
 
     #[inline]
-    pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
-        let (si, sj) = self.pair.states_axes(bodies, q, qd, Self::AXES);
+    pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, t: f64, n: usize, out: &mut ConstraintOut) {
         let (f, fd, fdd) = self.motion.eval(t, out.scratch);
         let (sf, cf) = f.sin_cos();
         let (xi, yi, xj) = (&si.axes[0], &si.axes[1], &sj.axes[0]);
@@ -35,8 +35,8 @@ impl RotationDriver {
         let rho2 = s * s + c * c;
         let layout = Some(out.layout);
         let row = &mut out.jac[0..n];
-        prim::dot_jacobian(bodies, &si, yi, &sj, xj, c / rho2, row, layout);
-        prim::dot_jacobian(bodies, &si, xi, &sj, xj, -s / rho2, row, layout);
+        prim::dot_jacobian(bodies, si, yi, sj, xj, c / rho2, row, layout);
+        prim::dot_jacobian(bodies, si, xi, sj, xj, -s / rho2, row, layout);
         if let Some(p) = out.phi.as_deref_mut() {
             p[0] = (s * cf - c * sf).atan2(s * sf + c * cf);
         }
@@ -67,13 +67,12 @@ impl TranslationDriver {
     pub const AXES: [u8; 2] = [0b100, 0];
 
     #[inline]
-    pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
-        let (si, sj) = self.pair.states_axes(bodies, q, qd, Self::AXES);
+    pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, t: f64, n: usize, out: &mut ConstraintOut) {
         let (f, fd, fdd) = self.motion.eval(t, out.scratch);
         let a = &si.axes[2];
-        let (v, _, h) = prim::dot2_terms(a, &si, &sj);
+        let (v, _, h) = prim::dot2_terms(a, si, sj);
         let layout = Some(out.layout);
-        prim::dot2_jacobian(bodies, a, &si, &sj, 1.0, &mut out.jac[0..n], layout);
+        prim::dot2_jacobian(bodies, a, si, sj, 1.0, &mut out.jac[0..n], layout);
         if let Some(p) = out.phi.as_deref_mut() {
             p[0] = v - f;
         }

@@ -19,7 +19,7 @@ pub mod revolute;
 pub mod spherical;
 pub mod universal;
 
-use crate::body::marker3::{Marker3, Marker3State, ALL_AXES};
+use crate::body::marker3::{Frame3, Marker3, Marker3State, ALL_AXES};
 use crate::body::{Body, Marker};
 use crate::constraint::ConstraintOut;
 use crate::error::{Error, Result};
@@ -55,14 +55,39 @@ impl Pair {
 
     #[inline]
     pub fn states(&self, bodies: &[Body], q: &[f64], qd: &[f64]) -> (Marker3State, Marker3State) {
-        self.states_axes(bodies, q, qd, [ALL_AXES; 2])
+        self.states_axes(bodies, &[], q, qd, [ALL_AXES; 2])
+    }
+
+    /// `states_axes` written into `st` (`Marker3::state_into`).
+    #[inline]
+    pub fn states_into(&self, st: &mut [Marker3State; 2], bodies: &[Body], frames: &[Frame3], q: &[f64], qd: &[f64], axes: [u8; 2]) {
+        self.i.state_into(&mut st[0], bodies, frames, q, qd, axes[0]);
+        self.j.state_into(&mut st[1], bodies, frames, q, qd, axes[1]);
     }
 
     /// The states with only the axes a kind reads (`AXES`: bit `k` of `axes[0]` for axis `k`
-    /// of `i`, of `axes[1]` for `j`).
+    /// of `i`, of `axes[1]` for `j`), the bodies' rotations from `frames` (`Marker3::state_in`).
     #[inline]
-    pub fn states_axes(&self, bodies: &[Body], q: &[f64], qd: &[f64], axes: [u8; 2]) -> (Marker3State, Marker3State) {
-        (self.i.state_axes(bodies, q, qd, axes[0]), self.j.state_axes(bodies, q, qd, axes[1]))
+    pub fn states_axes(&self, bodies: &[Body], frames: &[Frame3], q: &[f64], qd: &[f64], axes: [u8; 2]) -> (Marker3State, Marker3State) {
+        (self.i.state_in(bodies, frames, q, qd, axes[0]), self.j.state_in(bodies, frames, q, qd, axes[1]))
+    }
+}
+
+/// `f(si, sj, out)` with the pair's marker states (the axes in `axes`), written into the
+/// model's buffer with the bodies' cached rotations (`ConstraintOut::marker3`: no state zeroed
+/// or moved per call; by value without one).
+#[inline(always)]
+fn with_states(pair: &Pair, axes: [u8; 2], bodies: &[Body], q: &[f64], qd: &[f64], out: &mut ConstraintOut, f: impl FnOnce(&Marker3State, &Marker3State, &mut ConstraintOut)) {
+    match out.marker3.take() {
+        Some(w) => {
+            pair.states_into(&mut w.states, bodies, &w.frames, q, qd, axes);
+            f(&w.states[0], &w.states[1], out);
+            out.marker3 = Some(w);
+        }
+        None => {
+            let (si, sj) = pair.states_axes(bodies, &[], q, qd, axes);
+            f(&si, &sj, out);
+        }
     }
 }
 
@@ -99,12 +124,9 @@ macro_rules! spatial_kinds {
             #[inline(never)]
             pub fn eval(&self, bodies: &[Body], t: f64, q: &[f64], qd: &[f64], n: usize, out: &mut ConstraintOut) {
                 match self {
-                    $(SpatialConstraint::$variant(c) => {
-                        let (si, sj) = c.pair.states_axes(bodies, q, qd, <$ty>::AXES);
-                        c.eval(bodies, &si, &sj, n, out)
-                    })*
-                    SpatialConstraint::Rotation(c) => c.eval(bodies, t, q, qd, n, out),
-                    SpatialConstraint::Translation(c) => c.eval(bodies, t, q, qd, n, out),
+                    $(SpatialConstraint::$variant(c) => with_states(&c.pair, <$ty>::AXES, bodies, q, qd, out, |si, sj, out| c.eval(bodies, si, sj, n, out)),)*
+                    SpatialConstraint::Rotation(c) => with_states(&c.pair, RotationDriver::AXES, bodies, q, qd, out, |si, sj, out| c.eval(bodies, si, sj, t, n, out)),
+                    SpatialConstraint::Translation(c) => with_states(&c.pair, TranslationDriver::AXES, bodies, q, qd, out, |si, sj, out| c.eval(bodies, si, sj, t, n, out)),
                     SpatialConstraint::Normalization(c) => c.eval(bodies, q, qd, n, out),
                 }
             }

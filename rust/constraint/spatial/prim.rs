@@ -4,7 +4,7 @@
 //! the row's second derivative; `Phi_t = 0`). The product rule gives them all:
 //! `s = u . w`: `J_s = w^T J_u + u^T J_w`, `sd = u . wd + w . ud`, `h_s = u . h_w + w . h_u + 2 ud . wd`.
 
-use crate::body::marker3::{add_jacobian, Kin3, Marker3State};
+use crate::body::marker3::{add_jacobian, add_point_rows, Kin3, Marker3State};
 use crate::body::Body;
 use crate::constraint::ConstraintOut;
 use crate::linalg::rot3::{dot, scale, sub, V3};
@@ -57,13 +57,10 @@ fn put(out: &mut ConstraintOut, k: usize, value: f64, h: f64) {
 #[inline]
 pub fn coincidence(bodies: &[Body], si: &Marker3State, sj: &Marker3State, n: usize, out: &mut ConstraintOut, k: usize) {
     let (d, _, hd) = separation(si, sj);
+    let rows = &mut out.jac[k * n..(k + 3) * n];
+    add_point_rows(bodies, sj, 1.0, rows, n, out.layout);
+    add_point_rows(bodies, si, -1.0, rows, n, out.layout);
     for c in 0..3 {
-        let mut e = [0.0; 3];
-        e[c] = 1.0;
-        let layout = Some(out.layout);
-        let row = &mut out.jac[(k + c) * n..(k + c + 1) * n];
-        add_jacobian(bodies, sj, &sj.point, &e, row, layout);
-        add_jacobian(bodies, si, &si.point, &scale(-1.0, &e), row, layout);
         put(out, k + c, d[c], hd[c]);
     }
 }
