@@ -240,22 +240,24 @@ impl GenAlpha {
         if !self.newton.as_mut().expect("GENALPHA: init first").read_stiff(sys, &self.q_new, &self.qd_new)? {
             return Err(Error::argument("method", "GENALPHA needs a system with a structured Jacobian (mass, stiffness, constraints)"));
         }
-        self.factor(h)
+        self.factor(h, sys.conditioning_rank() < sys.n_constraints())
     }
 
-    /// Assemble and factor `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]` for step `h`.
-    fn factor(&mut self, h: f64) -> Result<()> {
+    /// Assemble and factor `[M + gamma' C + beta' K, A^T; A - gamma' db/dqd, 0]` for step `h`;
+    /// regularized at once when `deficient` (the UK solve's rank below m: the LU may keep a
+    /// rounding pivot of the singular matrix, `RadauM::factor`).
+    fn factor(&mut self, h: f64, deficient: bool) -> Result<()> {
         self.st.stats.nlu += 1;
         self.lu_h = h;
         let (bp, gp) = self.primes(h);
         let nw = self.newton.as_mut().expect("GENALPHA: init first");
-        if nw.factor_real(bp, gp, 0.0) {
+        if !deficient && nw.factor_real(bp, gp, 0.0) {
             return Ok(());
         }
         // redundant constraint rows make the saddle-point matrix singular: regularize the
         // multiplier block (the correction dx is unaffected where A has full row rank)
         let scale = nw.mass_scale();
-        self.st.stats.nlu += 1;
+        self.st.stats.nlu += usize::from(!deficient);
         if !nw.factor_real(bp, gp, -1e-12 * scale) {
             return Err(Error::Solver(format!("GENALPHA: iteration matrix singular at t = {}", self.st.t)));
         }
@@ -451,7 +453,7 @@ impl Stepper for GenAlpha {
                 initial_step_second_order(sys, t0, y0, &self.qdd, self.opts.rtol, &self.atol, 2, hmax, &mut self.st.stats.nfev)?
             }
         };
-        self.factor(self.st.h)?;
+        self.factor(self.st.h, sys.conditioning_rank() < sys.n_constraints())?;
         Ok(())
     }
 

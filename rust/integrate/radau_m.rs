@@ -313,12 +313,19 @@ impl RadauM {
             return Err(Error::argument("method", "RADAU5M needs a system with a structured Jacobian (mass, stiffness, constraints)"));
         }
         self.corot.set_reference(&self.qs[2]);
-        self.factor(h)
+        // the UK solve's rank at the last step's end: redundant rows (rank below m) make the
+        // saddle-point matrices singular
+        let deficient = sys.conditioning_rank() < self.m;
+        self.factor(h, deficient)
     }
 
     /// Assemble and factor the real and the complex iteration matrices for step `h`:
-    /// `[M + g C + g^2 K, A^T; A - g Bv, reg I]` with `g = h lambda` and `g = h mu`.
-    fn factor(&mut self, h: f64) -> Result<()> {
+    /// `[M + g C + g^2 K, A^T; A - g Bv, reg I]` with `g = h lambda` and `g = h mu`: `reg = 0`
+    /// first, unless `deficient` (the UK solve found redundant rows): then regularized at once.
+    /// A singular matrix is not always refused by the LU: rounding leaves pivots of 1e-33 to
+    /// 1e-26 of their column's scale where an exact elimination gives zero (the continuous-beam
+    /// lattice, docs/integrators.md "Redundant constraints"), and Newton diverges on them.
+    fn factor(&mut self, h: f64, deficient: bool) -> Result<()> {
         self.lu_h = h;
         self.st.stats.nlu += 2;
         let nw = self.newton.as_mut().expect("RADAU5M: init first");
@@ -327,7 +334,8 @@ impl RadauM {
         let (p, q) = (h * self.mu.0, h * self.mu.1);
         let (g2r, gr, gi) = (p * p - q * q, p, q);
         let g2i = 2.0 * gr * gi;
-        for reg in [0.0, -1e-12 * scale] {
+        let regs = [0.0, -1e-12 * scale];
+        for &reg in &regs[usize::from(deficient)..] {
             if nw.factor_real(g * g, g, reg) && nw.factor_complex(C64::new(g2r, g2i), C64::new(gr, gi), reg) {
                 return Ok(());
             }
