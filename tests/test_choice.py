@@ -187,11 +187,12 @@ def test_a_spinning_cable_does_not_reject_most_of_its_steps():
     assert res.extra["nreject"] < 0.03 * res.extra["naccept"], res.extra
 
 
-def _beam3_pendulum():
-    """A geometrically exact beam (4 elements: 35 coordinates, the dense analysis) on a spherical
-    joint, spun and falling: its elements, not its node bodies, are elastic."""
+def _beam3_pendulum(elements=4):
+    """A geometrically exact beam on a spherical joint, spun and falling: its elements, not its
+    node bodies, are elastic (4 elements: 35 coordinates, the dense analysis; 10 elements: 77
+    coordinates, the sparse analysis)."""
     s = ukflex.SpatialScene(gravity=(0, 0, -9.81))
-    bar = s.beam("bar", (0, 0, 0), (0.5, 0, 0), ukflex.Rectangular(0.02, 0.02), elements=4, density=7850,
+    bar = s.beam("bar", (0, 0, 0), (0.5, 0, 0), ukflex.Rectangular(0.02, 0.02), elements=elements, density=7850,
                  youngs_modulus=2.1e9, poisson_ratio=0.3, angular_velocity=(0, 0, 3))
     s.spherical(s.ground.marker((0, 0, 0)), bar.node(0))
     return s
@@ -268,16 +269,6 @@ def test_the_cores_decision_is_the_former_python_ones():
     assert methods >= {("DOPRI5", False), ("RADAU5M", True), ("RADAU5M", False)}, methods
 
 
-def _spun_bar():
-    """A geometrically exact bar of 10 elements on a spherical joint, spun and falling: 77
-    coordinates, the sparse analysis."""
-    s = ukflex.SpatialScene(gravity=(0, 0, -9.81))
-    bar = s.beam("bar", (0, 0, 0), (0.5, 0, 0), ukflex.Rectangular(0.02, 0.02), elements=10, density=7850,
-                 youngs_modulus=2.1e9, poisson_ratio=0.3, angular_velocity=(0, 0, 3))
-    s.spherical(s.ground.marker((0, 0, 0)), bar.node(0))
-    return s
-
-
 def test_auto_states_a_beam3_floor_within_3x_of_the_error_it_reaches():
     """A geometrically exact beam's rigid motion is its node chain's as one body, and its floor is
     read at the nodes (rust/integrate/choice/chains.rs): the spun falling pendulum on 4 elements
@@ -293,7 +284,7 @@ def test_auto_states_a_beam3_floor_within_3x_of_the_error_it_reaches():
     assert err / 3 < floor < 3 * err, (floor, err)
     assert "whatever rtol" in runs[0].extra["auto"]["reason"]
 
-    system = ukflex.System(_spun_bar())
+    system = ukflex.System(_beam3_pendulum(elements=10))
     assert system.n_coords >= system.SPARSE_MODES_MIN
     sparse = choose_method(system, 0.0, 0.3, 1e-6)
     dense = system.core.auto_choice(0.0, system.q0, system.qd0, 0.3, 1e-6)
@@ -328,7 +319,7 @@ def test_the_floor_is_stated_when_read_and_is_the_choosers():
     assert auto["reason"] == full.reason + auto["reason"][len(full.reason):] and "; scipy Radau" in auto["reason"]
     assert auto["floor"] == full.floor and auto["floor_modes"] == full.floor_modes
     # a large system: the sparse analysis' modes, and the floor's dense spectrum when read
-    system = ukflex.System(_spun_bar())
+    system = ukflex.System(_beam3_pendulum(elements=10))
     auto = simulate(system, 0.3).extra["auto"]
     assert dict.__getitem__(auto, "floor") is None
     full = choose_method(system, 0.0, 0.3, 1e-6)
