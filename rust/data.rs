@@ -8,7 +8,7 @@ use faer::{Mat, Par};
 
 use crate::body::marker3::Marker3Work;
 use crate::body::BodyData;
-use crate::constraint::jac::SegJac;
+use crate::constraint::jac::{DenseJac, SegJac};
 use crate::model::Model;
 use crate::error::{Error, Result};
 use crate::linalg::small_svd::QrJacobi;
@@ -52,10 +52,10 @@ pub struct Data {
     pub phi: Vec<f64>,
     /// `A = Phi_q` in per-row segment form (always current after `dynamics::constraints`).
     pub ajac: SegJac,
-    /// `A = Phi_q`, m x n row-major: empty until `ensure_dense_jac` (the dense UK path, the
-    /// implicit integrators, `System.A`); once allocated, `dynamics::constraints` keeps it current.
-    pub jac: Vec<f64>,
-    pub dense_jac: bool,
+    /// `A = Phi_q`, m x n row-major: none until `ensure_dense_jac` (the dense UK path, the
+    /// implicit integrators, `System.A`); once allocated, read through `jac.read(&ajac)` (or
+    /// `dense_jac`), which scatters the segment form when `dynamics::constraints` changed it.
+    pub jac: DenseJac,
     /// `Phi_t` (m).
     pub phi_t: Vec<f64>,
     /// `b = gamma` (m).
@@ -162,8 +162,7 @@ impl Data {
             force: vec![0.0; n],
             phi: vec![0.0; m],
             ajac,
-            jac: Vec::new(),
-            dense_jac: false,
+            jac: DenseJac::default(),
             phi_t: vec![0.0; m],
             gamma: vec![0.0; m],
             motion_scratch: vec![0.0; model.constraints.iter().map(|c| c.scratch_len()).max().unwrap_or(0)],
@@ -232,20 +231,24 @@ impl Data {
         Ok(())
     }
 
-    /// Allocate the dense `m x n` copy of `A` (`jac`) if it is not there yet, filled from the
-    /// segment form; from then on `dynamics::constraints` keeps it current. Refused (before
+    /// Allocate the dense `m x n` copy of `A` (`jac`) if it is not there yet; each read
+    /// (`dense_jac`, `jac.read`) returns the segment form as it is then. Refused (before
     /// allocating) above `memory_limit`.
     pub fn ensure_dense_jac(&mut self) -> Result<()> {
-        if self.dense_jac {
+        if self.jac.is_on() {
             return Ok(());
         }
         let (m, n) = (self.ajac.m, self.ajac.n);
         let hint = "the dense m x n constraint Jacobian is this large; use DOPRI5 with uk_solver='sparse' for a long chain or rope, or raise memory_limit";
         Error::check_memory("the dense constraint Jacobian A (m x n)", 8 * m as u64 * n as u64, self.memory_limit, hint)?;
-        self.jac = vec![0.0; m * n];
-        self.ajac.scatter(&mut self.jac);
-        self.dense_jac = true;
+        self.jac.allocate(m, n);
         Ok(())
+    }
+
+    /// The dense `A` (m x n row-major) of the last `dynamics::constraints` (allocated by
+    /// `ensure_dense_jac`; empty before).
+    pub fn dense_jac(&mut self) -> &[f64] {
+        self.jac.read(&self.ajac)
     }
 
     /// Which UK path the last factorization took: "sparse" or "dense" (or "none").

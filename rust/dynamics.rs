@@ -81,19 +81,21 @@ pub fn apply_finv_sparse(model: &Model, bodies: &[BodyData], v: &mut [f64]) {
     }
 }
 
-/// Constraint terms: `A` (in segment form, `data.ajac`; also the dense `data.jac` when that
-/// exists), `Phi_t`, `gamma`, and `Phi` when `with_phi`. O(nnz(A)): no pass over `m x n`.
+/// Constraint terms: `A` (in segment form, `data.ajac`; the dense `data.jac`, when allocated,
+/// is scattered from it when read), `Phi_t`, `gamma`, and `Phi` when `with_phi`. O(nnz(A)): no
+/// pass over `m x n`.
 pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64], with_phi: bool) {
     // spatial rows compute their value anyway: keep it, it sets the rank tolerance (uk::dense)
     let with_phi = with_phi || data.spatial_drift.is_some();
     if let Some(w) = data.marker3.as_deref_mut() {
         crate::body::marker3::Frame3::fill(&model.bodies, q, qd, &mut w.frames);
     }
+    // the kernels add into zeroed rows: one fill for all (not one call per constraint)
+    data.ajac.vals.fill(0.0);
     for (k, c) in model.constraints.iter().enumerate() {
         let rows = c.rows();
         let r0 = c.row;
         let (vals, layout, width) = data.ajac.constraint_block(k, r0, rows);
-        vals.fill(0.0);
         let out = ConstraintOut {
             phi: if with_phi { Some(&mut data.phi[r0..r0 + rows]) } else { None },
             jac: vals,
@@ -108,10 +110,7 @@ pub fn constraints(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f64]
     if let Some(d) = data.spatial_drift.as_mut() {
         *d = data.phi.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
     }
-    if data.dense_jac {
-        // entries outside the pattern were zeroed at allocation and are never written
-        data.ajac.scatter(&mut data.jac);
-    }
+    data.jac.invalidate();
 }
 
 /// Dense mass matrix (n x n, row-major) from the body blocks of the last `mass_and_forces`

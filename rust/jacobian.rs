@@ -272,11 +272,11 @@ impl StructuredJacobian {
         dynamics::stiffness_into(model, data, q, qd, &mut self.k);
         data.ensure_dense_jac()?;
         dynamics::constraints(model, data, t, q, qd, false);
-        self.assemble_saddle(&data.jac, n, m, 0.0);
+        self.assemble_saddle(data.jac.read(&data.ajac), n, m, 0.0);
         if !lu_cm(&mut self.saddle, &mut self.piv, nm) {
             // redundant constraint rows: the multiplier block, slightly regularized
             let scale = self.m_dense.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(f64::MIN_POSITIVE);
-            self.assemble_saddle(&data.jac, n, m, -1e-12 * scale);
+            self.assemble_saddle(data.jac.read(&data.ajac), n, m, -1e-12 * scale);
             if !lu_cm(&mut self.saddle, &mut self.piv, nm) {
                 return Err(crate::error::Error::Solver("structured Jacobian: the saddle-point matrix is singular".into()));
             }

@@ -373,7 +373,8 @@ fn pseudoinverse_backends_agree_including_redundant_rows() {
             assert!(e < 1e-10, "{backend:?}: qdd differs by {e:e}");
             // multipliers of dependent rows are not unique: compare A^T lambda (the forces)
             let n = model.n;
-            let force = |l: &[f64]| -> Vec<f64> { (0..n).map(|j| (0..model.m).map(|i| data.jac[i * n + j] * l[i]).sum()).collect() };
+            let a = data.dense_jac().to_vec();
+            let force = |l: &[f64]| -> Vec<f64> { (0..n).map(|j| (0..model.m).map(|i| a[i * n + j] * l[i]).sum()).collect() };
             let (f, f0) = (force(lam), force(lam0));
             let e = f.iter().zip(&f0).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / max_abs(&f0);
             assert!(e < 1e-9, "{backend:?}: constraint forces differ by {e:e}");

@@ -151,7 +151,7 @@ fn sparse_workspace_keeps_no_dense_jacobian_and_reports_the_certificate() {
     let (q, qd) = chain_state(&model, &mut rng);
     uk::acceleration(&model, &mut sp, 0.0, &q, &qd).unwrap();
     assert_eq!(sp.factored_with, Factored::SparseGram);
-    assert!(sp.jac.is_empty() && !sp.dense_jac && !sp.dense_ready, "no m x n buffer on the sparse path");
+    assert!(!sp.jac.is_on() && !sp.dense_ready, "no m x n buffer on the sparse path");
     assert_eq!(sp.ajac.nnz(), 2 * 1024 * 6 - 2 * 3, "two rigid bodies per row, one at the pivot");
     // the residual A qdd - b of the solve, from the segment form
     let (mut p, mut v, mut a) = (vec![0.0; model.m], vec![0.0; model.m], vec![0.0; model.m]);
@@ -162,7 +162,7 @@ fn sparse_workspace_keeps_no_dense_jacobian_and_reports_the_certificate() {
     // above EXACT_RANK_MAX_ROWS: the certified report, no dense SVD
     let info = uk::exact_rank_info(&model, &mut sp).unwrap();
     assert!(!info.exact && info.rank == model.m && info.sigma_min_kept > info.tolerance);
-    assert!(!sp.dense_ready && sp.jac.is_empty());
+    assert!(!sp.dense_ready && !sp.jac.is_on());
     // at or below it: the exact values (the dense SVD on demand), which the bounds enclose
     let small = Model::from_json(&chain_scene(64)).unwrap();
     let mut s2 = data(&small, UkSolver::Sparse);
@@ -200,5 +200,5 @@ fn baumgarte_and_state_correction_agree_on_both_paths() {
     assert!(cs.position_residual_after <= 1e-12 && cs.velocity_residual_after <= 1e-12);
     assert!(rel_diff(&cs.q, &cd.q) <= 1e-9, "corrected q differ by {:e}", rel_diff(&cs.q, &cd.q));
     assert!(rel_diff(&cs.qd, &cd.qd) <= 1e-9, "corrected qd differ by {:e}", rel_diff(&cs.qd, &cd.qd));
-    assert!(!sp.dense_ready && sp.jac.is_empty(), "the correction stayed on the sparse path");
+    assert!(!sp.dense_ready && !sp.jac.is_on(), "the correction stayed on the sparse path");
 }

@@ -8,9 +8,10 @@
 //! pieces back to columns of `A`. A chain of K links has 6 values per row (two rigid bodies),
 //! 12 K values in all, instead of the dense `m x n = 6 K^2`.
 //!
-//! The dense `m x n` copy (`Data::jac`) exists only when something needs it (the dense UK path,
-//! the implicit integrators' Newton matrices, `System.A`): `dynamics::constraints` scatters into
-//! it after filling this form.
+//! The dense `m x n` copy (`Data::jac`, a `DenseJac`) exists only when something needs it (the
+//! dense UK path, the implicit integrators' Newton matrices, `System.A`), and is scattered from
+//! this form when it is read after `dynamics::constraints` changed it (`DenseJac::read`): a
+//! call whose kernels read only the segment form (the spatial Gram path) pays nothing for it.
 
 use super::Constraint;
 use crate::body::Body;
@@ -135,5 +136,48 @@ impl SegJac {
     pub fn constraint_block(&mut self, k: usize, first_row: usize, rows: usize) -> (&mut [f64], &[(usize, usize)], usize) {
         let (a, b) = (self.row_ptr[first_row], self.row_ptr[first_row + rows]);
         (&mut self.vals[a..b], &self.layouts[k], self.widths[k])
+    }
+}
+
+/// The dense row-major `m x n` copy of `A`, built from the segment form when read: its values
+/// are private, so no reader sees a copy older than the last `dynamics::constraints`.
+#[derive(Debug, Clone, Default)]
+pub struct DenseJac {
+    vals: Vec<f64>,
+    on: bool,
+    /// The values match the segment form (no `dynamics::constraints` since the last scatter).
+    current: bool,
+}
+
+impl DenseJac {
+    /// Allocated (`Data::ensure_dense_jac`).
+    #[inline]
+    pub fn is_on(&self) -> bool {
+        self.on
+    }
+
+    /// Allocate the `m x n` zeros (entries outside the pattern stay zero for ever); the stored
+    /// entries are scattered at the first read.
+    pub fn allocate(&mut self, m: usize, n: usize) {
+        self.vals = vec![0.0; m * n];
+        self.on = true;
+        self.current = false;
+    }
+
+    /// The segment form was rewritten (`dynamics::constraints`): the next read scatters it.
+    #[inline]
+    pub fn invalidate(&mut self) {
+        self.current = false;
+    }
+
+    /// `A`, m x n row-major, as the segment form `ajac` holds it now (scattered here if it
+    /// changed since the last read); empty when not allocated.
+    #[inline]
+    pub fn read(&mut self, ajac: &SegJac) -> &[f64] {
+        if self.on && !self.current {
+            ajac.scatter(&mut self.vals);
+            self.current = true;
+        }
+        &self.vals
     }
 }

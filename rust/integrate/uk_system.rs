@@ -317,7 +317,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         data.ensure_dense_jac()?;
         dynamics::dense_mass_into(model, data, m);
         dynamics::stiffness_into(model, data, q, qd, k);
-        a.copy_from_slice(&data.jac);
+        a.copy_from_slice(data.jac.read(&data.ajac));
         let n = model.n;
         self.move_damping(q, qd, &mut |i, j, v| c[i * n + j] += v);
         Ok(true)
@@ -373,7 +373,7 @@ impl SecondOrderSystem for UkSystem<'_> {
         dynamics::dense_mass_into(model, data, m);
         dynamics::tangent_into(model, data, q, qd, k, c);
         dynamics::constraints(model, data, t, q, qd, false);
-        a.copy_from_slice(&data.jac);
+        a.copy_from_slice(data.jac.read(&data.ajac));
         let vpat = self.vpat.get_or_insert_with(|| Pattern::new(model, &data.ajac, false, data.memory_limit).ok());
         match vpat {
             Some(p) => dense_velocity_terms(model, data, t, q, qd, p, &mut self.pws.v, c, bv),

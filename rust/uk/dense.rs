@@ -21,7 +21,7 @@ pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
     // B^T = F^-1 A^T, column by column
     for i in 0..m {
         let col = data.bt.col_as_slice_mut(i);
-        col.copy_from_slice(&data.jac[i * n..(i + 1) * n]);
+        col.copy_from_slice(&data.jac.read(&data.ajac)[i * n..(i + 1) * n]);
         apply_finv_sparse(model, &data.bodies, col);
     }
     let rcond = data.tolerance.rcond_at(n, m, data.spatial_drift);

@@ -45,7 +45,7 @@ fn check(text: &str, what: &str) {
     let t = 0.37;
     let eval = |data: &mut Data, t: f64, q: &[f64], qd: &[f64]| {
         dynamics::constraints(&model, data, t, q, qd, true);
-        (data.phi.clone(), data.jac.clone(), data.phi_t.clone(), data.gamma.clone())
+        (data.phi.clone(), data.dense_jac().to_vec(), data.phi_t.clone(), data.gamma.clone())
     };
     let (_phi, a, phi_t, gamma) = eval(&mut data, t, &q, &qd);
     let h = 1e-6;
