@@ -22,6 +22,11 @@ use crate::linalg::rot3::{add, col, cross, frame_from_z, m34_t_vec, m34_vec, mat
 /// Every axis (`Marker3::state_axes`).
 pub const ALL_AXES: u8 = 0b111;
 
+/// Bit 3 of an axes mask: the point's rate `vd` is not read (a joint whose rows use the
+/// points only through their coincidence: its `vd` is left NaN on a rigid3 body, where it
+/// costs a 3 x 4 product).
+pub const NO_POINT_RATE: u8 = 0b1000;
+
 #[derive(Debug, Clone)]
 pub struct Marker3 {
     pub base: Marker,
@@ -75,7 +80,8 @@ pub struct Frame3 {
 
 /// The joint rows' marker workspace (`Data::marker3`): each body's `Frame3` at the state of the
 /// last `dynamics::constraints`, and the two states of the joint being evaluated
-/// (`Marker3::state_into` writes every field: nothing of a previous joint is read).
+/// (`Marker3::state_into` writes every field its readers read: nothing of a previous joint is
+/// read).
 #[derive(Debug, Clone)]
 pub struct Marker3Work {
     pub frames: Vec<Frame3>,
@@ -180,7 +186,7 @@ impl Marker3 {
     }
 
     /// Kinematics at `(q, qd)` of the point and of the axes in `axes` (bit `k`: axis `k`); the
-    /// other axes are left zero. A joint kind names the axes its rows read (`AXES`), so that a
+    /// other axes are not computed (`state_into`). A joint kind names the axes its rows read (`AXES`), so that a
     /// spherical joint computes no axis at all.
     #[inline]
     pub fn state_axes(&self, bodies: &[Body], q: &[f64], qd: &[f64], axes: u8) -> Marker3State {
@@ -197,34 +203,53 @@ impl Marker3 {
         st
     }
 
-    /// `state_in` written into `st`: every field of `st` is written (what it held before is
-    /// never read), so a caller's buffer is reused without being zeroed or moved.
+    /// `state_in` written into `st`, field by field: what a reader of this marker reads is
+    /// written (never zeroed first and overwritten), so a caller's buffer is reused as it is.
+    /// Written: `body`, `rigid`, `iface`; of the point and of each axis in `axes`, `v`, `vd`,
+    /// `h`, `jr`, `flex`, and `jp` on a rigid3 / flexible3 body; `c` and `rot` on a flexible3
+    /// body only (read only with `flex != 0`). An axis not in `axes` gets `v = NaN` and nothing
+    /// else: a kind that read an axis it did not name in `AXES` would give NaN rows; the same
+    /// for the point's `vd` on a rigid3 body with `NO_POINT_RATE` in `axes`.
     #[inline]
     pub fn state_into(&self, st: &mut Marker3State, bodies: &[Body], frames: &[Frame3], q: &[f64], qd: &[f64], axes: u8) {
         st.body = self.body;
         st.rigid = self.rigid;
         st.iface = self.iface;
-        st.rot = [[0.0; 3]; 3];
-        for k in 0..3 {
-            let ax = &mut st.axes[k];
-            *ax = Kin3::default();
-            if axes & (1 << k) != 0 {
+        let fixed_axes = |st: &mut Marker3State| {
+            for k in 0..3 {
+                let ax = &mut st.axes[k];
+                if axes & (1 << k) == 0 {
+                    ax.v = [f64::NAN; 3];
+                    continue;
+                }
                 ax.v = col(&self.c, k);
+                ax.vd = [0.0; 3];
+                ax.h = [0.0; 3];
+                ax.jr = 0.0;
+                ax.flex = 0;
             }
-        }
-        let pt = &mut st.point;
-        *pt = Kin3::default();
+        };
         let Some(bi) = self.body else {
+            let pt = &mut st.point;
             pt.v = self.s;
+            pt.vd = [0.0; 3];
+            pt.h = [0.0; 3];
+            pt.jr = 0.0;
+            pt.flex = 0;
+            fixed_axes(st);
             return;
         };
         let o = bodies[bi].offset;
         let r = [q[o], q[o + 1], q[o + 2]];
         let rd = [qd[o], qd[o + 1], qd[o + 2]];
-        pt.jr = 1.0;
         if !self.rigid {
+            let pt = &mut st.point;
             pt.v = r;
             pt.vd = rd;
+            pt.h = [0.0; 3];
+            pt.jr = 1.0;
+            pt.flex = 0;
+            fixed_axes(st);
             return;
         }
         let (p, pd) = (&q[o + 3..o + 7], &qd[o + 3..o + 7]);
@@ -240,21 +265,27 @@ impl Marker3 {
             return self.flexible_state(st, k, f, fr, r, rd, q, qd, o, axes);
         }
         let (a, ad) = (&fr.a, &fr.ad);
+        let pt = &mut st.point;
         pt.jp = rot_b(p, &self.s);
         pt.v = add(&r, &mat_vec(a, &self.s));
-        pt.vd = add(&rd, &m34_vec(&pt.jp, pd));
+        pt.vd = if axes & NO_POINT_RATE == 0 { add(&rd, &m34_vec(&pt.jp, pd)) } else { [f64::NAN; 3] };
         pt.h = scale(2.0, &mat_vec(ad, &self.s));
+        pt.jr = 1.0;
+        pt.flex = 0;
         for k in 0..3 {
+            let ax = &mut st.axes[k];
             if axes & (1 << k) == 0 {
+                ax.v = [f64::NAN; 3];
                 continue;
             }
             let ck = col(&self.c, k);
             // `quad_term(pd, ck)` with `A(pd)` computed once per body
-            let ax = &mut st.axes[k];
             ax.jp = rot_b(p, &ck);
             ax.v = mat_vec(a, &ck);
             ax.vd = m34_vec(&ax.jp, pd);
             ax.h = scale(2.0, &mat_vec(ad, &ck));
+            ax.jr = 0.0;
+            ax.flex = 0;
         }
     }
 
@@ -273,6 +304,7 @@ impl Marker3 {
         st.point = Kin3 { v: add(&r, &mat_vec(&a, &s)), vd, h, jr: 1.0, jp, flex: 1, c: [0.0; 3] };
         for kx in 0..3 {
             if axes & (1 << kx) == 0 {
+                st.axes[kx].v = [f64::NAN; 3];
                 continue;
             }
             let ck = col(&self.c, kx);

@@ -11,7 +11,7 @@
 //! * translation of `P_j` along `z_i`: `Phi = z_i . d - f`, `Phi_t = -f'`, `gamma = -h + f''`.
 
 use super::{prim, Pair};
-use crate::body::marker3::Marker3State;
+use crate::body::marker3::{Marker3State, NO_POINT_RATE};
 use crate::body::Body;
 use crate::constraint::{ConstraintOut, Motion};
 
@@ -22,8 +22,8 @@ pub struct RotationDriver {
 }
 
 impl RotationDriver {
-    /// The marker axes its row reads (`x_i`, `y_i`; `x_j`).
-    pub const AXES: [u8; 2] = [0b011, 0b001];
+    /// The marker axes its row reads (`x_i`, `y_i`; `x_j`); not the points' rates.
+    pub const AXES: [u8; 2] = [0b011 | NO_POINT_RATE, 0b001 | NO_POINT_RATE];
 
     #[inline]
     pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, t: f64, n: usize, out: &mut ConstraintOut) {

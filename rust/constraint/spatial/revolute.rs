@@ -1,7 +1,7 @@
 //! Revolute joint about the markers' `z` axes (5 rows): `d = 0`, `x_i . z_j = 0`, `y_i . z_j = 0`.
 
 use super::{prim, Pair};
-use crate::body::marker3::Marker3State;
+use crate::body::marker3::{Marker3State, NO_POINT_RATE};
 use crate::body::Body;
 use crate::constraint::ConstraintOut;
 
@@ -12,8 +12,8 @@ pub struct Revolute3 {
 
 impl Revolute3 {
     pub const ROWS: &'static [&'static str] = &["x", "y", "z", "xz", "yz"];
-    /// The marker axes its rows read (x_i, y_i; z_j).
-    pub const AXES: [u8; 2] = [0b011, 0b100];
+    /// The marker axes its rows read (x_i, y_i; z_j); not the points' rates.
+    pub const AXES: [u8; 2] = [0b011 | NO_POINT_RATE, 0b100 | NO_POINT_RATE];
 
     #[inline]
     pub fn eval(&self, bodies: &[Body], si: &Marker3State, sj: &Marker3State, n: usize, out: &mut ConstraintOut) {
