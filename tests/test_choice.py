@@ -243,16 +243,6 @@ def test_the_cores_decision_is_the_former_python_ones():
             where = (label, rtol, new, old)
             assert new.method == old.method and new.options.keys() == old.options.keys(), where
             reason, keys = new.reason, ("step", "omega_elastic", "omega_max", "rtol")
-            balanced = new.step_rtol is not None
-            if balanced:
-                # changed on purpose (round i26-bal): a start at rest with constant loads and no
-                # driver gets the step balanced against its floor (docs/integrators.md, round
-                # i26-bal); the former
-                # step is the rtol step it starts from, and the floor is read at the longer step
-                assert label.startswith(("pinned", "cantilever")) and new.step > new.step_rtol == pytest.approx(old.step, rel=1e-6), where
-                head, _, tail = reason.partition("; balanced against the floor")
-                reason = head + tail[tail.index(" s)") + 3:]
-                keys = tuple(k for k in keys if k != "step")
             if new.method == "DOPRI5":
                 # new in the core (not a former decision): DOPRI5 runs at DOPRI5_RTOL_PER_RTOL rtol
                 assert old.rtol is None and new.rtol == pytest.approx(DOPRI5_RTOL_PER_RTOL * rtol, rel=1e-12), where
@@ -270,7 +260,7 @@ def test_the_cores_decision_is_the_former_python_ones():
                 a, b = getattr(new, key), getattr(old, key)
                 assert (a is None) == (b is None) and (a is None or a == pytest.approx(b, rel=1e-6)), (key, where)
             assert (new.floor is None) == (old.floor is None), where
-            if old.floor is not None and not label.startswith("beam3") and not balanced:
+            if old.floor is not None and not label.startswith("beam3"):
                 assert new.floor == pytest.approx(old.floor, rel=1e-3, abs=1e-15), where
                 assert len(new.floor_modes) == len(old.floor_modes), where
                 for a, b in zip(new.floor_modes, old.floor_modes):

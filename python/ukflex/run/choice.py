@@ -88,7 +88,6 @@ FIRST_MODES = int(_core.AUTO["FIRST_MODES"])
 FLOOR_DENSE_MAX = int(_core.AUTO["FLOOR_DENSE_MAX"])
 DOPRI5_RTOL_PER_RTOL = _core.AUTO["DOPRI5_RTOL_PER_RTOL"]
 FLOOR_POINTS = tuple(_core.AUTO["FLOOR_POINTS"])
-BALANCE_SLACK = _core.AUTO["BALANCE_SLACK"]
 
 
 @dataclass
@@ -101,11 +100,6 @@ class MethodChoice:
     omega_elastic: Optional[float] = None
     omega_max: float = 0.0
     step: Optional[float] = None
-    #: the step that resolves the lowest elastic mode to rtol's amplitude budget, where ``step``
-    #: is longer: balanced against the floor (the start alone sets the modes off, and the longer
-    #: step leaves the history error within ``BALANCE_SLACK`` of this one's;
-    #: ``rust/integrate/choice/balance.rs``)
-    step_rtol: Optional[float] = None
     #: the integrator's rtol when it differs from the user's
     rtol: Optional[float] = None
     #: RADAU5M's error floor [m]: the fast modes the initial state sets off, which its step damps
@@ -269,14 +263,8 @@ def _stated(d: Dict[str, Any], span: float) -> MethodChoice:
                     f"damped: the history stays ~{d['floor']:.1e} m off at a body point whatever rtol "
                     "(method='DOPRI5' keeps them)")
         floor = {} if d["floor"] is None else {"floor": d["floor"], "floor_modes": [tuple(m) for m in d["floor_modes"]]}
-        h_rtol = d["step_rtol"]
-        if h_rtol is not None:
-            said = (f"; balanced against the floor: the run starts at rest with constant loads and no driver, so the "
-                    "start alone sets its modes off, and at this step their history error (the fast modes damped, the "
-                    f"resolved ones' loss) is within {BALANCE_SLACK:.0%} of the one at the step that resolves the "
-                    f"lowest elastic mode to rtol's budget ({h_rtol:.3g} s)") + said
         return MethodChoice(
-            "RADAU5M", options={"step": h}, omega_elastic=w_c, omega_max=w_max, step=h, step_rtol=h_rtol, rtol=d["rtol"], **floor,
+            "RADAU5M", options={"step": h}, omega_elastic=w_c, omega_max=w_max, step=h, rtol=d["rtol"], **floor,
             reason=(f"stiff: the step {h:.3g} s ({w_c * h:.2g} rad of the lowest elastic mode, {w_c:.4g} rad/s, "
                     f"amplitude loss {RADAU_DECAY * (w_c * h) ** 5 * w_c * span:.1e} over the run) is "
                     f"{h * w_max:.3g}/omega_max ({w_max:.4g} rad/s), beyond what an explicit method may take "

@@ -11,7 +11,7 @@ use crate::error::Error;
 use crate::integrate::choice::{self, AutoChoice, Spectrum};
 
 /// The decision as a dict: verdict, method (None when more modes are needed), omega_elastic,
-/// omega_max, step, step_rtol (the rtol step when `step` was balanced against the floor), newton_rtol, rtol (the integrator's, `choice::integrator_rtol`), phase, floor, floor_modes, overdamped (None or a dict omega,
+/// omega_max, step, newton_rtol, rtol (the integrator's, `choice::integrator_rtol`), phase, floor, floor_modes, overdamped (None or a dict omega,
 /// zeta, fast, h_explicit).
 fn choice_dict<'py>(py: Python<'py>, c: &AutoChoice, rtol: f64) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
@@ -20,7 +20,6 @@ fn choice_dict<'py>(py: Python<'py>, c: &AutoChoice, rtol: f64) -> PyResult<Boun
     d.set_item("omega_elastic", c.omega_elastic)?;
     d.set_item("omega_max", c.omega_max)?;
     d.set_item("step", c.step)?;
-    d.set_item("step_rtol", c.step_rtol)?;
     d.set_item("newton_rtol", c.newton_rtol)?;
     d.set_item("rtol", choice::integrator_rtol(c, rtol))?;
     d.set_item("phase", c.phase)?;
@@ -51,7 +50,7 @@ impl PySystem {
     /// `n_dof` alone the answer needs no spectrum (no degree of freedom, no elastic potential)
     /// or has `method` None (ask with a spectrum), and with a spectrum `verdict`
     /// "need_more_modes" asks for more modes. Returns a dict (verdict, method, omega_elastic,
-    /// omega_max, step, step_rtol (the rtol step when `step` was balanced against the floor), newton_rtol, rtol (the integrator's, `choice::integrator_rtol`), phase, floor, floor_modes, overdamped).
+    /// omega_max, step, newton_rtol, rtol (the integrator's, `choice::integrator_rtol`), phase, floor, floor_modes, overdamped).
     /// `floor=False` leaves out the floor of a fixed-step RADAU5M choice (floor None, no
     /// modes): it decides nothing, and `simulate` computes it when `res.extra["auto"]` is read.
     #[pyo3(signature = (t0, q, qd, t_end, rtol, n_dof=None, omega=None, shapes=None, omega_max=None, floor=true))]

@@ -28,9 +28,6 @@ use super::{SceneTraits, FLOOR_POINTS};
 /// A floor at most this share of the model's length scale is the round-off of a start that sets
 /// nothing off (1.7e-15 m on the right-angle cantilever, whose load starts from zero).
 const ROUND_OFF_FLOOR: f64 = 1e-12;
-/// The start is at rest when the rigidified acceleration is at most this share of the
-/// acceleration (mass norms): the mechanism held, the bodies' deformation alone moves.
-const AT_REST: f64 = 1e-6;
 
 #[derive(Clone, Copy)]
 struct C(f64, f64);
@@ -74,30 +71,9 @@ fn sample_steps(steps: f64) -> Vec<f64> {
     j
 }
 
-/// Up to this many steps [`history_error`] follows `R^j` and `exp(z j)` step by step (two complex
-/// products a step) instead of from moduli and phases at each sample (three `exp` and a `cos`):
-/// the balanced step ([`super::balance`]) evaluates the floor several times.
-const RECURRENCE_MAX: f64 = 512.0;
-
-/// `max_j |R(z)^j - exp(z j)|` over the sampled steps `j` (non-decreasing).
+/// `max_j |R(z)^j - exp(z j)|` over the sampled steps, from moduli and phases (real arithmetic).
 fn history_error(z: C, j: &[f64]) -> f64 {
     let r = radau_stability(z);
-    if j.last().is_some_and(|&last| last <= RECURRENCE_MAX) {
-        let ez = z.0.exp();
-        let e1 = C(ez * z.1.cos(), ez * z.1.sin());
-        let (mut p, mut e, mut k) = (C(1.0, 0.0), C(1.0, 0.0), 0.0);
-        let mut worst = f64::NEG_INFINITY;
-        for &jj in j {
-            while k < jj {
-                p = p.mul(r);
-                e = e.mul(e1);
-                k += 1.0;
-            }
-            let (dr, di) = (p.0 - e.0, p.1 - e.1);
-            worst = worst.max(dr * dr + di * di);
-        }
-        return worst.sqrt();
-    }
     let lr0 = r.0.hypot(r.1).ln();
     let dphase0 = r.1.atan2(r.0) - z.1;
     j.iter()
@@ -198,90 +174,50 @@ fn mode_displacements(model: &Model, q: &[f64], sp: &Spectrum, modes: &[usize]) 
     Ok(out)
 }
 
-/// What the start sets off, mode by mode: `(omega, lambda, modal amplitude, body point per unit)` of the
-/// fast modes (above `omega_c`: the floor) and of the resolved ones (at and below it, elastic or
-/// not, each `omega > 0`: what the step's own error on them is, [`Excitation::resolved`]).
-pub struct Excitation {
-    fast: Vec<(f64, C, f64, f64)>,
-    resolved: Vec<(f64, C, f64, f64)>,
-    /// The start at rest with the mechanism held (no velocity, no rigidified acceleration): the
-    /// motion is the modes' free vibration about the loads' equilibrium, which the start sets off
-    /// (with constant loads and no driver, [`SceneTraits::driven`], the only thing that does).
-    pub at_rest: bool,
-}
-
-impl Excitation {
-    /// The modes' start amplitudes at `(t0, q, qd)` (every mode of `sp`, a complete spectrum);
-    /// the resolved modes' only `resolved`.
-    pub fn new(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &[f64], qd: &[f64], sp: &Spectrum, omega_c: f64, resolved: bool) -> Result<Excitation> {
-        let n = model.n;
-        let is_fast = |k: usize| sp.omega[k] > omega_c * (1.0 + 1e-9);
-        let wanted = |k: usize| is_fast(k) || (resolved && sp.omega[k] > 0.0);
-        let mut ex = Excitation { fast: Vec::new(), resolved: Vec::new(), at_rest: false };
-        let modes: Vec<usize> = (0..sp.len()).filter(|&k| wanted(k)).collect();
-        if !modes.iter().any(|&k| is_fast(k)) {
-            return Ok(ex);
-        }
-        dynamics::mass_and_forces(model, data, t0, q, qd);
-        let mass = dynamics::dense_mass(model, data);
-        uk::acceleration(model, data, t0, q, qd)?;
-        let qdd = data.qdd.clone();
-        let rigid = rigidified_acceleration(model, data, t0, q, qd, &mass)?;
-        let excite: Vec<f64> = (0..n).map(|i| qdd[i] - rigid[i]).collect();
-        let mexc: Vec<f64> = (0..n).map(|i| (0..n).map(|j| mass[i * n + j] * excite[j]).sum()).collect();
-        let m_norm = |v: &[f64]| (0..n).map(|i| v[i] * (0..n).map(|j| mass[i * n + j] * v[j]).sum::<f64>()).sum::<f64>().max(0.0).sqrt();
-        ex.at_rest = qd.iter().all(|&v| v == 0.0) && m_norm(&rigid) <= AT_REST * m_norm(&qdd);
-        let zeta = if traits.damped { damping_ratios(model, data, t0, q, qd, sp, &mass, &wanted)? } else { vec![0.0; sp.len()] };
-        let d = mode_displacements(model, q, sp, &modes)?;
-        for (o, &k) in modes.iter().enumerate() {
-            let w = sp.omega[k];
-            let s = sp.mode(k);
-            let amp = (0..n).map(|i| s[i] * mexc[i]).sum::<f64>().abs() / (w * w);
-            let zt = zeta[k];
-            // the physical motion decays as exp(lambda t): under-damped, the oscillating root; over, the slow one
-            let disc = zt * zt - 1.0;
-            let lam = if disc >= 0.0 { C(w * (-zt + disc.sqrt()), 0.0) } else { C(-w * zt, w * (-disc).sqrt()) };
-            let part = (w, lam, amp, d[o]);
-            if is_fast(k) { ex.fast.push(part) } else { ex.resolved.push(part) }
-        }
-        Ok(ex)
-    }
-
-    /// The floor [m] at the fixed step `h` over `span` (largest displacement error of a beam
-    /// point) and its three largest contributions `(omega, amplitude of the body point, error)`.
-    pub fn floor(&self, model: &Model, h: f64, span: f64) -> (f64, Vec<[f64; 3]>) {
-        let j = sample_steps((span / h).ceil().max(1.0));
-        let parts: Vec<(f64, f64, f64)> = self.fast.iter().map(|&(w, lam, amp, d)| (w, amp * d, amp * history_error(lam.scale(h), &j) * d)).collect();
-        let total: f64 = parts.iter().map(|p| p.2).sum();
-        // what the start sets off is round-off (a load or a drive starting from rest): no floor
-        if total <= self.round_off(model) {
-            return (0.0, Vec::new());
-        }
-        let mut order: Vec<usize> = (0..parts.len()).collect();
-        order.sort_by(|&a, &b| parts[b].2.total_cmp(&parts[a].2));
-        let top = order.into_iter().take(3).filter(|&k| parts[k].2 > 0.0).map(|k| [parts[k].0, parts[k].1, parts[k].2]).collect();
-        (total, top)
-    }
-
-    fn round_off(&self, model: &Model) -> f64 {
-        ROUND_OFF_FLOOR * model.length_scale
-    }
-
-    /// The history error [m] of the fixed step `h` over `span` on the modes the start sets off:
-    /// the floor's sum (0 where it is round-off) and the step's own error on the resolved modes
-    /// (the same sum over the modes at and below `omega_c`).
-    pub fn history(&self, model: &Model, h: f64, span: f64) -> (f64, f64) {
-        let j = sample_steps((span / h).ceil().max(1.0));
-        let sum = |modes: &[(f64, C, f64, f64)]| modes.iter().map(|&(_, lam, amp, d)| amp * history_error(lam.scale(h), &j) * d).sum::<f64>();
-        let floor = sum(&self.fast);
-        (if floor <= self.round_off(model) { 0.0 } else { floor }, sum(&self.resolved))
-    }
-}
-
 /// The floor [m] (largest displacement error of a beam point) and its three largest
 /// contributions `(omega, amplitude of the body point, error)`.
 pub fn transient_floor(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &[f64], qd: &[f64], sp: &Spectrum, omega_c: f64, h: f64, span: f64) -> Result<(f64, Vec<[f64; 3]>)> {
-    Ok(Excitation::new(model, data, traits, t0, q, qd, sp, omega_c, false)?.floor(model, h, span))
+    let n = model.n;
+    let fast: Vec<usize> = (0..sp.len()).filter(|&k| sp.omega[k] > omega_c * (1.0 + 1e-9)).collect();
+    if fast.is_empty() {
+        return Ok((0.0, Vec::new()));
+    }
+    dynamics::mass_and_forces(model, data, t0, q, qd);
+    let mass = dynamics::dense_mass(model, data);
+    uk::acceleration(model, data, t0, q, qd)?;
+    let qdd = data.qdd.clone();
+    let rigid = rigidified_acceleration(model, data, t0, q, qd, &mass)?;
+    let excite: Vec<f64> = (0..n).map(|i| qdd[i] - rigid[i]).collect();
+    let mexc: Vec<f64> = (0..n).map(|i| (0..n).map(|j| mass[i * n + j] * excite[j]).sum()).collect();
+    let zeta = if traits.damped {
+        let is_fast = |k: usize| sp.omega[k] > omega_c * (1.0 + 1e-9);
+        damping_ratios(model, data, t0, q, qd, sp, &mass, &is_fast)?
+    } else {
+        vec![0.0; sp.len()]
+    };
+    let j = sample_steps((span / h).ceil().max(1.0));
+    let d = mode_displacements(model, q, sp, &fast)?;
+    let mut parts: Vec<(f64, f64, f64)> = Vec::with_capacity(fast.len());
+    for (o, &k) in fast.iter().enumerate() {
+        let w = sp.omega[k];
+        let s = sp.mode(k);
+        let amp = (0..n).map(|i| s[i] * mexc[i]).sum::<f64>().abs() / (w * w);
+        let zt = zeta[k];
+        // the physical motion decays as exp(lambda t): under-damped, the oscillating root; over, the slow one
+        let disc = zt * zt - 1.0;
+        let lam = if disc >= 0.0 { C(w * (-zt + disc.sqrt()), 0.0) } else { C(-w * zt, w * (-disc).sqrt()) };
+        let err = history_error(lam.scale(h), &j);
+        parts.push((w, amp * d[o], amp * err * d[o]));
+    }
+    let total: f64 = parts.iter().map(|p| p.2).sum();
+    // what the start sets off is round-off (a load or a drive starting from rest): no floor
+    if total <= ROUND_OFF_FLOOR * model.length_scale {
+        return Ok((0.0, Vec::new()));
+    }
+    let mut order: Vec<usize> = (0..parts.len()).collect();
+    order.sort_by(|&a, &b| parts[b].2.total_cmp(&parts[a].2));
+    let top = order.into_iter().take(3).filter(|&k| parts[k].2 > 0.0).map(|k| [parts[k].0, parts[k].1, parts[k].2]).collect();
+    Ok((total, top))
 }
 
 #[cfg(test)]
@@ -306,24 +242,6 @@ mod tests {
         assert_eq!(*j.last().unwrap(), 307.0);
         assert!(j.windows(2).skip(32).all(|w| w[1] >= w[0]));
         assert_eq!(sample_steps(5.0).iter().fold(0.0f64, |m, &x| m.max(x)), 5.0);
-    }
-
-    #[test]
-    fn the_step_by_step_history_error_is_the_sampled_one() {
-        // (the moduli-and-phases form loses ~1e-12 to cancellation where the error is small)
-        for steps in [45.0, 300.0] {
-            let j = sample_steps(steps);
-            for z in [C(0.0, 0.39), C(0.0, 3.5), C(-0.05, 12.0), C(-40.0, 0.0)] {
-                let r = radau_stability(z);
-                let (lr0, dphase0) = (r.0.hypot(r.1).ln(), r.1.atan2(r.0) - z.1);
-                let by_phase = j.iter().map(|&j| {
-                    let (lr, lz, dp) = (lr0 * j, z.0 * j, dphase0 * j);
-                    ((2.0 * lr).exp() + (2.0 * lz).exp() - 2.0 * (lr + lz).exp() * dp.cos()).max(0.0).sqrt()
-                }).fold(f64::NEG_INFINITY, f64::max);
-                let e = history_error(z, &j);
-                assert!((e - by_phase).abs() <= 1e-10 + 1e-9 * by_phase, "{steps} {:?}: {e} {by_phase}", (z.0, z.1));
-            }
-        }
     }
 
     #[test]

@@ -15,7 +15,6 @@
 //! here in one call ([`spectrum::dense_spectrum`], [`choose`]); a large system's lowest modes
 //! come from the sparse Lanczos of `ukflex.analysis.modes` and are handed to [`choose`].
 
-mod balance;
 mod chains;
 mod floor;
 mod overdamped;
@@ -125,7 +124,6 @@ pub fn constants() -> Vec<(&'static str, f64)> {
         ("FIRST_MODES", FIRST_MODES as f64),
         ("FLOOR_DENSE_MAX", FLOOR_DENSE_MAX as f64),
         ("DOPRI5_RTOL_PER_RTOL", DOPRI5_RTOL_PER_RTOL),
-        ("BALANCE_SLACK", balance::BALANCE_SLACK),
     ]
 }
 
@@ -143,9 +141,6 @@ pub struct SceneTraits {
     /// A geometrically exact beam (`beam3_element`s): RADAU5M's Newton at most
     /// `NEWTON_MAX_RTOL_BEAM`, tighter below `NEWTON_BEAM_FULL_RTOL` ([`newton_rtol`]).
     pub beam: bool,
-    /// A driver, or a load that is not a constant (an expression, a table, a callable): something
-    /// other than the start may set the modes off during the run ([`balance`] reads the start).
-    pub driven: bool,
 }
 
 impl SceneTraits {
@@ -169,8 +164,7 @@ impl SceneTraits {
         let beam = model.forces.iter().any(|f| matches!(&f.kind, ForceKind::Spatial(s) if s.kind() == "beam3_element"));
         let flexible = beam || model.bodies.iter().any(|b| b.capabilities().elastic);
         let contact = forces.iter().any(|f| f.get("kind").and_then(Value::as_str) == Some("revolute_clearance"));
-        let driven = model.constraints.iter().any(|c| c.is_driver()) || model.forces.iter().flat_map(|f| f.values()).any(|v| !v.is_const());
-        SceneTraits { damped, elastic_potential: flexible || spring, contact, beam, driven }
+        SceneTraits { damped, elastic_potential: flexible || spring, contact, beam }
     }
 }
 
@@ -233,9 +227,6 @@ pub struct AutoChoice {
     pub omega_max: f64,
     /// The step the elastic modes need (RADAU5M's fixed step when `Stiff`).
     pub step: Option<f64>,
-    /// The step that resolves the lowest elastic mode to the amplitude budget, where `step` was
-    /// balanced against the floor ([`balance`]) and is longer.
-    pub step_rtol: Option<f64>,
     /// RADAU5M's Newton tolerance with a fixed step.
     pub newton_rtol: Option<f64>,
     /// The amplitude budget over the run.
@@ -254,7 +245,7 @@ impl AutoChoice {
     }
 
     fn plain(verdict: Verdict, method: &'static str, omega_max: f64) -> AutoChoice {
-        AutoChoice { verdict, method, omega_elastic: None, omega_max, step: None, step_rtol: None, newton_rtol: None, phase: 0.0, floor: None, floor_modes: Vec::new(), overdamped: None }
+        AutoChoice { verdict, method, omega_elastic: None, omega_max, step: None, newton_rtol: None, phase: 0.0, floor: None, floor_modes: Vec::new(), overdamped: None }
     }
 }
 
@@ -352,22 +343,6 @@ pub fn choose(model: &Model, data: &mut Data, traits: SceneTraits, t0: f64, q: &
         c.verdict = Verdict::Stiff;
         c.method = "RADAU5M";
         c.newton_rtol = Some(newton_rtol(traits, rtol));
-        // the start alone sets the modes off: the step balanced against the floor it makes
-        // (a small system's whole spectrum; not a geometrically exact beam's)
-        if sp.complete() && !traits.driven && !traits.beam {
-            let ex = floor::Excitation::new(model, data, traits, t0, q, qd, sp, omega_c, true)?;
-            if ex.at_rest {
-                let hb = balance::balanced_step(model, &ex, omega_c, h, span);
-                if hb > h {
-                    c.step = Some(hb);
-                    c.step_rtol = Some(h);
-                }
-            }
-            if with_floor {
-                (c.floor, c.floor_modes) = { let (t, m) = ex.floor(model, c.step.unwrap_or(h), span); (Some(t), m) };
-            }
-            return Ok(c);
-        }
         let dense;
         let full = if !with_floor {
             None
@@ -414,10 +389,10 @@ mod tests {
 
     #[test]
     fn the_prelude_needs_no_spectrum_for_prescribed_or_rigid_scenes() {
-        let rigid = SceneTraits { elastic_potential: false, ..SceneTraits::default() };
+        let rigid = SceneTraits { damped: false, elastic_potential: false, contact: false, beam: false };
         assert_eq!(prelude(rigid, 0).unwrap().verdict, Verdict::NoDof);
         assert_eq!(prelude(rigid, 3).unwrap().verdict, Verdict::NoElasticPotential);
-        assert!(prelude(SceneTraits { elastic_potential: true, ..SceneTraits::default() }, 3).is_none());
+        assert!(prelude(SceneTraits { damped: false, elastic_potential: true, contact: false, beam: false }, 3).is_none());
     }
 
     #[test]

@@ -76,7 +76,6 @@ pub fn choice(model: &Model, data: &mut Data, t0: f64, q: &[f64], qd: &[f64], sp
         omega_elastic: Some(omega_m),
         omega_max: fmax,
         step: Some(h),
-        step_rtol: None,
         newton_rtol: None,
         phase,
         floor: None,
