@@ -118,20 +118,25 @@ impl EnvelopeCholesky {
             if !(d > 0.0 && d.is_finite()) {
                 return false;
             }
+            // the square root and the reciprocal of the pivot side by side (not one after the
+            // other, the column's chain): 1 / sqrt d = sqrt d * (1 / d)
             let l = d.sqrt();
-            let inv = 1.0 / l;
+            let inv = l * (1.0 / d);
             data[dj] = l;
             self.inv_diag[j] = inv;
             let c = &self.col[self.col_ptr[j]..self.col_ptr[j + 1]];
-            for &(_, kj) in c {
-                data[kj] *= inv;
+            // the scaled column, also gathered (its entries are read by every update)
+            let lc = &mut self.lcol[..c.len()];
+            for (x, &(_, kj)) in lc.iter_mut().zip(c) {
+                let v = data[kj] * inv;
+                data[kj] = v;
+                *x = v;
             }
             let p = &self.pair[self.pair_ptr[j]..self.pair_ptr[j + 1]];
-            for (a, &(_, aj)) in c.iter().enumerate() {
-                let la = data[aj];
+            for (a, &la) in lc.iter().enumerate() {
                 // (k_a, k_b) for b <= a: the lower triangle of the pairs
-                for (&(_, bj), &ab) in c[..=a].iter().zip(&p[a * c.len()..]) {
-                    data[ab] -= la * data[bj];
+                for (&lb, &ab) in lc[..=a].iter().zip(&p[a * lc.len()..]) {
+                    data[ab] -= la * lb;
                 }
             }
         }
@@ -170,14 +175,16 @@ impl EnvelopeCholesky {
             for (x, &(_, kj)) in lc.iter_mut().zip(c) {
                 *x = l[kj];
             }
-            // Z_ij for the rows i of column j: only entries of columns > j are read
+            // Z_ij = -s_i / L_jj for the rows i of column j (only entries of columns > j are
+            // read; the rows are independent), and Z_jj = (1 / L_jj + sum_i L_ij s_i / L_jj) / L_jj
+            // from the same s_i (not from the stored Z_ij: one chain less per column)
+            let mut t = [0.0; 2];
             for (a, &(_, ij)) in c.iter().enumerate() {
-                let zrow = &p[a * c.len()..(a + 1) * c.len()];
-                let s: f64 = lc.iter().zip(zrow).map(|(&lk, &ik)| lk * z[ik]).sum();
+                let s: f64 = lc.iter().zip(&p[a * c.len()..(a + 1) * c.len()]).map(|(&lk, &ik)| lk * z[ik]).sum();
                 z[ij] = -s * inv;
+                t[a & 1] += lc[a] * s;
             }
-            let s: f64 = lc.iter().zip(c).map(|(&lk, &(_, kj))| lk * z[kj]).sum();
-            let d = (inv - s) * inv;
+            let d = (inv + (t[0] + t[1]) * inv) * inv;
             z[self.ptr[j + 1] - 1] = d;
             trace += d;
         }
