@@ -22,8 +22,9 @@
 //! `trace(S) = |R|_F^2`. The computed `L` is the exact factor of `S + E`, `E` in the `S_22` block
 //! only (`D` and `X` are read off `B^T`), `|E|_2 <= delta = 2 (2 w - 1) (gamma_{w+3} +
 //! gamma_l) max_i (S_22)_ii` (`w` the widest row of the envelope, `l` the longest dot product of
-//! an entry of `S_22`; Higham, *Accuracy and Stability*, Thm 10.3, as in `uk::sparse`, with two
-//! roundings more than its division: `factor_in_place` scales a column by `sqrt d * (1 / d)`). Rank
+//! an entry of `S_22`; Higham, *Accuracy and Stability*, Thm 10.3, as in `uk::sparse`; `S_22` is
+//! factored as `L_22 D_22 L_22^T`, whose bound has the same form with `gamma_{w+2}`:
+//! `linalg::envelope`). Rank
 //! `m` is certified when `lower = 1 / (2 trace(S^-1)) - delta > tol^2`, `tol = max(atol, rcond
 //! sqrt(trace S))` with the dense path's `rcond` (`RankTolerance::rcond_at`); otherwise the
 //! dense rank-revealing path decides. The report is the dense QR's: `sigma_max = sqrt(trace S)
@@ -35,8 +36,9 @@
 //! the QR's identity reflectors do); solving with `S_22` squares the condition number of `Y`,
 //! and one refinement step with `Y` itself, `x += S_22^-1 (r~ - Y Y^T x)`, brings the error back
 //! to `O(cond(B) eps)` on the certified cases (as in `uk::sparse`). The step runs only where it
-//! can matter. The computed `x` solves `(S_22 + E) x = r~` with `|E_pq| <= gamma_{3w+3} |L_p|
-//! |L_q| <= gamma_{3w+3} sqrt(S_pp S_qq)` (Higham, Thm 10.4; `|L_p|^2 = S_pp`), so `E = D H D`
+//! can matter. The computed `x` solves `(S_22 + E) x = r~` with `|E_pq| <= gamma_{3w+3} (|L_22|
+//! D_22 |L_22|^T)_pq <= gamma_{3w+3} sqrt(S_pp S_qq)` (Higham, Thms 9.4 and 10.4, the factor
+//! `L_22 D_22 L_22^T` of `linalg::envelope`; its diagonal is `S_pp`), so `E = D H D`
 //! with `D = diag(S_22)^1/2` and `|H|_2 <= (2 w - 1) gamma_{3w+3}` (at most `2 w - 1` entries a
 //! row). The correction's error in the norm that matters, `|Y^T (x - x*)| = |S_22^-1/2 E x|`, is
 //! then at most `|H|_2 |D S_22^-1 D|_2 |Y^T x|` (Demmel's scaling argument: the diagonally
