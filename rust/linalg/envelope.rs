@@ -1,26 +1,32 @@
-//! Envelope (profile) storage of a symmetric positive definite matrix, its Cholesky factor and
+//! Envelope (profile) storage of a symmetric positive definite matrix, its `L D L^T` factor and
 //! the selected inverse inside the envelope.
 //!
-//! Row `i` stores the columns `first[i]..=i` of the lower triangle contiguously. The Cholesky
-//! factor `L` (`S = L L^T`) has its nonzeros inside the same envelope (George and Liu, *Computer
-//! Solution of Large Sparse Positive Definite Systems*, 1981, ch. 4), so it is computed in place,
-//! column by column (right-looking: each column's outer product is subtracted from the later
-//! columns, updates independent of one another; the row-by-row form, one dot product per entry,
-//! chains each entry on the ones before it in its row and was slower on the Gram matrices of
-//! `uk::gram`); the triangular solves run over the contiguous rows. The rounding bound of the
-//! factor (Higham, *Accuracy and Stability*, Thm 10.3) does not depend on the order of the sums. For a matrix whose rows couple only within a few blocks (the Gram
-//! matrix of the spatial UK path, `uk::gram`) the envelope is much smaller than a band of the
-//! same rows: the work is `sum_i (i - first[i])^2 / 2` instead of `n hb^2 / 2`.
+//! Row `i` stores the columns `first[i]..=i` of the lower triangle contiguously. The factor
+//! `S = L D L^T` (`L` unit lower triangular: the Cholesky factor is `L D^1/2`) has its nonzeros
+//! inside the same envelope (George and Liu, *Computer Solution of Large Sparse Positive Definite
+//! Systems*, 1981, ch. 4), so it is computed in place, column by column (right-looking: each
+//! column's outer product is subtracted from the later columns, updates independent of one
+//! another; the row-by-row form, one dot product per entry, chains each entry on the ones before
+//! it in its row and was slower on the Gram matrices of `uk::gram`); the triangular solves run
+//! over the contiguous rows. `L D L^T` rather than `L L^T`: the chain from one pivot to the next
+//! is a reciprocal and two products, without a square root. Rounding (Higham, *Accuracy and
+//! Stability*, Thm 9.3 with `U = D L^T`, one rounding more for the pivot's reciprocal): the
+//! computed factors satisfy `L D L^T = S + E` with `|E| <= gamma_{w+2} |L| D |L|^T`, `w` the
+//! widest row, and `(|L| D |L|^T)_ij <= ((L D L^T)_ii (L D L^T)_jj)^1/2` (Cauchy-Schwarz, `D >
+//! 0`), the form of the Cholesky bound (Thm 10.3); it does not depend on the order of the sums.
+//! For a matrix whose rows couple only within a few blocks (the Gram matrix of the spatial UK
+//! path, `uk::gram`) the envelope is much smaller than a band of the same rows: the work is
+//! `sum_i (i - first[i])^2 / 2` instead of `n hb^2 / 2`.
 //!
-//! Selected inverse (Takahashi, Fagan and Chen 1973): `Z = S^-1` on the envelope from
-//! `Z_ij = (delta_ij / L_jj - sum_{k > j} L_kj Z_ki) / L_jj`, `i >= j`, columns from the last.
-//! The rows `k > j` with `L_kj` inside the envelope (`first[k] <= j`) pairwise have their entry
-//! inside it too, so the recurrence never leaves the envelope; `trace(S^-1)` is its diagonal sum.
-//! Everything is allocation free after `EnvelopeCholesky::new`.
+//! Selected inverse (Takahashi, Fagan and Chen 1973): `Z = S^-1 = L^-T D^-1 L^-1` on the
+//! envelope from `Z_ij = delta_ij / d_j - sum_{k > j} L_kj Z_ki`, `i >= j`, columns from the
+//! last. The rows `k > j` with `L_kj` inside the envelope (`first[k] <= j`) pairwise have their
+//! entry inside it too, so the recurrence never leaves the envelope; `trace(S^-1)` is its
+//! diagonal sum. Everything is allocation free after `EnvelopeCholesky::new`.
 
 use super::dot4;
 
-/// Lower envelope of a symmetric `n x n` matrix, then its Cholesky factor (`factor_in_place`).
+/// Lower envelope of a symmetric `n x n` matrix, then its `L D L^T` factor (`factor_in_place`).
 #[derive(Debug, Clone)]
 pub struct EnvelopeCholesky {
     pub n: usize,
@@ -28,8 +34,9 @@ pub struct EnvelopeCholesky {
     first: Vec<usize>,
     /// Start of row `i` in `data` (`n + 1` entries); its diagonal is at `ptr[i + 1] - 1`.
     ptr: Vec<usize>,
-    /// The matrix's lower envelope, then `L`.
+    /// The matrix's lower envelope, then `L` below the diagonal and `D` on it.
     pub data: Vec<f64>,
+    /// `1 / d_i`.
     inv_diag: Vec<f64>,
     /// Column `j` of the envelope below the diagonal: `(k, index of (k, j))` for the rows `k > j`
     /// with `first[k] <= j`, at `col[col_ptr[j]..col_ptr[j + 1]]`.
@@ -99,13 +106,13 @@ impl EnvelopeCholesky {
         self.data.is_empty()
     }
 
-    /// The diagonal entry of row `i` (of the matrix before `factor_in_place`, of `L` after).
+    /// The diagonal entry of row `i` (of the matrix before `factor_in_place`, `d_i` after).
     #[inline]
     pub fn diag(&self, i: usize) -> f64 {
         self.data[self.ptr[i + 1] - 1]
     }
 
-    /// Cholesky `S = L L^T` in place. `false` at a pivot that is not positive and finite (the
+    /// `S = L D L^T` in place. `false` at a pivot that is not positive and finite (the
     /// factor is then unusable). Right-looking, column by column: column `j` is scaled by its
     /// pivot and its outer product subtracted from the later columns (`pair`, the lookups of the
     /// selected inverse): the updates of one column are independent of one another, where the
@@ -118,20 +125,21 @@ impl EnvelopeCholesky {
             if !(d > 0.0 && d.is_finite()) {
                 return false;
             }
-            let l = d.sqrt();
-            let inv = 1.0 / l;
-            data[dj] = l;
+            let inv = 1.0 / d;
             self.inv_diag[j] = inv;
             let c = &self.col[self.col_ptr[j]..self.col_ptr[j + 1]];
-            for &(_, kj) in c {
+            // the column before scaling, gathered (read by every update): S_ab -= L_aj (d_j L_bj)
+            let uc = &mut self.lcol[..c.len()];
+            for (u, &(_, kj)) in uc.iter_mut().zip(c) {
+                *u = data[kj];
                 data[kj] *= inv;
             }
             let p = &self.pair[self.pair_ptr[j]..self.pair_ptr[j + 1]];
             for (a, &(_, aj)) in c.iter().enumerate() {
                 let la = data[aj];
                 // (k_a, k_b) for b <= a: the lower triangle of the pairs
-                for (&(_, bj), &ab) in c[..=a].iter().zip(&p[a * c.len()..]) {
-                    data[ab] -= la * data[bj];
+                for (&ub, &ab) in uc[..=a].iter().zip(&p[a * uc.len()..]) {
+                    data[ab] -= la * ub;
                 }
             }
         }
@@ -143,13 +151,14 @@ impl EnvelopeCholesky {
         let n = self.n;
         for i in 0..n {
             let (fi, pi) = (self.first[i], self.ptr[i]);
-            let s = x[i] - dot4(&self.data[pi..pi + i - fi], &x[fi..i]);
-            x[i] = s * self.inv_diag[i];
+            x[i] -= dot4(&self.data[pi..pi + i - fi], &x[fi..i]);
+        }
+        for (x, inv) in x.iter_mut().zip(&self.inv_diag) {
+            *x *= inv;
         }
         for i in (0..n).rev() {
             let (fi, pi) = (self.first[i], self.ptr[i]);
-            let xi = x[i] * self.inv_diag[i];
-            x[i] = xi;
+            let xi = x[i];
             for (xk, l) in x[fi..i].iter_mut().zip(&self.data[pi..pi + i - fi]) {
                 *xk -= l * xi;
             }
@@ -164,20 +173,20 @@ impl EnvelopeCholesky {
         for j in (0..self.n).rev() {
             let c = &self.col[self.col_ptr[j]..self.col_ptr[j + 1]];
             let p = &self.pair[self.pair_ptr[j]..self.pair_ptr[j + 1]];
-            let inv = self.inv_diag[j];
             // column j of L gathered once (each of its entries is read by every row of the column)
             let lc = &mut self.lcol[..c.len()];
             for (x, &(_, kj)) in lc.iter_mut().zip(c) {
                 *x = l[kj];
             }
-            // Z_ij for the rows i of column j: only entries of columns > j are read
+            // Z_ij = -s_i for the rows i of column j (only entries of columns > j are read; the
+            // rows are independent), and Z_jj = 1 / d_j + sum_i L_ij s_i from the same s_i
+            let mut t = [0.0; 2];
             for (a, &(_, ij)) in c.iter().enumerate() {
-                let zrow = &p[a * c.len()..(a + 1) * c.len()];
-                let s: f64 = lc.iter().zip(zrow).map(|(&lk, &ik)| lk * z[ik]).sum();
-                z[ij] = -s * inv;
+                let s: f64 = lc.iter().zip(&p[a * c.len()..(a + 1) * c.len()]).map(|(&lk, &ik)| lk * z[ik]).sum();
+                z[ij] = -s;
+                t[a & 1] += lc[a] * s;
             }
-            let s: f64 = lc.iter().zip(c).map(|(&lk, &(_, kj))| lk * z[kj]).sum();
-            let d = (inv - s) * inv;
+            let d = self.inv_diag[j] + (t[0] + t[1]);
             z[self.ptr[j + 1] - 1] = d;
             trace += d;
         }

@@ -20,9 +20,11 @@
 //! trace(S_22^-1)` (`x_b` the row of `X` of unit `b`: its entries are on rows that share body
 //! `b`, so the selected inverse of `S_22` on its envelope holds every product needed), and
 //! `trace(S) = |R|_F^2`. The computed `L` is the exact factor of `S + E`, `E` in the `S_22` block
-//! only (`D` and `X` are read off `B^T`), `|E|_2 <= delta = 2 (2 w - 1) (gamma_{w+1} +
+//! only (`D` and `X` are read off `B^T`), `|E|_2 <= delta = 2 (2 w - 1) (gamma_{w+3} +
 //! gamma_l) max_i (S_22)_ii` (`w` the widest row of the envelope, `l` the longest dot product of
-//! an entry of `S_22`; Higham, *Accuracy and Stability*, Thm 10.3, as in `uk::sparse`). Rank
+//! an entry of `S_22`; Higham, *Accuracy and Stability*, Thm 10.3, as in `uk::sparse`; `S_22` is
+//! factored as `L_22 D_22 L_22^T`, whose bound has the same form with `gamma_{w+2}`:
+//! `linalg::envelope`). Rank
 //! `m` is certified when `lower = 1 / (2 trace(S^-1)) - delta > tol^2`, `tol = max(atol, rcond
 //! sqrt(trace S))` with the dense path's `rcond` (`RankTolerance::rcond_at`); otherwise the
 //! dense rank-revealing path decides. The report is the dense QR's: `sigma_max = sqrt(trace S)
@@ -34,9 +36,10 @@
 //! the QR's identity reflectors do); solving with `S_22` squares the condition number of `Y`,
 //! and one refinement step with `Y` itself, `x += S_22^-1 (r~ - Y Y^T x)`, brings the error back
 //! to `O(cond(B) eps)` on the certified cases (as in `uk::sparse`). The step runs only where it
-//! can matter. The computed `x` solves `(S_22 + E) x = r~` with `|E_pq| <= gamma_{3w+1} |L_p|
-//! |L_q| <= gamma_{3w+1} sqrt(S_pp S_qq)` (Higham, Thm 10.4; `|L_p|^2 = S_pp`), so `E = D H D`
-//! with `D = diag(S_22)^1/2` and `|H|_2 <= (2 w - 1) gamma_{3w+1}` (at most `2 w - 1` entries a
+//! can matter. The computed `x` solves `(S_22 + E) x = r~` with `|E_pq| <= gamma_{3w+3} (|L_22|
+//! D_22 |L_22|^T)_pq <= gamma_{3w+3} sqrt(S_pp S_qq)` (Higham, Thms 9.4 and 10.4, the factor
+//! `L_22 D_22 L_22^T` of `linalg::envelope`; its diagonal is `S_pp`), so `E = D H D`
+//! with `D = diag(S_22)^1/2` and `|H|_2 <= (2 w - 1) gamma_{3w+3}` (at most `2 w - 1` entries a
 //! row). The correction's error in the norm that matters, `|Y^T (x - x*)| = |S_22^-1/2 E x|`, is
 //! then at most `|H|_2 |D S_22^-1 D|_2 |Y^T x|` (Demmel's scaling argument: the diagonally
 //! scaled condition, not `cond(S_22)`), and `|D S_22^-1 D|_2 <= trace(D S_22^-1 D) = sum_p S_pp
@@ -350,14 +353,14 @@ impl GramUk {
             ke / (1.0 - ke)
         };
         let w = self.env.width.max(1);
-        let delta = 2.0 * (2 * w - 1) as f64 * (gamma(w + 1) + gamma(self.max_dot)) * max_d;
+        let delta = 2.0 * (2 * w - 1) as f64 * (gamma(w + 3) + gamma(self.max_dot)) * max_d;
         let lower = 0.5 / trace_sinv - delta;
         let sigma_max = trace_s.sqrt();
         let tol = atol.max(rcond * sigma_max);
         let conditioned = trace_s * trace_sinv <= GRAM_MAX_COND * GRAM_MAX_COND;
         // the unrefined solution's bound against the QR's (module docs, "Accuracy")
         let scaled: f64 = self.sdiag.iter().enumerate().map(|(p, s)| s * self.z[self.env.index(p, p)]).sum();
-        let unrefined = (2 * w - 1) as f64 * gamma(3 * w + 1) * scaled;
+        let unrefined = (2 * w - 1) as f64 * gamma(3 * w + 3) * scaled;
         self.refine = !(unrefined <= (model.n * self.m) as f64 * f64::EPSILON * (trace_s * trace_sinv).sqrt());
         if lower.is_finite() && lower > 0.0 && lower > tol * tol && conditioned {
             Some(RankInfo { rank: self.m, sigma_max, sigma_min_kept: 1.0 / trace_sinv.sqrt(), sigma_max_dropped: 0.0, tolerance: tol, exact: false })
