@@ -4,6 +4,8 @@
 
 use faer::Mat;
 
+use super::small_svd::QrJacobi;
+
 /// `x . y` (over the shorter length) with four independent partial sums: a plain sum is one
 /// chain of dependent additions (the compiler may not reorder floating-point sums), which
 /// bounds the small dot products of the kernel by the adder's latency. The order is fixed, so
@@ -126,9 +128,29 @@ pub fn solve_upper(l: &[f64], n: usize, x: &mut [f64]) {
 }
 
 /// `y = B^+ r = U S^+ V^T r` with `B^T = bt = U S V^T` (`k x m`), singular values at or below
-/// `max(k, m) eps sigma_max` dropped (the cut of `scipy.linalg.pinv`). Allocates (faer's thin
-/// SVD): for the initial-state correction, not the per-step path.
+/// `max(k, m) eps sigma_max` dropped (the cut of `scipy.linalg.pinv`). Allocates (a QR, and
+/// faer's thin SVD where the QR does not certify full rank): for the initial-state correction,
+/// not the per-step path.
 pub fn pinv_solve(bt: &Mat<f64>, r: &[f64]) -> Result<Vec<f64>, faer::linalg::svd::SvdError> {
+    let (k, m) = (bt.nrows(), bt.ncols());
+    // full rank certified by the QR of `bt` (its bound of sigma_min above the tolerance that its
+    // bound of sigma_max sets): the SVD would keep every value, and the pseudoinverse's solution
+    // is the QR's minimum-norm one (a fraction of the SVD's cost)
+    if m > 0 && m <= k {
+        let mut qr = QrJacobi::new(k, m);
+        qr.qr_cols(|j| bt.col_as_slice(j));
+        let (upper, lower) = qr.full_rank_bounds();
+        if upper.is_finite() && lower > (k.max(m) as f64) * f64::EPSILON * upper {
+            let (mut y, mut lambda) = (vec![0.0; k], vec![0.0; m]);
+            qr.full_rank_solve(r, &mut y, &mut lambda);
+            return Ok(y);
+        }
+    }
+    svd_pinv_solve(bt, r)
+}
+
+/// `pinv_solve` by the SVD alone.
+fn svd_pinv_solve(bt: &Mat<f64>, r: &[f64]) -> Result<Vec<f64>, faer::linalg::svd::SvdError> {
     let (k, m) = (bt.nrows(), bt.ncols());
     let svd = bt.thin_svd()?;
     let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
@@ -153,6 +175,27 @@ pub fn pinv_solve(bt: &Mat<f64>, r: &[f64]) -> Result<Vec<f64>, faer::linalg::sv
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The QR's solution where it certifies full rank is the SVD's (to rounding); a duplicated
+    /// column (rank deficient) goes to the SVD, which drops it.
+    #[test]
+    fn pinv_solve_by_the_qr_matches_the_svd() {
+        let (k, m) = (12usize, 7usize);
+        let mut bt = Mat::<f64>::from_fn(k, m, |i, j| ((i * 7 + j * 3) as f64).sin() + if i == j { 2.0 } else { 0.0 });
+        let r: Vec<f64> = (0..m).map(|i| (i as f64).cos()).collect();
+        for deficient in [false, true] {
+            if deficient {
+                for i in 0..k {
+                    bt[(i, m - 1)] = bt[(i, 0)];
+                }
+            }
+            let (a, b) = (pinv_solve(&bt, &r).unwrap(), svd_pinv_solve(&bt, &r).unwrap());
+            let big = b.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+            for p in 0..k {
+                assert!((a[p] - b[p]).abs() < 1e-13 * big, "deficient {deficient}: y[{p}] {} vs {}", a[p], b[p]);
+            }
+        }
+    }
 
     #[test]
     fn cholesky3_rejects_indefinite() {

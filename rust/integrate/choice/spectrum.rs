@@ -19,6 +19,7 @@ use crate::dynamics;
 use crate::error::{Error, Result};
 use crate::jacobian;
 use crate::linalg::dense::{cholesky, solve_lower, solve_upper};
+use crate::linalg::small_svd::QrJacobi;
 use crate::model::Model;
 
 use super::{BODY_SHARE, ELASTIC_SHARE};
@@ -56,7 +57,8 @@ impl Spectrum {
 }
 
 /// `(rank, null-space basis)` of `A(q)`: the basis `n x (n - rank)` column-major (its columns
-/// contiguous), from the SVD; the identity without constraints.
+/// contiguous), from the QR of `A^T` where it certifies full rank, else from the SVD; the
+/// identity without constraints.
 pub struct NullSpace(pub usize, Vec<f64>);
 
 /// The rank of `A(q)` and its null space (`NullSpace`).
@@ -72,6 +74,25 @@ pub fn constraint_rank(model: &Model, data: &mut Data, q: &[f64]) -> Result<Null
     dynamics::constraints(model, data, 0.0, q, &vec![0.0; n], false);
     let mut a = vec![0.0; m * n];
     data.ajac.scatter(&mut a);
+    // full rank certified by the QR of A^T (its lower bound of sigma_min above the SVD's
+    // tolerance, which its upper bound of sigma_max bounds): the SVD would keep every value, and
+    // Q's last n - m columns are an orthonormal basis of the same null space
+    if m < n {
+        let mut qr = QrJacobi::new(n, m);
+        qr.qr_cols(|i| &a[i * n..(i + 1) * n]);
+        let (upper, lower) = qr.full_rank_bounds();
+        if upper.is_finite() && lower > (m.max(n) as f64) * f64::EPSILON * upper {
+            let mut basis = vec![0.0; n * (n - m)];
+            qr.complement_into(&mut basis);
+            return Ok(NullSpace(m, basis));
+        }
+    }
+    svd_null_space(m, n, &a)
+}
+
+/// `NullSpace` of the m x n row-major `a` by the SVD (singular values above `max(m, n) eps
+/// sigma_max` kept).
+fn svd_null_space(m: usize, n: usize, a: &[f64]) -> Result<NullSpace> {
     let am = Mat::<f64>::from_fn(m, n, |i, j| a[i * n + j]);
     let svd = am.svd().map_err(|e| Error::Solver(format!("method='auto': the SVD of the constraint Jacobian failed ({e:?})")))?;
     let s = svd.S().column_vector();
@@ -343,4 +364,46 @@ pub fn damping_ratios(model: &Model, data: &mut Data, t: f64, q: &[f64], qd: &[f
         zeta[k] = (-smd / (2.0 * w)).max(0.0);
     }
     Ok(zeta)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where the QR of `A^T` certifies full rank (A05, the spatial slider-crank) its basis spans
+    /// the SVD's null space: the same rank, orthonormal columns, `A N = 0`, `N N^T` equal.
+    #[test]
+    fn the_qr_basis_spans_the_svds_null_space() {
+        for json in [include_str!("../../../benches/data/spatial/flyball.json"), include_str!("../../../benches/data/spatial/slider_crank.json")] {
+            let model = Model::from_json(json).unwrap();
+            let mut data = Data::new(&model);
+            let (n, m) = (model.n, model.m);
+            let q: Vec<f64> = model.q0.iter().enumerate().map(|(i, x)| x + 1e-3 * (i as f64).sin()).collect();
+            let NullSpace(rank, basis) = constraint_rank(&model, &mut data, &q).unwrap();
+            let mut a = vec![0.0; m * n];
+            data.ajac.scatter(&mut a);
+            let NullSpace(rank_svd, basis_svd) = svd_null_space(m, n, &a).unwrap();
+            assert_eq!((rank, rank_svd), (m, m));
+            let k = n - m;
+            let col = |b: &[f64], c: usize, i: usize| b[c * n + i];
+            let amax = a.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+            for c in 0..k {
+                for d in 0..k {
+                    let dot: f64 = (0..n).map(|i| col(&basis, c, i) * col(&basis, d, i)).sum();
+                    assert!((dot - if c == d { 1.0 } else { 0.0 }).abs() < 1e-13);
+                }
+                for r in 0..m {
+                    let an: f64 = (0..n).map(|i| a[r * n + i] * col(&basis, c, i)).sum();
+                    assert!(an.abs() < 1e-13 * amax, "A N [{r}, {c}] = {an}");
+                }
+            }
+            for i in 0..n {
+                for j in 0..n {
+                    let p: f64 = (0..k).map(|c| col(&basis, c, i) * col(&basis, c, j)).sum();
+                    let p_svd: f64 = (0..k).map(|c| col(&basis_svd, c, i) * col(&basis_svd, c, j)).sum();
+                    assert!((p - p_svd).abs() < 1e-12, "N N^T [{i}, {j}]: {p} vs {p_svd}");
+                }
+            }
+        }
+    }
 }
