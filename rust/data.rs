@@ -13,7 +13,7 @@ use crate::model::Model;
 use crate::error::{Error, Result};
 use crate::linalg::small_svd::QrJacobi;
 use crate::uk::gram::GramUk;
-use crate::uk::sparse::SparseUk;
+use crate::uk::sparse::{RowAnalysis, SparseUk};
 use crate::force::friction::FrictionWork;
 /// The UK settings and rank types live in `uk::settings`; the workspace holds them (and
 /// `data::RankInfo`, ... stay valid paths).
@@ -27,9 +27,9 @@ pub const SPARSE_MIN_ROWS: usize = 8;
 
 /// `UkSolver::Auto`: sparse when there are enough rows and the band work is well below the
 /// dense `O(n m^2)` (a narrow band after RCM).
-pub fn prefer_sparse(model: &Model, sp: &SparseUk) -> bool {
+pub fn prefer_sparse(model: &Model, rows: &RowAnalysis) -> bool {
     let (n, m) = (model.n as f64, model.m as f64);
-    model.m >= SPARSE_MIN_ROWS && 4.0 * sp.flops() < 2.0 * n * m * m
+    model.m >= SPARSE_MIN_ROWS && 4.0 * rows.flops() < 2.0 * n * m * m
 }
 
 /// Bytes of the dense UK buffers (`B^T`, thin SVD, QR + Jacobi, faer scratch).
@@ -141,8 +141,9 @@ impl Data {
             _ if m == 0 => None,
             UkSolver::Sparse => Some(Box::new(SparseUk::new(model))),
             UkSolver::Auto => {
-                let sp = SparseUk::new(model);
-                if prefer_sparse(model, &sp) { Some(Box::new(sp)) } else { None }
+                // the band pairs and the workspace only where the estimate takes the sparse path
+                let rows = RowAnalysis::new(model);
+                if prefer_sparse(model, &rows) { Some(Box::new(SparseUk::from_rows(model, rows))) } else { None }
             }
         };
         let hint = if sparse.is_some() { "raise memory_limit" } else { "use uk_solver='sparse' for a long chain or rope, or raise memory_limit" };

@@ -40,7 +40,7 @@ use crate::model::Model;
 mod factor;
 mod velocity;
 use factor::Lu;
-pub use factor::{newton_entries, BandLayout, Factorization};
+pub use factor::{newton_entries, BandLayout, Factorization, SparsePlan};
 pub use velocity::{fill_velocity_terms, velocity_differences};
 
 /// Symbolic analysis of the structure (once per model).
@@ -486,16 +486,18 @@ impl BandNewton {
         lu + 24 * n as u64
     }
 
-    pub fn new(s: Structure, layout: BandLayout, complex: bool, kind: Factorization) -> BandNewton {
-        let (n, size) = (s.pattern.n, layout.size);
-        let entries = if kind == Factorization::Static { newton_entries(&s.pattern, &layout) } else { Vec::new() };
-        let real = Lu::<f64>::new(kind, &layout, &entries);
+    /// The matrices of a plan's structure, factored as it says.
+    pub fn new(plan: SparsePlan) -> BandNewton {
+        let SparsePlan { structure: s, layout, order, complex, .. } = plan;
+        let n = s.pattern.n;
+        let size = layout.size;
+        let real = Lu::<f64>::new(&layout, order.clone());
         let perm = &layout.perm;
         let cc = s.pattern.entries().map(|(i, j)| real.index(perm[i], perm[j])).collect();
         let ar = s.pattern.a_entries().map(|(r, j)| real.index(perm[n + r], perm[j])).collect();
         let at = s.pattern.a_entries().map(|(r, j)| real.index(perm[j], perm[n + r])).collect();
         let diag = (0..s.pattern.m).map(|r| real.index(perm[n + r], perm[n + r])).collect();
-        let cplx = complex.then(|| Lu::<C64>::new(kind, &layout, &entries));
+        let cplx = complex.then(|| Lu::<C64>::new(&layout, order));
         let z = |k: usize| vec![0.0; k];
         BandNewton { s, layout, cc, ar, at, diag, real, cplx, xr: z(size), xc: vec![C64::default(); if complex { size } else { 0 }], fr: z(size), fi: z(size), vr: z(n), vi: z(n) }
     }

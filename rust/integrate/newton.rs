@@ -23,8 +23,8 @@ use crate::band_lu::C64;
 use crate::error::{Error, Result};
 use crate::data::Data;
 use crate::model::Model;
-use crate::linalg::static_lu::StaticLu;
-use crate::sparse_newton::{newton_entries, BandLayout, BandNewton, Factorization, Pattern, Structure};
+use crate::linalg::static_lu::Ordering;
+use crate::sparse_newton::{newton_entries, BandLayout, BandNewton, Pattern, SparsePlan, Structure};
 
 /// How an implicit method factors its Newton matrices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -95,21 +95,29 @@ pub const STATIC_LU_MAX: usize = 256;
 pub const STATIC_LU_METHODS: &[&str] = &["RADAU5M"];
 
 /// How the sparse form factors (`pattern` in `layout`) for `method`: the band LU where the band
-/// is narrow; with Radau IIA's complex matrix and a method of `STATIC_LU_METHODS`, from `SPARSE_NEWTON_MIN_COMPLEX` to
+/// is narrow (`None`); with Radau IIA's complex matrix and a method of `STATIC_LU_METHODS`, from `SPARSE_NEWTON_MIN_COMPLEX` to
 /// `STATIC_LU_MAX`, a wide band, and a minimum degree elimination of at most a quarter of the
-/// dense one's multiply-adds, the sparse LU with kept pivots (A05, 64 x 64: ~5 000 against
-/// ~87 000; a flexible body's dense FFRF block fills in and stays dense or banded).
-pub fn factorization(pattern: &Pattern, layout: &BandLayout, complex: bool, method: &str) -> Factorization {
+/// dense one's multiply-adds, the sparse LU with kept pivots on that order (`Some`; A05, 64 x 64:
+/// ~5 000 against ~87 000; a flexible body's dense FFRF block fills in and stays dense or banded).
+pub fn static_order(pattern: &Pattern, layout: &BandLayout, complex: bool, method: &str) -> Option<Ordering> {
     let size = layout.size;
     if !complex || !STATIC_LU_METHODS.contains(&method) || narrow(layout) || !(SPARSE_NEWTON_MIN_COMPLEX..=STATIC_LU_MAX).contains(&size) {
-        return Factorization::Band;
+        return None;
     }
-    let lu = StaticLu::<f64>::new(size, newton_entries(pattern, layout).into_iter());
-    if 4 * lu.estimated_flops() <= (size * size * size / 3) as u64 {
-        Factorization::Static
-    } else {
-        Factorization::Band
-    }
+    let order = Ordering::new(size, newton_entries(pattern, layout).into_iter());
+    (4 * order.estimated_flops() <= (size * size * size / 3) as u64).then_some(order)
+}
+
+/// The sparse form's analysis of `structure` for `method`: the band layout and the factorization.
+fn analyse(structure: Structure, complex: bool, method: &str) -> SparsePlan {
+    let layout = BandLayout::new(&structure.pattern);
+    let order = static_order(&structure.pattern, &layout, complex, method);
+    SparsePlan { structure, layout, order, complex }
+}
+
+/// Whether the run takes the sparse form of `plan` when `asked`.
+fn takes(plan: &SparsePlan, asked: LinearSolver, complex: bool) -> bool {
+    asked == LinearSolver::Sparse || prefer_sparse(&plan.layout, complex) || plan.order.is_some()
 }
 
 /// The solve with a factorization at which GENALPHA forms its inverse (dense, small only).
@@ -204,7 +212,8 @@ impl NewtonMatrices {
 
     pub fn sparse(structure: Structure, complex: bool) -> Self {
         let layout = BandLayout::new(&structure.pattern);
-        NewtonMatrices { inner: Inner::Sparse(Box::new(BandNewton::new(structure, layout, complex, Factorization::Band))) }
+        let plan = SparsePlan { structure, layout, order: None, complex };
+        NewtonMatrices { inner: Inner::Sparse(Box::new(BandNewton::new(plan))) }
     }
 
     /// The Newton matrices `method` runs on with `system` (n coordinates, m rows), for the
@@ -225,29 +234,25 @@ impl NewtonMatrices {
         if asked == LinearSolver::Dense || (asked == LinearSolver::Auto && sys.n() + sys.n_constraints() < sparse_min(complex)) {
             return Ok(None);
         }
-        let structure = match sys.sparse_structure() {
+        let plan = match sys.sparse_structure() {
             // `Auto`: a pattern above the memory limit (a dense body of many coordinates) means the
             // dense form, whose own check then speaks
             Err(Error::Memory { .. }) if asked == LinearSolver::Auto => return Ok(None),
-            r => r?,
+            Ok(Some(s)) => analyse(s, complex, method),
+            Ok(None) if asked == LinearSolver::Sparse => return Err(Error::argument("linear_solver", format!("{method}: this system has no sparse structure (use 'dense' or 'auto')"))),
+            Ok(None) => return Ok(None),
+            Err(e) => return Err(e),
         };
-        match structure {
-            Some(s) => {
-                let layout = BandLayout::new(&s.pattern);
-                let kind = factorization(&s.pattern, &layout, complex, method);
-                if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) || kind == Factorization::Static {
-                    sys.check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex, kind))?;
-                    return Ok(Some(BandNewton::new(s, layout, complex, kind)));
-                }
-                Ok(None)
-            }
-            None if asked == LinearSolver::Sparse => Err(Error::argument("linear_solver", format!("{method}: this system has no sparse structure (use 'dense' or 'auto')"))),
-            None => Ok(None),
+        if takes(&plan, asked, complex) {
+            sys.check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&plan.layout, complex, plan.kind()))?;
+            return Ok(Some(BandNewton::new(plan)));
         }
+        Ok(None)
     }
 
     /// What `for_system` will take for the UK system of `model` (its workspace `data`):
-    /// `Sparse` or `Dense` (checks the sparse form's memory; the caller checks the dense one's).
+    /// `Sparse` or `Dense` (checks the sparse form's memory; the caller checks the dense one's):
+    /// the binding asks before the run where the dense matrices would not fit.
     pub fn resolve(model: &Model, data: &Data, asked: LinearSolver, complex: bool, method: &str) -> Result<LinearSolver> {
         if asked == LinearSolver::Dense || (asked == LinearSolver::Auto && model.n + model.m < sparse_min(complex)) {
             return Ok(LinearSolver::Dense);
@@ -256,10 +261,9 @@ impl NewtonMatrices {
             Err(Error::Memory { .. }) if asked == LinearSolver::Auto => return Ok(LinearSolver::Dense),
             r => r?,
         };
-        let layout = BandLayout::new(&p);
-        let kind = factorization(&p, &layout, complex, method);
-        if asked == LinearSolver::Sparse || prefer_sparse(&layout, complex) || kind == Factorization::Static {
-            Error::check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&layout, complex, kind), data.memory_limit, "raise memory_limit")?;
+        let plan = analyse(Structure::new(p), complex, method);
+        if takes(&plan, asked, complex) {
+            Error::check_memory("the sparse Newton matrices (band LU)", BandNewton::bytes(&plan.layout, complex, plan.kind()), data.memory_limit, "raise memory_limit")?;
             return Ok(LinearSolver::Sparse);
         }
         Ok(LinearSolver::Dense)

@@ -124,6 +124,46 @@ fn permuted_pattern(pattern: &[bool], rows: &[usize], cols: &[usize], s: &mut Bi
     }
 }
 
+/// The structural analysis of a `StaticLu`: its pattern and the minimum degree column order.
+#[derive(Debug, Clone)]
+pub struct Ordering {
+    n: usize,
+    /// Structural pattern (row-major, caller's indices).
+    pattern: Vec<bool>,
+    md: Vec<usize>,
+}
+
+impl Ordering {
+    /// The pattern of the `n x n` matrix whose structural entries are `entries`, and its order.
+    pub fn new(n: usize, entries: impl Iterator<Item = (usize, usize)>) -> Self {
+        let mut pattern = vec![false; n * n];
+        for (i, j) in entries {
+            pattern[i * n + j] = true;
+        }
+        let md = minimum_degree(n, &pattern);
+        Ordering { n, pattern, md }
+    }
+
+    /// Multiply-adds of a factorization with diagonal pivots in the minimum degree order (the
+    /// structural estimate the choice of the linear solver reads).
+    pub fn estimated_flops(&self) -> u64 {
+        let n = self.n;
+        let mut s = Bits::new(n);
+        permuted_pattern(&self.pattern, &self.md, &self.md, &mut s);
+        let mut flops = 0u64;
+        for k in 0..n {
+            let nu = (k + 1..n).filter(|&j| s.get(k, j)).count() as u64;
+            for i in k + 1..n {
+                if s.get(i, k) {
+                    flops += nu;
+                    s.or_row(i, k);
+                }
+            }
+        }
+        flops
+    }
+}
+
 /// An `n x n` matrix and, after `factor`, its LU factors in a kept pivot sequence.
 #[derive(Debug, Clone)]
 pub struct StaticLu<T: Scalar> {
@@ -162,11 +202,13 @@ pub struct StaticLu<T: Scalar> {
 impl<T: Scalar> StaticLu<T> {
     /// Storage for an `n x n` matrix whose structural entries are `entries` (all zero).
     pub fn new(n: usize, entries: impl Iterator<Item = (usize, usize)>) -> Self {
-        let mut pattern = vec![false; n * n];
-        for (i, j) in entries {
-            pattern[i * n + j] = true;
-        }
-        let md = minimum_degree(n, &pattern);
+        Self::with_ordering(Ordering::new(n, entries))
+    }
+
+    /// The same on an analysis already made (the real and the complex matrix of one pattern
+    /// share it: the minimum degree order is found once).
+    pub fn with_ordering(o: Ordering) -> Self {
+        let Ordering { n, pattern, md } = o;
         let z = |k: usize| vec![T::default(); k];
         let tri = n * n.saturating_sub(1) / 2;
         StaticLu {
@@ -199,25 +241,6 @@ impl<T: Scalar> StaticLu<T> {
         let n = n as u64;
         // values and the analysis' copy; the pattern; the four lists (half each) and the fill
         (2 * std::mem::size_of::<T>() as u64 + 1 + 12) * n * n
-    }
-
-    /// Multiply-adds of a factorization with diagonal pivots in the minimum degree order (the
-    /// structural estimate the choice of the linear solver reads).
-    pub fn estimated_flops(&self) -> u64 {
-        let n = self.n;
-        let mut s = Bits::new(n);
-        permuted_pattern(&self.pattern, &self.md, &self.md, &mut s);
-        let mut flops = 0u64;
-        for k in 0..n {
-            let nu = (k + 1..n).filter(|&j| s.get(k, j)).count() as u64;
-            for i in k + 1..n {
-                if s.get(i, k) {
-                    flops += nu;
-                    s.or_row(i, k);
-                }
-            }
-        }
-        flops
     }
 
     pub fn n(&self) -> usize {
@@ -519,8 +542,10 @@ mod tests {
         let (n, m) = (34, 30);
         let size = n + m;
         let pat = saddle_pattern(n, m);
-        let mut lu = StaticLu::<T>::new(size, pat.iter().copied());
-        assert!(lu.estimated_flops() * 4 < (size * size * size / 3) as u64, "{}", lu.estimated_flops());
+        let order = Ordering::new(size, pat.iter().copied());
+        let flops = order.estimated_flops();
+        assert!(flops * 4 < (size * size * size / 3) as u64, "{flops}");
+        let mut lu = StaticLu::<T>::with_ordering(order);
         let mut rng = Lcg(11);
         // several matrices on one pattern: the first chooses the pivots, the next ones reuse
         // them or ask for new ones; every solve is exact to rounding

@@ -5,7 +5,8 @@
 use super::Pattern;
 use crate::linalg::rcm::rcm;
 use crate::linalg::band_lu::{BandLu, Scalar};
-use crate::linalg::static_lu::{Factored, StaticLu};
+use crate::linalg::static_lu::{Factored, Ordering, StaticLu};
+use super::Structure;
 
 /// How `BandNewton` factors: the band LU (a narrow band after RCM) or the sparse LU with a
 /// fill-reducing order and kept pivots (`static_lu`: a wide band whose elimination stays sparse).
@@ -13,6 +14,25 @@ use crate::linalg::static_lu::{Factored, StaticLu};
 pub enum Factorization {
     Band,
     Static,
+}
+
+/// The sparse form's analysis of a structure for one method (`NewtonMatrices::for_system`): its
+/// band layout (RCM) and, where the static LU is taken, its minimum degree order, which the
+/// real and the complex factorization then share (the order is found once).
+#[derive(Debug, Clone)]
+pub struct SparsePlan {
+    pub structure: Structure,
+    pub layout: BandLayout,
+    /// `Some`: the static LU on this order; `None`: the band LU.
+    pub order: Option<Ordering>,
+    /// With Radau IIA's complex matrix.
+    pub complex: bool,
+}
+
+impl SparsePlan {
+    pub fn kind(&self) -> Factorization {
+        if self.order.is_some() { Factorization::Static } else { Factorization::Band }
+    }
 }
 
 /// One of the two factorizations, behind the band LU's interface.
@@ -23,11 +43,11 @@ pub(super) enum Lu<T: Scalar> {
 }
 
 impl<T: Scalar> Lu<T> {
-    pub(super) fn new(kind: Factorization, layout: &BandLayout, entries: &[(usize, usize)]) -> Self {
-        let (size, hb) = (layout.size, layout.hb);
-        match kind {
-            Factorization::Band => Lu::Band(BandLu::new(size, hb, hb)),
-            Factorization::Static => Lu::Static(StaticLu::new(size, entries.iter().copied())),
+    /// The static LU on `order`, the band LU in `layout` without one.
+    pub(super) fn new(layout: &BandLayout, order: Option<Ordering>) -> Self {
+        match order {
+            Some(o) => Lu::Static(StaticLu::with_ordering(o)),
+            None => Lu::Band(BandLu::new(layout.size, layout.hb, layout.hb)),
         }
     }
     pub(super) fn clear(&mut self) {

@@ -55,6 +55,68 @@ struct Seg {
     val: usize,
 }
 
+/// The first part of the symbolic analysis: segments of `A`'s rows, the rows each body enters,
+/// the RCM order and the half-bandwidth; enough for the automatic choice's estimate (`flops`)
+/// before any workspace is built (`data::Data::build`).
+pub struct RowAnalysis {
+    seg_ptr: Vec<usize>,
+    segs: Vec<Seg>,
+    /// `(row, segment)` of every row a body enters.
+    rows_of_body: Vec<Vec<(usize, usize)>>,
+    perm: Vec<usize>,
+    hb: usize,
+    /// Nonzeros of `A` under the segment pattern.
+    val: usize,
+}
+
+impl RowAnalysis {
+    pub fn new(model: &Model) -> RowAnalysis {
+        let m = model.m;
+        let mut seg_ptr = vec![0];
+        let mut segs = Vec::new();
+        let mut val = 0;
+        let mut rows_of_body: Vec<Vec<(usize, usize)>> = vec![Vec::new(); model.bodies.len()];
+        for c in &model.constraints {
+            let mut bodies: Vec<usize> = c.bodies().into_iter().flatten().collect();
+            bodies.sort_unstable();
+            bodies.dedup();
+            for r in c.row..c.row + c.rows() {
+                for &b in &bodies {
+                    let body = &model.bodies[b];
+                    rows_of_body[b].push((r, segs.len()));
+                    segs.push(Seg { body: b, col: body.offset, len: body.n_coords, val });
+                    val += body.n_coords;
+                }
+                seg_ptr.push(segs.len());
+            }
+        }
+        let perm = rcm(m, &rows_of_body);
+        // half-bandwidth
+        let mut hb = 0;
+        for rows in &rows_of_body {
+            for &(ra, _) in rows {
+                for &(rb, _) in rows {
+                    hb = hb.max(perm[ra].abs_diff(perm[rb]));
+                }
+            }
+        }
+        RowAnalysis { seg_ptr, segs, rows_of_body, perm, hb, val }
+    }
+
+    /// Rough flop count of one `factor` + `correct` (for the auto choice): the dot products of
+    /// the band pairs, the band Cholesky and selected inverse, the segments.
+    pub fn flops(&self) -> f64 {
+        let w = (self.hb + 1) as f64;
+        let mut dots = 0usize;
+        for rows in &self.rows_of_body {
+            for &(ra, sa) in rows {
+                dots += self.segs[sa].len * rows.iter().filter(|&&(rb, _)| self.perm[rb] <= self.perm[ra]).count();
+            }
+        }
+        2.0 * dots as f64 + 2.0 * self.perm.len() as f64 * w * w + 8.0 * self.val as f64
+    }
+}
+
 /// Symbolic analysis and numeric workspace of the sparse UK path (sized once per model).
 #[derive(Debug, Clone)]
 pub struct SparseUk {
@@ -88,35 +150,13 @@ pub struct SparseUk {
 impl SparseUk {
     /// Symbolic analysis: segments of `A`'s rows, RCM order, band pairs.
     pub fn new(model: &Model) -> SparseUk {
+        SparseUk::from_rows(model, RowAnalysis::new(model))
+    }
+
+    /// The rest of the analysis (the band pairs) and the workspace, on the rows' analysis.
+    pub fn from_rows(model: &Model, rows: RowAnalysis) -> SparseUk {
         let (n, m) = (model.n, model.m);
-        let mut seg_ptr = vec![0];
-        let mut segs = Vec::new();
-        let mut val = 0;
-        let mut rows_of_body: Vec<Vec<(usize, usize)>> = vec![Vec::new(); model.bodies.len()];
-        for c in &model.constraints {
-            let mut bodies: Vec<usize> = c.bodies().into_iter().flatten().collect();
-            bodies.sort_unstable();
-            bodies.dedup();
-            for r in c.row..c.row + c.rows() {
-                for &b in &bodies {
-                    let body = &model.bodies[b];
-                    rows_of_body[b].push((r, segs.len()));
-                    segs.push(Seg { body: b, col: body.offset, len: body.n_coords, val });
-                    val += body.n_coords;
-                }
-                seg_ptr.push(segs.len());
-            }
-        }
-        let perm = rcm(m, &rows_of_body);
-        // half-bandwidth and pairs
-        let mut hb = 0;
-        for rows in &rows_of_body {
-            for &(ra, _) in rows {
-                for &(rb, _) in rows {
-                    hb = hb.max(perm[ra].abs_diff(perm[rb]));
-                }
-            }
-        }
+        let RowAnalysis { seg_ptr, segs, rows_of_body, perm, hb, val } = rows;
         let w = hb + 1;
         let mut pairs = Vec::new();
         let mut max_dot = vec![0usize; m * w];
@@ -159,13 +199,6 @@ impl SparseUk {
     /// Nonzeros of `A` (= of `B`) under the segment pattern.
     pub fn nnz(&self) -> usize {
         self.vals.len()
-    }
-
-    /// Rough flop count of one `factor` + `correct` (for the auto choice).
-    pub fn flops(&self) -> f64 {
-        let w = (self.hb + 1) as f64;
-        let dots: f64 = self.pairs.iter().map(|p| p.3 as f64).sum();
-        2.0 * dots + 2.0 * self.m as f64 * w * w + 8.0 * self.nnz() as f64
     }
 
     /// Heap bytes of this workspace.

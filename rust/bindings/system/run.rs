@@ -159,16 +159,20 @@ impl PySystem {
         let model = &self.model;
         // the run's own workspace (built before releasing the GIL so that a refusal is an error)
         let data = Data::build(model, solver, limit).map_err(to_py)?;
-        // GENALPHA and RADAU5M: the sparse Newton matrices where they pay (or when asked for),
-        // decided here so that the dense ones are refused before the run when too large
+        // GENALPHA and RADAU5M: the sparse Newton matrices where they pay (or when asked for).
+        // The run chooses (`NewtonMatrices::for_system`, one analysis of the pattern); the
+        // choice is made here as well only where the dense matrices would not fit, so that they
+        // are refused before the run unless the sparse ones take their place
+        let early = |name: &str| linear_solver == LinearSolver::Auto && implicit_bytes(model, name) > limit;
         let mut opts = opts;
-        if let Method::GenAlpha(_) | Method::RadauM(_) = method {
+        if matches!(method, Method::GenAlpha(_) | Method::RadauM(_)) && early(method.name()) {
             opts.linear_solver = NewtonMatrices::resolve(model, &data, linear_solver, matches!(method, Method::RadauM(_)), method.name()).map_err(to_py)?;
         }
         if method == Method::Radau5 {
             // with the structured Jacobian RADAU5 solves its iteration matrices as saddle points
             opts.linear_solver = match jacobian {
-                Differences::Structured => NewtonMatrices::resolve(model, &data, linear_solver, true, method.name()).map_err(to_py)?,
+                Differences::Structured if early("RADAU5") => NewtonMatrices::resolve(model, &data, linear_solver, true, method.name()).map_err(to_py)?,
+                Differences::Structured => linear_solver,
                 _ => LinearSolver::Dense,
             };
         }
