@@ -94,11 +94,10 @@ pub struct RadauM {
     m: usize,
     st: StepState,
     /// The tolerances (the user's, as solve_ivp means them; `atol`: 2n entries) and Newton's
-    /// (RADAU5's internal ones, `0.1 rtol^(2/3)`, 2n entries).
+    /// (RADAU5's internal ones, `0.1 rtol^(2/3)`, positions).
     rtol: f64,
     newton_rtol: f64,
     newton_atol: Vec<f64>,
-    newton_velocity: bool,
     atol: Vec<f64>,
     fnewt: f64,
     /// Radau IIA matrix, its square, nodes; the transformation `T`, `T^-1` and the eigenvalues
@@ -207,9 +206,8 @@ impl RadauM {
         // stopping rule is calibrated on them; with a fixed step rtol sets only these)
         let rtol = error_test_rtol(opts.rtol);
         let newton_rtol = 0.1 * opts.rtol.powf(2.0 / 3.0);
-        let newton_atol: Vec<f64> = atol_user.iter().map(|a| newton_rtol * a / opts.rtol).collect();
+        let newton_atol: Vec<f64> = atol_user[..n].iter().map(|a| newton_rtol * a / opts.rtol).collect();
         let atol: Vec<f64> = atol_user.iter().map(|a| a * rtol / opts.rtol).collect();
-        let newton_velocity = ro.step.is_none() && opts.rtol >= iteration::NEWTON_VELOCITY_RTOL;
         let fnewt = (10.0 * f64::EPSILON / newton_rtol).max(0.03f64.min(newton_rtol.sqrt()));
         let s6 = 6f64.sqrt();
         let a = [
@@ -236,7 +234,6 @@ impl RadauM {
             rtol,
             newton_rtol,
             newton_atol,
-            newton_velocity,
             atol,
             fnewt,
             a,
@@ -375,6 +372,7 @@ impl RadauM {
     fn newton_scal(&self, i: usize) -> f64 {
         self.newton_atol[i] + self.newton_rtol * (self.qs[2][i] - self.q0[i]).abs()
     }
+
 
     /// Starting values: the last step's stage accelerations and multipliers extrapolated
     /// (quadratic through its three stages) to this step's stage times; on the first step (or

@@ -3,12 +3,6 @@
 
 use super::*;
 
-/// With error control and from this user rtol up, Newton also weighs the velocity corrections
-/// against `NEWTON_VELOCITY_SLACK` x the error test's velocity weights at Newton's tolerances
-/// (docs/integrators.md, round i26-damp: the damped cantilever's steps).
-pub(super) const NEWTON_VELOCITY_RTOL: f64 = 1e-6;
-const NEWTON_VELOCITY_SLACK: f64 = 2.0;
-
 impl RadauM {
     /// One Newton attempt of step `h`. `Ok(Some(iterations))` on convergence, `Ok(None)` on
     /// divergence or slow convergence (`self.st.h` is then the step to retry with).
@@ -80,17 +74,9 @@ impl RadauM {
             for k2 in 0..n {
                 let d: [f64; 3] = std::array::from_fn(|i| self.dw[i][k2]);
                 let s = 1.0 / self.newton_scal(k2);
-                // velocity corrections as a position error within the step (`h dqd`) and, with
-                // error control, against the error test's velocity weights (`NEWTON_VELOCITY_RTOL`)
-                let sv = if self.newton_velocity {
-                    let sc = self.newton_atol[n + k2] + self.newton_rtol * self.v0[k2].abs().max(self.vs[2][k2].abs());
-                    (h * s).max(1.0 / (NEWTON_VELOCITY_SLACK * sc))
-                } else {
-                    h * s
-                };
                 for i in 0..3 {
                     let dq = h * h * (self.a2[i][0] * d[0] + self.a2[i][1] * d[1] + self.a2[i][2] * d[2]) * s;
-                    let dv = h * (self.a[i][0] * d[0] + self.a[i][1] * d[1] + self.a[i][2] * d[2]) * sv;
+                    let dv = h * h * (self.a[i][0] * d[0] + self.a[i][1] * d[1] + self.a[i][2] * d[2]) * s;
                     dyno += dq * dq + dv * dv;
                 }
             }
