@@ -94,7 +94,7 @@ pub struct RadauM {
     m: usize,
     st: StepState,
     /// The tolerances (the user's, as solve_ivp means them; `atol`: 2n entries) and Newton's
-    /// (RADAU5's internal ones, `0.1 rtol^(2/3)`, positions).
+    /// (RADAU5's internal ones, `0.1 rtol^(2/3)`, 2n entries).
     rtol: f64,
     newton_rtol: f64,
     newton_atol: Vec<f64>,
@@ -152,6 +152,7 @@ pub struct RadauM {
     /// Step control state (Hairer).
     faccon: f64,
     theta: f64,
+    theta_v: f64, // the velocity corrections' last measured contraction (`iteration`)
     hacc: f64,
     erracc: f64,
     first: bool,
@@ -206,7 +207,7 @@ impl RadauM {
         // stopping rule is calibrated on them; with a fixed step rtol sets only these)
         let rtol = error_test_rtol(opts.rtol);
         let newton_rtol = 0.1 * opts.rtol.powf(2.0 / 3.0);
-        let newton_atol: Vec<f64> = atol_user[..n].iter().map(|a| newton_rtol * a / opts.rtol).collect();
+        let newton_atol: Vec<f64> = atol_user.iter().map(|a| newton_rtol * a / opts.rtol).collect();
         let atol: Vec<f64> = atol_user.iter().map(|a| a * rtol / opts.rtol).collect();
         let fnewt = (10.0 * f64::EPSILON / newton_rtol).max(0.03f64.min(newton_rtol.sqrt()));
         let s6 = 6f64.sqrt();
@@ -274,6 +275,7 @@ impl RadauM {
             age: 0,
             faccon: 1.0,
             theta: 1.0,
+            theta_v: 1.0,
             hacc: 0.0,
             erracc: 0.0,
             first: true,

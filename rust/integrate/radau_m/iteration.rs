@@ -3,6 +3,24 @@
 
 use super::*;
 
+/// With error control, from this user rtol up, Newton's stop also asks the velocity corrections to
+/// be small, against `NEWTON_VELOCITY_SLACK` x the error test's velocity weights at Newton's
+/// tolerances: after the position test passes it iterates on (at most `NEWTON_VELOCITY_EXTRA`
+/// times) while the velocity norm, times its contraction factor (`theta_v / (1 - theta_v)`,
+/// remembered from the last velocity iteration and relaxed like `faccon`), is above `fnewt` and
+/// still contracts by `NEWTON_VELOCITY_CONTRACTION`. The position test alone decides contraction,
+/// divergence, rejection and the iteration count the step control sees; corrections at their
+/// rounding floor stop contracting, so the extra iteration moves the answer by rounding only. A
+/// velocity contraction worse than `REFRESH_CONTRACTION` reads the velocity terms again. Without it
+/// the damped cantilever's Newton left its fast overdamped modes' velocities off their slow path,
+/// which the error test read as errors (docs/integrators.md, "The damped cantilever"). Below 1e-8
+/// the spring of `test_rtol_means_what_solve_ivp_means` lost its tolerance proportionality (at rtol
+/// 1e-9: 0.13 -> 0.26 rtol).
+const NEWTON_VELOCITY_RTOL: f64 = 1e-8;
+const NEWTON_VELOCITY_SLACK: f64 = 4.0;
+const NEWTON_VELOCITY_EXTRA: usize = 2;
+const NEWTON_VELOCITY_CONTRACTION: f64 = 0.5;
+
 impl RadauM {
     /// One Newton attempt of step `h`. `Ok(Some(iterations))` on convergence, `Ok(None)` on
     /// divergence or slow convergence (`self.st.h` is then the step to retry with).
@@ -12,9 +30,18 @@ impl RadauM {
         let t0 = self.st.t;
         self.faccon = self.faccon.max(f64::EPSILON).powf(0.8);
         self.theta = self.theta.abs();
+        self.theta_v = self.theta_v.max(f64::EPSILON).powf(0.8);
+        let fv = if self.theta_v < 0.99 { self.theta_v / (1.0 - self.theta_v) } else { 1.0 };
         let mut dynold = 0.0f64;
         let mut thqold = 0.0f64;
-        for k in 1..=NIT {
+        let velocity = self.ro.step.is_none() && self.opts.rtol >= NEWTON_VELOCITY_RTOL;
+        // the velocity norm of the last iteration; the iteration where the positions converged
+        let mut dvnold = f64::INFINITY;
+        let mut converged: Option<usize> = None;
+        for k in 1..=NIT + NEWTON_VELOCITY_EXTRA {
+            if converged.is_none() && k > NIT {
+                break;
+            }
             self.stages(h);
             for i in 0..3 {
                 let (r1, r2) = self.res[i].split_at_mut(n);
@@ -53,6 +80,7 @@ impl RadauM {
             // velocity corrections of all stages (one division per coordinate: six in the chain
             // of the sum cost their latency)
             let mut dyno = 0.0;
+            let mut dvn = 0.0;
             for k2 in 0..nm {
                 let (x0, x1, x2) = (self.xr[k2], self.xc[k2], self.xi[k2]);
                 for i in 0..3 {
@@ -79,11 +107,34 @@ impl RadauM {
                     let dv = h * h * (self.a[i][0] * d[0] + self.a[i][1] * d[1] + self.a[i][2] * d[2]) * s;
                     dyno += dq * dq + dv * dv;
                 }
+                if velocity {
+                    let sc = self.newton_atol[n + k2] + self.newton_rtol * self.v0[k2].abs().max(self.vs[2][k2].abs());
+                    let sv = 1.0 / (NEWTON_VELOCITY_SLACK * sc);
+                    for i in 0..3 {
+                        let dv = h * (self.a[i][0] * d[0] + self.a[i][1] * d[1] + self.a[i][2] * d[2]) * sv;
+                        dvn += dv * dv;
+                    }
+                }
             }
             let dyno = (dyno / (6 * n) as f64).sqrt();
-            if !dyno.is_finite() {
+            let dvn = (dvn / (3 * n) as f64).sqrt();
+            if !dyno.is_finite() || !dvn.is_finite() {
                 self.st.nonfinite = Some(("qdd", 0));
                 return Ok(None);
+            }
+            if let Some(kc) = converged {
+                // past the positions' stop: on while the velocities contract
+                self.theta_v = (dvn / dvnold).min(1.0);
+                if self.theta_v > REFRESH_CONTRACTION {
+                    self.refresh = true;
+                }
+                let fvk = if self.theta_v < 0.99 { self.theta_v / (1.0 - self.theta_v) } else { self.faccon };
+                if fvk * dvn <= self.fnewt || k - kc >= NEWTON_VELOCITY_EXTRA || dvn > NEWTON_VELOCITY_CONTRACTION * dvnold {
+                    self.stages(h);
+                    return Ok(Some(kc));
+                }
+                dvnold = dvn;
+                continue;
             }
             if k >= 2 {
                 let thq = dyno / dynold;
@@ -106,9 +157,15 @@ impl RadauM {
             }
             dynold = dyno.max(f64::EPSILON);
             if self.faccon * dyno <= self.fnewt {
+                if velocity && self.faccon.min(fv) * dvn > self.fnewt && dvn <= NEWTON_VELOCITY_CONTRACTION * dvnold {
+                    converged = Some(k);
+                    dvnold = dvn;
+                    continue;
+                }
                 self.stages(h);
                 return Ok(Some(k));
             }
+            dvnold = dvn;
         }
         self.st.h = 0.5 * h;
         Ok(None)
