@@ -223,3 +223,26 @@ def test_bricard_cod_backend_matches_the_svd_on_the_manifold():
         assert not cod.rank_info(0.0, q, qd, False)["exact"]       # the decomposition's bounds
     with pytest.raises(ukflex.InvalidArgumentError):
         cod.set_pseudoinverse("svd?")
+
+
+def test_bricard_default_gives_the_svds_truncation_off_the_manifold():
+    """The default (``auto``) on A04's rank-34 B: the SVD's truncation by deflation (the lifted QR
+    of R, rust/linalg/small_svd/deflate.rs), not the SVD itself; its accelerations and
+    multipliers are the SVD's to rounding on the manifold and 1e-6 off it (where the complete
+    orthogonal decomposition's truncation differs from the SVD's by about the drift), with the
+    same rank, and its rank report is the bounds (``exact`` False) until asked for exactly."""
+    auto, svd = (ukflex.System(spatial_scenes.bricard()) for _ in range(2))
+    svd.set_pseudoinverse("faer")
+    res = ukflex.simulate(svd, 1.0, method="DOPRI5", rtol=1e-10)
+    rng = np.random.default_rng(5)
+    for k in (0, res.t.size // 2, -1):
+        for off in (0.0, 1e-6):
+            q = res.y[:35, k] + off * rng.standard_normal(35)
+            qd = res.y[35:, k]
+            a, b = auto.qdd(0.0, q, qd), svd.qdd(0.0, q, qd)
+            assert np.abs(a - b).max() < 1e-11 * np.abs(b).max(), (k, off)
+            la, lb = auto.multipliers(0.0, q, qd), svd.multipliers(0.0, q, qd)
+            assert np.abs(la - lb).max() < 1e-10 * np.abs(lb).max(), (k, off)
+            info = auto.rank_info(0.0, q, qd, False)
+            assert info["rank"] == 34 and not info["exact"], info
+            assert auto.rank_info(0.0, q, qd)["exact"]

@@ -32,6 +32,7 @@
 //! pseudoinverse's rank decision at its default tolerance `max(m, n) eps sigma_max`. Rejected.
 
 mod cod;
+mod deflate;
 pub use cod::{CodRank, RankRule};
 
 /// Column-major workspace for the QR + Jacobi SVD of an n x m matrix with m <= n.
@@ -69,6 +70,8 @@ pub struct QrJacobi {
     pub sweeps: usize,
     /// The complete orthogonal decomposition of `R` (rank-deficient `G` without an SVD: `cod`).
     cod: cod::Cod,
+    /// The SVD's truncation at rank `m - 1` without the SVD (`deflate`; made at its first use).
+    deflate: deflate::Deflate,
 }
 
 /// Maximum number of Jacobi sweeps before giving up (quadratic convergence: ~5 usually).
@@ -96,6 +99,7 @@ impl QrJacobi {
             tp: vec![0.0; m],
             sweeps: 0,
             cod: cod::Cod::new(m),
+            deflate: deflate::Deflate::default(),
         }
     }
 

@@ -52,6 +52,16 @@ pub(super) fn factor_dense(model: &Model, data: &mut Data) -> Result<()> {
                 // R, the SVD only when its bounds cannot decide the rank
                 let (red, rcond_red) = redundant.unwrap_or((0, rcond));
                 let rule = RankRule { rcond, atol, redundant: red, rcond_redundant: rcond_red };
+                // one redundant row (as at the last consistent state, or none known yet): the
+                // SVD's truncation by deflation, certified, without the SVD
+                if backend == SvdBackend::Auto && data.redundant <= 1 {
+                    if let Some(c) = qrj.deflate_factor(&rule) {
+                        data.factored_with = Factored::Deflated;
+                        data.rank_info = RankInfo { rank: c.rank, sigma_max: c.sigma_max, sigma_min_kept: c.sigma_min_kept, sigma_max_dropped: c.sigma_max_dropped, tolerance: c.tolerance, exact: false };
+                        record_redundancy(data, n, m);
+                        return Ok(());
+                    }
+                }
                 if let Some(c) = if backend == SvdBackend::Cod { qrj.cod_factor(&rule) } else { None } {
                     data.factored_with = Factored::Cod;
                     data.rank_info = RankInfo { rank: c.rank, sigma_max: c.sigma_max, sigma_min_kept: c.sigma_min_kept, sigma_max_dropped: c.sigma_max_dropped, tolerance: c.tolerance, exact: false };
@@ -195,7 +205,7 @@ pub fn exact_rank_info(model: &Model, data: &mut Data) -> Result<RankInfo> {
         data.ensure_dense(model)?;
         factor_dense(model, data)?;
     }
-    if data.factored_with == Factored::Cod && !data.rank_info.exact {
+    if matches!(data.factored_with, Factored::Cod | Factored::Deflated) && !data.rank_info.exact {
         // the bounds of the decomposition: the exact values by the SVD of the same B^T (the
         // correction then uses it: same q, same rank)
         let (n, m) = (model.n, model.m);
@@ -242,10 +252,12 @@ pub(super) fn correct_residual(model: &Model, data: &mut Data) {
     let (n, m) = (model.n, model.m);
     let k = n.min(m);
     let rank = data.rank_info.rank;
-    if matches!(data.factored_with, Factored::FullRankQr | Factored::Cod) {
+    if matches!(data.factored_with, Factored::FullRankQr | Factored::Cod | Factored::Deflated) {
         let qrj = data.qrj.as_mut().expect("factored with QR");
         if data.factored_with == Factored::Cod {
             qrj.cod_solve(&data.residual, &mut data.y, &mut data.lambda);
+        } else if data.factored_with == Factored::Deflated {
+            qrj.deflate_solve(&data.residual, &mut data.y, &mut data.lambda);
         } else {
             qrj.full_rank_solve(&data.residual, &mut data.y, &mut data.lambda);
         }

@@ -68,6 +68,9 @@ pub enum Factored {
     /// Certified rank-revealing complete orthogonal decomposition of the QR's `R` in `qrj`
     /// (`QrJacobi::cod_factor`: rank-deficient `B` without an SVD).
     Cod,
+    /// Certified rank `m - 1`: the SVD's truncation by the lifted QR of `R` in `qrj`
+    /// (`QrJacobi::deflate_factor`: one redundant row without an SVD).
+    Deflated,
     /// Certified full-rank band Cholesky of `A M^-1 A^T` in `sparse` (`uk::sparse`).
     SparseGram,
     /// Certified full-rank envelope Cholesky of `A M^-1 A^T`, the normalization rows

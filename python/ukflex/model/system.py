@@ -186,9 +186,10 @@ class System:
             _, self.description = normalize(description)
         elif hasattr(description, "core_text"):
             # a spatial scene: the core's build below is its validation (one build, not two:
-            # 0.4 of A05's 1.3 ms); the description kept is the text read back (a deep copy)
+            # 0.4 of A05's 1.3 ms); the description kept is the text, read back (a deep copy) at
+            # its first use (`description`)
             text = description.core_text()
-            self.description = json.loads(text)
+            self._description_text = text
         elif hasattr(description, "to_dict") and hasattr(description, "validate"):
             description.validate()
             self.description = description.to_dict()
@@ -246,6 +247,19 @@ class System:
                 f"the scene's energy at the initial state is out of the double-precision range ({exc}); "
                 "check lengths, masses, gravity and their units"
             ) from exc
+
+    @property
+    def description(self) -> Dict[str, Any]:
+        """The validated description (a spatial scene's read back from the core's text at the
+        first use: a run does not need it, 0.09 ms of A05's 0.6 ms build)."""
+        d = self.__dict__.get("_description")
+        if d is None:
+            d = self._description = json.loads(self.__dict__["_description_text"])
+        return d
+
+    @description.setter
+    def description(self, value: Dict[str, Any]) -> None:
+        self._description = value
 
     def _bind(self, core: Any) -> None:
         """Attach the compiled object and its bound per-step methods (no Python layer per call)."""

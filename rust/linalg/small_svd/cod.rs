@@ -297,13 +297,13 @@ fn apply_z(c: &mut Cod, m: usize, r: usize, forward: bool) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use faer::Mat;
 
-    struct Rng(u64);
+    pub(in crate::linalg::small_svd) struct Rng(pub u64);
     impl Rng {
-        fn next(&mut self) -> f64 {
+        pub(in crate::linalg::small_svd) fn next(&mut self) -> f64 {
             self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         }
@@ -311,7 +311,7 @@ mod tests {
 
     /// `G = X diag(s) Y^T` (n x m, column-major) with random orthogonal-ish `X`, `Y` (QR of
     /// random matrices through faer) and the given singular values.
-    fn with_singular_values(rng: &mut Rng, n: usize, m: usize, s: &[f64]) -> Vec<f64> {
+    pub(in crate::linalg::small_svd) fn with_singular_values(rng: &mut Rng, n: usize, m: usize, s: &[f64]) -> Vec<f64> {
         let x = Mat::<f64>::from_fn(n, m, |_, _| rng.next()).qr().compute_thin_Q();
         let y = Mat::<f64>::from_fn(m, m, |_, _| rng.next()).qr().compute_thin_Q();
         let mut g = vec![0.0; n * m];
@@ -321,6 +321,24 @@ mod tests {
             }
         }
         g
+    }
+
+    /// `G` (21 x 20) with three unit columns (normalization rows) and a duplicated joint
+    /// column: rank m - 1 whatever the rest. Returns `(n, m, units, G)`.
+    pub(in crate::linalg::small_svd) fn unit_columns_rank_m1(rng: &mut Rng) -> (usize, usize, [(usize, usize); 3], Vec<f64>) {
+        let (n, m) = (21usize, 20usize);
+        let units = [(17usize, 6usize), (18, 13), (19, 20)];
+        let mut s: Vec<f64> = (0..m).map(|k| 1.0 - 0.03 * k as f64).collect();
+        s[m - 1] = 0.0;
+        let mut g = with_singular_values(rng, n, m, &s);
+        for &(c, r) in &units {
+            let col = &mut g[c * n..(c + 1) * n];
+            col.fill(0.0);
+            col[r] = 0.7;
+        }
+        let c0 = g[..n].to_vec();
+        g[5 * n..6 * n].copy_from_slice(&c0);
+        (n, m, units, g)
     }
 
     /// The SVD's answer: rank by `rule`, `y = B^+ r`, `lambda = -(B B^T)^+ r` for `B = G^T`.
@@ -398,19 +416,7 @@ mod tests {
             assert_eq!(check(QrJacobi::new(n, m), &gd, &plain, &mut rng, 1e-6), m);
         }
         // unit columns (normalization rows): same answers
-        let (n, m) = (21usize, 20usize);
-        let units = [(17usize, 6usize), (18, 13), (19, 20)];
-        let mut s: Vec<f64> = (0..m).map(|k| 1.0 - 0.03 * k as f64).collect();
-        s[m - 1] = 0.0;
-        let mut g = with_singular_values(&mut rng, n, m, &s);
-        for &(c, r) in &units {
-            let col = &mut g[c * n..(c + 1) * n];
-            col.fill(0.0);
-            col[r] = 0.7;
-        }
-        // a duplicated joint column: rank m - 1 whatever the rest
-        let c0 = g[..n].to_vec();
-        g[5 * n..6 * n].copy_from_slice(&c0);
+        let (n, m, units, g) = unit_columns_rank_m1(&mut rng);
         let rule = RankRule { rcond: (n as f64) * eps, atol: 0.0, redundant: 0, rcond_redundant: 0.0 };
         let r = check(QrJacobi::with_unit_columns(n, m, &units), &g, &rule, &mut rng, 1e-9);
         assert!(r < m);
