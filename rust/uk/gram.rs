@@ -13,6 +13,9 @@
 //! Only `S_22` is factored: its rows couple when they share a body, so in the reverse
 //! Cuthill-McKee order of that graph it lives on a narrow envelope (the spatial slider-crank's
 //! 17 joint rows: 4 blocks of 3 to 5 rows, each coupled to its neighbours; `linalg::envelope`).
+//! Where that envelope is block tridiagonal with blocks of at most 6 rows (the slider-crank and
+//! the heavy top) `S_22` is factored by fixed-size blocks instead (`linalg::block_tridiag`,
+//! chosen once at setup: the same factor evaluated in another order, with the same bounds).
 //! This is the factor the dense QR computes (`R = L^T` up to signs) without the Householder
 //! work on the exact zeros.
 //!
@@ -53,7 +56,7 @@
 use super::settings::RankInfo;
 use crate::body::{BodyData, BodyKind};
 use crate::constraint::jac::{Seg, SegJac};
-use crate::linalg::envelope::EnvelopeCholesky;
+use crate::linalg::block_tridiag::SpdProfile;
 use crate::model::Model;
 
 /// The Gram path serves `B` whose condition estimate `sqrt(trace S trace S^-1)` (at least
@@ -106,9 +109,9 @@ pub struct GramUk {
     finv: Vec<Option<(f64, [[f64; 4]; 4])>>,
     /// Longest dot product that makes one entry of `S_22`.
     max_dot: usize,
-    env: EnvelopeCholesky,
-    /// Selected inverse of `S_22` (the layout of `env`).
-    z: Vec<f64>,
+    /// `S_22`, its factor and selected inverse: by blocks where its envelope is block
+    /// tridiagonal with small blocks (the spatial slider-crank), the envelope otherwise.
+    env: SpdProfile,
     /// `d_b = B^T[c_b, row_b]`, and scratch per unit.
     d: Vec<f64>,
     zu: Vec<f64>,
@@ -146,6 +149,11 @@ fn seg_dot(x: &[f64], y: &[f64]) -> f64 {
 impl GramUk {
     /// Symbolic analysis on the pattern of `ajac` (the model's `SegJac`).
     pub fn new(model: &Model, ajac: &SegJac) -> GramUk {
+        GramUk::with_profile(model, ajac, true)
+    }
+
+    /// `new`; `blocks: false` keeps `S_22` on the generic envelope whatever its pattern.
+    pub fn with_profile(model: &Model, ajac: &SegJac, blocks: bool) -> GramUk {
         let (n, m) = (model.n, model.m);
         let mut unit_of_row = vec![None; m];
         let mut unit_of_body = vec![None; model.bodies.len()];
@@ -182,7 +190,7 @@ impl GramUk {
         let rows: Vec<usize> = order.iter().map(|&a| joint_rows[a]).collect();
         // each row's envelope starts at the first row it shares a body with
         let first: Vec<usize> = order.iter().enumerate().map(|(p, &a)| adj[a].iter().map(|&b| perm[b]).fold(p, usize::min)).collect();
-        let env = EnvelopeCholesky::new(first);
+        let env = SpdProfile::new(first, blocks);
         // the pairs of S_22 (off the unit coordinates) and the entries of X
         let mut pairs = Vec::new();
         let mut dots = vec![0usize; env.len()];
@@ -225,7 +233,7 @@ impl GramUk {
             }
             quad_ptr.push(quad.len());
         }
-        let (nu, mj, len) = (units.len(), rows.len(), env.len());
+        let (nu, mj) = (units.len(), rows.len());
         GramUk {
             m,
             rows,
@@ -241,7 +249,6 @@ impl GramUk {
             finv: vec![None; model.bodies.len()],
             max_dot: dots.into_iter().max().unwrap_or(0),
             env,
-            z: vec![0.0; len],
             d: vec![0.0; nu],
             zu: vec![0.0; nu],
             rt: vec![0.0; mj],
@@ -306,8 +313,8 @@ impl GramUk {
         }
         // each entry's products summed in a register, then stored once (the pairs are sorted
         // by entry: a sum through memory waits on the previous store)
-        let data = &mut self.env.data;
-        data.fill(0.0);
+        self.env.clear();
+        let data = self.env.data_mut();
         let vals = &self.vals;
         let mut pairs = self.pairs.iter().peekable();
         while let Some(&(e, a, b, len)) = pairs.next() {
@@ -329,11 +336,12 @@ impl GramUk {
         if !trace_s.is_finite() || self.d.iter().any(|d| !(d.abs() > 0.0)) || !self.env.factor_in_place() {
             return None;
         }
-        let mut trace_sinv = self.env.selected_inverse_trace(&mut self.z);
+        let mut trace_sinv = self.env.selected_inverse_trace();
+        let z = self.env.z();
         // four partial sums per unit in registers (a sum through memory waits on each store,
         // one register on each addition)
         for (b, d) in self.d.iter().enumerate() {
-            let term = |&(e, s, t, w): &(usize, usize, usize, f64)| w * self.z[e] * self.xval[s] * self.xval[t];
+            let term = |&(e, s, t, w): &(usize, usize, usize, f64)| w * z[e] * self.xval[s] * self.xval[t];
             let quad = self.quad[self.quad_ptr[b]..self.quad_ptr[b + 1]].chunks_exact(4);
             let rest = quad.remainder();
             let (mut a0, mut a1, mut a2, mut a3) = (0.0, 0.0, 0.0, 0.0);
@@ -352,14 +360,14 @@ impl GramUk {
             let ke = k as f64 * f64::EPSILON;
             ke / (1.0 - ke)
         };
-        let w = self.env.width.max(1);
+        let w = self.env.width().max(1);
         let delta = 2.0 * (2 * w - 1) as f64 * (gamma(w + 3) + gamma(self.max_dot)) * max_d;
         let lower = 0.5 / trace_sinv - delta;
         let sigma_max = trace_s.sqrt();
         let tol = atol.max(rcond * sigma_max);
         let conditioned = trace_s * trace_sinv <= GRAM_MAX_COND * GRAM_MAX_COND;
         // the unrefined solution's bound against the QR's (module docs, "Accuracy")
-        let scaled: f64 = self.sdiag.iter().enumerate().map(|(p, s)| s * self.z[self.env.index(p, p)]).sum();
+        let scaled: f64 = self.sdiag.iter().enumerate().map(|(p, s)| s * z[self.env.index(p, p)]).sum();
         let unrefined = (2 * w - 1) as f64 * gamma(3 * w + 3) * scaled;
         self.refine = !(unrefined <= (model.n * self.m) as f64 * f64::EPSILON * (trace_s * trace_sinv).sqrt());
         if lower.is_finite() && lower > 0.0 && lower > tol * tol && conditioned {
