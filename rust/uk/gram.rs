@@ -263,6 +263,11 @@ impl GramUk {
         }
     }
 
+    /// Whether `S_22` is factored by blocks (`linalg::block_tridiag`).
+    pub fn on_blocks(&self) -> bool {
+        self.env.is_blocks()
+    }
+
     /// Heap bytes of the workspace of `GramUk::new` (a bound without building it: the pattern,
     /// the values, and an envelope and pair lists no larger than those of the dense `S`).
     pub fn bytes(model: &Model) -> u64 {
@@ -564,6 +569,56 @@ mod tests {
         }
     }
 
+    /// The block factor of `S_22` against the generic envelope on the same scenes: the same
+    /// decisions, traces, corrections and multipliers to rounding. The slider-crank (4 blocks of
+    /// 3 to 5 rows) and the heavy top (one block of 3) take the blocks, A05 (a block of more
+    /// than 6 rows) keeps the envelope, A04 (blocks, rank 34 of 35) is refused by both (their
+    /// `GramUk` is called directly here: `uk` refuses them by condition and rank).
+    #[test]
+    fn blocks_match_the_envelope_path() {
+        let scenes = [
+            (include_str!("../../benches/data/spatial/slider_crank.json"), true),
+            (include_str!("../../benches/data/spatial/heavy_top.json"), true),
+            (include_str!("../../benches/data/spatial/flyball.json"), false),
+            (include_str!("../../benches/data/spatial/bricard.json"), true),
+        ];
+        for (si, (json, blocks)) in scenes.into_iter().enumerate() {
+            let (model, q, qd) = scene(json);
+            let mut data = Data::build(&model, UkSolver::Dense, u64::MAX).unwrap();
+            uk::evaluate(&model, &mut data, 0.1, &q, &qd, false).unwrap();
+            let mut blk = super::GramUk::with_profile(&model, &data.ajac, true);
+            let mut env = super::GramUk::with_profile(&model, &data.ajac, false);
+            assert!(!env.on_blocks());
+            assert_eq!(blk.on_blocks(), blocks, "scene {si}");
+            let (a, b) = (blk.factor(&model, &data.bodies, &data.ajac, 1e-12, 0.0), env.factor(&model, &data.bodies, &data.ajac, 1e-12, 0.0));
+            assert_eq!(a.map(|i| i.rank), b.map(|i| i.rank), "scene {si}");
+            assert!((blk.trace_s - env.trace_s).abs() <= 1e-14 * env.trace_s, "scene {si}");
+            // A04 (rank 34 of 35): S_22 is singular to rounding, nothing more to compare
+            if si == 3 {
+                assert!(a.is_none());
+                continue;
+            }
+            let rel = (blk.trace_sinv - env.trace_sinv).abs() / env.trace_sinv;
+            assert!(rel < 1e-10, "scene {si}: trace(S^-1) {} vs {}", blk.trace_sinv, env.trace_sinv);
+            assert_eq!(blk.refine, env.refine);
+            let (n, m) = (model.n, model.m);
+            let y0: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
+            let mut out = [(vec![0.0; m], y0.clone(), vec![0.0; m]), (vec![0.0; m], y0, vec![0.0; m])];
+            blk.correct(&data.gamma, &mut out[0].0, &mut out[0].1, &mut out[0].2);
+            env.correct(&data.gamma, &mut out[1].0, &mut out[1].1, &mut out[1].2);
+            // the two differ by the rounding of a solve with S_22: cond(S_22) eps at most
+            let tol = 1e3 * f64::EPSILON * env.trace_s * env.trace_sinv;
+            let ymax = out[1].1.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
+            let lmax = out[1].2.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
+            for i in 0..n {
+                assert!((out[0].1[i] - out[1].1[i]).abs() <= tol * ymax, "scene {si}: y[{i}] {} vs {}", out[0].1[i], out[1].1[i]);
+            }
+            for i in 0..m {
+                assert!((out[0].2[i] - out[1].2[i]).abs() <= tol * lmax, "scene {si}: lambda[{i}] {} vs {}", out[0].2[i], out[1].2[i]);
+            }
+        }
+    }
+
     /// A tolerance above the smallest singular value: the certificate refuses and the dense
     /// rank-revealing path drops it, as without the Gram path.
     #[test]
@@ -572,6 +627,7 @@ mod tests {
         let mut data = Data::new(&model);
         uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
         assert_eq!(data.factored_with, Factored::Gram);
+        assert!(data.gram.as_ref().unwrap().on_blocks());
         let exact = uk::singular_values(&model, &mut data).unwrap().unwrap();
         let ratio = exact[model.m - 1] / exact[0];
         // just above sigma_min: the Gram certificate (and the QR's) cannot pass
