@@ -149,55 +149,63 @@ fn backward_block<const S: usize, const T: usize>(blocks: &[Blk], inv: &[Col], x
 }
 
 /// The selected inverse's block `k` (its diagonal block, full, and the block of rows of
-/// `k + 1`) by Takahashi's recurrence, columns from the last; returns its diagonal's sum.
+/// `k + 1`) by Takahashi's recurrence, columns from the last; returns its diagonal's sum. Each
+/// entry's sum is split in its part through the next block, which does not depend on the other
+/// columns (`G = Z_{k+1,k+1} L_{k+1,k}`, then `K = Z_{k+1,k}^T L_{k+1,k}`, all independent
+/// products), and the short part inside the block, the only chain from column to column.
 fn selinv_block<const S: usize, const T: usize>(blocks: &[Blk], inv: &[Col], z: &mut [Blk], k: usize) -> f64 {
     let l = &blocks[2 * k];
-    let ln = if T > 0 { &blocks[2 * k + 3] } else { l };
     let (lo, hi) = z.split_at_mut(2 * k + 2);
     let zk = &mut lo[2 * k];
-    let (zn, zs) = if T > 0 {
+    let mut kk = [[0.0; P]; P];
+    if T > 0 {
+        let ln = &blocks[2 * k + 3];
         let (a, b) = hi.split_at_mut(1);
-        (&a[0], &mut b[0])
-    } else {
-        (&*zk, &mut [[0.0; P]; P])
-    };
-    let zn = *zn;
-    let mut zs_l = *zs;
-    for j in (0..S).rev() {
-        // the rows of the next block
+        let (zn, zs) = (&a[0], &mut b[0]);
+        // Z_{k+1,k} = -(G + Z_{k+1,k} strictly-lower part of L_kk), columns from the last
         for m in 0..T {
-            let mut s = 0.0;
-            for i in j + 1..S {
-                s += l[i][j] * zs_l[m][i];
+            for j in 0..S {
+                let mut g = 0.0;
+                for m2 in 0..T {
+                    g += ln[m2][j] * zn[m][m2];
+                }
+                zs[m][j] = g;
             }
-            for m2 in 0..T {
-                s += ln[m2][j] * zn[m][m2];
-            }
-            zs_l[m][j] = -s;
         }
+        for j in (0..S).rev() {
+            for m in 0..T {
+                let mut s = zs[m][j];
+                for i in j + 1..S {
+                    s += l[i][j] * zs[m][i];
+                }
+                zs[m][j] = -s;
+            }
+        }
+        for i in 0..S {
+            for j in 0..=i {
+                let mut s = 0.0;
+                for m in 0..T {
+                    s += ln[m][j] * zs[m][i];
+                }
+                kk[i][j] = s;
+            }
+        }
+    }
+    for j in (0..S).rev() {
         // the rows i > j of this block
         for i in j + 1..S {
-            let mut s = 0.0;
+            let mut s = kk[i][j];
             for i2 in j + 1..S {
                 s += l[i2][j] * zk[i2][i];
-            }
-            for m in 0..T {
-                s += ln[m][j] * zs_l[m][i];
             }
             zk[i][j] = -s;
             zk[j][i] = -s;
         }
-        let mut t = 0.0;
+        let mut t = kk[j][j];
         for i in j + 1..S {
             t += l[i][j] * zk[i][j];
         }
-        for m in 0..T {
-            t += ln[m][j] * zs_l[m][j];
-        }
         zk[j][j] = inv[k][j] - t;
-    }
-    if T > 0 {
-        *zs = zs_l;
     }
     (0..S).map(|j| zk[j][j]).sum()
 }
