@@ -104,7 +104,11 @@ pub struct GramUk {
     quad: Vec<(usize, usize, usize, f64)>,
     quad_ptr: Vec<usize>,
     /// `S_22[entry] += vals_a . vals_b` over `(entry, a, b, len)`.
+    /// (the entries made of one or of two six-entry products, the common case, apart:
+    /// `(entry, a, b)` and `(entry, a, b, a2, b2)`; the other entries in `pairs`)
     pairs: Vec<(usize, usize, usize, usize)>,
+    six1: Vec<(usize, usize, usize)>,
+    six2: Vec<(usize, usize, usize, usize, usize)>,
     /// Per body: a rigid3 body's `F^-1` as `(1 / sqrt m, T)` (`Rigid3::finv_matrix`), this call's.
     finv: Vec<Option<(f64, [[f64; 4]; 4])>>,
     /// Longest dot product that makes one entry of `S_22`.
@@ -131,6 +135,12 @@ pub struct GramUk {
     pub skip: u32,
 }
 
+/// `seg_dot` of six entries.
+#[inline(always)]
+fn dot6(x: &[f64; 6], y: &[f64; 6]) -> f64 {
+    ((x[0] * y[0] + x[2] * y[2]) + (x[1] * y[1] + x[3] * y[3])) + x[4] * y[4] + x[5] * y[5]
+}
+
 /// `dot4(x, y)` to the bit, with the six- and seven-entry cases (a rigid3 body off its unit
 /// coordinate: most products of `S_22`; a rigid3 body's segment) written out so that they have
 /// no loop and no remainder branches.
@@ -138,7 +148,7 @@ pub struct GramUk {
 fn seg_dot(x: &[f64], y: &[f64]) -> f64 {
     let head = |x: &[f64], y: &[f64]| (x[0] * y[0] + x[2] * y[2]) + (x[1] * y[1] + x[3] * y[3]);
     if let (Ok(x), Ok(y)) = (<&[f64; 6]>::try_from(x), <&[f64; 6]>::try_from(y)) {
-        head(x, y) + x[4] * y[4] + x[5] * y[5]
+        dot6(x, y)
     } else if let (Ok(x), Ok(y)) = (<&[f64; 7]>::try_from(x), <&[f64; 7]>::try_from(y)) {
         head(x, y) + x[4] * y[4] + x[5] * y[5] + x[6] * y[6]
     } else {
@@ -220,7 +230,16 @@ impl GramUk {
                 }
             }
         }
-        pairs.sort_unstable_by_key(|p| p.0);
+        pairs.sort_by_key(|p| p.0);
+        let (mut six1, mut six2, mut rest) = (Vec::new(), Vec::new(), Vec::new());
+        for group in pairs.chunk_by(|p, q| p.0 == q.0) {
+            match group {
+                [(e, a, b, 6)] => six1.push((*e, *a, *b)),
+                [(e, a, b, 6), (_, a2, b2, 6)] => six2.push((*e, *a, *b, *a2, *b2)),
+                _ => rest.extend_from_slice(group),
+            }
+        }
+        let pairs = rest;
         // x_b^T Z x_b = sum over the ordered pairs of X's entries of unit b
         let (mut quad, mut quad_ptr) = (Vec::new(), vec![0]);
         for b in 0..units.len() {
@@ -246,6 +265,8 @@ impl GramUk {
             quad,
             quad_ptr,
             pairs,
+            six1,
+            six2,
             finv: vec![None; model.bodies.len()],
             max_dot: dots.into_iter().max().unwrap_or(0),
             env,
@@ -321,6 +342,13 @@ impl GramUk {
         self.env.clear();
         let data = self.env.data_mut();
         let vals = &self.vals;
+        let six = |a: usize| -> &[f64; 6] { vals[a..a + 6].try_into().unwrap() };
+        for &(e, a, b) in &self.six1 {
+            data[e] = dot6(six(a), six(b));
+        }
+        for &(e, a, b, a2, b2) in &self.six2 {
+            data[e] = dot6(six(a), six(b)) + dot6(six(a2), six(b2));
+        }
         let mut pairs = self.pairs.iter().peekable();
         while let Some(&(e, a, b, len)) = pairs.next() {
             let mut s = seg_dot(&vals[a..a + len], &vals[b..b + len]);
