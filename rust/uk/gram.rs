@@ -337,26 +337,7 @@ impl GramUk {
             self.vals[e] = 0.0;
             trace_s += *x * *x;
         }
-        // each entry's products summed in a register, then stored once (the pairs are sorted
-        // by entry: a sum through memory waits on the previous store)
-        self.env.clear();
-        let data = self.env.data_mut();
-        let vals = &self.vals;
-        let six = |a: usize| -> &[f64; 6] { vals[a..a + 6].try_into().unwrap() };
-        for &(e, a, b) in &self.six1 {
-            data[e] = dot6(six(a), six(b));
-        }
-        for &(e, a, b, a2, b2) in &self.six2 {
-            data[e] = dot6(six(a), six(b)) + dot6(six(a2), six(b2));
-        }
-        let mut pairs = self.pairs.iter().peekable();
-        while let Some(&(e, a, b, len)) = pairs.next() {
-            let mut s = seg_dot(&vals[a..a + len], &vals[b..b + len]);
-            while let Some(&(_, a, b, len)) = pairs.next_if(|p| p.0 == e) {
-                s += seg_dot(&vals[a..a + len], &vals[b..b + len]);
-            }
-            data[e] = s;
-        }
+        self.assemble_s22();
         let mut max_d = 0.0f64;
         for p in 0..self.rows.len() {
             let s = self.env.diag(p);
@@ -407,6 +388,31 @@ impl GramUk {
             Some(RankInfo { rank: self.m, sigma_max, sigma_min_kept: 1.0 / trace_sinv.sqrt(), sigma_max_dropped: 0.0, tolerance: tol, exact: false })
         } else {
             None
+        }
+    }
+
+    /// `S_22 = Y^T Y` on its profile (`pairs`, `six1`, `six2`). Each entry's products summed in
+    /// a register, then stored once (the pairs are sorted by entry: a sum through memory waits
+    /// on the previous store). Out of line: it keeps `factor` short.
+    #[inline(never)]
+    fn assemble_s22(&mut self) {
+        self.env.clear();
+        let data = self.env.data_mut();
+        let vals = &self.vals;
+        let six = |a: usize| -> &[f64; 6] { vals[a..a + 6].try_into().unwrap() };
+        for &(e, a, b) in &self.six1 {
+            data[e] = dot6(six(a), six(b));
+        }
+        for &(e, a, b, a2, b2) in &self.six2 {
+            data[e] = dot6(six(a), six(b)) + dot6(six(a2), six(b2));
+        }
+        let mut pairs = self.pairs.iter().peekable();
+        while let Some(&(e, a, b, len)) = pairs.next() {
+            let mut s = seg_dot(&vals[a..a + len], &vals[b..b + len]);
+            while let Some(&(_, a, b, len)) = pairs.next_if(|p| p.0 == e) {
+                s += seg_dot(&vals[a..a + len], &vals[b..b + len]);
+            }
+            data[e] = s;
         }
     }
 
