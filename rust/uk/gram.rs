@@ -290,11 +290,14 @@ impl GramUk {
     }
 
     /// Heap bytes of the workspace of `GramUk::new` (a bound without building it: the pattern,
-    /// the values, and an envelope and pair lists no larger than those of the dense `S`).
+    /// the values, an envelope and pair lists no larger than those of the dense `S`, and the
+    /// blocks).
     pub fn bytes(model: &Model) -> u64 {
         let nnz: u64 = model.constraints.iter().map(|c| c.rows() as u64 * c.bodies().into_iter().flatten().map(|b| model.bodies[b].n_coords as u64).sum::<u64>()).sum();
         let (n, m) = (model.n as u64, model.m as u64);
-        8 * (3 * nnz + 6 * m * m + 8 * m + n) + 48 * m * m + 48 * nnz
+        // (+ the block storage of `linalg::block_tridiag`, at most one block per row: two 6 x 6
+        // blocks of S_22 and two of Z, two 6-vectors, the kernels and the row map)
+        8 * (3 * nnz + 6 * m * m + 8 * m + n) + 48 * m * m + 48 * nnz + 1312 * m
     }
 
     /// `B^T`, `S_22`, its envelope Cholesky factor and the full-rank certificate (module docs)
