@@ -99,10 +99,13 @@ pub struct GramUk {
     /// values (`factor` moves them out of `vals`, which then holds `Y`).
     xs: Vec<(usize, usize, usize)>,
     xval: Vec<f64>,
-    /// The quadratic forms `x_b^T Z x_b`: `(index of Z(p, q), index of x_p and of x_q in xval,
-    /// weight)`, those of unit `b` at `quad[quad_ptr[b]..quad_ptr[b + 1]]`.
-    quad: Vec<(usize, usize, usize, f64)>,
-    quad_ptr: Vec<usize>,
+    /// The quadratic forms `x_b^T Z x_b`: the diagonal terms `(index of Z(p, p), index of x_p
+    /// in xval)` and the off-diagonal ones (counted twice) `(index of Z(p, q), of x_p, of x_q)`,
+    /// those of unit `b` at `quad_d[quad_ptr[b].0..quad_ptr[b + 1].0]` and
+    /// `quad_o[quad_ptr[b].1..quad_ptr[b + 1].1]`.
+    quad_d: Vec<(u32, u32)>,
+    quad_o: Vec<(u32, u32, u32)>,
+    quad_ptr: Vec<(usize, usize)>,
     /// `S_22[entry] += vals_a . vals_b` over `(entry, a, b, len)`.
     /// (the entries made of one or of two six-entry products, the common case, apart:
     /// `(entry, a, b)` and `(entry, a, b, a2, b2)`; the other entries in `pairs`)
@@ -241,16 +244,20 @@ impl GramUk {
         }
         let pairs = rest;
         // x_b^T Z x_b = sum over the ordered pairs of X's entries of unit b
-        let (mut quad, mut quad_ptr) = (Vec::new(), vec![0]);
+        let (mut quad_d, mut quad_o, mut quad_ptr) = (Vec::new(), Vec::new(), vec![(0, 0)]);
         for b in 0..units.len() {
             let mine: Vec<(usize, usize)> = xs.iter().enumerate().filter(|(_, x)| x.1 == b).map(|(t, x)| (t, x.0)).collect();
             for (a, &(s, ps)) in mine.iter().enumerate() {
                 for &(t, pt) in &mine[..=a] {
-                    let w = if pt == ps { 1.0 } else { 2.0 };
-                    quad.push((env.index(ps.max(pt), ps.min(pt)), s, t, w));
+                    let e = env.index(ps.max(pt), ps.min(pt)) as u32;
+                    if pt == ps {
+                        quad_d.push((e, s as u32));
+                    } else {
+                        quad_o.push((e, s as u32, t as u32));
+                    }
                 }
             }
-            quad_ptr.push(quad.len());
+            quad_ptr.push((quad_d.len(), quad_o.len()));
         }
         let (nu, mj) = (units.len(), rows.len());
         GramUk {
@@ -262,7 +269,8 @@ impl GramUk {
             vals: vec![0.0; ajac.vals.len()],
             xval: vec![0.0; xs.len()],
             xs,
-            quad,
+            quad_d,
+            quad_o,
             quad_ptr,
             pairs,
             six1,
@@ -355,21 +363,31 @@ impl GramUk {
         }
         let mut trace_sinv = self.env.selected_inverse_trace();
         let z = self.env.z();
-        // four partial sums per unit in registers (a sum through memory waits on each store,
-        // one register on each addition)
+        // two partial sums per kind of term (a sum through memory waits on each store, one
+        // register on each addition); the off-diagonal terms doubled once (exactly)
+        let x = &self.xval;
         for (b, d) in self.d.iter().enumerate() {
-            let term = |&(e, s, t, w): &(usize, usize, usize, f64)| w * z[e] * self.xval[s] * self.xval[t];
-            let quad = self.quad[self.quad_ptr[b]..self.quad_ptr[b + 1]].chunks_exact(4);
-            let rest = quad.remainder();
-            let (mut a0, mut a1, mut a2, mut a3) = (0.0, 0.0, 0.0, 0.0);
-            for c in quad {
-                (a0, a1, a2, a3) = (a0 + term(&c[0]), a1 + term(&c[1]), a2 + term(&c[2]), a3 + term(&c[3]));
+            let ((d0, o0), (d1, o1)) = (self.quad_ptr[b], self.quad_ptr[b + 1]);
+            let (mut a0, mut a1, mut c0, mut c1) = (0.0, 0.0, 0.0, 0.0);
+            let diag = self.quad_d[d0..d1].chunks_exact(2);
+            if let [(e, s)] = diag.remainder() {
+                a1 = z[*e as usize] * x[*s as usize] * x[*s as usize];
             }
-            // the last partial chunk on the first sums, as before
-            for (a, c) in [&mut a0, &mut a1, &mut a2].into_iter().zip(rest) {
-                *a += term(c);
+            for c in diag {
+                let ((e0, s0), (e1, s1)) = (c[0], c[1]);
+                a0 += z[e0 as usize] * x[s0 as usize] * x[s0 as usize];
+                a1 += z[e1 as usize] * x[s1 as usize] * x[s1 as usize];
             }
-            let zu = 1.0 + ((a0 + a2) + (a1 + a3));
+            let off = self.quad_o[o0..o1].chunks_exact(2);
+            if let [(e, s, t)] = off.remainder() {
+                c1 = z[*e as usize] * x[*s as usize] * x[*t as usize];
+            }
+            for c in off {
+                let ((e0, s0, t0), (e1, s1, t1)) = (c[0], c[1]);
+                c0 += z[e0 as usize] * x[s0 as usize] * x[t0 as usize];
+                c1 += z[e1 as usize] * x[s1 as usize] * x[t1 as usize];
+            }
+            let zu = 1.0 + ((a0 + a1) + 2.0 * (c0 + c1));
             trace_sinv += zu / (d * d);
         }
         self.trace_sinv = trace_sinv;
