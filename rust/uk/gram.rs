@@ -99,16 +99,14 @@ pub struct GramUk {
     /// values (`factor` moves them out of `vals`, which then holds `Y`).
     xs: Vec<(usize, usize, usize)>,
     xval: Vec<f64>,
-    /// The quadratic forms `x_b^T Z x_b`: the diagonal terms `(index of Z(p, p), index of x_p
-    /// in xval)` and the off-diagonal ones (counted twice) `(index of Z(p, q), of x_p, of x_q)`,
-    /// those of unit `b` at `quad_d[quad_ptr[b].0..quad_ptr[b + 1].0]` and
-    /// `quad_o[quad_ptr[b].1..quad_ptr[b + 1].1]`.
+    /// The quadratic forms `x_b^T Z x_b`: diagonal terms `(index of Z(p, p), of x_p in xval)`,
+    /// off-diagonal ones (counted twice) `(index of Z(p, q), of x_p, of x_q)`; unit `b`'s at
+    /// `quad_ptr[b]..quad_ptr[b + 1]` (`.0` in `quad_d`, `.1` in `quad_o`).
     quad_d: Vec<(u32, u32)>,
     quad_o: Vec<(u32, u32, u32)>,
     quad_ptr: Vec<(usize, usize)>,
     /// `S_22[entry] += vals_a . vals_b` over `(entry, a, b, len)`.
-    /// (the entries made of one or of two six-entry products, the common case, apart:
-    /// `(entry, a, b)` and `(entry, a, b, a2, b2)`; the other entries in `pairs`)
+    /// (entries of one or two six-entry products apart: `(entry, a, b)`, `(entry, a, b, a2, b2)`)
     pairs: Vec<(usize, usize, usize, usize)>,
     six1: Vec<(usize, usize, usize)>,
     six2: Vec<(usize, usize, usize, usize, usize)>,
@@ -299,12 +297,10 @@ impl GramUk {
 
     /// Heap bytes of the workspace of `GramUk::new` (a bound without building it: the pattern,
     /// the values, an envelope and pair lists no larger than those of the dense `S`, and the
-    /// blocks).
+    /// blocks: two 6 x 6 of `S_22` and two of `Z`, two 6-vectors, kernels and row map per row).
     pub fn bytes(model: &Model) -> u64 {
         let nnz: u64 = model.constraints.iter().map(|c| c.rows() as u64 * c.bodies().into_iter().flatten().map(|b| model.bodies[b].n_coords as u64).sum::<u64>()).sum();
         let (n, m) = (model.n as u64, model.m as u64);
-        // (+ the block storage of `linalg::block_tridiag`, at most one block per row: two 6 x 6
-        // blocks of S_22 and two of Z, two 6-vectors, the kernels and the row map)
         8 * (3 * nnz + 6 * m * m + 8 * m + n) + 48 * m * m + 48 * nnz + 1312 * m
     }
 
@@ -363,8 +359,7 @@ impl GramUk {
         }
         let mut trace_sinv = self.env.selected_inverse_trace();
         let z = self.env.z();
-        // two partial sums per kind of term (a sum through memory waits on each store, one
-        // register on each addition); the off-diagonal terms doubled once (exactly)
+        // two partial sums per kind of term in registers; the off-diagonal terms doubled once
         let x = &self.xval;
         for (b, d) in self.d.iter().enumerate() {
             let ((d0, o0), (d1, o1)) = (self.quad_ptr[b], self.quad_ptr[b + 1]);
@@ -412,9 +407,8 @@ impl GramUk {
         }
     }
 
-    /// `S_22 = Y^T Y` on its profile (`pairs`, `six1`, `six2`). Each entry's products summed in
-    /// a register, then stored once (the pairs are sorted by entry: a sum through memory waits
-    /// on the previous store). Out of line: it keeps `factor` short.
+    /// `S_22 = Y^T Y` on its profile (`pairs`, `six1`, `six2`), each entry summed in a register
+    /// and stored once (a sum through memory waits on each store). Out of line: `factor` short.
     #[inline(never)]
     fn assemble_s22(&mut self) {
         self.env.clear();
