@@ -3,7 +3,8 @@
 //! batches of `CALLS` calls each, reporting the lowest batch (what the load did not reach) and
 //! the median batch per call. Run: `cargo bench --bench spatial_batches` (about 5 s).
 //! With an argument `one`, only the slider-crank; `perf`, only it for ten times as long (a
-//! `perf record` target); `stages`, its stages one by one (lowest batch each).
+//! `perf record` target); `stages`, its stages one by one (lowest batch each); `a05`, only the
+//! flyball governor (A05), with as many batches as the slider-crank.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -68,6 +69,10 @@ fn stages(json: &str) {
 fn main() {
     if std::env::args().any(|a| a == "stages") {
         stages(include_str!("data/spatial/slider_crank.json"));
+        return;
+    }
+    if std::env::args().any(|a| a == "a05") {
+        run("flyball", include_str!("data/spatial/flyball.json"), BATCHES);
         return;
     }
     let perf = std::env::args().any(|a| a == "perf");

@@ -5,7 +5,8 @@
 //! * `banded`: band storage, the banded Cholesky (constant FFRF and ANCF mass factors, the
 //!   Gram matrix of the sparse UK path) with its selected inverse and an inertia count;
 //! * `envelope`: envelope (profile) storage, its Cholesky factor and selected inverse (the
-//!   Gram matrix of the spatial UK path);
+//!   Gram matrix of the spatial UK path); `block_tridiag`: the same factor by fixed-size
+//!   blocks where that envelope is block tridiagonal with small blocks;
 //! * `band_lu`: the band LU with partial pivoting of the implicit methods' sparse Newton
 //!   matrices, real and complex; `static_lu`: their sparse LU with a fill-reducing order and
 //!   kept pivots (a wide band whose elimination stays sparse); `lu`: their dense LU;
@@ -20,6 +21,7 @@
 
 pub mod band_lu;
 pub mod banded;
+pub mod block_tridiag;
 pub mod dense;
 pub mod dual;
 pub mod envelope;

@@ -13,6 +13,9 @@
 //! Only `S_22` is factored: its rows couple when they share a body, so in the reverse
 //! Cuthill-McKee order of that graph it lives on a narrow envelope (the spatial slider-crank's
 //! 17 joint rows: 4 blocks of 3 to 5 rows, each coupled to its neighbours; `linalg::envelope`).
+//! Where that envelope is block tridiagonal with blocks of at most 6 rows (the slider-crank and
+//! the heavy top) `S_22` is factored by fixed-size blocks instead (`linalg::block_tridiag`,
+//! chosen once at setup: the same factor evaluated in another order, with the same bounds).
 //! This is the factor the dense QR computes (`R = L^T` up to signs) without the Householder
 //! work on the exact zeros.
 //!
@@ -53,7 +56,7 @@
 use super::settings::RankInfo;
 use crate::body::{BodyData, BodyKind};
 use crate::constraint::jac::{Seg, SegJac};
-use crate::linalg::envelope::EnvelopeCholesky;
+use crate::linalg::block_tridiag::SpdProfile;
 use crate::model::Model;
 
 /// The Gram path serves `B` whose condition estimate `sqrt(trace S trace S^-1)` (at least
@@ -96,19 +99,24 @@ pub struct GramUk {
     /// values (`factor` moves them out of `vals`, which then holds `Y`).
     xs: Vec<(usize, usize, usize)>,
     xval: Vec<f64>,
-    /// The quadratic forms `x_b^T Z x_b`: `(index of Z(p, q), index of x_p and of x_q in xval,
-    /// weight)`, those of unit `b` at `quad[quad_ptr[b]..quad_ptr[b + 1]]`.
-    quad: Vec<(usize, usize, usize, f64)>,
-    quad_ptr: Vec<usize>,
+    /// The quadratic forms `x_b^T Z x_b`: diagonal terms `(index of Z(p, p), of x_p in xval)`,
+    /// off-diagonal ones (counted twice) `(index of Z(p, q), of x_p, of x_q)`; unit `b`'s at
+    /// `quad_ptr[b]..quad_ptr[b + 1]` (`.0` in `quad_d`, `.1` in `quad_o`).
+    quad_d: Vec<(u32, u32)>,
+    quad_o: Vec<(u32, u32, u32)>,
+    quad_ptr: Vec<(usize, usize)>,
     /// `S_22[entry] += vals_a . vals_b` over `(entry, a, b, len)`.
+    /// (entries of one or two six-entry products apart: `(entry, a, b)`, `(entry, a, b, a2, b2)`)
     pairs: Vec<(usize, usize, usize, usize)>,
+    six1: Vec<(usize, usize, usize)>,
+    six2: Vec<(usize, usize, usize, usize, usize)>,
     /// Per body: a rigid3 body's `F^-1` as `(1 / sqrt m, T)` (`Rigid3::finv_matrix`), this call's.
     finv: Vec<Option<(f64, [[f64; 4]; 4])>>,
     /// Longest dot product that makes one entry of `S_22`.
     max_dot: usize,
-    env: EnvelopeCholesky,
-    /// Selected inverse of `S_22` (the layout of `env`).
-    z: Vec<f64>,
+    /// `S_22`, its factor and selected inverse: by blocks where its envelope is block
+    /// tridiagonal with small blocks (the spatial slider-crank), the envelope otherwise.
+    env: SpdProfile,
     /// `d_b = B^T[c_b, row_b]`, and scratch per unit.
     d: Vec<f64>,
     zu: Vec<f64>,
@@ -128,6 +136,12 @@ pub struct GramUk {
     pub skip: u32,
 }
 
+/// `seg_dot` of six entries.
+#[inline(always)]
+fn dot6(x: &[f64; 6], y: &[f64; 6]) -> f64 {
+    ((x[0] * y[0] + x[2] * y[2]) + (x[1] * y[1] + x[3] * y[3])) + x[4] * y[4] + x[5] * y[5]
+}
+
 /// `dot4(x, y)` to the bit, with the six- and seven-entry cases (a rigid3 body off its unit
 /// coordinate: most products of `S_22`; a rigid3 body's segment) written out so that they have
 /// no loop and no remainder branches.
@@ -135,7 +149,7 @@ pub struct GramUk {
 fn seg_dot(x: &[f64], y: &[f64]) -> f64 {
     let head = |x: &[f64], y: &[f64]| (x[0] * y[0] + x[2] * y[2]) + (x[1] * y[1] + x[3] * y[3]);
     if let (Ok(x), Ok(y)) = (<&[f64; 6]>::try_from(x), <&[f64; 6]>::try_from(y)) {
-        head(x, y) + x[4] * y[4] + x[5] * y[5]
+        dot6(x, y)
     } else if let (Ok(x), Ok(y)) = (<&[f64; 7]>::try_from(x), <&[f64; 7]>::try_from(y)) {
         head(x, y) + x[4] * y[4] + x[5] * y[5] + x[6] * y[6]
     } else {
@@ -146,6 +160,11 @@ fn seg_dot(x: &[f64], y: &[f64]) -> f64 {
 impl GramUk {
     /// Symbolic analysis on the pattern of `ajac` (the model's `SegJac`).
     pub fn new(model: &Model, ajac: &SegJac) -> GramUk {
+        GramUk::with_profile(model, ajac, true)
+    }
+
+    /// `new`; `blocks: false` keeps `S_22` on the generic envelope whatever its pattern.
+    pub fn with_profile(model: &Model, ajac: &SegJac, blocks: bool) -> GramUk {
         let (n, m) = (model.n, model.m);
         let mut unit_of_row = vec![None; m];
         let mut unit_of_body = vec![None; model.bodies.len()];
@@ -182,7 +201,7 @@ impl GramUk {
         let rows: Vec<usize> = order.iter().map(|&a| joint_rows[a]).collect();
         // each row's envelope starts at the first row it shares a body with
         let first: Vec<usize> = order.iter().enumerate().map(|(p, &a)| adj[a].iter().map(|&b| perm[b]).fold(p, usize::min)).collect();
-        let env = EnvelopeCholesky::new(first);
+        let env = SpdProfile::new(first, blocks);
         // the pairs of S_22 (off the unit coordinates) and the entries of X
         let mut pairs = Vec::new();
         let mut dots = vec![0usize; env.len()];
@@ -212,20 +231,33 @@ impl GramUk {
                 }
             }
         }
-        pairs.sort_unstable_by_key(|p| p.0);
+        pairs.sort_by_key(|p| p.0);
+        let (mut six1, mut six2, mut rest) = (Vec::new(), Vec::new(), Vec::new());
+        for group in pairs.chunk_by(|p, q| p.0 == q.0) {
+            match group {
+                [(e, a, b, 6)] => six1.push((*e, *a, *b)),
+                [(e, a, b, 6), (_, a2, b2, 6)] => six2.push((*e, *a, *b, *a2, *b2)),
+                _ => rest.extend_from_slice(group),
+            }
+        }
+        let pairs = rest;
         // x_b^T Z x_b = sum over the ordered pairs of X's entries of unit b
-        let (mut quad, mut quad_ptr) = (Vec::new(), vec![0]);
+        let (mut quad_d, mut quad_o, mut quad_ptr) = (Vec::new(), Vec::new(), vec![(0, 0)]);
         for b in 0..units.len() {
             let mine: Vec<(usize, usize)> = xs.iter().enumerate().filter(|(_, x)| x.1 == b).map(|(t, x)| (t, x.0)).collect();
             for (a, &(s, ps)) in mine.iter().enumerate() {
                 for &(t, pt) in &mine[..=a] {
-                    let w = if pt == ps { 1.0 } else { 2.0 };
-                    quad.push((env.index(ps.max(pt), ps.min(pt)), s, t, w));
+                    let e = env.index(ps.max(pt), ps.min(pt)) as u32;
+                    if pt == ps {
+                        quad_d.push((e, s as u32));
+                    } else {
+                        quad_o.push((e, s as u32, t as u32));
+                    }
                 }
             }
-            quad_ptr.push(quad.len());
+            quad_ptr.push((quad_d.len(), quad_o.len()));
         }
-        let (nu, mj, len) = (units.len(), rows.len(), env.len());
+        let (nu, mj) = (units.len(), rows.len());
         GramUk {
             m,
             rows,
@@ -235,13 +267,15 @@ impl GramUk {
             vals: vec![0.0; ajac.vals.len()],
             xval: vec![0.0; xs.len()],
             xs,
-            quad,
+            quad_d,
+            quad_o,
             quad_ptr,
             pairs,
+            six1,
+            six2,
             finv: vec![None; model.bodies.len()],
             max_dot: dots.into_iter().max().unwrap_or(0),
             env,
-            z: vec![0.0; len],
             d: vec![0.0; nu],
             zu: vec![0.0; nu],
             rt: vec![0.0; mj],
@@ -256,12 +290,18 @@ impl GramUk {
         }
     }
 
+    /// Whether `S_22` is factored by blocks (`linalg::block_tridiag`).
+    pub fn on_blocks(&self) -> bool {
+        self.env.is_blocks()
+    }
+
     /// Heap bytes of the workspace of `GramUk::new` (a bound without building it: the pattern,
-    /// the values, and an envelope and pair lists no larger than those of the dense `S`).
+    /// the values, an envelope and pair lists no larger than those of the dense `S`, and the
+    /// blocks: two 6 x 6 of `S_22` and two of `Z`, two 6-vectors, kernels and row map per row).
     pub fn bytes(model: &Model) -> u64 {
         let nnz: u64 = model.constraints.iter().map(|c| c.rows() as u64 * c.bodies().into_iter().flatten().map(|b| model.bodies[b].n_coords as u64).sum::<u64>()).sum();
         let (n, m) = (model.n as u64, model.m as u64);
-        8 * (3 * nnz + 6 * m * m + 8 * m + n) + 48 * m * m + 48 * nnz
+        8 * (3 * nnz + 6 * m * m + 8 * m + n) + 48 * m * m + 48 * nnz + 1312 * m
     }
 
     /// `B^T`, `S_22`, its envelope Cholesky factor and the full-rank certificate (module docs)
@@ -304,19 +344,7 @@ impl GramUk {
             self.vals[e] = 0.0;
             trace_s += *x * *x;
         }
-        // each entry's products summed in a register, then stored once (the pairs are sorted
-        // by entry: a sum through memory waits on the previous store)
-        let data = &mut self.env.data;
-        data.fill(0.0);
-        let vals = &self.vals;
-        let mut pairs = self.pairs.iter().peekable();
-        while let Some(&(e, a, b, len)) = pairs.next() {
-            let mut s = seg_dot(&vals[a..a + len], &vals[b..b + len]);
-            while let Some(&(_, a, b, len)) = pairs.next_if(|p| p.0 == e) {
-                s += seg_dot(&vals[a..a + len], &vals[b..b + len]);
-            }
-            data[e] = s;
-        }
+        self.assemble_s22();
         let mut max_d = 0.0f64;
         for p in 0..self.rows.len() {
             let s = self.env.diag(p);
@@ -329,22 +357,32 @@ impl GramUk {
         if !trace_s.is_finite() || self.d.iter().any(|d| !(d.abs() > 0.0)) || !self.env.factor_in_place() {
             return None;
         }
-        let mut trace_sinv = self.env.selected_inverse_trace(&mut self.z);
-        // four partial sums per unit in registers (a sum through memory waits on each store,
-        // one register on each addition)
+        let mut trace_sinv = self.env.selected_inverse_trace();
+        let z = self.env.z();
+        // two partial sums per kind of term in registers; the off-diagonal terms doubled once
+        let x = &self.xval;
         for (b, d) in self.d.iter().enumerate() {
-            let term = |&(e, s, t, w): &(usize, usize, usize, f64)| w * self.z[e] * self.xval[s] * self.xval[t];
-            let quad = self.quad[self.quad_ptr[b]..self.quad_ptr[b + 1]].chunks_exact(4);
-            let rest = quad.remainder();
-            let (mut a0, mut a1, mut a2, mut a3) = (0.0, 0.0, 0.0, 0.0);
-            for c in quad {
-                (a0, a1, a2, a3) = (a0 + term(&c[0]), a1 + term(&c[1]), a2 + term(&c[2]), a3 + term(&c[3]));
+            let ((d0, o0), (d1, o1)) = (self.quad_ptr[b], self.quad_ptr[b + 1]);
+            let (mut a0, mut a1, mut c0, mut c1) = (0.0, 0.0, 0.0, 0.0);
+            let diag = self.quad_d[d0..d1].chunks_exact(2);
+            if let [(e, s)] = diag.remainder() {
+                a1 = z[*e as usize] * x[*s as usize] * x[*s as usize];
             }
-            // the last partial chunk on the first sums, as before
-            for (a, c) in [&mut a0, &mut a1, &mut a2].into_iter().zip(rest) {
-                *a += term(c);
+            for c in diag {
+                let ((e0, s0), (e1, s1)) = (c[0], c[1]);
+                a0 += z[e0 as usize] * x[s0 as usize] * x[s0 as usize];
+                a1 += z[e1 as usize] * x[s1 as usize] * x[s1 as usize];
             }
-            let zu = 1.0 + ((a0 + a2) + (a1 + a3));
+            let off = self.quad_o[o0..o1].chunks_exact(2);
+            if let [(e, s, t)] = off.remainder() {
+                c1 = z[*e as usize] * x[*s as usize] * x[*t as usize];
+            }
+            for c in off {
+                let ((e0, s0, t0), (e1, s1, t1)) = (c[0], c[1]);
+                c0 += z[e0 as usize] * x[s0 as usize] * x[t0 as usize];
+                c1 += z[e1 as usize] * x[s1 as usize] * x[t1 as usize];
+            }
+            let zu = 1.0 + ((a0 + a1) + 2.0 * (c0 + c1));
             trace_sinv += zu / (d * d);
         }
         self.trace_sinv = trace_sinv;
@@ -352,20 +390,44 @@ impl GramUk {
             let ke = k as f64 * f64::EPSILON;
             ke / (1.0 - ke)
         };
-        let w = self.env.width.max(1);
+        let w = self.env.width().max(1);
         let delta = 2.0 * (2 * w - 1) as f64 * (gamma(w + 3) + gamma(self.max_dot)) * max_d;
         let lower = 0.5 / trace_sinv - delta;
         let sigma_max = trace_s.sqrt();
         let tol = atol.max(rcond * sigma_max);
         let conditioned = trace_s * trace_sinv <= GRAM_MAX_COND * GRAM_MAX_COND;
         // the unrefined solution's bound against the QR's (module docs, "Accuracy")
-        let scaled: f64 = self.sdiag.iter().enumerate().map(|(p, s)| s * self.z[self.env.index(p, p)]).sum();
+        let scaled: f64 = self.sdiag.iter().enumerate().map(|(p, s)| s * z[self.env.index(p, p)]).sum();
         let unrefined = (2 * w - 1) as f64 * gamma(3 * w + 3) * scaled;
         self.refine = !(unrefined <= (model.n * self.m) as f64 * f64::EPSILON * (trace_s * trace_sinv).sqrt());
         if lower.is_finite() && lower > 0.0 && lower > tol * tol && conditioned {
             Some(RankInfo { rank: self.m, sigma_max, sigma_min_kept: 1.0 / trace_sinv.sqrt(), sigma_max_dropped: 0.0, tolerance: tol, exact: false })
         } else {
             None
+        }
+    }
+
+    /// `S_22 = Y^T Y` on its profile (`pairs`, `six1`, `six2`), each entry summed in a register
+    /// and stored once (a sum through memory waits on each store). Out of line: `factor` short.
+    #[inline(never)]
+    fn assemble_s22(&mut self) {
+        self.env.clear();
+        let data = self.env.data_mut();
+        let vals = &self.vals;
+        let six = |a: usize| -> &[f64; 6] { vals[a..a + 6].try_into().unwrap() };
+        for &(e, a, b) in &self.six1 {
+            data[e] = dot6(six(a), six(b));
+        }
+        for &(e, a, b, a2, b2) in &self.six2 {
+            data[e] = dot6(six(a), six(b)) + dot6(six(a2), six(b2));
+        }
+        let mut pairs = self.pairs.iter().peekable();
+        while let Some(&(e, a, b, len)) = pairs.next() {
+            let mut s = seg_dot(&vals[a..a + len], &vals[b..b + len]);
+            while let Some(&(_, a, b, len)) = pairs.next_if(|p| p.0 == e) {
+                s += seg_dot(&vals[a..a + len], &vals[b..b + len]);
+            }
+            data[e] = s;
         }
     }
 
@@ -556,6 +618,56 @@ mod tests {
         }
     }
 
+    /// The block factor of `S_22` against the generic envelope on the same scenes: the same
+    /// decisions, traces, corrections and multipliers to rounding. The slider-crank (4 blocks of
+    /// 3 to 5 rows) and the heavy top (one block of 3) take the blocks, A05 (a block of more
+    /// than 6 rows) keeps the envelope, A04 (blocks, rank 34 of 35) is refused by both (their
+    /// `GramUk` is called directly here: `uk` refuses them by condition and rank).
+    #[test]
+    fn blocks_match_the_envelope_path() {
+        let scenes = [
+            (include_str!("../../benches/data/spatial/slider_crank.json"), true),
+            (include_str!("../../benches/data/spatial/heavy_top.json"), true),
+            (include_str!("../../benches/data/spatial/flyball.json"), false),
+            (include_str!("../../benches/data/spatial/bricard.json"), true),
+        ];
+        for (si, (json, blocks)) in scenes.into_iter().enumerate() {
+            let (model, q, qd) = scene(json);
+            let mut data = Data::build(&model, UkSolver::Dense, u64::MAX).unwrap();
+            uk::evaluate(&model, &mut data, 0.1, &q, &qd, false).unwrap();
+            let mut blk = super::GramUk::with_profile(&model, &data.ajac, true);
+            let mut env = super::GramUk::with_profile(&model, &data.ajac, false);
+            assert!(!env.on_blocks());
+            assert_eq!(blk.on_blocks(), blocks, "scene {si}");
+            let (a, b) = (blk.factor(&model, &data.bodies, &data.ajac, 1e-12, 0.0), env.factor(&model, &data.bodies, &data.ajac, 1e-12, 0.0));
+            assert_eq!(a.map(|i| i.rank), b.map(|i| i.rank), "scene {si}");
+            assert!((blk.trace_s - env.trace_s).abs() <= 1e-14 * env.trace_s, "scene {si}");
+            // A04 (rank 34 of 35): S_22 is singular to rounding, nothing more to compare
+            if si == 3 {
+                assert!(a.is_none());
+                continue;
+            }
+            let rel = (blk.trace_sinv - env.trace_sinv).abs() / env.trace_sinv;
+            assert!(rel < 1e-10, "scene {si}: trace(S^-1) {} vs {}", blk.trace_sinv, env.trace_sinv);
+            assert_eq!(blk.refine, env.refine);
+            let (n, m) = (model.n, model.m);
+            let y0: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
+            let mut out = [(vec![0.0; m], y0.clone(), vec![0.0; m]), (vec![0.0; m], y0, vec![0.0; m])];
+            blk.correct(&data.gamma, &mut out[0].0, &mut out[0].1, &mut out[0].2);
+            env.correct(&data.gamma, &mut out[1].0, &mut out[1].1, &mut out[1].2);
+            // the two differ by the rounding of a solve with S_22: cond(S_22) eps at most
+            let tol = 1e3 * f64::EPSILON * env.trace_s * env.trace_sinv;
+            let ymax = out[1].1.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
+            let lmax = out[1].2.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
+            for i in 0..n {
+                assert!((out[0].1[i] - out[1].1[i]).abs() <= tol * ymax, "scene {si}: y[{i}] {} vs {}", out[0].1[i], out[1].1[i]);
+            }
+            for i in 0..m {
+                assert!((out[0].2[i] - out[1].2[i]).abs() <= tol * lmax, "scene {si}: lambda[{i}] {} vs {}", out[0].2[i], out[1].2[i]);
+            }
+        }
+    }
+
     /// A tolerance above the smallest singular value: the certificate refuses and the dense
     /// rank-revealing path drops it, as without the Gram path.
     #[test]
@@ -564,6 +676,7 @@ mod tests {
         let mut data = Data::new(&model);
         uk::acceleration(&model, &mut data, 0.1, &q, &qd).unwrap();
         assert_eq!(data.factored_with, Factored::Gram);
+        assert!(data.gram.as_ref().unwrap().on_blocks());
         let exact = uk::singular_values(&model, &mut data).unwrap().unwrap();
         let ratio = exact[model.m - 1] / exact[0];
         // just above sigma_min: the Gram certificate (and the QR's) cannot pass
