@@ -544,10 +544,10 @@ mod tests {
             (include_str!("../../benches/data/spatial/slider_crank.json"), Factored::Gram),
             (include_str!("../../benches/data/spatial/heavy_top.json"), Factored::Gram),
             (include_str!("../../benches/data/spatial/flyball.json"), Factored::FullRankQr),
-            (include_str!("../../benches/data/spatial/bricard.json"), Factored::Faer),
+            (include_str!("../../benches/data/spatial/bricard.json"), Factored::Deflated),
         ];
         for (si, (json, path)) in scenes.into_iter().enumerate() {
-            let full_rank = path != Factored::Faer;
+            let full_rank = path != Factored::Deflated;
             let (model, q0, qd0) = scene(json);
             let (n, m) = (model.n, model.m);
             let mut data = Data::new(&model);
