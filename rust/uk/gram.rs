@@ -58,6 +58,7 @@ use crate::body::{BodyData, BodyKind};
 use crate::constraint::jac::{Seg, SegJac};
 use crate::linalg::block_tridiag::SpdProfile;
 use crate::model::Model;
+use super::seg::{dot6, seg_dot, t_times};
 
 /// The Gram path serves `B` whose condition estimate `sqrt(trace S trace S^-1)` (at least
 /// `cond(B)`) is at most this; beyond it the dense QR keeps its `O(cond(B) eps)` constraint
@@ -110,7 +111,8 @@ pub struct GramUk {
     pairs: Vec<(usize, usize, usize, usize)>,
     six1: Vec<(usize, usize, usize)>,
     six2: Vec<(usize, usize, usize, usize, usize)>,
-    /// Per body: a rigid3 body's `F^-1` as `(1 / sqrt m, T)` (`Rigid3::finv_matrix`), this call's.
+    /// Per body: a rigid3 body's `F^-1` as `(1 / sqrt m, T^T)` (`Rigid3::finv_matrix`, `T` by
+    /// columns: the product below in pairs of rows), this call's.
     finv: Vec<Option<(f64, [[f64; 4]; 4])>>,
     /// Longest dot product that makes one entry of `S_22`.
     max_dot: usize,
@@ -134,27 +136,6 @@ pub struct GramUk {
     pub trace_sinv: f64,
     /// Factorizations left to the dense QR after the last refusal (`GRAM_RETRY`).
     pub skip: u32,
-}
-
-/// `seg_dot` of six entries.
-#[inline(always)]
-fn dot6(x: &[f64; 6], y: &[f64; 6]) -> f64 {
-    ((x[0] * y[0] + x[2] * y[2]) + (x[1] * y[1] + x[3] * y[3])) + x[4] * y[4] + x[5] * y[5]
-}
-
-/// `dot4(x, y)` to the bit, with the six- and seven-entry cases (a rigid3 body off its unit
-/// coordinate: most products of `S_22`; a rigid3 body's segment) written out so that they have
-/// no loop and no remainder branches.
-#[inline(always)]
-fn seg_dot(x: &[f64], y: &[f64]) -> f64 {
-    let head = |x: &[f64], y: &[f64]| (x[0] * y[0] + x[2] * y[2]) + (x[1] * y[1] + x[3] * y[3]);
-    if let (Ok(x), Ok(y)) = (<&[f64; 6]>::try_from(x), <&[f64; 6]>::try_from(y)) {
-        dot6(x, y)
-    } else if let (Ok(x), Ok(y)) = (<&[f64; 7]>::try_from(x), <&[f64; 7]>::try_from(y)) {
-        head(x, y) + x[4] * y[4] + x[5] * y[5] + x[6] * y[6]
-    } else {
-        crate::linalg::dot4(x, y)
-    }
 }
 
 impl GramUk {
@@ -313,19 +294,20 @@ impl GramUk {
         // factor once as a matrix, its segments read from `A` and written in one pass
         for (f, (body, bd)) in self.finv.iter_mut().zip(model.bodies.iter().zip(bodies)) {
             if let (BodyKind::Rigid3(k), BodyData::Rigid3(d)) = (&body.kind, bd) {
-                *f = Some(k.finv_matrix(d));
+                let (im, t) = k.finv_matrix(d);
+                *f = Some((im, std::array::from_fn(|l| std::array::from_fn(|i| t[i][l]))));
             }
         }
         for s in &self.segs {
             let (a, v) = (&ajac.vals[s.val..s.val + s.len], &mut self.vals[s.val..s.val + s.len]);
             match &self.finv[s.body] {
-                Some((im, t)) if s.len == 7 => {
+                Some((im, tc)) if s.len == 7 => {
+                    let (a, v): (&[f64; 7], &mut [f64; 7]) = (a.try_into().unwrap(), v.try_into().unwrap());
                     for c in 0..3 {
                         v[c] = a[c] * im;
                     }
-                    for (o, row) in v[3..7].iter_mut().zip(t) {
-                        *o = row[0] * a[3] + row[1] * a[4] + row[2] * a[5] + row[3] * a[6];
-                    }
+                    let o = t_times(tc, [a[3], a[4], a[5], a[6]]);
+                    v[3..7].copy_from_slice(&o);
                 }
                 _ => {
                     v.copy_from_slice(a);

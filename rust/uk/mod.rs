@@ -17,6 +17,7 @@
 pub mod dense;
 pub mod friction;
 pub mod gram;
+mod seg;
 pub mod settings;
 pub mod sparse;
 
