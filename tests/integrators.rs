@@ -407,3 +407,29 @@ fn jacobi_svd_converges_with_exactly_duplicated_rows() {
         assert!(e < 1e-9, "state {k}: duplicated vs single declaration differ by {e:e}");
     }
 }
+
+// ---------------------------------------------------------------- vector registers
+/// A run starts on clean vector registers whatever ran before it: faer's eigensolver at order
+/// 40 leaves the upper halves of the vector registers in use on this project's machine, which
+/// made every SSE kernel of the run that followed auto's analysis 2x slower (round i26-simd).
+/// Without `simd_state::clean_upper` at `integrate_observed`'s entry the state stays in use
+/// through the run (the kernels' SSE code never clears it). Where the CPU cannot tell, or faer
+/// left it clean, there is nothing to show and the test says so.
+#[test]
+fn a_run_clears_the_upper_halves_of_the_vector_registers() {
+    use faer::{Mat, Side};
+    use ukflex::linalg::simd_state::upper_in_use;
+    let k = 40;
+    let c = Mat::<f64>::from_fn(k, k, |i, j| if i == j { 1.0 + i as f64 } else { 0.01 / (1.0 + (i + j) as f64) });
+    let _ = c.self_adjoint_eigen(Side::Lower).unwrap();
+    let dirty = upper_in_use();
+    let model = Model::from_json(&paper_scene("euler-bernoulli", 1, true)).unwrap();
+    let y0: Vec<f64> = model.q0.iter().chain(&model.qd0).copied().collect();
+    let mut sys = UkSystem::new(&model, Data::new(&model));
+    let sol = integrate(&mut Dopri5::new(2 * model.n, Options::default()).unwrap(), &mut sys, 0.0, &y0, 1e-3, None).unwrap();
+    assert_eq!(sol.status, 0, "{}", sol.message);
+    if dirty != Some(true) {
+        println!("faer's eigensolver left the upper state {dirty:?}: nothing to show here");
+    }
+    assert_ne!(upper_in_use(), Some(true), "the run ended with the upper halves in use (before it: {dirty:?})");
+}

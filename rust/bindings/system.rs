@@ -87,6 +87,8 @@ impl PySystem {
             Err(poisoned) => poisoned.into_inner(),
         };
         let model = &self.model;
+        // the kernels' SSE code on clean vector registers, whatever ran before (linalg::simd_state)
+        crate::linalg::simd_state::clean_upper();
         match catch_unwind(AssertUnwindSafe(|| f(model, &mut guard))) {
             Ok(r) => r.map_err(to_py),
             Err(_) => Err(SolverError::new_err("internal error in the ukflex core (a bug: please report it)")),

@@ -50,7 +50,7 @@ pub fn check_conditioning(model: &Model, data: &mut Data, t: f64, q: &[f64], qd:
         let s = norms[j].sqrt();
         a[i * n + j] / if s == 0.0 { 1.0 } else { s }
     });
-    let svd = scaled.thin_svd().map_err(|_| Error::Solver("the singular values of A did not converge".into()))?;
+    let svd = crate::linalg::simd_state::after_wide(|| scaled.thin_svd()).map_err(|_| Error::Solver("the singular values of A did not converge".into()))?;
     let sv: Vec<f64> = (0..m.min(n)).map(|k| svd.S().column_vector()[k]).collect();
     let top = sv.iter().cloned().fold(0.0_f64, f64::max);
     let tol = (m.max(n) as f64) * f64::EPSILON * top;

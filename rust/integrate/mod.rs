@@ -494,6 +494,8 @@ impl<'a> Progress<'a> {
 /// `integrate_dense` with progress reports (`Progress`) after the accepted steps.
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_observed<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut S, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, dense: bool, mut progress: Option<&mut Progress<'_>>) -> Result<Solution> {
+    // whatever ran before (faer, another library): the kernels' SSE code runs on clean registers
+    crate::linalg::simd_state::clean_upper();
     let dim = y0.len();
     if dim != 2 * sys.n() {
         return Err(Error::Shape { what: "y0".into(), expected: 2 * sys.n(), got: dim });

@@ -152,7 +152,7 @@ pub fn pinv_solve(bt: &Mat<f64>, r: &[f64]) -> Result<Vec<f64>, faer::linalg::sv
 /// `pinv_solve` by the SVD alone.
 fn svd_pinv_solve(bt: &Mat<f64>, r: &[f64]) -> Result<Vec<f64>, faer::linalg::svd::SvdError> {
     let (k, m) = (bt.nrows(), bt.ncols());
-    let svd = bt.thin_svd()?;
+    let svd = super::simd_state::after_wide(|| bt.thin_svd())?;
     let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
     let smax = if s.nrows() > 0 { s[0] } else { 0.0 };
     let tol = (k.max(m) as f64) * f64::EPSILON * smax;

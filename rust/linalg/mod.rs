@@ -12,6 +12,8 @@
 //!   kept pivots (a wide band whose elimination stays sparse); `lu`: their dense LU;
 //! * `small_svd`: the QR + one-sided Jacobi SVD of the UK pseudoinverse;
 //! * `rcm`: the reverse Cuthill-McKee order that makes the sparse matrices banded;
+//! * `simd_state`: the vector registers' upper halves cleared after faer's decompositions and
+//!   before a run (faer's AVX kernels can leave them in use, which slows the SSE kernels 2x);
 //! * `quadrature`: the Gauss rule of the element integrals;
 //! * `dual`: forward-mode dual and hyper-dual numbers (exact gradients and Hessians of small
 //!   generic energies: the 3D beam element).
@@ -29,6 +31,7 @@ pub mod lu;
 pub mod lu_rows;
 pub mod quadrature;
 pub mod rcm;
+pub mod simd_state;
 pub mod rot3;
 pub mod small_svd;
 pub mod static_lu;

@@ -116,15 +116,17 @@ pub const AUTO_JACOBI_MAX_ROWS: usize = 12;
 
 fn faer_svd(data: &mut Data) -> Result<()> {
     let stack = MemStack::new(&mut data.mem);
-    svd(
-        data.bt.as_ref(),
-        data.svd_s.as_mut(),
-        Some(data.svd_u.as_mut()),
-        Some(data.svd_v.as_mut()),
-        Par::Seq,
-        stack,
-        Default::default(),
-    )
+    crate::linalg::simd_state::after_wide(|| {
+        svd(
+            data.bt.as_ref(),
+            data.svd_s.as_mut(),
+            Some(data.svd_u.as_mut()),
+            Some(data.svd_v.as_mut()),
+            Par::Seq,
+            stack,
+            Default::default(),
+        )
+    })
     .map_err(|e| Error::Solver(format!("SVD of A F^-T did not converge: {e:?}")))?;
     data.factored_with = Factored::Faer;
     Ok(())

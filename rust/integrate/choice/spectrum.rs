@@ -19,6 +19,7 @@ use crate::dynamics;
 use crate::error::{Error, Result};
 use crate::jacobian;
 use crate::linalg::dense::{cholesky, solve_lower, solve_upper};
+use crate::linalg::simd_state::after_wide;
 use crate::linalg::small_svd::QrJacobi;
 use crate::model::Model;
 
@@ -94,7 +95,7 @@ pub fn constraint_rank(model: &Model, data: &mut Data, q: &[f64]) -> Result<Null
 /// sigma_max` kept).
 fn svd_null_space(m: usize, n: usize, a: &[f64]) -> Result<NullSpace> {
     let am = Mat::<f64>::from_fn(m, n, |i, j| a[i * n + j]);
-    let svd = am.svd().map_err(|e| Error::Solver(format!("method='auto': the SVD of the constraint Jacobian failed ({e:?})")))?;
+    let svd = after_wide(|| am.svd()).map_err(|e| Error::Solver(format!("method='auto': the SVD of the constraint Jacobian failed ({e:?})")))?;
     let s = svd.S().column_vector();
     let smax = if s.nrows() > 0 { s[0] } else { 0.0 };
     let tol = (m.max(n) as f64) * f64::EPSILON * smax;
@@ -206,7 +207,7 @@ fn generalized_eigen(mr: &mut [f64], kr: &[f64], k: usize) -> Result<(Vec<f64>, 
             c[(j, i)] = s;
         }
     }
-    let evd = c.self_adjoint_eigen(Side::Lower).map_err(|e| Error::Solver(format!("method='auto': the eigenproblem failed ({e:?})")))?;
+    let evd = after_wide(|| c.self_adjoint_eigen(Side::Lower)).map_err(|e| Error::Solver(format!("method='auto': the eigenproblem failed ({e:?})")))?;
     let (u, s) = (evd.U(), evd.S().column_vector());
     let omega: Vec<f64> = (0..k).map(|j| s[j].signum() * s[j].abs().sqrt()).collect();
     // V = L^-T U
