@@ -27,6 +27,12 @@ beside it.
 
     python benches/auto_speed.py             # ~5 min: the table of docs/integrators.md, benches/data/auto_speed.csv
     python benches/auto_speed.py --quick     # ~2 min: 2 repetitions, fewer configurations
+    python benches/auto_speed.py --elements 8  # the same scenes on 8 elements (model error ~5x smaller)
+
+Repetitions: ``--repeat`` of every configuration, and more of those that might be the fastest
+(at most ``SHORT`` times auto's first call) on the short scenes, until they fill ~``MIN_SWEEP`` s of
+interleaved calls (at most ``MAX_REPEAT`` repetitions): on the 0.02 s pinned beam (calls under
+1 ms) medians of 5 moved the ratio between 1.7 and 2.7 from run to run.
 
 The references are computed once and kept in benches/data/auto_speed_refs.npz (delete it to
 recompute: ~3 min more).
@@ -51,7 +57,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, "data")
 REFS = os.path.join(DATA, "auto_speed_refs.npz")
 NOUT = 401
-N_MODEL, N_REF = 4, 32
+N_MODEL, N_REF = 4, 32  # the table's model (``--elements``) and the physical reference's cable
+MIN_SWEEP, MAX_REPEAT, SHORT = 1.0, 41, 3.0  # CPU seconds of repetitions; repetitions at most; which repeat
 SAME = 1.1  # "the same error": within this factor of auto's
 BUDGET = 5.0  # seconds per run: slower configurations are out of the race
 
@@ -143,18 +150,22 @@ def _exudyn_reference(te):
     return np.interp(te, data[:, 0], data[:, 1])
 
 
-def references(kinds):
-    """{kind: (physical reference, {formulation: same-model fine run})}, computed once (cached)."""
+def references(kinds, elements=N_MODEL):
+    """{kind: (physical reference, {formulation: same-model fine run})}, computed once (cached);
+    the same-model runs of a model of ``elements`` other than :data:`N_MODEL` are kept apart."""
     cached = dict(np.load(REFS)) if os.path.exists(REFS) else {}
     out = {}
     for kind in kinds:
         tag = f"{kind}@field" if kind in ("four_bar", "spin_up") else kind  # the cache of the single-point output stays apart
-        keys = [f"{tag}/physical", f"{tag}/ffrf", f"{tag}/ancf"]
+        model = "" if elements == N_MODEL else f"@n{elements}"
+        keys = [f"{tag}/physical", f"{tag}/ffrf{model}", f"{tag}/ancf{model}"]
         if not all(k in cached for k in keys):
             print(f"# reference of {kind} ...", flush=True)
             T = _scene(kind, "ancf", N_MODEL)[1]
             te = np.linspace(0.0, T, NOUT)
-            if kind == "slider_crank":
+            if keys[0] in cached:
+                pass
+            elif kind == "slider_crank":
                 cached[keys[0]] = _exudyn_reference(te)
             else:
                 h = ukflex.simulate(_scene(kind, "ancf", N_REF)[0].build(), T).extra["auto"]["step"]
@@ -162,12 +173,12 @@ def references(kinds):
                 assert res.status == 0, res.message
                 cached[keys[0]] = y
             for f in ("ffrf", "ancf"):
-                h = ukflex.simulate(_scene(kind, f, N_MODEL)[0].build(), T).extra["auto"]["step"]
-                _, y, res = _run(kind, f, N_MODEL, "RADAU5M", budget=None, step=h / 16, rtol=1e-10)
+                h = ukflex.simulate(_scene(kind, f, elements)[0].build(), T).extra["auto"]["step"]
+                _, y, res = _run(kind, f, elements, "RADAU5M", budget=None, step=h / 16, rtol=1e-10)
                 assert res.status == 0, res.message
-                cached[f"{tag}/{f}"] = y
+                cached[f"{tag}/{f}{model}"] = y
             np.savez(REFS, **cached)
-        out[kind] = (cached[keys[0]], {f: cached[f"{tag}/{f}"] for f in ("ffrf", "ancf")})
+        out[kind] = (cached[keys[0]], {f: cached[f"{tag}/{f}{model}"] for f in ("ffrf", "ancf")})
     return out
 
 
@@ -217,27 +228,32 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--kinds", default=",".join(KINDS))
+    ap.add_argument("--elements", type=int, default=N_MODEL)
     args = ap.parse_args()
+    n_model = args.elements
     warnings.simplefilter("ignore")
     kinds = args.kinds.split(",")
     repeat = 2 if args.quick else args.repeat
-    refs = references(kinds)
+    refs = references(kinds, n_model)
     rows = []
     summary = []
     for kind in kinds:
         phys, same = refs[kind]
         peak = np.abs(phys).max()
         for f in ("ffrf", "ancf"):
-            scene, T, _ = _scene(kind, f, N_MODEL)
+            scene, T, _ = _scene(kind, f, n_model)
             h = ukflex.simulate(scene.build(), T).extra["auto"].get("step") or T / 200
             cfg = configurations(h, args.quick)
             walls = {c[1]: [] for c in cfg}  # (cpu, wall) per repetition
             result = {}
-            for rep in range(repeat):
+            reps, rep, short = repeat, 0, None
+            while rep < reps:
                 for series, label, method, kw in (cfg if rep % 2 == 0 else cfg[::-1]):
                     if label in result and result[label] is None:
                         continue  # failed or over budget once: out
-                    wall, y, res = _run(kind, f, N_MODEL, method, **kw)
+                    if rep >= repeat and label not in short:
+                        continue  # far slower than auto: not the fastest at its error
+                    wall, y, res = _run(kind, f, n_model, method, **kw)
                     if y is None:
                         result[label] = None
                         continue
@@ -247,6 +263,12 @@ def main() -> None:
                     a = res.extra.get("auto") or {}
                     result[label] = (series, err, ierr, res.method, a.get("floor"), a.get("step"),
                                      res.extra.get("naccept"), res.extra.get("nreject"))
+                rep += 1
+                if rep == 1 and not args.quick:  # short scenes: more repetitions of the short calls
+                    first = walls["auto (default)"][0][0] if walls["auto (default)"] else math.inf
+                    short = {k for k, v in walls.items() if v and v[0][0] <= SHORT * first}
+                    sweep = sum(walls[k][0][0] for k in short)
+                    reps = max(repeat, min(MAX_REPEAT, math.ceil(MIN_SWEEP / max(sweep, 1e-9))))
             table = []
             for series, label, method, kw in cfg:
                 r = result.get(label)
@@ -262,11 +284,12 @@ def main() -> None:
             best, by_physical = fastest_at(table, auto, own=True), fastest_at(table, auto, own=False)
             summary.append((kind, f, auto, best, by_physical))
             print(f"{kind:18} {f:5} auto {1e3 * auto[2]:8.2f} ms CPU  err {auto[3][1]:.2e} (integration {auto[3][2]:.1e}, "
-                  f"{auto[3][3]}, {auto[3][6]} steps, {auto[3][7]} rejected)  fastest at that error: {best[1]} "
+                  f"{auto[3][3]}, {auto[3][6]} steps, {auto[3][7]} rejected; {reps} repetitions)  fastest at that error: {best[1]} "
                   f"{1e3 * best[2]:.2f} ms ({best[3][1]:.2e}, integration {best[3][2]:.1e})  ratio {auto[2] / best[2]:.2f}"
                   f" (wall {wall_ratio(walls, auto, best):.2f})"
                   f"  [by the physical error alone: {by_physical[1]}, ratio {auto[2] / by_physical[2]:.2f}]", flush=True)
-    with open(os.path.join(DATA, "auto_speed.csv"), "w", newline="") as fh:
+    name = "auto_speed.csv" if n_model == N_MODEL else f"auto_speed_n{n_model}.csv"
+    with open(os.path.join(DATA, name), "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["scene", "formulation", "configuration", "median CPU ms", "median wall ms", "physical error",
                     "integration error", "notes"])
@@ -276,7 +299,7 @@ def main() -> None:
           "| by the physical error alone: fastest, ratio |")
     print("|---|---|---|---|---|---|")
     for kind, f, auto, best, phys in summary:
-        print(f"| {kind} | {f.upper()} N = {N_MODEL} | {1e3 * auto[2]:.1f} ms, {auto[3][1]:.2e} ({auto[3][2]:.1e}) | "
+        print(f"| {kind} | {f.upper()} N = {n_model} | {1e3 * auto[2]:.1f} ms, {auto[3][1]:.2e} ({auto[3][2]:.1e}) | "
               f"{best[1]}: {1e3 * best[2]:.1f} ms, {best[3][1]:.2e} ({best[3][2]:.1e}) | {auto[2] / best[2]:.2f} | "
               f"{phys[1]}: {1e3 * phys[2]:.1f} ms, {auto[2] / phys[2]:.2f} |")
 
