@@ -38,9 +38,8 @@ pub mod choice;
 mod uk_system;
 
 pub use dopri5::{Dopri5, PROJECTION_MOVE_LIMIT};
-pub use galpha::{GenAlpha, GenAlphaOptions};
 pub use newton::{LinearSolver, NewtonMatrices};
-pub use {radau5::Radau5, radau_m::{RadauM, RadauMOptions}};
+pub use {galpha::{GenAlpha, GenAlphaOptions}, radau5::Radau5, radau_m::{RadauM, RadauMOptions}};
 pub use dense::{DenseParts, DenseRecord, DenseView};
 pub use options::{check_tolerances, default_projection, options_of, Method, Options, RunPlan, RunRequest, ATOL_PER_RTOL, COMMON_OPTIONS, DEFAULT_RTOL, METHOD_OPTIONS, NATIVE_METHODS, PROJECTION_MAX_ITER, PROJECTION_PER_ATOL, RTOL_MIN};
 pub use uk_system::{Conditioning, UkSystem};
@@ -494,8 +493,7 @@ impl<'a> Progress<'a> {
 /// `integrate_dense` with progress reports (`Progress`) after the accepted steps.
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_observed<St: Stepper, S: SecondOrderSystem>(stepper: &mut St, sys: &mut S, t0: f64, y0: &[f64], t_end: f64, t_eval: Option<&[f64]>, dense: bool, mut progress: Option<&mut Progress<'_>>) -> Result<Solution> {
-    // whatever ran before (faer, another library): the kernels' SSE code runs on clean registers
-    crate::linalg::simd_state::clean_upper();
+    crate::linalg::simd_state::clean_upper(); // whatever ran before: the SSE kernels on clean registers
     let dim = y0.len();
     if dim != 2 * sys.n() {
         return Err(Error::Shape { what: "y0".into(), expected: 2 * sys.n(), got: dim });
