@@ -8,8 +8,7 @@
 //! and ZMM_Hi256 bits set. Every legacy-SSE instruction after that pays for a merge with the
 //! dirty upper state, until something clears it: on this project's machine (AMD EPYC) the
 //! RADAU5M run that followed auto's analysis of an ANCF beam of 8 elements took 2.0x its time
-//! (1.42 against 0.70 ms, the same steps, iterations and bits), and runs of the same scene in
-//! one process took 4 or 8 ms depending on what had run before (round i26-simd,
+//! (1.42 against 0.70 ms, the same steps, iterations and bits; round i26-simd,
 //! docs/integrators.md).
 //!
 //! [`after_wide`] runs a faer decomposition and then [`clean_upper`]; a run
